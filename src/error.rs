@@ -1,0 +1,181 @@
+//! Error types, one enum per concern, each carrying the context a user needs to find the problem.
+
+use std::fmt;
+use std::path::PathBuf;
+
+/// A mesh that cannot be evaluated as given.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MeshError {
+    /// A triangle references a vertex that does not exist.
+    IndexOutOfRange {
+        /// Triangle (0-based).
+        face: usize,
+        /// The offending index.
+        index: u64,
+        /// Number of vertices in the mesh.
+        vertex_count: usize,
+    },
+    /// A vertex coordinate is NaN or infinite.
+    NonFiniteCoordinate {
+        /// Vertex (0-based).
+        vertex: usize,
+        /// Axis 0, 1 or 2.
+        axis: usize,
+        /// The value found.
+        value: f64,
+    },
+    /// More vertices than a `u32` index can address.
+    TooManyVertices {
+        /// Number of vertices.
+        count: usize,
+    },
+}
+
+impl fmt::Display for MeshError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            MeshError::IndexOutOfRange {
+                face,
+                index,
+                vertex_count,
+            } => write!(
+                f,
+                "face {face} references vertex {index}, but the mesh has {vertex_count} vertices"
+            ),
+            MeshError::NonFiniteCoordinate {
+                vertex,
+                axis,
+                value,
+            } => write!(
+                f,
+                "vertex {vertex} has a non-finite coordinate {value} on axis {}",
+                ["x", "y", "z"][*axis]
+            ),
+            MeshError::TooManyVertices { count } => {
+                write!(f, "{count} vertices do not fit 32-bit indices")
+            }
+        }
+    }
+}
+
+impl std::error::Error for MeshError {}
+
+/// A query point that cannot be evaluated.
+#[derive(Clone, Debug, PartialEq)]
+pub enum QueryError {
+    /// A query coordinate is NaN or infinite.
+    NonFinite {
+        /// Query index in the batch (0 for a single query).
+        index: usize,
+        /// The point.
+        point: [f64; 3],
+    },
+}
+
+impl fmt::Display for QueryError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            QueryError::NonFinite { index, point } => {
+                write!(f, "query {index} has a non-finite coordinate: {point:?}")
+            }
+        }
+    }
+}
+
+impl std::error::Error for QueryError {}
+
+/// Where in a file a problem was found.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Location {
+    /// 1-based line of a text file.
+    Line(usize),
+    /// Byte offset in a binary file.
+    Byte(u64),
+    /// 0-based face (element) index.
+    Face(usize),
+    /// 0-based vertex (element) index.
+    Vertex(usize),
+    /// No finer location is known.
+    File,
+}
+
+impl fmt::Display for Location {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Location::Line(l) => write!(f, "line {l}"),
+            Location::Byte(b) => write!(f, "byte {b}"),
+            Location::Face(i) => write!(f, "face {i}"),
+            Location::Vertex(i) => write!(f, "vertex {i}"),
+            Location::File => write!(f, "file"),
+        }
+    }
+}
+
+/// A file that could not be read as a mesh or as points.
+#[derive(Debug)]
+pub struct LoadError {
+    /// The file.
+    pub path: PathBuf,
+    /// Where in the file.
+    pub location: Location,
+    /// What is wrong.
+    pub kind: LoadErrorKind,
+}
+
+/// What went wrong while loading.
+#[derive(Debug)]
+pub enum LoadErrorKind {
+    /// The operating system refused to read the file.
+    Io(std::io::Error),
+    /// The format could not be determined from extension or content.
+    UnknownFormat,
+    /// The file ends before the data its header or structure promises.
+    Truncated(String),
+    /// The content does not follow the format.
+    Syntax(String),
+    /// The data parsed but does not form a valid mesh.
+    Mesh(MeshError),
+    /// The file holds no triangles (or no points).
+    Empty,
+}
+
+impl LoadError {
+    /// Convenience constructor.
+    pub fn new(path: impl Into<PathBuf>, location: Location, kind: LoadErrorKind) -> Self {
+        LoadError {
+            path: path.into(),
+            location,
+            kind,
+        }
+    }
+}
+
+impl fmt::Display for LoadError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let p = self.path.display();
+        let what = match &self.kind {
+            LoadErrorKind::Io(e) => format!("cannot read: {e}"),
+            LoadErrorKind::UnknownFormat => {
+                "unknown format (expected .obj, .stl, .off or .ply)".to_string()
+            }
+            LoadErrorKind::Truncated(s) => format!("truncated: {s}"),
+            LoadErrorKind::Syntax(s) => s.clone(),
+            LoadErrorKind::Mesh(e) => e.to_string(),
+            LoadErrorKind::Empty => "contains no triangles".to_string(),
+        };
+        match self.location {
+            Location::File => write!(f, "{p}: {what}"),
+            ref l => write!(f, "{p}: {l}: {what}"),
+        }
+    }
+}
+
+impl std::error::Error for LoadError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match &self.kind {
+            LoadErrorKind::Io(e) => Some(e),
+            LoadErrorKind::Mesh(e) => Some(e),
+            _ => None,
+        }
+    }
+}

@@ -1,0 +1,71 @@
+//! The direct solid-angle sum `w(q) = (1/4π) Σ_f Ω_f(q)` (Van Oosterom–Strackee per triangle,
+//! Neumaier-compensated accumulation): the ground truth the other evaluators are tested against,
+//! and the `beta <= 0` path of the FOSSIL-style API.
+//!
+//! On-surface semantics: a triangle whose plane contains the query exactly contributes 0 (the
+//! principal value), so the direct sum returns the local solid-angle fraction: 1/2 on a face of
+//! a closed mesh, 1/8 at the corner of a cube, 1/4 on its edges. Never NaN for finite input.
+
+use rayon::prelude::*;
+
+use crate::Mesh;
+use crate::kernel::compensated::NeumaierSum;
+use crate::kernel::spherical::{cross, dot, norm, triangle_solid_angle};
+
+const INV_4PI: f64 = 1.0 / (4.0 * std::f64::consts::PI);
+
+/// Winding number of `mesh` at `q` by the direct sum. `O(F)`.
+pub fn winding_number_direct(mesh: &Mesh, q: [f64; 3]) -> f64 {
+    let p = mesh.positions();
+    let mut sum = NeumaierSum::new();
+    for t in mesh.triangles() {
+        let r = t.map(|i| sub(p[i as usize], q));
+        sum.add(triangle_solid_angle(r[0], r[1], r[2]));
+    }
+    sum.value() * INV_4PI
+}
+
+/// [`winding_number_direct`] for many points, in parallel (rayon).
+pub fn winding_number_direct_batch(mesh: &Mesh, points: &[[f64; 3]]) -> Vec<f64> {
+    points
+        .par_iter()
+        .map(|&q| winding_number_direct(mesh, q))
+        .collect()
+}
+
+/// Gradient `∇w(q)` by the Biot–Savart form: the field of a surface depends only on its boundary,
+/// so summing the closed-form segment integral over every triangle edge (interior edges cancel)
+/// gives the gradient. Not finite on the surface's edges.
+pub fn winding_number_gradient_direct(mesh: &Mesh, q: [f64; 3]) -> [f64; 3] {
+    let p = mesh.positions();
+    let mut g = [NeumaierSum::new(); 3];
+    for t in mesh.triangles() {
+        for (i, j) in [(0, 1), (1, 2), (2, 0)] {
+            if t[i] == t[j] {
+                continue;
+            }
+            let s = segment_gradient(sub(p[t[i] as usize], q), sub(p[t[j] as usize], q));
+            for k in 0..3 {
+                g[k].add(s[k]);
+            }
+        }
+    }
+    g.map(|s| s.value() * INV_4PI)
+}
+
+/// `∇_q` of the solid-angle contribution of the directed segment from `q + ra` to `q + rb`:
+/// `(ra × rb)(|ra| + |rb|) / (|ra||rb|(|ra||rb| + ra·rb))` (Biot–Savart for a straight segment),
+/// shared by every evaluator's gradient.
+#[inline]
+pub fn segment_gradient(ra: [f64; 3], rb: [f64; 3]) -> [f64; 3] {
+    let la = norm(ra);
+    let lb = norm(rb);
+    let c = cross(ra, rb);
+    let f = (la + lb) / (la * lb * (la * lb + dot(ra, rb)));
+    [c[0] * f, c[1] * f, c[2] * f]
+}
+
+#[inline]
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}

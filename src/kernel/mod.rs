@@ -1,0 +1,11 @@
+//! The exact kernel. Nothing outside this module computes a predicate or chooses an `atan2`
+//! branch.
+//!
+//! - [`quantize`]: the fixed-point grid (power-of-two cell size) and the query clamp;
+//! - [`predicates`]: the symbolically perturbed orientation sign shared by the ray–triangle test
+//!   and the atan2 branch, and the perturbed depth test (filter + exact fallback);
+//! - [`spherical`]: the solid-angle and spherical-triangle formulas;
+//! - [`compensated`]: Neumaier summation.
+
+pub mod compensated;
+pub mod spherical;

@@ -1,0 +1,225 @@
+//! Signed areas of spherical triangles: the only place where an `atan2` of a solid angle is taken.
+//!
+//! Two formulas live here:
+//! - [`triangle_solid_angle`]: Van Oosterom & Strackee (1983), the signed solid angle of a
+//!   planar triangle seen from the origin, in plain `f64` (the direct evaluator);
+//! - [`antipodal_edge_area`]: the Antipodal method's per-boundary-edge term
+//!   `Area(A, B, x1) = 2·atan2(x1·(A×B), 1 + A·B + A·x1 + B·x1)` (paper Alg. 1 / Eq. 9), with the
+//!   ray fixed to `+z` (so `x1 = −z`), its numerator's sign supplied by the exact perturbed
+//!   predicate and the symbolic limits of the degenerate configurations written out.
+
+/// `2·atan2(s·mag, den)` where the sign `s ∈ {−1, 0, 1}` of the numerator was decided exactly.
+///
+/// Never lets a rounding-signed `±0.0` choose the branch: a zero magnitude with `den < 0` gives
+/// `s·2π` (the side the exact predicate chose), with `den ≥ 0` it gives 0.
+#[inline]
+pub fn signed_double_atan2(s: i32, mag: f64, den: f64) -> f64 {
+    if s == 0 {
+        return 0.0;
+    }
+    let sf = f64::from(s);
+    if mag == 0.0 {
+        return if den < 0.0 {
+            sf * std::f64::consts::TAU
+        } else {
+            0.0
+        };
+    }
+    2.0 * (sf * mag).atan2(den)
+}
+
+/// Signed solid angle subtended at the origin by the triangle with corners `a, b, c` (positions
+/// relative to the query point), in `[-2π, 2π]`.
+///
+/// Van Oosterom & Strackee: `tan(Ω/2) = a·(b×c) / (|a||b||c| + (a·b)|c| + (b·c)|a| + (c·a)|b|)`.
+///
+/// On-surface semantics: when the triple product is exactly zero (the query lies in the plane of
+/// the triangle, on an edge, or on a vertex) the result is 0, the principal value. This is what
+/// makes the direct sum return 1/2 on a face of a closed mesh and the solid-angle fraction
+/// (e.g. 1/8) at a convex corner. Never NaN for finite input.
+#[inline]
+pub fn triangle_solid_angle(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
+    let la = norm(a);
+    let lb = norm(b);
+    let lc = norm(c);
+    let det = dot(a, cross(b, c));
+    if det == 0.0 {
+        return 0.0;
+    }
+    let den = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
+    2.0 * det.atan2(den)
+}
+
+/// What the exact predicates established about one boundary edge `a → b` relative to the
+/// symbolically perturbed query `q_ε = q + (ε1, ε2, ε3)`, `ε3 ≪ ε2 ≪ ε1`, with the ray along `+z`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EdgeSigns {
+    /// Exact sign of the numerator `x1·(A×B) = −(A×B)_z` at `q_ε`: minus the perturbed 2D
+    /// orientation of `(a − q_ε, b − q_ε)` (the same predicate the crossing test uses). Zero
+    /// only for edges parallel to the ray.
+    pub numerator: i32,
+    /// `q_ε` lies strictly inside the segment to first order (exact collinearity), so `A` and
+    /// `B` are antipodal and the area is a limit.
+    pub query_inside_segment: bool,
+}
+
+/// The Antipodal method's term for one boundary edge (before the weight and the `1/4π`):
+/// the signed area of the spherical triangle `(A, B, x1)`, `A = (a−q)/|a−q|`, `B` likewise,
+/// `x1 = −z` (the antipode of the ray direction).
+///
+/// `ra = a − q`, `rb = b − q` are in the ray frame and must be exactly zero in a component
+/// exactly when the quantized coordinates agree (the callers build them from exact integer
+/// differences). The degenerate configurations take the limit at `q_ε`:
+/// - `a == q`: `A = −x̂` (the direction from `q_ε` back to `a`);
+/// - `a` on the ray (`ra_xy = 0`, `ra_z > 0`): `Area = 2·atan2(B_y, −B_x)` (first order in ε);
+/// - `q_ε` inside the segment: `Area = 2·atan2(x1·(u×p), −x1·p)`, `u` the edge direction and
+///   `p` the direction of the perturbation perpendicular to it.
+///
+/// In each case the magnitude comes from floating point and the branch from `signs.numerator`.
+pub fn antipodal_edge_area(ra: [f64; 3], rb: [f64; 3], signs: EdgeSigns) -> f64 {
+    let s = signs.numerator;
+    if s == 0 {
+        // Edge parallel to the ray: A, B and x1 lie on one great half-circle; area 0.
+        return 0.0;
+    }
+    if signs.query_inside_segment {
+        let u = normalized([rb[0] - ra[0], rb[1] - ra[1], rb[2] - ra[2]]);
+        // Dominant perpendicular part of (ε1, ε2, ε3): e1 − (u·e1)u, or e2 when u = ±e1.
+        let p = if u[1] == 0.0 && u[2] == 0.0 {
+            [0.0, 1.0, 0.0]
+        } else {
+            normalized([1.0 - u[0] * u[0], -u[0] * u[1], -u[0] * u[2]])
+        };
+        let n = -(u[0] * p[1] - u[1] * p[0]);
+        return signed_double_atan2(s, n.abs(), p[2]);
+    }
+    let a_on_ray = ra[0] == 0.0 && ra[1] == 0.0 && ra[2] > 0.0;
+    let b_on_ray = rb[0] == 0.0 && rb[1] == 0.0 && rb[2] > 0.0;
+    let a_dir = limit_direction(ra);
+    let b_dir = limit_direction(rb);
+    if a_on_ray {
+        return signed_double_atan2(s, b_dir[1].abs(), -b_dir[0]);
+    }
+    if b_on_ray {
+        return signed_double_atan2(s, a_dir[1].abs(), -a_dir[0]);
+    }
+    // Generic case. Numerator and denominator scaled by |ra||rb| > 0:
+    //   n·|ra||rb| = −(ra × rb)_z
+    //   den·|ra||rb| = (|ra| − ra_z)(|rb| − rb_z) + ra_x rb_x + ra_y rb_y
+    // (expand 1 + A·B − A_z − B_z); |r| − r_z is evaluated without cancellation.
+    let (ra, la) = if ra == [0.0; 3] {
+        ([-1.0, 0.0, 0.0], 1.0)
+    } else {
+        (ra, norm(ra))
+    };
+    let (rb, lb) = if rb == [0.0; 3] {
+        ([-1.0, 0.0, 0.0], 1.0)
+    } else {
+        (rb, norm(rb))
+    };
+    let n = ra[0] * rb[1] - ra[1] * rb[0];
+    let den = len_minus_z(ra, la) * len_minus_z(rb, lb) + ra[0] * rb[0] + ra[1] * rb[1];
+    signed_double_atan2(s, n.abs(), den)
+}
+
+/// `|r| − r_z` without cancellation when `r` points up.
+#[inline]
+fn len_minus_z(r: [f64; 3], len: f64) -> f64 {
+    if r[2] > 0.0 {
+        (r[0] * r[0] + r[1] * r[1]) / (len + r[2])
+    } else {
+        len - r[2]
+    }
+}
+
+/// Unit direction from `q_ε` towards a point at offset `r` from `q`: `r/|r|`, or `−x̂` when
+/// `r = 0` (then `a − q_ε = −(ε1, ε2, ε3)` whose direction tends to `−x̂`).
+#[inline]
+fn limit_direction(r: [f64; 3]) -> [f64; 3] {
+    if r == [0.0; 3] {
+        [-1.0, 0.0, 0.0]
+    } else {
+        normalized(r)
+    }
+}
+
+#[inline]
+pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+#[inline]
+pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+#[inline]
+pub(crate) fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+#[inline]
+fn normalized(a: [f64; 3]) -> [f64; 3] {
+    let l = norm(a);
+    [a[0] / l, a[1] / l, a[2] / l]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn octant_triangle_subtends_an_eighth_of_the_sphere() {
+        let w = triangle_solid_angle([1., 0., 0.], [0., 1., 0.], [0., 0., 1.]);
+        assert!((w - 4.0 * PI / 8.0).abs() < 1e-15);
+        let w = triangle_solid_angle([1., 0., 0.], [0., 0., 1.], [0., 1., 0.]);
+        assert!((w + 4.0 * PI / 8.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn coplanar_query_gives_zero_not_nan() {
+        assert_eq!(
+            triangle_solid_angle([0.; 3], [1., 0., 0.], [0., 1., 0.]),
+            0.0
+        );
+        assert_eq!(
+            triangle_solid_angle([-1., 0., 0.], [1., 0., 0.], [0., 1., 0.]),
+            0.0
+        );
+        assert_eq!(triangle_solid_angle([0.; 3], [0.; 3], [0.; 3]), 0.0);
+    }
+
+    #[test]
+    fn zero_magnitude_takes_the_exact_side() {
+        assert_eq!(signed_double_atan2(1, 0.0, -1.0), 2.0 * PI);
+        assert_eq!(signed_double_atan2(-1, 0.0, -1.0), -2.0 * PI);
+        assert_eq!(signed_double_atan2(-1, 0.0, 1.0), 0.0);
+        assert_eq!(signed_double_atan2(0, 1.0, -1.0), 0.0);
+    }
+
+    #[test]
+    fn generic_edge_matches_the_paper_formula() {
+        // Paper: 2·atan2(x1·(A×B), 1 + A·B + A·x1 + B·x1) with x1 = −z.
+        let ra = [0.3, -0.7, 0.2];
+        let rb = [-0.4, 0.1, 0.9];
+        let a = normalized(ra);
+        let b = normalized(rb);
+        let x1 = [0.0, 0.0, -1.0];
+        let paper = 2.0 * dot(x1, cross(a, b)).atan2(1.0 + dot(a, b) + dot(a, x1) + dot(b, x1));
+        let s = if dot(x1, cross(a, b)) > 0.0 { 1 } else { -1 };
+        let ours = antipodal_edge_area(
+            ra,
+            rb,
+            EdgeSigns {
+                numerator: s,
+                query_inside_segment: false,
+            },
+        );
+        assert!((paper - ours).abs() < 1e-14, "{paper} vs {ours}");
+    }
+}

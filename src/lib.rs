@@ -1,0 +1,33 @@
+//! # gwn — robust generalized winding numbers
+//!
+//! The generalized winding number `w(q)` of a triangle mesh counts how many times the surface
+//! wraps around `q`: 1 inside a closed outward-oriented surface, 0 outside, 2 where two shells
+//! overlap, and a smooth fraction near holes of an open, dirty mesh.
+//!
+//! Evaluators:
+//! - [`eval::direct`]: the Van Oosterom–Strackee solid-angle sum with compensated accumulation
+//!   (ground truth, `O(F)` per query);
+//! - [`eval::antipodal`]: the exact Antipodal method: `w = χ + (1/4π) Σ_boundary area`, with the
+//!   crossing count χ of one axis-aligned ray and the atan2 branch decided by one symbolically
+//!   perturbed integer predicate ([`kernel`]), `O(B + log F)` per query.
+//!
+//! ```
+//! use gwn::{Mesh, eval::direct::winding_number_direct};
+//! let tet = Mesh::from_slices(
+//!     &[[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]],
+//!     &[[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]],
+//! )?;
+//! let w = winding_number_direct(&tet, [0.1, 0.1, 0.1]);
+//! assert!((w - 1.0).abs() < 1e-12);
+//! # Ok::<(), gwn::error::MeshError>(())
+//! ```
+
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod error;
+pub mod eval;
+pub mod kernel;
+pub mod mesh;
+
+pub use mesh::{BoundingBox, Mesh};
