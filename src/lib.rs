@@ -25,8 +25,11 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod bvh;
+pub mod curve2d;
 pub mod error;
 pub mod eval;
+pub mod io;
 pub mod kernel;
 pub mod mesh;
 

@@ -8,4 +8,7 @@
 //! - [`compensated`]: Neumaier summation.
 
 pub mod compensated;
+pub mod frame;
+pub mod predicates;
+pub mod quantize;
 pub mod spherical;

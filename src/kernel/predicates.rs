@@ -1,0 +1,307 @@
+//! The symbolically perturbed predicates on grid coordinates (ray frame, ray along `+z`).
+//!
+//! The query is `q_ε = q + (ε1, ε2, ε3)` with `0 < ε3 ≪ ε2 ≪ ε1` infinitesimal (Edelsbrunner &
+//! Mücke's simulation of simplicity; antipodal paper, Supp. Sec. 2.1). Every predicate is a
+//! polynomial in ε whose sign is the sign of its first non-zero coefficient in the order
+//! (real, ε1, ε2, ε3). Since all predicates are evaluated at the *same* symbolic point, their
+//! answers are those of one actual point `q + (t, t², t³)` for small `t > 0`: they can never
+//! contradict one another.
+//!
+//! [`perturbed_orient2d`] is THE shared sign: the ray–triangle test uses it for each triangle
+//! edge, and the Antipodal boundary term uses minus it as the sign of the atan2 numerator
+//! `x1·(A×B)`. That is why the integer part (crossings) and the fractional part (areas) jump
+//! together and the sum never jumps.
+
+use num_bigint::BigInt;
+
+use super::quantize::Precision;
+
+/// Integer width of the predicates: `i64` arithmetic on a 30-bit grid, `i128` on a 60-bit grid.
+pub trait Width: Copy + Send + Sync + std::fmt::Debug + 'static {
+    /// The grid precision this width serves.
+    const PRECISION: Precision;
+    /// `sign(a0·b1 − a1·b0)` for grid differences `a`, `b`.
+    fn det2_sign(a0: i64, a1: i64, b0: i64, b1: i64) -> i32;
+    /// `sign(d·n)` where `d` are grid differences and `n` an exact degree-2 normal (`i128`).
+    fn dot3_sign(d: [i64; 3], n: [i128; 3]) -> i32;
+}
+
+/// 30-bit grid: differences < 2^31, so 2×2 determinants fit `i64` and the depth test `i128`.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct W64;
+
+/// 60-bit grid: differences < 2^61, so 2×2 determinants fit `i128`; the depth test needs ~185 bits
+/// and runs a floating-point filter with an exact `BigInt` fallback.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct W128;
+
+impl Width for W64 {
+    const PRECISION: Precision = Precision::Bits30;
+    #[inline]
+    fn det2_sign(a0: i64, a1: i64, b0: i64, b1: i64) -> i32 {
+        // |a|,|b| < 2^31 ⇒ each product < 2^62, the difference < 2^63.
+        let d = a0 * b1 - a1 * b0;
+        d.signum() as i32
+    }
+    #[inline]
+    fn dot3_sign(d: [i64; 3], n: [i128; 3]) -> i32 {
+        // |n_k| < 2^63, |d_k| < 2^31 ⇒ |d·n| < 3·2^94.
+        let v = i128::from(d[0]) * n[0] + i128::from(d[1]) * n[1] + i128::from(d[2]) * n[2];
+        v.signum() as i32
+    }
+}
+
+impl Width for W128 {
+    const PRECISION: Precision = Precision::Bits60;
+    #[inline]
+    fn det2_sign(a0: i64, a1: i64, b0: i64, b1: i64) -> i32 {
+        // |a|,|b| < 2^61 ⇒ each product < 2^122, the difference < 2^123.
+        let d = i128::from(a0) * i128::from(b1) - i128::from(a1) * i128::from(b0);
+        d.signum() as i32
+    }
+    #[inline]
+    fn dot3_sign(d: [i64; 3], n: [i128; 3]) -> i32 {
+        // Filter: the f64 conversions of d (< 2^61) and n (< 2^123) carry relative error ≤ 2^-53
+        // each, the three products and two sums add ≤ 3 more roundings: |error| ≤ 6u·Σ|d_k n_k|
+        // (u = 2^-53). 1e-14 leaves a wide margin.
+        let t = [
+            d[0] as f64 * n[0] as f64,
+            d[1] as f64 * n[1] as f64,
+            d[2] as f64 * n[2] as f64,
+        ];
+        let v = t[0] + t[1] + t[2];
+        let bound = 1e-14 * (t[0].abs() + t[1].abs() + t[2].abs());
+        if v > bound {
+            return 1;
+        }
+        if v < -bound {
+            return -1;
+        }
+        exact_dot3_sign(d, n)
+    }
+}
+
+/// Exact sign of `d·n` in arbitrary precision (the rare fallback of the 60-bit depth test).
+#[cold]
+pub fn exact_dot3_sign(d: [i64; 3], n: [i128; 3]) -> i32 {
+    let v: BigInt = (0..3)
+        .map(|k| BigInt::from(d[k]) * BigInt::from(n[k]))
+        .sum();
+    match v.sign() {
+        num_bigint::Sign::Plus => 1,
+        num_bigint::Sign::Minus => -1,
+        num_bigint::Sign::NoSign => 0,
+    }
+}
+
+/// Result of the perturbed 2D orientation: the sign, and whether the unperturbed determinant was
+/// exactly zero (the query's projection is on the line through the edge's projection).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Orient2d {
+    /// Sign of `det(a − q_ε, b − q_ε)` restricted to x, y: +1 when `(q, a, b)` turn
+    /// counter-clockwise seen from `+z`. Zero only when `a` and `b` project to the same point.
+    pub sign: i32,
+    /// The real (ε-free) part was zero.
+    pub degenerate: bool,
+}
+
+/// THE shared predicate: orientation of `(q_ε, a, b)` projected along the ray (`+z`).
+///
+/// `det(a − q_ε, b − q_ε) = D0 + ε1·(a_y − b_y) + ε2·(b_x − a_x)` exactly (the ε1·ε2 terms
+/// cancel), so the sign is that of the first non-zero of `D0`, `a_y − b_y`, `b_x − a_x`.
+#[inline]
+pub fn perturbed_orient2d<W: Width>(q: [i64; 2], a: [i64; 2], b: [i64; 2]) -> Orient2d {
+    let s = W::det2_sign(a[0] - q[0], a[1] - q[1], b[0] - q[0], b[1] - q[1]);
+    if s != 0 {
+        return Orient2d {
+            sign: s,
+            degenerate: false,
+        };
+    }
+    let s1 = (a[1] - b[1]).signum() as i32;
+    let sign = if s1 != 0 {
+        s1
+    } else {
+        (b[0] - a[0]).signum() as i32
+    };
+    Orient2d {
+        sign,
+        degenerate: true,
+    }
+}
+
+/// Signed crossing of the ray from `q_ε` along `+z` with triangle `(p0, p1, p2)`: `+1` when the
+/// ray leaves through the side the triangle's normal points to (`n_z > 0`), `−1` when it enters,
+/// `0` when it misses. Exact for every input (no tolerance), consistent with
+/// [`perturbed_orient2d`] on the triangle's edges.
+#[inline]
+pub fn ray_crossing<W: Width>(q: [i64; 3], p: [[i64; 3]; 3]) -> i32 {
+    let q2 = [q[0], q[1]];
+    let s0 = perturbed_orient2d::<W>(q2, [p[0][0], p[0][1]], [p[1][0], p[1][1]]).sign;
+    if s0 == 0 {
+        return 0;
+    }
+    let s1 = perturbed_orient2d::<W>(q2, [p[1][0], p[1][1]], [p[2][0], p[2][1]]).sign;
+    if s1 != s0 {
+        return 0;
+    }
+    let s2 = perturbed_orient2d::<W>(q2, [p[2][0], p[2][1]], [p[0][0], p[0][1]]).sign;
+    if s2 != s0 {
+        return 0;
+    }
+    // The projection of q_ε is strictly inside the projected triangle, whose orientation s0 is
+    // sign(n_z). The ray hits the triangle iff q_ε is strictly below its plane along z, i.e.
+    // sign((q_ε − p0)·n) = −sign(n_z).
+    let side = perturbed_plane_side::<W>(q, p);
+    if side == -s0 { s0 } else { 0 }
+}
+
+/// Sign of `(q_ε − p0)·n`, `n = (p1 − p0)×(p2 − p0)`: real part, then the ε1, ε2, ε3
+/// coefficients `n_x`, `n_y`, `n_z`. Zero only for a degenerate triangle (`n = 0`).
+#[inline]
+pub fn perturbed_plane_side<W: Width>(q: [i64; 3], p: [[i64; 3]; 3]) -> i32 {
+    let e1 = sub(p[1], p[0]);
+    let e2 = sub(p[2], p[0]);
+    let n = cross_exact(e1, e2);
+    let s = W::dot3_sign(sub(q, p[0]), n);
+    if s != 0 {
+        return s;
+    }
+    for c in n {
+        if c != 0 {
+            return c.signum() as i32;
+        }
+    }
+    0
+}
+
+/// Exact cross product of grid differences (< 2^61 each ⇒ components < 2^123).
+#[inline]
+pub fn cross_exact(a: [i64; 3], b: [i64; 3]) -> [i128; 3] {
+    let m = |x: i64, y: i64| i128::from(x) * i128::from(y);
+    [
+        m(a[1], b[2]) - m(a[2], b[1]),
+        m(a[2], b[0]) - m(a[0], b[2]),
+        m(a[0], b[1]) - m(a[1], b[0]),
+    ]
+}
+
+/// Whether `q_ε` lies strictly inside the segment `a b` to first order in ε: `q` on the open
+/// segment (exact collinearity and opposite directions), or `q` equal to an endpoint with the
+/// segment leaving it along `+x` (the dominant perturbation direction). Only meaningful when the
+/// 2D orientation was degenerate.
+#[inline]
+pub fn query_inside_segment(q: [i64; 3], a: [i64; 3], b: [i64; 3]) -> bool {
+    let ra = sub(a, q);
+    let rb = sub(b, q);
+    let along_pos_x = |r: [i64; 3]| r[0] > 0 && r[1] == 0 && r[2] == 0;
+    if ra == [0; 3] {
+        return along_pos_x(rb);
+    }
+    if rb == [0; 3] {
+        return along_pos_x(ra);
+    }
+    let c = cross_exact(ra, rb);
+    if c != [0; 3] {
+        return false;
+    }
+    let dot = i128::from(ra[0]) * i128::from(rb[0])
+        + i128::from(ra[1]) * i128::from(rb[1])
+        + i128::from(ra[2]) * i128::from(rb[2]);
+    dot < 0
+}
+
+#[inline]
+fn sub(a: [i64; 3], b: [i64; 3]) -> [i64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn orient2d_resolves_collinear_cases_by_the_perturbation() {
+        // Proper left turn.
+        let o = perturbed_orient2d::<W64>([0, 0], [1, 0], [0, 1]);
+        assert_eq!(
+            o,
+            Orient2d {
+                sign: 1,
+                degenerate: false
+            }
+        );
+        // q on the line through a horizontal edge: decided by ε2 (b_x − a_x).
+        let o = perturbed_orient2d::<W128>([5, 0], [1, 0], [3, 0]);
+        assert_eq!(
+            o,
+            Orient2d {
+                sign: 1,
+                degenerate: true
+            }
+        );
+        // q on the line through a vertical edge: decided by ε1 (a_y − b_y).
+        let o = perturbed_orient2d::<W64>([0, 7], [0, 1], [0, 3]);
+        assert_eq!(o.sign, -1);
+        // Edge projecting to a point.
+        assert_eq!(perturbed_orient2d::<W64>([0, 0], [2, 2], [2, 2]).sign, 0);
+    }
+
+    #[test]
+    fn widths_agree_on_small_inputs_and_the_filter_falls_back() {
+        for (a, b) in [([3, -2], [5, 7]), ([0, 0], [1, 1]), ([-4, 2], [2, -1])] {
+            assert_eq!(
+                W64::det2_sign(a[0], a[1], b[0], b[1]),
+                W128::det2_sign(a[0], a[1], b[0], b[1])
+            );
+        }
+        // Large values where f64 cannot decide: d·n = 2^60·(2^62+1) − (2^60+... ) constructed to be 1.
+        let big = 1_i64 << 60;
+        let d = [big, -1, 0];
+        let n = [
+            (1_i128 << 62) + 1,
+            (big as i128) * (1 << 62) + big as i128 - 1,
+            0,
+        ];
+        // exact: 2^60·(2^62+1) − (2^122 + 2^60 − 1) = 1
+        assert_eq!(exact_dot3_sign(d, n), 1);
+        assert_eq!(W128::dot3_sign(d, n), 1);
+    }
+
+    #[test]
+    fn ray_hits_interior_and_counts_shared_vertices_once() {
+        // Two triangles sharing the edge (0,0)-(4,4) at height 1, normals +z; q below the
+        // shared edge's midpoint: the perturbation assigns the ray to exactly one of them.
+        let q = [2, 2, -3];
+        let t1 = [[0, 0, 1], [4, 0, 1], [4, 4, 1]];
+        let t2 = [[0, 0, 1], [4, 4, 1], [0, 4, 1]];
+        let c = ray_crossing::<W64>(q, t1) + ray_crossing::<W64>(q, t2);
+        assert_eq!(c, 1);
+        // Through the shared vertex of a fan of 4 triangles around (0,0): exactly one hit.
+        let fan = [
+            [[0, 0, 1], [2, 0, 1], [0, 2, 1]],
+            [[0, 0, 1], [0, 2, 1], [-2, 0, 1]],
+            [[0, 0, 1], [-2, 0, 1], [0, -2, 1]],
+            [[0, 0, 1], [0, -2, 1], [2, 0, 1]],
+        ];
+        let c: i32 = fan
+            .iter()
+            .map(|&t| ray_crossing::<W128>([0, 0, 0], t))
+            .sum();
+        assert_eq!(c, 1);
+        // Query above the plane: no hit; flipped triangle: −1.
+        assert_eq!(ray_crossing::<W64>([1, 1, 5], t1), 0);
+        assert_eq!(ray_crossing::<W64>([3, 1, 0], [t1[0], t1[2], t1[1]]), -1);
+        // Query exactly on the triangle: decided by ε (n_x = n_y = 0, n_z > 0 ⇒ above).
+        assert_eq!(ray_crossing::<W64>([3, 1, 1], t1), 0);
+    }
+
+    #[test]
+    fn inside_segment_detection() {
+        assert!(query_inside_segment([1, 1, 1], [0, 0, 0], [2, 2, 2]));
+        assert!(!query_inside_segment([3, 3, 3], [0, 0, 0], [2, 2, 2]));
+        assert!(query_inside_segment([0, 0, 0], [0, 0, 0], [5, 0, 0]));
+        assert!(!query_inside_segment([0, 0, 0], [0, 0, 0], [-5, 0, 0]));
+        assert!(query_inside_segment([0, 0, 0], [5, 0, 0], [0, 0, 0]));
+    }
+}

@@ -1,0 +1,89 @@
+//! Shared test helpers: small closed-form meshes and the shared-corpus locator.
+#![allow(dead_code)]
+
+use gwn::Mesh;
+
+/// Unit cube [0,1]³, 12 outward-oriented triangles.
+pub fn unit_cube() -> Mesh {
+    Mesh::from_slices(&CUBE_V, &CUBE_T).unwrap()
+}
+
+/// Unit cube without its top face (z = 1): open, 10 triangles.
+pub fn open_cube() -> Mesh {
+    Mesh::from_slices(&CUBE_V, &CUBE_T[..10]).unwrap()
+}
+
+pub const CUBE_V: [[f64; 3]; 8] = [
+    [0., 0., 0.],
+    [1., 0., 0.],
+    [1., 1., 0.],
+    [0., 1., 0.],
+    [0., 0., 1.],
+    [1., 0., 1.],
+    [1., 1., 1.],
+    [0., 1., 1.],
+];
+
+/// Bottom, four sides, then the top face last (so `[..10]` removes the top).
+pub const CUBE_T: [[u32; 3]; 12] = [
+    [0, 2, 1],
+    [0, 3, 2],
+    [0, 1, 5],
+    [0, 5, 4],
+    [1, 2, 6],
+    [1, 6, 5],
+    [2, 3, 7],
+    [2, 7, 6],
+    [3, 0, 4],
+    [3, 4, 7],
+    [4, 5, 6],
+    [4, 6, 7],
+];
+
+/// `../shared/meshes` if present, else prints why the caller skips and returns `None`.
+pub fn shared_meshes() -> Option<std::path::PathBuf> {
+    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes");
+    if p.join("manifest.csv").exists() {
+        Some(p)
+    } else {
+        eprintln!(
+            "skipping: {} not found (shared mesh corpus absent)",
+            p.display()
+        );
+        None
+    }
+}
+
+/// Deterministic pseudo-random numbers (SplitMix64) so tests need no RNG dependency.
+pub struct Rng(pub u64);
+
+impl Rng {
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E3779B97F4A7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58476D1CE4E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D049BB133111EB);
+        z ^ (z >> 31)
+    }
+    /// Uniform in [0, 1).
+    pub fn f64(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+    pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.f64()
+    }
+}
+
+/// The oracle for on-surface and grazing queries: the direct sum at the actual point
+/// `q + R·(t, t², t³)·scale` (R the ray frame's rotation back to world), which tends to the value
+/// at the symbolically perturbed point as `t → 0` (error `O(t)`).
+pub fn direct_at_perturbed(
+    mesh: &gwn::Mesh,
+    q: [f64; 3],
+    ray: gwn::kernel::frame::RayAxis,
+    scale: f64,
+) -> f64 {
+    let t = 1e-4;
+    let d = ray.to_world([t * scale, t * t * scale, t * t * t * scale]);
+    gwn::eval::direct::winding_number_direct(mesh, [q[0] + d[0], q[1] + d[1], q[2] + d[2]])
+}
