@@ -26,7 +26,8 @@ use crate::Mesh;
 use crate::bvh::RayBvh;
 use crate::kernel::frame::RayAxis;
 use crate::kernel::predicates::{
-    W64, W128, Width, perturbed_orient2d, query_inside_segment, ray_crossing,
+    W64, W128, Width, perturbed_orient2d, perturbed_plane_side, projected_containment,
+    query_inside_segment, ray_crossing,
 };
 use crate::kernel::quantize::{Grid, GridRangeError, Precision, Snap};
 use crate::kernel::spherical::{EdgeSigns, antipodal_edge_area, antipodal_edge_area_gradient};
@@ -145,6 +146,18 @@ impl WindingNumber {
         match &self.core {
             Dispatch::Narrow(c) => c.parts(q),
             Dispatch::Wide(c) => c.parts(q),
+        }
+    }
+
+    /// Winding numbers along one line parallel to the ray: at the points `q` with the world
+    /// coordinate along the ray axis ([`Options::ray`]) replaced by each `ts[k]`. One BVH
+    /// traversal serves the whole column, and each crossing triangle is placed among the points by
+    /// a binary search with the same exact perturbed depth test, so the result is identical to
+    /// calling [`WindingNumber::eval`] point by point (this is the ray reuse of voxel grids).
+    pub fn eval_column(&self, q: [f64; 3], ts: &[f64]) -> Vec<f64> {
+        match &self.core {
+            Dispatch::Narrow(c) => c.column(q, ts),
+            Dispatch::Wide(c) => c.column(q, ts),
         }
     }
 
@@ -310,6 +323,89 @@ impl<W: Width> Core<W> {
         };
         let area = self.boundary_sum(qi, z_exact, qf[2]);
         (chi, area)
+    }
+
+    fn column(&self, q: [f64; 3], ts: &[f64]) -> Vec<f64> {
+        let axis = self.ray.map()[2].0;
+        let at = |t: f64| {
+            let mut p = q;
+            p[axis] = t;
+            p
+        };
+        let snap = self.snap_frame(q);
+        let (Snap::In(x), Snap::In(y)) = (snap[0], snap[1]) else {
+            return ts.iter().map(|&t| self.value(at(t))).collect();
+        };
+        if q.iter().any(|c| !c.is_finite()) {
+            return vec![f64::NAN; ts.len()];
+        }
+        let limit = self.grid.limit();
+        // Frame z of every point (integer, or clamped with a flag), sorted ascending.
+        let zs: Vec<(i64, bool, f64)> = ts
+            .iter()
+            .map(|&t| {
+                let p = at(t);
+                let qf = self.ray.to_frame(p);
+                match self.snap_frame(p)[2] {
+                    Snap::In(z) => (z, true, qf[2]),
+                    Snap::Low => (-limit, false, qf[2]),
+                    Snap::High => (limit, false, qf[2]),
+                }
+            })
+            .collect();
+        let mut order: Vec<usize> = (0..ts.len()).filter(|&k| ts[k].is_finite()).collect();
+        order.sort_by_key(|&k| zs[k].0);
+        // Points strictly above the grid never see a crossing.
+        let active = order
+            .iter()
+            .take_while(|&&k| zs[k].0 < limit || zs[k].1)
+            .count();
+        // chi_diff[j]: change of χ between sorted points j−1 and j.
+        let mut chi_diff = vec![0i64; active + 1];
+        let u = |v: i64| (v as f64 * self.to_unit) as f32;
+        self.bvh
+            .for_each_on_ray(u(x), u(y), f32::NEG_INFINITY, |f| {
+                let p = self.tris[f as usize].map(|i| self.verts[i as usize]);
+                let s = projected_containment::<W>([x, y], p);
+                if s == 0 {
+                    return;
+                }
+                // Hit for the sorted points strictly below the plane: a prefix (the plane side is
+                // monotone in z for a triangle whose projection contains the column).
+                let below = |j: usize| perturbed_plane_side::<W>([x, y, zs[order[j]].0], p) == -s;
+                let (mut lo, mut hi) = (0, active);
+                while lo < hi {
+                    let mid = (lo + hi) / 2;
+                    if below(mid) {
+                        lo = mid + 1;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                chi_diff[0] += i64::from(s);
+                chi_diff[lo] -= i64::from(s);
+            });
+        let mut out = vec![f64::NAN; ts.len()];
+        let mut chi = 0i64;
+        for (j, &k) in order.iter().enumerate() {
+            let (z, exact, qz) = zs[k];
+            let c = if j < active {
+                chi += chi_diff[j];
+                chi
+            } else {
+                0
+            };
+            out[k] = c as f64 + self.boundary_sum([x, y, z], exact, qz) * INV_4PI;
+        }
+        out
+    }
+
+    fn value(&self, q: [f64; 3]) -> f64 {
+        if q.iter().any(|c| !c.is_finite()) {
+            return f64::NAN;
+        }
+        let (chi, area) = self.parts(q);
+        chi as f64 + area * INV_4PI
     }
 
     /// χ: signed crossings of the ray from `q_ε` along `+z` (every candidate, no early exit).

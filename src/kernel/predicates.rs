@@ -136,7 +136,24 @@ pub fn perturbed_orient2d<W: Width>(q: [i64; 2], a: [i64; 2], b: [i64; 2]) -> Or
 /// [`perturbed_orient2d`] on the triangle's edges.
 #[inline]
 pub fn ray_crossing<W: Width>(q: [i64; 3], p: [[i64; 3]; 3]) -> i32 {
-    let q2 = [q[0], q[1]];
+    let s0 = projected_containment::<W>([q[0], q[1]], p);
+    if s0 == 0 {
+        return 0;
+    }
+    // The projection of q_ε is strictly inside the projected triangle, whose orientation s0 is
+    // sign(n_z). The ray hits the triangle iff q_ε is strictly below its plane along z, i.e.
+    // sign((q_ε − p0)·n) = −sign(n_z).
+    if perturbed_plane_side::<W>(q, p) == -s0 {
+        s0
+    } else {
+        0
+    }
+}
+
+/// The 2D half of [`ray_crossing`]: `sign(n_z)` when the projection of `q_ε` lies strictly inside
+/// the projected triangle, else 0. All three edge tests are [`perturbed_orient2d`].
+#[inline]
+pub fn projected_containment<W: Width>(q2: [i64; 2], p: [[i64; 3]; 3]) -> i32 {
     let s0 = perturbed_orient2d::<W>(q2, [p[0][0], p[0][1]], [p[1][0], p[1][1]]).sign;
     if s0 == 0 {
         return 0;
@@ -149,11 +166,7 @@ pub fn ray_crossing<W: Width>(q: [i64; 3], p: [[i64; 3]; 3]) -> i32 {
     if s2 != s0 {
         return 0;
     }
-    // The projection of q_ε is strictly inside the projected triangle, whose orientation s0 is
-    // sign(n_z). The ray hits the triangle iff q_ε is strictly below its plane along z, i.e.
-    // sign((q_ε − p0)·n) = −sign(n_z).
-    let side = perturbed_plane_side::<W>(q, p);
-    if side == -s0 { s0 } else { 0 }
+    s0
 }
 
 /// Sign of `(q_ε − p0)·n`, `n = (p1 − p0)×(p2 − p0)`: real part, then the ε1, ε2, ε3
