@@ -42,3 +42,12 @@ pub fn progress(len: u64, what: &str) -> indicatif::ProgressBar {
     pb.set_message(what.to_string());
     pb
 }
+
+/// Loads a mesh for a subcommand: STL files are welded unless `no_weld`; errors name the file.
+pub fn load_mesh_for_cli(path: &std::path::Path, no_weld: bool) -> Result<gwn::Mesh, CliError> {
+    let opts = gwn::io::LoadOptions {
+        weld: if no_weld { Some(false) } else { None },
+    };
+    let loaded = gwn::io::load_mesh_with(path, &opts)?;
+    Ok(loaded.mesh)
+}

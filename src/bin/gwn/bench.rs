@@ -1,0 +1,127 @@
+//! `gwn bench`: throughput of the evaluators, measured side by side in one run.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::Args as ClapArgs;
+use gwn::Mesh;
+use gwn::eval::antipodal::WindingNumber;
+use gwn::eval::direct::winding_number_direct;
+use rayon::prelude::*;
+
+use crate::common::{CliError, load_mesh_for_cli};
+
+/// Benchmark the evaluators on meshes: per mesh, faces, boundary edges, precompute time and
+/// queries/s of `exact` and `direct` on an N³ grid over the bounding box enlarged by 10 % per
+/// side, with each thread count. `direct` is timed on an evenly spaced subset of the grid
+/// (`--direct-sample`) because it costs O(faces) per query.
+///
+/// Example: gwn bench ../shared/meshes --grid 32 --threads-list 1,2 --markdown
+#[derive(ClapArgs, Debug)]
+#[command(verbatim_doc_comment)]
+pub struct Args {
+    /// Mesh files or folders (every .obj/.stl/.off/.ply inside, sorted).
+    #[arg(required = true)]
+    pub paths: Vec<PathBuf>,
+    /// Grid resolution per axis.
+    #[arg(long, default_value_t = 32)]
+    pub grid: usize,
+    /// Thread counts to measure.
+    #[arg(long, value_delimiter = ',', default_value = "1,2")]
+    pub threads_list: Vec<usize>,
+    /// Number of grid points on which the direct sum is timed.
+    #[arg(long, default_value_t = 256)]
+    pub direct_sample: usize,
+    /// Print a Markdown table.
+    #[arg(long)]
+    pub markdown: bool,
+}
+
+/// Runs `gwn bench`.
+pub fn run(args: Args) -> Result<(), CliError> {
+    let mut files = Vec::new();
+    for p in &args.paths {
+        if p.is_dir() {
+            let mut v: Vec<PathBuf> = std::fs::read_dir(p)
+                .map_err(|e| CliError(format!("{}: {e}", p.display())))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| {
+                    p.extension()
+                        .and_then(|e| e.to_str())
+                        .is_some_and(|e| ["obj", "stl", "off", "ply"].contains(&e.to_ascii_lowercase().as_str()))
+                })
+                .collect();
+            v.sort();
+            files.extend(v);
+        } else {
+            files.push(p.clone());
+        }
+    }
+    let mut header = String::from("mesh | faces | boundary | precompute ms");
+    for t in &args.threads_list {
+        header += &format!(" | exact q/s ({t}t) | direct q/s ({t}t)");
+    }
+    header += " | exact/direct";
+    if args.markdown {
+        println!("| {header} |");
+        println!("|{}", "---|".repeat(header.matches('|').count() + 1));
+    } else {
+        println!("{}", header.replace(" | ", "\t"));
+    }
+    for f in files {
+        let mesh = load_mesh_for_cli(&f, false)?;
+        let Some(row) = bench_mesh(&mesh, &args)? else { continue };
+        let name = f.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        let line = format!("{name} | {row}");
+        if args.markdown {
+            println!("| {line} |");
+        } else {
+            println!("{}", line.replace(" | ", "\t"));
+        }
+    }
+    Ok(())
+}
+
+fn bench_mesh(mesh: &Mesh, args: &Args) -> Result<Option<String>, CliError> {
+    let Some(bbox) = mesh.bounding_box() else { return Ok(None) };
+    let b = bbox.enlarged(0.1);
+    let n = args.grid.max(1);
+    let points: Vec<[f64; 3]> = (0..n * n * n)
+        .map(|i| {
+            let idx = [i % n, (i / n) % n, i / (n * n)];
+            std::array::from_fn(|k| b.min[k] + (b.max[k] - b.min[k]) * (idx[k] as f64 + 0.5) / n as f64)
+        })
+        .collect();
+    let step = (points.len() / args.direct_sample.max(1)).max(1);
+    let sample: Vec<[f64; 3]> = points.iter().step_by(step).copied().collect();
+    let t0 = Instant::now();
+    let wn = WindingNumber::new(mesh).map_err(|e| CliError(e.to_string()))?;
+    let pre = t0.elapsed().as_secs_f64() * 1e3;
+    let mut row = format!(
+        "{} | {} | {pre:.1}",
+        mesh.triangles().len(),
+        wn.boundary_edge_count()
+    );
+    let mut ratio = 0.0;
+    for &t in &args.threads_list {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build()
+            .map_err(|e| CliError(e.to_string()))?;
+        let (exact_qps, direct_qps) = pool.install(|| {
+            let t0 = Instant::now();
+            let w = wn.eval_batch(&points);
+            let exact = points.len() as f64 / t0.elapsed().as_secs_f64();
+            std::hint::black_box(w);
+            let t0 = Instant::now();
+            let d: Vec<f64> = sample.par_iter().map(|&q| winding_number_direct(mesh, q)).collect();
+            let direct = sample.len() as f64 / t0.elapsed().as_secs_f64();
+            std::hint::black_box(d);
+            (exact, direct)
+        });
+        ratio = exact_qps / direct_qps;
+        row += &format!(" | {exact_qps:.0} | {direct_qps:.0}");
+    }
+    row += &format!(" | {ratio:.1}×");
+    Ok(Some(row))
+}
