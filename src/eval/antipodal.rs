@@ -26,11 +26,14 @@ use crate::Mesh;
 use crate::bvh::RayBvh;
 use crate::kernel::frame::RayAxis;
 use crate::kernel::predicates::{
-    W64, W128, Width, perturbed_orient2d, perturbed_plane_side, projected_containment,
+    W64, W128, Width, perturbed_orient2d_offsets, perturbed_plane_side, projected_containment,
     query_inside_segment, ray_crossing,
 };
 use crate::kernel::quantize::{Grid, GridRangeError, Precision, Snap};
-use crate::kernel::spherical::{EdgeSigns, antipodal_edge_area, antipodal_edge_area_gradient};
+use crate::kernel::spherical::{
+    AtanBatch, EdgeSigns, antipodal_edge_area, antipodal_edge_area_generic,
+    antipodal_edge_area_gradient, filtered_generic_terms,
+};
 use crate::mesh::boundary_edges;
 
 const INV_4PI: f64 = 1.0 / (4.0 * std::f64::consts::PI);
@@ -423,33 +426,45 @@ impl<W: Width> Core<W> {
     /// `Σ k·Area(A, B, x1)` with exact branch signs. `z_exact` is false when the query's frame z
     /// lies outside the grid (then `qz` is used in floating point for the magnitudes).
     fn boundary_sum(&self, qi: [i64; 3], z_exact: bool, qz: f64) -> f64 {
-        let cell = self.cell;
+        // Offsets in grid units (the area is scale invariant). With the query's z outside the
+        // grid, z offsets come from floating point (no branch depends on them).
+        let inv_cell = 1.0 / self.cell;
         let oz = self.origin[2];
-        let rel = |p: [i64; 3]| -> [f64; 3] {
-            let dz = if z_exact {
-                (p[2] - qi[2]) as f64 * cell
+        let dz = |p: [i64; 3]| -> f64 {
+            if z_exact {
+                (p[2] - qi[2]) as f64
             } else {
-                (p[2] as f64 * cell + oz) - qz
-            };
-            [
-                (p[0] - qi[0]) as f64 * cell,
-                (p[1] - qi[1]) as f64 * cell,
-                dz,
-            ]
+                ((p[2] as f64 * self.cell + oz) - qz) * inv_cell
+            }
         };
         let mut sum = 0.0;
+        // Edges whose sign the floating-point filter settled go through a 4-wide SIMD atan2;
+        // the rest (exact fallback, degenerate limits) are summed one by one.
+        let mut batch = AtanBatch::default();
         for i in 0..self.bw.len() {
             let a = self.ba[i];
             let b = self.bb[i];
-            let o = perturbed_orient2d::<W>([qi[0], qi[1]], [a[0], a[1]], [b[0], b[1]]);
-            let inside = o.degenerate && z_exact && query_inside_segment(qi, a, b);
-            let signs = EdgeSigns {
-                numerator: -o.sign,
-                query_inside_segment: inside,
+            let ra_i = [a[0] - qi[0], a[1] - qi[1]];
+            let rb_i = [b[0] - qi[0], b[1] - qi[1]];
+            let ra = [ra_i[0] as f64, ra_i[1] as f64, dz(a)];
+            let rb = [rb_i[0] as f64, rb_i[1] as f64, dz(b)];
+            if let Some((num, den)) = filtered_generic_terms(ra, rb) {
+                batch.push(num, den, self.bw[i]);
+                continue;
+            }
+            let o = perturbed_orient2d_offsets::<W>(ra_i, rb_i, [ra[0], ra[1]], [rb[0], rb[1]]);
+            let area = if !o.degenerate {
+                antipodal_edge_area_generic(ra, rb, -o.sign)
+            } else {
+                let signs = EdgeSigns {
+                    numerator: -o.sign,
+                    query_inside_segment: z_exact && query_inside_segment(qi, a, b),
+                };
+                antipodal_edge_area(ra, rb, signs)
             };
-            sum += self.bw[i] * antipodal_edge_area(rel(a), rel(b), signs);
+            sum += self.bw[i] * area;
         }
-        sum
+        sum + batch.finish()
     }
 
     /// Boundary sum for a query whose ray cannot approach the mesh: plain floating point.

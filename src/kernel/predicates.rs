@@ -130,6 +130,37 @@ pub fn perturbed_orient2d<W: Width>(q: [i64; 2], a: [i64; 2], b: [i64; 2]) -> Or
     }
 }
 
+/// [`perturbed_orient2d`] for an edge given by its offsets from the query, with a floating-point
+/// filter in front: `ra_f`, `rb_f` must be the `f64` conversions of `ra`, `rb`. When the filter
+/// answers, the answer equals the exact one (so the shared-sign property is kept); otherwise the
+/// exact integer evaluation runs. The conversions (relative error ≤ u = 2^-53 each), the two
+/// products and the difference bound the error of `d` by `4u·(|p1| + |p2|)`; we test `8u`.
+#[inline]
+pub fn perturbed_orient2d_offsets<W: Width>(
+    ra: [i64; 2],
+    rb: [i64; 2],
+    ra_f: [f64; 2],
+    rb_f: [f64; 2],
+) -> Orient2d {
+    let p1 = ra_f[0] * rb_f[1];
+    let p2 = ra_f[1] * rb_f[0];
+    let d = p1 - p2;
+    let bound = 8.0 * f64::EPSILON * 0.5 * (p1.abs() + p2.abs());
+    if d > bound {
+        return Orient2d {
+            sign: 1,
+            degenerate: false,
+        };
+    }
+    if d < -bound {
+        return Orient2d {
+            sign: -1,
+            degenerate: false,
+        };
+    }
+    perturbed_orient2d::<W>([0, 0], ra, rb)
+}
+
 /// Signed crossing of the ray from `q_ε` along `+z` with triangle `(p0, p1, p2)`: `+1` when the
 /// ray leaves through the side the triangle's normal points to (`n_z > 0`), `−1` when it enters,
 /// `0` when it misses. Exact for every input (no tolerance), consistent with
