@@ -64,6 +64,15 @@ impl RayBvh {
         }
     }
 
+    /// Renumbers the primitives in leaf order: returns the permutation (`new index → old index`)
+    /// and makes the BVH report new indices, so callers can store per-primitive data contiguously
+    /// in traversal order.
+    pub fn renumber_in_leaf_order(&mut self) -> Vec<u32> {
+        let order = std::mem::take(&mut self.prims);
+        self.prims = (0..order.len() as u32).collect();
+        order
+    }
+
     /// Calls `f` for every primitive whose padded box contains `(x, y)` transversally and reaches
     /// `z_min` or above along `+z` (`z_min = −∞` gives the whole column). Each primitive at most
     /// once.

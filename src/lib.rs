@@ -29,8 +29,17 @@ pub mod bvh;
 pub mod curve2d;
 pub mod error;
 pub mod eval;
+pub mod grid;
 pub mod io;
 pub mod kernel;
 pub mod mesh;
+pub mod products;
+#[cfg(any(feature = "testing", feature = "cli"))]
+pub mod testing;
 
 pub use mesh::{BoundingBox, Mesh};
+
+/// The README's library example, compiled and run as a doctest.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;

@@ -34,13 +34,21 @@ fn point_triangle_distance(q: [f64; 3], p: [[f64; 3]; 3]) -> f64 {
     let seg = |a: [f64; 3], b: [f64; 3]| {
         let ab = sub(b, a);
         let l = dot(ab, ab);
-        let t = if l > 0.0 { (dot(sub(q, a), ab) / l).clamp(0.0, 1.0) } else { 0.0 };
+        let t = if l > 0.0 {
+            (dot(sub(q, a), ab) / l).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
         dist(q, [a[0] + t * ab[0], a[1] + t * ab[1], a[2] + t * ab[2]])
     };
     let mut d = seg(p[0], p[1]).min(seg(p[1], p[2])).min(seg(p[2], p[0]));
     let e1 = sub(p[1], p[0]);
     let e2 = sub(p[2], p[0]);
-    let n = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]];
+    let n = [
+        e1[1] * e2[2] - e1[2] * e2[1],
+        e1[2] * e2[0] - e1[0] * e2[2],
+        e1[0] * e2[1] - e1[1] * e2[0],
+    ];
     let nn = dot(n, n);
     if nn > 0.0 {
         let h = dot(sub(q, p[0]), n) / nn;
@@ -50,7 +58,14 @@ fn point_triangle_distance(q: [f64; 3], p: [[f64; 3]; 3]) -> f64 {
             let b = p[(i + 1) % 3];
             let c = sub(b, a);
             let w = sub(x, a);
-            dot([c[1] * w[2] - c[2] * w[1], c[2] * w[0] - c[0] * w[2], c[0] * w[1] - c[1] * w[0]], n) >= 0.0
+            dot(
+                [
+                    c[1] * w[2] - c[2] * w[1],
+                    c[2] * w[0] - c[0] * w[2],
+                    c[0] * w[1] - c[1] * w[0],
+                ],
+                n,
+            ) >= 0.0
         });
         if inside {
             d = d.min(h.abs() * nn.sqrt());
@@ -61,16 +76,26 @@ fn point_triangle_distance(q: [f64; 3], p: [[f64; 3]; 3]) -> f64 {
 
 #[test]
 fn exact_agrees_with_direct_and_with_other_rays_on_the_shared_corpus() {
-    let Some(dir) = common::shared_meshes() else { return };
+    let Some(dir) = common::shared_meshes() else {
+        return;
+    };
     let manifest = std::fs::read_to_string(dir.join("manifest.csv")).unwrap();
-    let files: Vec<&str> = manifest.lines().skip(1).filter_map(|l| l.split(',').next()).collect();
+    let files: Vec<&str> = manifest
+        .lines()
+        .skip(1)
+        .filter_map(|l| l.split(',').next())
+        .collect();
     assert!(files.len() > 90, "manifest has {} rows", files.len());
     let mut worst = (0.0f64, String::new());
     let mut worst_dir = (0.0f64, String::new());
     let mut total_queries = 0usize;
     for (fi, file) in files.iter().enumerate() {
-        let mesh = gwn::io::load_mesh(dir.join(file)).unwrap_or_else(|e| panic!("{e}")).mesh;
-        let Some(bbox) = mesh.bounding_box() else { continue };
+        let mesh = gwn::io::load_mesh(dir.join(file))
+            .unwrap_or_else(|e| panic!("{e}"))
+            .mesh;
+        let Some(bbox) = mesh.bounding_box() else {
+            continue;
+        };
         let diag = bbox.diagonal();
         let eps = 1e-6 * diag;
         let big = bbox.enlarged(0.1);
@@ -83,20 +108,37 @@ fn exact_agrees_with_direct_and_with_other_rays_on_the_shared_corpus() {
             .filter(|&q| farther_than(&mesh, q, eps))
             .collect();
         let queries = &queries[..queries.len().min(1000)];
-        assert!(queries.len() >= 1000, "{file}: only {} queries off the surface", queries.len());
+        assert!(
+            queries.len() >= 1000,
+            "{file}: only {} queries off the surface",
+            queries.len()
+        );
         total_queries += queries.len();
         let exact = WindingNumber::new(&mesh).unwrap();
         let w: Vec<f64> = exact.eval_batch(queries);
-        let d: Vec<f64> = queries.par_iter().map(|&q| winding_number_direct(&mesh, q)).collect();
+        let d: Vec<f64> = queries
+            .par_iter()
+            .map(|&q| winding_number_direct(&mesh, q))
+            .collect();
         for i in 0..queries.len() {
             let e = (w[i] - d[i]).abs();
             if e > worst.0 {
-                worst = (e, format!("{file} at {:?}: exact {} direct {}", queries[i], w[i], d[i]));
+                worst = (
+                    e,
+                    format!("{file} at {:?}: exact {} direct {}", queries[i], w[i], d[i]),
+                );
             }
         }
         // Direction independence: other rays resolve every degeneracy differently.
         for ray in [RayAxis::NegZ, RayAxis::PosX] {
-            let other = WindingNumber::with_options(&mesh, Options { ray, ..Default::default() }).unwrap();
+            let other = WindingNumber::with_options(
+                &mesh,
+                Options {
+                    ray,
+                    ..Default::default()
+                },
+            )
+            .unwrap();
             for (i, &q) in queries.iter().enumerate().take(300) {
                 let (chi0, _) = exact.parts(q);
                 let v = other.eval(q);
@@ -105,13 +147,29 @@ fn exact_agrees_with_direct_and_with_other_rays_on_the_shared_corpus() {
                     worst_dir = (e, format!("{file} {ray:?} at {q:?}: {v} vs {}", w[i]));
                 }
                 if exact.boundary_edge_count() == 0 {
-                    assert_eq!(other.parts(q).0, chi0, "{file} {ray:?} at {q:?}: integer parts differ");
+                    assert_eq!(
+                        other.parts(q).0,
+                        chi0,
+                        "{file} {ray:?} at {q:?}: integer parts differ"
+                    );
                 }
             }
         }
     }
-    eprintln!("{} meshes, {total_queries} queries: max |exact − direct| = {:.3e} ({})", files.len(), worst.0, worst.1);
-    eprintln!("max direction dependence = {:.3e} ({})", worst_dir.0, worst_dir.1);
+    eprintln!(
+        "{} meshes, {total_queries} queries: max |exact − direct| = {:.3e} ({})",
+        files.len(),
+        worst.0,
+        worst.1
+    );
+    eprintln!(
+        "max direction dependence = {:.3e} ({})",
+        worst_dir.0, worst_dir.1
+    );
     assert!(worst.0 <= 1e-10, "exact vs direct: {}", worst.1);
-    assert!(worst_dir.0 <= 1e-10, "direction dependence: {}", worst_dir.1);
+    assert!(
+        worst_dir.0 <= 1e-10,
+        "direction dependence: {}",
+        worst_dir.1
+    );
 }

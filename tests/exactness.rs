@@ -1,12 +1,13 @@
 //! The kernel issue's oracles: grazing cases on small integer grids (proptest, shrinking),
-//! closed self-intersecting shells (exact integer answers), direction independence.
+//! closed self-intersecting shells (exact integer answers), direction independence. The byte
+//! decoders live in `gwn::testing` (shared with the `kernel_grazing` fuzz target).
 
 mod common;
 
-use common::grazing::{boxes, decode, on_surface};
 use gwn::eval::antipodal::{Options, WindingNumber};
 use gwn::kernel::frame::RayAxis;
 use gwn::kernel::quantize::Precision;
+use gwn::testing::{boxes_from_bytes, on_surface, soup_from_bytes as decode};
 use proptest::prelude::*;
 
 /// Every ray direction and both precisions, against the direct sum at the perturbed point.
@@ -80,7 +81,8 @@ proptest! {
 
     #[test]
     fn unions_of_boxes_give_exact_integers(bytes in proptest::collection::vec(any::<u8>(), 0..40), q in proptest::array::uniform3(-20i32..20)) {
-        let (mesh, bs) = boxes(&bytes);
+        let case = boxes_from_bytes(&bytes);
+        let (mesh, bs) = (case.mesh, case.boxes);
         // Quarter-grid queries: on faces, edges and corners of the boxes whenever q is integral.
         let q = q.map(|v| f64::from(v) * 0.25);
         let off_surface = q.iter().all(|c| c.fract() != 0.0);

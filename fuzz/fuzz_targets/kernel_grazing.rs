@@ -1,23 +1,21 @@
-//! Fuzzes the exact kernel on degenerate meshes of the integer grid −4..4 (decoder shared with
-//! `tests/common/grazing.rs`): off the surface, every ray direction must give the same winding
-//! number; on it, the value must be finite and within 2e-3 of the direct sum at the perturbed
-//! point. Run: `cargo fuzz run --sanitizer none kernel_grazing -- -max_total_time=60`.
+//! Fuzzes the exact kernel on degenerate meshes of the integer grid −4..4 (decoder
+//! `gwn::testing::soup_from_bytes`, shared with `tests/exactness.rs`): off the surface, every
+//! ray direction must give the same winding number; on it, the value must be finite and within
+//! 2e-3 of the direct sum at the perturbed point. Run: `cargo fuzz run --sanitizer none kernel_grazing -- -max_total_time=60`.
 #![no_main]
 
 use gwn::eval::antipodal::{Options, WindingNumber};
 use gwn::kernel::frame::RayAxis;
+use gwn::testing::{on_surface, soup_from_bytes};
 use libfuzzer_sys::fuzz_target;
 
-#[path = "../../tests/common/grazing.rs"]
-mod grazing;
-
 fuzz_target!(|data: &[u8]| {
-    let case = grazing::decode(data);
+    let case = soup_from_bytes(data);
     let base = WindingNumber::new(&case.mesh).unwrap();
     for &q in &case.queries {
         let w0 = base.eval(q);
         assert!(w0.is_finite());
-        let on = grazing::on_surface(&case.mesh, q);
+        let on = on_surface(&case.mesh, q);
         for ray in RayAxis::ALL {
             let wn = WindingNumber::with_options(
                 &case.mesh,

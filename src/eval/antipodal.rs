@@ -24,16 +24,13 @@ use rayon::prelude::*;
 
 use crate::Mesh;
 use crate::bvh::RayBvh;
+use crate::kernel::boundary::BoundaryEdges;
 use crate::kernel::frame::RayAxis;
 use crate::kernel::predicates::{
-    W64, W128, Width, perturbed_orient2d_offsets, perturbed_plane_side, projected_containment,
-    query_inside_segment, ray_crossing,
+    W64, W128, Width, perturbed_plane_side, projected_containment, ray_crossing,
 };
 use crate::kernel::quantize::{Grid, GridRangeError, Precision, Snap};
-use crate::kernel::spherical::{
-    AtanBatch, EdgeSigns, antipodal_edge_area, antipodal_edge_area_generic,
-    antipodal_edge_area_gradient, filtered_generic_terms,
-};
+use crate::kernel::spherical::{EdgeSigns, antipodal_edge_area, antipodal_edge_area_gradient};
 use crate::mesh::boundary_edges;
 
 const INV_4PI: f64 = 1.0 / (4.0 * std::f64::consts::PI);
@@ -117,8 +114,8 @@ impl WindingNumber {
             Precision::Bits60 => Dispatch::Wide(Core::build(mesh, options)?),
         };
         let boundary = match &core {
-            Dispatch::Narrow(c) => c.bw.len(),
-            Dispatch::Wide(c) => c.bw.len(),
+            Dispatch::Narrow(c) => c.boundary.len(),
+            Dispatch::Wide(c) => c.boundary.len(),
         };
         Ok(WindingNumber {
             core,
@@ -217,11 +214,9 @@ struct Core<W: Width> {
     cell: f64,
     /// Scale from grid integers to normalized BVH coordinates.
     to_unit: f64,
-    verts: Vec<[i64; 3]>,
-    tris: Vec<[u32; 3]>,
-    ba: Vec<[i64; 3]>,
-    bb: Vec<[i64; 3]>,
-    bw: Vec<f64>,
+    /// Triangle corners in grid coordinates (frame), in BVH leaf order.
+    tri_pts: Vec<[[i64; 3]; 3]>,
+    boundary: BoundaryEdges,
     bvh: RayBvh,
     _width: PhantomData<W>,
 }
@@ -244,11 +239,14 @@ impl<W: Width> Core<W> {
             .iter()
             .map(|&p| ray.to_frame(grid.snap_vertex(p)))
             .collect();
-        let tris = mesh.triangles().to_vec();
+        let tris = mesh.triangles();
         let boundary = boundary_edges(mesh);
-        let ba = boundary.iter().map(|e| verts[e.from as usize]).collect();
-        let bb = boundary.iter().map(|e| verts[e.to as usize]).collect();
-        let bw = boundary.iter().map(|e| f64::from(e.weight)).collect();
+        let boundary = BoundaryEdges::new(
+            boundary.iter().map(|e| verts[e.from as usize]).collect(),
+            boundary.iter().map(|e| verts[e.to as usize]).collect(),
+            boundary.iter().map(|e| f64::from(e.weight)).collect(),
+            grid.precision().bits(),
+        );
         let to_unit = 1.0 / (1_i64 << (grid.precision().bits() - 1)) as f64;
         let boxes: Vec<([f32; 3], [f32; 3])> = tris
             .iter()
@@ -263,18 +261,20 @@ impl<W: Width> Core<W> {
                 (lo, hi)
             })
             .collect();
-        let bvh = RayBvh::build(&boxes);
+        let mut bvh = RayBvh::build(&boxes);
+        let tri_pts = bvh
+            .renumber_in_leaf_order()
+            .into_iter()
+            .map(|f| tris[f as usize].map(|i| verts[i as usize]))
+            .collect();
         Ok(Core {
             origin: ray.to_frame(grid.origin()),
             cell: grid.cell(),
             grid,
             ray,
             to_unit,
-            verts,
-            tris,
-            ba,
-            bb,
-            bw,
+            tri_pts,
+            boundary,
             bvh,
             _width: PhantomData,
         })
@@ -287,11 +287,8 @@ impl<W: Width> Core<W> {
             grid,
             ray,
             to_unit: 1.0,
-            verts: Vec::new(),
-            tris: Vec::new(),
-            ba: Vec::new(),
-            bb: Vec::new(),
-            bw: Vec::new(),
+            tri_pts: Vec::new(),
+            boundary: BoundaryEdges::default(),
             bvh: RayBvh::default(),
             _width: PhantomData,
         }
@@ -368,7 +365,7 @@ impl<W: Width> Core<W> {
         let u = |v: i64| (v as f64 * self.to_unit) as f32;
         self.bvh
             .for_each_on_ray(u(x), u(y), f32::NEG_INFINITY, |f| {
-                let p = self.tris[f as usize].map(|i| self.verts[i as usize]);
+                let p = self.tri_pts[f as usize];
                 let s = projected_containment::<W>([x, y], p);
                 if s == 0 {
                     return;
@@ -416,9 +413,7 @@ impl<W: Width> Core<W> {
         let mut chi = 0i64;
         let u = |v: i64| (v as f64 * self.to_unit) as f32;
         self.bvh.for_each_on_ray(u(qi[0]), u(qi[1]), u(qi[2]), |f| {
-            let t = self.tris[f as usize];
-            let p = t.map(|i| self.verts[i as usize]);
-            chi += i64::from(ray_crossing::<W>(qi, p));
+            chi += i64::from(ray_crossing::<W>(qi, self.tri_pts[f as usize]));
         });
         chi
     }
@@ -426,53 +421,17 @@ impl<W: Width> Core<W> {
     /// `Σ k·Area(A, B, x1)` with exact branch signs. `z_exact` is false when the query's frame z
     /// lies outside the grid (then `qz` is used in floating point for the magnitudes).
     fn boundary_sum(&self, qi: [i64; 3], z_exact: bool, qz: f64) -> f64 {
-        // Offsets in grid units (the area is scale invariant). With the query's z outside the
-        // grid, z offsets come from floating point (no branch depends on them).
-        let inv_cell = 1.0 / self.cell;
-        let oz = self.origin[2];
-        let dz = |p: [i64; 3]| -> f64 {
-            if z_exact {
-                (p[2] - qi[2]) as f64
-            } else {
-                ((p[2] as f64 * self.cell + oz) - qz) * inv_cell
-            }
-        };
-        let mut sum = 0.0;
-        // Edges whose sign the floating-point filter settled go through a 4-wide SIMD atan2;
-        // the rest (exact fallback, degenerate limits) are summed one by one.
-        let mut batch = AtanBatch::default();
-        for i in 0..self.bw.len() {
-            let a = self.ba[i];
-            let b = self.bb[i];
-            let ra_i = [a[0] - qi[0], a[1] - qi[1]];
-            let rb_i = [b[0] - qi[0], b[1] - qi[1]];
-            let ra = [ra_i[0] as f64, ra_i[1] as f64, dz(a)];
-            let rb = [rb_i[0] as f64, rb_i[1] as f64, dz(b)];
-            if let Some((num, den)) = filtered_generic_terms(ra, rb) {
-                batch.push(num, den, self.bw[i]);
-                continue;
-            }
-            let o = perturbed_orient2d_offsets::<W>(ra_i, rb_i, [ra[0], ra[1]], [rb[0], rb[1]]);
-            let area = if !o.degenerate {
-                antipodal_edge_area_generic(ra, rb, -o.sign)
-            } else {
-                let signs = EdgeSigns {
-                    numerator: -o.sign,
-                    query_inside_segment: z_exact && query_inside_segment(qi, a, b),
-                };
-                antipodal_edge_area(ra, rb, signs)
-            };
-            sum += self.bw[i] * area;
-        }
-        sum + batch.finish()
+        let qz_units = (qz - self.origin[2]) / self.cell;
+        self.boundary.area_sum::<W>(qi, z_exact, qz_units)
     }
 
     /// Boundary sum for a query whose ray cannot approach the mesh: plain floating point.
     fn far_boundary_sum(&self, qf: [f64; 3]) -> f64 {
         let mut sum = 0.0;
-        for i in 0..self.bw.len() {
-            let ra = self.rel_f64(self.ba[i], qf);
-            let rb = self.rel_f64(self.bb[i], qf);
+        for i in 0..self.boundary.len() {
+            let (a, b, weight) = self.boundary.edge(i);
+            let ra = self.rel_f64(a, qf);
+            let rb = self.rel_f64(b, qf);
             let n = -(ra[0] * rb[1] - ra[1] * rb[0]);
             let signs = EdgeSigns {
                 numerator: if n > 0.0 {
@@ -484,7 +443,7 @@ impl<W: Width> Core<W> {
                 },
                 query_inside_segment: false,
             };
-            sum += self.bw[i] * antipodal_edge_area(ra, rb, signs);
+            sum += weight * antipodal_edge_area(ra, rb, signs);
         }
         sum
     }
@@ -497,12 +456,11 @@ impl<W: Width> Core<W> {
     fn gradient(&self, q: [f64; 3]) -> [f64; 3] {
         let qf = self.ray.to_frame(q);
         let mut g = [0.0; 3];
-        for i in 0..self.bw.len() {
-            let ra = self.rel_f64(self.ba[i], qf);
-            let rb = self.rel_f64(self.bb[i], qf);
-            let e = antipodal_edge_area_gradient(ra, rb);
+        for i in 0..self.boundary.len() {
+            let (a, b, weight) = self.boundary.edge(i);
+            let e = antipodal_edge_area_gradient(self.rel_f64(a, qf), self.rel_f64(b, qf));
             for k in 0..3 {
-                g[k] += self.bw[i] * e[k];
+                g[k] += weight * e[k];
             }
         }
         self.ray.to_world(g.map(|v| v * INV_4PI))

@@ -7,6 +7,7 @@
 //! - [`spherical`]: the solid-angle and spherical-triangle formulas;
 //! - [`compensated`]: Neumaier summation.
 
+pub mod boundary;
 pub mod compensated;
 pub mod frame;
 pub mod predicates;

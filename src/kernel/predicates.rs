@@ -55,7 +55,19 @@ impl Width for W128 {
     const PRECISION: Precision = Precision::Bits60;
     #[inline]
     fn det2_sign(a0: i64, a1: i64, b0: i64, b1: i64) -> i32 {
+        // Filter: the four conversions (relative error ≤ u = 2^-53 each), two products and one
+        // difference bound the error of d by 4u·(|p1| + |p2|); we test 8u. Exact otherwise:
         // |a|,|b| < 2^61 ⇒ each product < 2^122, the difference < 2^123.
+        let p1 = a0 as f64 * b1 as f64;
+        let p2 = a1 as f64 * b0 as f64;
+        let d = p1 - p2;
+        let bound = 4.0 * f64::EPSILON * (p1.abs() + p2.abs());
+        if d > bound {
+            return 1;
+        }
+        if d < -bound {
+            return -1;
+        }
         let d = i128::from(a0) * i128::from(b1) - i128::from(a1) * i128::from(b0);
         d.signum() as i32
     }
@@ -128,37 +140,6 @@ pub fn perturbed_orient2d<W: Width>(q: [i64; 2], a: [i64; 2], b: [i64; 2]) -> Or
         sign,
         degenerate: true,
     }
-}
-
-/// [`perturbed_orient2d`] for an edge given by its offsets from the query, with a floating-point
-/// filter in front: `ra_f`, `rb_f` must be the `f64` conversions of `ra`, `rb`. When the filter
-/// answers, the answer equals the exact one (so the shared-sign property is kept); otherwise the
-/// exact integer evaluation runs. The conversions (relative error ≤ u = 2^-53 each), the two
-/// products and the difference bound the error of `d` by `4u·(|p1| + |p2|)`; we test `8u`.
-#[inline]
-pub fn perturbed_orient2d_offsets<W: Width>(
-    ra: [i64; 2],
-    rb: [i64; 2],
-    ra_f: [f64; 2],
-    rb_f: [f64; 2],
-) -> Orient2d {
-    let p1 = ra_f[0] * rb_f[1];
-    let p2 = ra_f[1] * rb_f[0];
-    let d = p1 - p2;
-    let bound = 8.0 * f64::EPSILON * 0.5 * (p1.abs() + p2.abs());
-    if d > bound {
-        return Orient2d {
-            sign: 1,
-            degenerate: false,
-        };
-    }
-    if d < -bound {
-        return Orient2d {
-            sign: -1,
-            degenerate: false,
-        };
-    }
-    perturbed_orient2d::<W>([0, 0], ra, rb)
 }
 
 /// Signed crossing of the ray from `q_ε` along `+z` with triangle `(p0, p1, p2)`: `+1` when the
@@ -289,6 +270,15 @@ mod tests {
         assert_eq!(o.sign, -1);
         // Edge projecting to a point.
         assert_eq!(perturbed_orient2d::<W64>([0, 0], [2, 2], [2, 2]).sign, 0);
+    }
+
+    #[test]
+    fn det2_filter_defers_to_exact_when_f64_cannot_decide() {
+        let t = 1_i64 << 60;
+        // (2^60+1)(2^60−1) − 2^60·2^60 = −1, but every f64 product rounds to 2^120.
+        assert_eq!(W128::det2_sign(t + 1, t, t, t - 1), -1);
+        assert_eq!(W128::det2_sign(t, t + 1, t - 1, t), 1);
+        assert_eq!(W128::det2_sign(t, t, t, t), 0);
     }
 
     #[test]

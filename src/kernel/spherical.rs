@@ -103,10 +103,9 @@ pub fn antipodal_edge_area(ra: [f64; 3], rb: [f64; 3], signs: EdgeSigns) -> f64 
     if b_on_ray {
         return signed_double_atan2(s, a_dir[1].abs(), -a_dir[0]);
     }
-    // Generic case. Numerator and denominator scaled by |ra||rb| > 0:
-    //   n·|ra||rb| = −(ra × rb)_z
-    //   den·|ra||rb| = (|ra| − ra_z)(|rb| − rb_z) + ra_x rb_x + ra_y rb_y
-    // (expand 1 + A·B − A_z − B_z); |r| − r_z is evaluated without cancellation.
+    // Generic case, with unit A, B and x1 = −z:
+    //   n = −(A × B)_z,   den = 1 + A·B − A_z − B_z = (1 − A_z)(1 − B_z) + A_x B_x + A_y B_y,
+    // where 1 − A_z is evaluated without cancellation (len_minus_z).
     let (ra, la) = if ra == [0.0; 3] {
         ([-1.0, 0.0, 0.0], 1.0)
     } else {
@@ -146,79 +145,6 @@ pub fn antipodal_edge_area_gradient(r0: [f64; 3], r1: [f64; 3]) -> [f64; 3] {
         let gd = -(t1 + t2);
         cn * gn + cd * gd
     })
-}
-
-/// The generic case of [`antipodal_edge_area`] (the 2D orientation of the edge seen from the
-/// query is non-zero, so none of the limits apply): `s` is the exact sign of the numerator.
-#[inline]
-pub fn antipodal_edge_area_generic(ra: [f64; 3], rb: [f64; 3], s: i32) -> f64 {
-    let la = norm(ra);
-    let lb = norm(rb);
-    let n = ra[0] * rb[1] - ra[1] * rb[0];
-    let den = len_minus_z(ra, la) * len_minus_z(rb, lb) + ra[0] * rb[0] + ra[1] * rb[1];
-    signed_double_atan2(s, n.abs(), den)
-}
-
-/// The generic edge term when the `f64` orientation `d = ra_x rb_y − ra_y rb_x` clears the same
-/// error bound as [`crate::kernel::predicates::perturbed_orient2d_offsets`] (so its sign *is* the
-/// exact sign): returns `(numerator, denominator)` of `Area = 2·atan2(num, den)`, with
-/// `num = −d` carrying the exact sign. `None` when the exact predicate must decide.
-#[inline]
-pub fn filtered_generic_terms(ra: [f64; 3], rb: [f64; 3]) -> Option<(f64, f64)> {
-    let p1 = ra[0] * rb[1];
-    let p2 = ra[1] * rb[0];
-    let d = p1 - p2;
-    if d.abs() <= 8.0 * f64::EPSILON * 0.5 * (p1.abs() + p2.abs()) {
-        return None;
-    }
-    let la = norm(ra);
-    let lb = norm(rb);
-    let den = len_minus_z(ra, la) * len_minus_z(rb, lb) + ra[0] * rb[0] + ra[1] * rb[1];
-    Some((-d, den))
-}
-
-/// Accumulates `Σ w·2·atan2(num, den)` four terms at a time with `wide`'s SIMD `atan2`
-/// (within a few ulp of `std`, checked by the tests below and the agreement tests).
-#[derive(Default)]
-pub struct AtanBatch {
-    num: [f64; 4],
-    den: [f64; 4],
-    weight: [f64; 4],
-    len: usize,
-    acc: wide::f64x4,
-}
-
-impl AtanBatch {
-    /// Adds one term.
-    #[inline]
-    pub fn push(&mut self, num: f64, den: f64, weight: f64) {
-        self.num[self.len] = num;
-        self.den[self.len] = den;
-        self.weight[self.len] = weight;
-        self.len += 1;
-        if self.len == 4 {
-            self.flush();
-        }
-    }
-
-    #[inline]
-    fn flush(&mut self) {
-        let y = wide::f64x4::from(self.num);
-        let x = wide::f64x4::from(self.den);
-        let w = wide::f64x4::from(self.weight);
-        self.acc += y.atan2(x) * w;
-        self.len = 0;
-    }
-
-    /// The total (times 2).
-    pub fn finish(mut self) -> f64 {
-        let mut tail = 0.0;
-        for i in 0..self.len {
-            tail += self.weight[i] * self.num[i].atan2(self.den[i]);
-        }
-        self.len = 0;
-        2.0 * (self.acc.reduce_add() + tail)
-    }
 }
 
 /// `|r| − r_z` without cancellation when `r` points up.
@@ -303,6 +229,7 @@ mod tests {
 
     #[test]
     fn simd_atan2_matches_std() {
+        // The boundary loop (kernel::boundary) relies on wide's f64x4::atan2.
         let mut x: u64 = 12345;
         let mut next = || {
             x = x
@@ -310,19 +237,20 @@ mod tests {
                 .wrapping_add(1442695040888963407);
             ((x >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
         };
-        for _ in 0..20000 {
-            let (y, d) = (next() * 10f64.powi((next() * 8.0) as i32), next());
-            let mut b = AtanBatch::default();
-            for _ in 0..4 {
-                b.push(y, d, 0.25);
+        let mut worst = 0.0f64;
+        for _ in 0..50000 {
+            let y: [f64; 4] = std::array::from_fn(|_| next() * 10f64.powi((next() * 12.0) as i32));
+            let d: [f64; 4] = std::array::from_fn(|_| next() * 10f64.powi((next() * 12.0) as i32));
+            let got = wide::f64x4::from(y).atan2(wide::f64x4::from(d)).to_array();
+            for l in 0..4 {
+                let want = y[l].atan2(d[l]);
+                let ulps =
+                    (got[l] - want).abs() / (f64::EPSILON * want.abs().max(f64::MIN_POSITIVE));
+                worst = worst.max(ulps);
+                assert!(ulps <= 4.0, "{} {}: {} vs {want}", y[l], d[l], got[l]);
             }
-            let want = 2.0 * y.atan2(d);
-            let got = b.finish();
-            assert!(
-                (got - want).abs() <= 4.0 * f64::EPSILON * want.abs().max(1e-300),
-                "{y} {d}: {got} vs {want}"
-            );
         }
+        eprintln!("wide f64x4::atan2: worst {worst:.2} ulp vs std over 200000 samples");
     }
 
     #[test]

@@ -7,6 +7,7 @@
 //! users of this crate feed exactly such meshes.
 
 pub mod boundary;
+pub mod stats;
 
 pub use boundary::{BoundaryEdge, boundary_edges};
 
@@ -31,9 +32,9 @@ impl BoundingBox {
             max: first,
         };
         for p in it {
-            for k in 0..3 {
-                b.min[k] = b.min[k].min(p[k]);
-                b.max[k] = b.max[k].max(p[k]);
+            for (k, &c) in p.iter().enumerate() {
+                b.min[k] = b.min[k].min(c);
+                b.max[k] = b.max[k].max(c);
             }
         }
         Some(b)

@@ -1,8 +1,6 @@
 //! Shared test helpers: small closed-form meshes and the shared-corpus locator.
 #![allow(dead_code)]
 
-pub mod grazing;
-
 use gwn::Mesh;
 
 /// Unit cube [0,1]³, 12 outward-oriented triangles.

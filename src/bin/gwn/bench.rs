@@ -7,14 +7,17 @@ use clap::Args as ClapArgs;
 use gwn::Mesh;
 use gwn::eval::antipodal::WindingNumber;
 use gwn::eval::direct::winding_number_direct;
+use gwn::eval::fast::{FastParams, FastWindingNumber};
 use rayon::prelude::*;
 
 use crate::common::{CliError, load_mesh_for_cli};
 
-/// Benchmark the evaluators on meshes: per mesh, faces, boundary edges, precompute time and
-/// queries/s of `exact` and `direct` on an N³ grid over the bounding box enlarged by 10 % per
+/// Benchmark the evaluators on meshes: per mesh, faces, boundary edges, precompute time of
+/// `exact`, tree build time of `fast`, and queries/s of `exact`, `direct` and `fast`
+/// (Barnes–Hut, `--beta`, `--order`) on an N³ grid over the bounding box enlarged by 10 % per
 /// side, with each thread count. `direct` is timed on an evenly spaced subset of the grid
-/// (`--direct-sample`) because it costs O(faces) per query.
+/// (`--direct-sample`) because it costs O(faces) per query; the last column is the largest
+/// |fast − direct| on that subset.
 ///
 /// Example: gwn bench ../shared/meshes --grid 32 --threads-list 1,2 --markdown
 #[derive(ClapArgs, Debug)]
@@ -32,6 +35,13 @@ pub struct Args {
     /// Number of grid points on which the direct sum is timed.
     #[arg(long, default_value_t = 256)]
     pub direct_sample: usize,
+    /// Accuracy of the fast method (Barill et al.'s β: a node is approximated beyond β times
+    /// its radius).
+    #[arg(long, default_value_t = 2.0)]
+    pub beta: f64,
+    /// Expansion order of the fast method (0, 1 or 2).
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(0..=2))]
+    pub order: u8,
     /// Print a Markdown table.
     #[arg(long)]
     pub markdown: bool,
@@ -46,9 +56,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 .map_err(|e| CliError(format!("{}: {e}", p.display())))?
                 .filter_map(|e| e.ok().map(|e| e.path()))
                 .filter(|p| {
-                    p.extension()
-                        .and_then(|e| e.to_str())
-                        .is_some_and(|e| ["obj", "stl", "off", "ply"].contains(&e.to_ascii_lowercase().as_str()))
+                    p.extension().and_then(|e| e.to_str()).is_some_and(|e| {
+                        ["obj", "stl", "off", "ply"].contains(&e.to_ascii_lowercase().as_str())
+                    })
                 })
                 .collect();
             v.sort();
@@ -57,11 +67,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
             files.push(p.clone());
         }
     }
-    let mut header = String::from("mesh | faces | boundary | precompute ms");
+    let mut header = String::from("mesh | faces | boundary | precompute ms | fast build ms");
     for t in &args.threads_list {
-        header += &format!(" | exact q/s ({t}t) | direct q/s ({t}t)");
+        header += &format!(" | exact q/s ({t}t) | direct q/s ({t}t) | fast q/s ({t}t)");
     }
-    header += " | exact/direct";
+    header += " | exact/direct | fast/direct | fast max err";
     if args.markdown {
         println!("| {header} |");
         println!("|{}", "---|".repeat(header.matches('|').count() + 1));
@@ -70,8 +80,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     for f in files {
         let mesh = load_mesh_for_cli(&f, false)?;
-        let Some(row) = bench_mesh(&mesh, &args)? else { continue };
-        let name = f.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        let Some(row) = bench_mesh(&mesh, &args)? else {
+            continue;
+        };
+        let name = f
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
         let line = format!("{name} | {row}");
         if args.markdown {
             println!("| {line} |");
@@ -83,13 +98,17 @@ pub fn run(args: Args) -> Result<(), CliError> {
 }
 
 fn bench_mesh(mesh: &Mesh, args: &Args) -> Result<Option<String>, CliError> {
-    let Some(bbox) = mesh.bounding_box() else { return Ok(None) };
+    let Some(bbox) = mesh.bounding_box() else {
+        return Ok(None);
+    };
     let b = bbox.enlarged(0.1);
     let n = args.grid.max(1);
     let points: Vec<[f64; 3]> = (0..n * n * n)
         .map(|i| {
             let idx = [i % n, (i / n) % n, i / (n * n)];
-            std::array::from_fn(|k| b.min[k] + (b.max[k] - b.min[k]) * (idx[k] as f64 + 0.5) / n as f64)
+            std::array::from_fn(|k| {
+                b.min[k] + (b.max[k] - b.min[k]) * (idx[k] as f64 + 0.5) / n as f64
+            })
         })
         .collect();
     let step = (points.len() / args.direct_sample.max(1)).max(1);
@@ -97,31 +116,51 @@ fn bench_mesh(mesh: &Mesh, args: &Args) -> Result<Option<String>, CliError> {
     let t0 = Instant::now();
     let wn = WindingNumber::new(mesh).map_err(|e| CliError(e.to_string()))?;
     let pre = t0.elapsed().as_secs_f64() * 1e3;
+    let t0 = Instant::now();
+    let fast = FastWindingNumber::with_params(mesh, FastParams::barill(args.beta, args.order));
+    let build = t0.elapsed().as_secs_f64() * 1e3;
     let mut row = format!(
-        "{} | {} | {pre:.1}",
+        "{} | {} | {pre:.1} | {build:.1}",
         mesh.triangles().len(),
         wn.boundary_edge_count()
     );
     let mut ratio = 0.0;
+    let mut fast_ratio = 0.0;
+    let mut max_err = 0.0_f64;
     for &t in &args.threads_list {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(t)
             .build()
             .map_err(|e| CliError(e.to_string()))?;
-        let (exact_qps, direct_qps) = pool.install(|| {
+        let (exact_qps, direct_qps, fast_qps) = pool.install(|| {
             let t0 = Instant::now();
             let w = wn.eval_batch(&points);
             let exact = points.len() as f64 / t0.elapsed().as_secs_f64();
             std::hint::black_box(w);
             let t0 = Instant::now();
-            let d: Vec<f64> = sample.par_iter().map(|&q| winding_number_direct(mesh, q)).collect();
+            let d: Vec<f64> = sample
+                .par_iter()
+                .map(|&q| winding_number_direct(mesh, q))
+                .collect();
             let direct = sample.len() as f64 / t0.elapsed().as_secs_f64();
-            std::hint::black_box(d);
-            (exact, direct)
+            let t0 = Instant::now();
+            let w = fast.eval_batch(&points);
+            let fast_qps = points.len() as f64 / t0.elapsed().as_secs_f64();
+            // The fast values on the direct sample: the same grid points, same order. A NaN
+            // error is kept (f64::max would drop it).
+            for (&wf, &wd) in w.iter().step_by(step).zip(&d) {
+                let e = (wf - wd).abs();
+                if e > max_err || e.is_nan() {
+                    max_err = e;
+                }
+            }
+            std::hint::black_box(w);
+            (exact, direct, fast_qps)
         });
         ratio = exact_qps / direct_qps;
-        row += &format!(" | {exact_qps:.0} | {direct_qps:.0}");
+        fast_ratio = fast_qps / direct_qps;
+        row += &format!(" | {exact_qps:.0} | {direct_qps:.0} | {fast_qps:.0}");
     }
-    row += &format!(" | {ratio:.1}×");
+    row += &format!(" | {ratio:.1}× | {fast_ratio:.1}× | {max_err:.1e}");
     Ok(Some(row))
 }

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use clap::{Args as ClapArgs, ValueEnum};
 use gwn::eval::antipodal::{Options, WindingNumber};
 use gwn::eval::direct::{winding_number_direct, winding_number_gradient_direct};
+use gwn::eval::fast::{FastParams, FastWindingNumber, PointCloudWindingNumber};
 use gwn::kernel::frame::RayAxis;
 use gwn::kernel::quantize::Precision;
 use rayon::prelude::*;
@@ -18,6 +19,8 @@ pub enum Method {
     Exact,
     /// Direct solid-angle sum over all faces (O(faces) per query; the reference).
     Direct,
+    /// Barnes-Hut approximation (orders 0-2, accuracy --beta); the method for point clouds.
+    Fast,
 }
 
 /// Ray direction of the exact method.
@@ -56,7 +59,10 @@ impl From<Ray> for RayAxis {
     }
 }
 
-/// Evaluate the winding number of MESH at query points.
+/// Evaluate the winding number of MESH (or of an oriented point cloud) at query points.
+///
+/// A point cloud (.xyz/.csv/.txt/.pts with `x y z nx ny nz [area]`, or a PLY with normals and no
+/// faces) is evaluated with the fast dipole sum; areas are estimated when absent.
 ///
 /// Points come from a text file (one `x y z` or `x,y,z` per line; `#` comments and a header line
 /// are skipped) or a `.npy` float64/float32 array of shape (N, 3). Values go to stdout (one per
@@ -66,10 +72,12 @@ impl From<Ray> for RayAxis {
 ///   gwn eval mesh.obj --points queries.csv
 ///   gwn eval mesh.stl --points q.npy --out w.npy --method direct
 ///   gwn eval mesh.off --points q.txt --gradient --gradient-out g.npy
+///   gwn eval soup.stl --points q.csv --method fast --beta 2 --order 2
+///   gwn eval cloud.xyz --points q.csv
 #[derive(ClapArgs, Debug)]
 #[command(verbatim_doc_comment)]
 pub struct Args {
-    /// Mesh file (.obj, .stl, .off, .ply).
+    /// Mesh file (.obj, .stl, .off, .ply) or oriented point cloud (.xyz, .csv, .pts, .ply).
     pub mesh: PathBuf,
     /// Query points file (.csv/.txt/.xyz text or .npy).
     #[arg(long)]
@@ -84,7 +92,14 @@ pub struct Args {
     /// surface the value is taken at the point perturbed along this ray's frame).
     #[arg(long, value_enum, default_value_t = Ray::PosZ, allow_hyphen_values = true)]
     pub ray: Ray,
-    /// Also compute the gradient ∇w.
+    /// Accuracy of the fast method: a tree node is approximated when its distance exceeds
+    /// beta times its radius (Barill et al. 2018); larger is more accurate.
+    #[arg(long, default_value_t = 2.0)]
+    pub beta: f64,
+    /// Expansion order of the fast method (0, 1 or 2).
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(0..=2))]
+    pub order: u8,
+    /// Also compute the gradient ∇w (exact and direct methods).
     #[arg(long)]
     pub gradient: bool,
     /// Output file for values (.csv or .npy); stdout when absent.
@@ -109,15 +124,33 @@ fn parse_precision(s: &str) -> Result<u32, String> {
 
 /// Runs `gwn eval`.
 pub fn run(args: Args) -> Result<(), CliError> {
+    if is_point_cloud(&args.mesh) {
+        return run_cloud(&args);
+    }
     let mesh = load_mesh_for_cli(&args.mesh, args.no_weld)?;
     let points = gwn::io::points::load_points(&args.points)?;
+    if args.gradient && args.method == Method::Fast {
+        return Err(CliError::msg(
+            "--gradient is available with --method exact or direct, not fast",
+        ));
+    }
     let pb = progress(points.len() as u64, "evaluating");
     let chunk = 4096;
     let (values, grads): (Vec<f64>, Option<Vec<[f64; 3]>>) = match args.method {
         Method::Exact => {
-            let precision = if args.precision == 30 { Precision::Bits30 } else { Precision::Bits60 };
-            let wn = WindingNumber::with_options(&mesh, Options { precision, ray: args.ray.into() })
-                .map_err(|e| CliError(format!("{}: {e}", args.mesh.display())))?;
+            let precision = if args.precision == 30 {
+                Precision::Bits30
+            } else {
+                Precision::Bits60
+            };
+            let wn = WindingNumber::with_options(
+                &mesh,
+                Options {
+                    precision,
+                    ray: args.ray.into(),
+                },
+            )
+            .map_err(|e| CliError(format!("{}: {e}", args.mesh.display())))?;
             let mut values = Vec::with_capacity(points.len());
             for c in points.chunks(chunk) {
                 values.extend(wn.eval_batch(c));
@@ -133,18 +166,66 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 pb.inc(c.len() as u64);
             }
             let grads = args.gradient.then(|| {
-                points.par_iter().map(|&q| winding_number_gradient_direct(&mesh, q)).collect()
+                points
+                    .par_iter()
+                    .map(|&q| winding_number_gradient_direct(&mesh, q))
+                    .collect()
             });
             (values, grads)
+        }
+        Method::Fast => {
+            let params = FastParams::barill(args.beta, args.order);
+            let f = FastWindingNumber::with_params(&mesh, params);
+            let mut values = Vec::with_capacity(points.len());
+            for c in points.chunks(chunk) {
+                values.extend(f.eval_batch(c));
+                pb.inc(c.len() as u64);
+            }
+            (values, None)
         }
     };
     pb.finish_and_clear();
     write_outputs(&args, &values, grads.as_deref())
 }
 
+/// Text point formats are clouds; a PLY is a cloud when it has no faces.
+fn is_point_cloud(path: &std::path::Path) -> bool {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase())
+        .unwrap_or_default();
+    match ext.as_str() {
+        "xyz" | "csv" | "txt" | "pts" => true,
+        "ply" => matches!(
+            gwn::io::load_mesh(path),
+            Err(gwn::error::LoadError {
+                kind: gwn::error::LoadErrorKind::Empty,
+                ..
+            })
+        ),
+        _ => false,
+    }
+}
+
+fn run_cloud(args: &Args) -> Result<(), CliError> {
+    if args.method == Method::Exact && args.gradient {
+        return Err(CliError::msg(
+            "--gradient is not available for point clouds",
+        ));
+    }
+    let cloud = gwn::io::cloud::load_point_cloud(&args.mesh)?;
+    let points = gwn::io::points::load_points(&args.points)?;
+    let params = FastParams::barill(args.beta, args.order);
+    let wn = PointCloudWindingNumber::with_params(&cloud, params);
+    let values = wn.eval_batch(&points);
+    write_outputs(args, &values, None)
+}
+
 fn write_outputs(args: &Args, values: &[f64], grads: Option<&[[f64; 3]]>) -> Result<(), CliError> {
     use std::io::Write;
-    let save_err = |p: &PathBuf, e: std::io::Error| CliError(format!("{}: cannot write: {e}", p.display()));
+    let save_err =
+        |p: &PathBuf, e: std::io::Error| CliError(format!("{}: cannot write: {e}", p.display()));
     if let Some(p) = &args.out {
         gwn::io::points::save_values(p, values).map_err(|e| save_err(p, e))?;
     }

@@ -3,7 +3,17 @@
 
 use clap::{Parser, Subcommand};
 
+mod bench;
+mod classify;
 mod common;
+mod curve;
+mod eval;
+mod filter_tets;
+mod r#gen;
+mod info;
+mod sdf;
+mod slice;
+mod voxelize;
 
 /// Robust generalized winding numbers for open, dirty triangle meshes.
 ///
@@ -24,6 +34,26 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     // SUBCOMMANDS: one variant per file in src/bin/gwn/ (keep alphabetical).
+    /// Benchmark exact vs direct on meshes (queries/s on a 32³ grid, 1 and 2 threads).
+    Bench(bench::Args),
+    /// Classify the faces of mesh A by the winding number of mesh B (for booleans).
+    Classify(classify::Args),
+    /// 2D polygons: GauWN field pictures, untangling and offsetting (`gwn curve --help`).
+    Curve(curve::Args),
+    /// Evaluate w (and optionally ∇w) at query points.
+    Eval(eval::Args),
+    /// Keep the tetrahedra of a tet mesh whose centroid has w above a threshold.
+    FilterTets(filter_tets::Args),
+    /// Write a corpus of degenerate test meshes with certified winding numbers (`gwn gen --help`).
+    Gen(r#gen::Args),
+    /// Print format, size and topology of a mesh (boundary, non-manifold edges, components…).
+    Info(info::Args),
+    /// Signed distance on a voxel grid, signed by the winding number (inside where w > 1/2).
+    Sdf(sdf::Args),
+    /// Write a PNG slice of the winding-number field (the default job when no subcommand is given).
+    Slice(slice::Args),
+    /// Evaluate w on a voxel grid (ray reuse) and write .npy / occupancy / .vti.
+    Voxelize(voxelize::Args),
 }
 
 fn main() {
@@ -37,11 +67,19 @@ fn main() {
             std::process::exit(2);
         }
     }
-    let result = match cli.command {
+    let result: Result<(), common::CliError> = match cli.command {
         // DISPATCH: one arm per variant.
-        None => Err(common::CliError::msg(
-            "no subcommand given; see `gwn --help`",
-        )),
+        Some(Command::Bench(a)) => bench::run(a),
+        Some(Command::Classify(a)) => classify::run(a),
+        Some(Command::Curve(a)) => curve::run(a),
+        Some(Command::Eval(a)) => eval::run(a),
+        Some(Command::FilterTets(a)) => filter_tets::run(a),
+        Some(Command::Gen(a)) => r#gen::run(a),
+        Some(Command::Info(a)) => info::run(a),
+        Some(Command::Sdf(a)) => sdf::run(a),
+        Some(Command::Slice(a)) => slice::run(a),
+        Some(Command::Voxelize(a)) => voxelize::run(a),
+        None => slice::run_default(),
     };
     if let Err(e) = result {
         eprintln!("gwn: {e}");

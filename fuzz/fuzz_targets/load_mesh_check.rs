@@ -1,0 +1,38 @@
+// Shared by the fuzz target and by `tests/fuzz_corpus_loaders.rs` (via `include!`), so the
+// stable test replays the corpus through exactly the code the fuzzer runs.
+
+/// Feeds `data` to a loader: the first byte selects the format (OBJ, STL, OFF, PLY, detect by
+/// content, or query points), the rest is the file. Must never panic; a successful load must
+/// give a valid, non-empty mesh whose statistics compute.
+pub fn check_load_mesh(data: &[u8]) {
+    use gwn::io::{Format, LoadOptions, load_mesh_from_bytes_with, load_points_from_bytes};
+    let Some((&selector, body)) = data.split_first() else {
+        return;
+    };
+    let hint = match selector % 6 {
+        0 => Some(Format::Obj),
+        1 => Some(Format::Stl),
+        2 => Some(Format::Off),
+        3 => Some(Format::Ply),
+        4 => None,
+        _ => {
+            if let Ok(p) = load_points_from_bytes(body, "fuzz.txt") {
+                assert!(!p.is_empty());
+                assert!(p.iter().flatten().all(|c| c.is_finite()));
+            }
+            return;
+        }
+    };
+    let weld = Some(selector & 0x80 != 0);
+    match load_mesh_from_bytes_with(body, "fuzz", hint, &LoadOptions { weld }) {
+        Ok(l) => {
+            assert!(!l.mesh.triangles().is_empty());
+            let s = gwn::mesh::stats::MeshStats::compute(&l.mesh);
+            assert_eq!(s.faces, l.mesh.triangles().len());
+        }
+        Err(e) => {
+            let msg = e.to_string();
+            assert!(msg.starts_with("fuzz"));
+        }
+    }
+}

@@ -1,0 +1,51 @@
+//! `gwn filter-tets`: keep the tets of a tet mesh whose centroid is inside a surface.
+
+use std::path::PathBuf;
+
+use clap::Args as ClapArgs;
+use gwn::eval::antipodal::WindingNumber;
+use gwn::products::tets::{DEFAULT_THRESHOLD, filter_tets, load_tets, save_tets};
+
+use crate::common::{CliError, load_mesh_for_cli};
+
+/// Keep the tets of TETS whose centroid has w(MESH) > threshold, and write them to OUT.
+///
+/// TETS and OUT are MEDIT `.mesh` or TetGen `.node`/`.ele` (either file of the pair names it).
+/// Unreferenced points are dropped from the output.
+#[derive(ClapArgs, Debug)]
+pub struct Args {
+    /// Surface mesh (OBJ, STL, OFF, PLY).
+    pub mesh: PathBuf,
+    /// Tet mesh (.mesh, .node or .ele).
+    pub tets: PathBuf,
+    /// Output tet mesh (.mesh, .node or .ele).
+    #[arg(long, short)]
+    pub out: PathBuf,
+    /// Keep tets with w at the centroid above this value.
+    #[arg(long, default_value_t = DEFAULT_THRESHOLD, allow_negative_numbers = true)]
+    pub threshold: f64,
+    /// Do not weld STL vertices.
+    #[arg(long)]
+    pub no_weld: bool,
+}
+
+/// Runs `gwn filter-tets`.
+pub fn run(args: Args) -> Result<(), CliError> {
+    let mesh = load_mesh_for_cli(&args.mesh, args.no_weld)?;
+    let tets = load_tets(&args.tets)?;
+    let wn = WindingNumber::new(&mesh)?;
+    let keep = filter_tets(&tets.points, &tets.tets, &wn, args.threshold);
+    let kept = tets.select(&keep);
+    let written = save_tets(&args.out, &kept)
+        .map_err(|e| CliError::msg(format!("{}: {e}", args.out.display())))?;
+    println!(
+        "kept {} of {} tets (w > {} at the centroid)",
+        kept.tets.len(),
+        tets.tets.len(),
+        args.threshold
+    );
+    for p in written {
+        println!("wrote {}", p.display());
+    }
+    Ok(())
+}

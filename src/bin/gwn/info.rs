@@ -1,0 +1,87 @@
+//! `gwn info MESH`: format, size and topology of a mesh file.
+
+use std::path::PathBuf;
+
+use gwn::io::{LoadOptions, load_mesh_with};
+use gwn::mesh::stats::MeshStats;
+
+use crate::common::CliError;
+
+/// Arguments of `gwn info`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Mesh file (.obj, .stl, .off, .ply; detected by content if the extension is unknown).
+    pub mesh: PathBuf,
+    /// Do not merge bit-identical vertices (default: merge for STL only).
+    #[arg(long, conflicts_with = "weld")]
+    pub no_weld: bool,
+    /// Merge bit-identical vertices for every format.
+    #[arg(long)]
+    pub weld: bool,
+}
+
+/// Loads the mesh and prints its statistics.
+pub fn run(args: Args) -> Result<(), CliError> {
+    let weld = match (args.weld, args.no_weld) {
+        (true, _) => Some(true),
+        (_, true) => Some(false),
+        _ => None,
+    };
+    let loaded = load_mesh_with(&args.mesh, &LoadOptions { weld })?;
+    let s = MeshStats::compute(&loaded.mesh);
+    print!("{}", report(&args.mesh, &loaded, &s));
+    Ok(())
+}
+
+fn yes(b: bool) -> &'static str {
+    if b { "yes" } else { "no" }
+}
+
+/// The aligned text block `gwn info` prints.
+fn report(path: &std::path::Path, l: &gwn::io::LoadedMesh, s: &MeshStats) -> String {
+    let mut rows: Vec<(&str, String)> = vec![
+        ("file", path.display().to_string()),
+        ("format", l.format.to_string()),
+        ("triangles", s.faces.to_string()),
+        ("vertices", s.vertices.to_string()),
+    ];
+    if l.welded_vertices > 0 || l.format == gwn::io::Format::Stl {
+        rows.push(("welded vertices", l.welded_vertices.to_string()));
+    }
+    if l.polygons_triangulated > 0 {
+        rows.push(("polygons fanned", l.polygons_triangulated.to_string()));
+    }
+    rows.extend([
+        ("unreferenced vertices", s.unreferenced_vertices.to_string()),
+        ("components", s.components.to_string()),
+        ("boundary edges", s.boundary_edges.to_string()),
+        ("non-manifold edges", s.nonmanifold_edges.to_string()),
+        (
+            "signed boundary edges",
+            format!(
+                "{} ({} with weight > 1)",
+                s.signed_boundary_edges, s.signed_boundary_heavy_edges
+            ),
+        ),
+        ("degenerate faces", s.degenerate_faces.to_string()),
+        ("duplicate faces", s.duplicate_faces.to_string()),
+        ("closed", yes(s.closed).to_string()),
+        ("oriented closed", yes(s.oriented_closed).to_string()),
+    ]);
+    if let Some(b) = s.bounding_box {
+        rows.push(("bbox min", format!("{:?}", b.min)));
+        rows.push(("bbox max", format!("{:?}", b.max)));
+        rows.push(("diagonal", format!("{}", s.diagonal)));
+    }
+    let width = rows.iter().map(|(k, _)| k.len()).max().unwrap_or(0);
+    let mut out = String::new();
+    for (k, v) in rows {
+        out.push_str(&format!("{k:<width$}  {v}\n"));
+    }
+    if s.oriented_closed {
+        out.push_str("signed boundary is empty: w is an integer off the surface\n");
+    } else {
+        out.push_str("signed boundary is not empty: w varies continuously near the boundary\n");
+    }
+    out
+}

@@ -1,0 +1,70 @@
+//! Fast approximate winding numbers: the Barnes–Hut method of Barill, Dickson, Schmidt, Levin &
+//! Jacobson, *Fast Winding Numbers for Soups and Clouds* (SIGGRAPH 2018), for triangle soups and
+//! oriented point clouds, and the FOSSIL-style `winding_number(point, beta)` API.
+//!
+//! # Method
+//!
+//! A binary median-split AABB tree ([`FastWindingNumber`], [`PointCloudWindingNumber`]) stores
+//! per node the area-weighted centre `p̃`, the radius `r` (largest distance from `p̃` to any
+//! triangle corner or point below the node) and the [`Moments`] of order 0, 1 and 2 (exact
+//! closed forms for triangles: centroid rule and edge-midpoint rule), built bottom-up by
+//! re-centring the children's moments (parallel-axis shifts). `FASTWN(q)` (Algorithm 1) uses a
+//! node's expansion when `‖q − p̃‖ > β r`, sums exact Van Oosterom–Strackee solid angles (or exact
+//! dipoles, for points) over a near leaf, and otherwise opens the node. Per query the cost is
+//! `O(log F)` with an error controlled by `β` and the order: each far node's relative error is
+//! about `β^-(order+1)`.
+//!
+//! Defaults: β = 2, order 2 for triangles (RMS error 4e-4 – 1e-3 on the shared meshes); β = 2.3,
+//! order 2 for points.
+//!
+//! # Choosing β: FOSSIL vs Barill
+//!
+//! FOSSIL admits a node when `‖q − c‖ > β_F · D`, `D` the diagonal of the node's bounding box, and
+//! then uses a first-order dipole (`N · ∇G`, Barill's order 0). Barill admits it when
+//! `‖q − p̃‖ > β_B · r`. Both `p̃` and the element points lie in the box, so `r ≤ D`; and two element
+//! points sit on opposite faces of the box along its longest side (≥ `D/√3`), so by the triangle
+//! inequality `2r ≥ D/√3`. Hence
+//!
+//! ```text
+//! FOSSIL(β_F)  ≡  Barill(β_B = β_F · D/r),   1 ≤ D/r ≤ 2√3,
+//! ```
+//!
+//! node by node: the FOSSIL test is Barill's test with a per-node β between `β_F` and `3.46 β_F`.
+//! For a flat square patch centred on `p̃`, `D/r = 2`; for a ball-like cluster `D/r = 2√3`. On the
+//! trees built here for real meshes `D/r` ranges over about 1.2–2.7 with a median of 1.7–2.1 (see
+//! `docs/fast.md`), so FOSSIL's default `β_F = 2` recurses about as far as Barill `β_B ≈ 4`, but
+//! then uses order 0, whose error falls only like `β^-1`: measured RMS 1e-3 – 4e-3, where
+//! Barill's order 2 at `β_B = 2` reaches ≤ 1e-3 about 2.5–3× faster (it opens far fewer nodes).
+//! [`WindingNumberApi::winding_number`] interprets `beta` as Barill's `β_B` (order 2); [`FastParams::fossil`] reproduces FOSSIL's rule
+//! (with the far field's sign right: FOSSIL's published dipole takes `c − q` with the wrong sign;
+//! ours is tested against the direct sum).
+//!
+//! Note on the paper's Appendix A: `∇³G` is printed without the factor 3 on its first term;
+//! the code uses the harmonic (trace-free) form, see [`Moments`].
+//!
+//! # Exact vs fast
+//!
+//! | input | use |
+//! |---|---|
+//! | closed or nearly closed meshes (boundary edges ≪ faces) | exact (`eval::antipodal`) |
+//! | triangle soups, scans with many holes (boundary ≈ faces) | fast, β = 2, order 2 |
+//! | oriented point clouds | fast ([`PointCloudWindingNumber`]), β = 2.3, order 2 |
+//! | ground truth for tests | `eval::direct` |
+
+mod api;
+mod area;
+mod barnes_hut;
+mod cloud;
+mod moments;
+mod soup;
+mod tree;
+
+pub use api::WindingNumberApi;
+pub use area::estimate_areas;
+pub use barnes_hut::{Admissibility, FastParams};
+pub use cloud::{
+    DEFAULT_AREA_NEIGHBOURS, POINT_LEAF_SIZE, PointCloud, PointCloudError, PointCloudWindingNumber,
+    winding_number_points_direct,
+};
+pub use moments::{Moments, SYM_PAIRS};
+pub use soup::{FastWindingNumber, TRIANGLE_LEAF_SIZE};

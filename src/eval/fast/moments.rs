@@ -1,0 +1,351 @@
+//! Far-field (multipole) expansions of clusters of dipoles: Barill et al. 2018, Eqs. 13–21, with
+//! the closed-form triangle integrals of their Appendix B and the Green's-function derivatives of
+//! Appendix A.
+//!
+//! With `G(q, x) = −1/(4π‖x − q‖)` and `r = p̃ − q`, the winding number of a cluster expanded about
+//! its centre `p̃` is
+//!
+//! ```text
+//! w̃(q) = N·∇G + M1 : ∇²G + ½ M2 ⋮ ∇³G
+//! ∇G   = r / (4π d³)
+//! ∇²G  = I / (4π d³) − 3 r⊗r / (4π d⁵)
+//! ∇³G  = −3 (r⊗eᵢ⊗eᵢ + eᵢ⊗r⊗eᵢ + eᵢ⊗eᵢ⊗r) / (4π d⁵) + 15 r⊗r⊗r / (4π d⁷)
+//! ```
+//!
+//! where `N = ∫ n dA`, `M1 = ∫ (x − p̃)⊗n dA`, `M2 = ∫ (x − p̃)⊗(x − p̃)⊗n dA`.
+//!
+//! Note on Appendix A: the paper prints the first term of `∇³G` without the factor 3. Without it
+//! `∇³G` is not trace-free (`G` is harmonic, so every contraction of two indices of `∇³G` must
+//! vanish); with it, the trace is `(−3·5 + 15)·r_k/d⁵ = 0`. The unit tests check the factor
+//! numerically (the order-2 error must fall like `(r/d)⁵`).
+
+// The tensor code indexes like the formulas it transcribes (`M1[i][j] += δᵢ Nⱼ`).
+#![allow(clippy::needless_range_loop)]
+
+use crate::kernel::spherical::{cross, dot};
+
+const INV_4PI: f64 = 1.0 / (4.0 * std::f64::consts::PI);
+
+/// Index pairs `(i, j)` of the six independent entries of a symmetric 3×3 matrix, in the order
+/// `M2` stores them: the diagonal first, then `xy, xz, yz`.
+pub const SYM_PAIRS: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)];
+
+/// The expansion coefficients of a cluster of oriented surface elements about a centre.
+///
+/// For a cluster of triangles the integrals are exact (Appendix B of Barill et al.); for a point
+/// cloud each point `pᵢ` with area `aᵢ` and unit normal `n̂ᵢ` contributes the point mass
+/// `aᵢ n̂ᵢ` at `pᵢ`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Moments {
+    /// Expansion centre `p̃`: the area-weighted centroid of the cluster (the centre of its
+    /// bounding box when the total area is zero).
+    pub center: [f64; 3],
+    /// Largest distance from `center` to any point of any element of the cluster (triangle
+    /// corners, or the points of a cloud).
+    pub radius: f64,
+    /// Total (unsigned) area `Σ aₜ`.
+    pub area: f64,
+    /// Order 0: `N = ∫ n dA`, the total area-weighted normal.
+    pub n: [f64; 3],
+    /// Order 1: `M1[i][j] = ∫ (x − p̃)ᵢ nⱼ dA`.
+    pub m1: [[f64; 3]; 3],
+    /// Order 2: `M2[s][k] = ∫ (x − p̃)ᵢ (x − p̃)ⱼ n_k dA` with `(i, j) = SYM_PAIRS[s]`
+    /// (symmetric in `i, j`, so six of the nine rows are stored).
+    pub m2: [[f64; 3]; 6],
+}
+
+impl Moments {
+    /// The exact moments of the triangle `a, b, c` (counter-clockwise about its normal) about
+    /// `center`. The radius is left 0 (it belongs to a cluster, not to a moment).
+    ///
+    /// Order 0 and 1 use the one-point (centroid) rule and order 2 the edge-midpoint rule, both
+    /// exact for the constant, linear and quadratic integrands.
+    pub fn of_triangle(a: [f64; 3], b: [f64; 3], c: [f64; 3], center: [f64; 3]) -> Self {
+        let ab = sub(b, a);
+        let ac = sub(c, a);
+        let n = cross(ab, ac).map(|v| 0.5 * v);
+        let area = dot(n, n).sqrt();
+        let g = [
+            (a[0] + b[0] + c[0]) / 3.0 - center[0],
+            (a[1] + b[1] + c[1]) / 3.0 - center[1],
+            (a[2] + b[2] + c[2]) / 3.0 - center[2],
+        ];
+        let mut m1 = [[0.0; 3]; 3];
+        for i in 0..3 {
+            for j in 0..3 {
+                m1[i][j] = g[i] * n[j];
+            }
+        }
+        let mids = [mid(a, b, center), mid(b, c, center), mid(c, a, center)];
+        let mut m2 = [[0.0; 3]; 6];
+        for (s, &(i, j)) in SYM_PAIRS.iter().enumerate() {
+            let cij =
+                (mids[0][i] * mids[0][j] + mids[1][i] * mids[1][j] + mids[2][i] * mids[2][j]) / 3.0;
+            for k in 0..3 {
+                m2[s][k] = cij * n[k];
+            }
+        }
+        Moments {
+            center,
+            radius: 0.0,
+            area,
+            n,
+            m1,
+            m2,
+        }
+    }
+
+    /// The moments of one oriented point `p` carrying the area-weighted normal `an = a·n̂` (its
+    /// area is `|an|`) about `center`.
+    pub fn of_point(p: [f64; 3], an: [f64; 3], center: [f64; 3]) -> Self {
+        let d = sub(p, center);
+        let mut m1 = [[0.0; 3]; 3];
+        for i in 0..3 {
+            for j in 0..3 {
+                m1[i][j] = d[i] * an[j];
+            }
+        }
+        let mut m2 = [[0.0; 3]; 6];
+        for (s, &(i, j)) in SYM_PAIRS.iter().enumerate() {
+            for k in 0..3 {
+                m2[s][k] = d[i] * d[j] * an[k];
+            }
+        }
+        Moments {
+            center,
+            radius: 0.0,
+            area: dot(an, an).sqrt(),
+            n: an,
+            m1,
+            m2,
+        }
+    }
+
+    /// The same moments expanded about `new_center` (parallel-axis shift; exact). With
+    /// `δ = center − new_center`:
+    /// `M1' = M1 + δ⊗N`, `M2'ᵢⱼₖ = M2ᵢⱼₖ + δᵢ M1ⱼₖ + δⱼ M1ᵢₖ + δᵢδⱼ Nₖ`.
+    /// The radius is kept (it is not a moment; callers recompute it).
+    pub fn recentred(&self, new_center: [f64; 3]) -> Self {
+        let d = sub(self.center, new_center);
+        let mut m1 = self.m1;
+        for i in 0..3 {
+            for j in 0..3 {
+                m1[i][j] += d[i] * self.n[j];
+            }
+        }
+        let mut m2 = self.m2;
+        for (s, &(i, j)) in SYM_PAIRS.iter().enumerate() {
+            for k in 0..3 {
+                m2[s][k] += d[i] * self.m1[j][k] + d[j] * self.m1[i][k] + d[i] * d[j] * self.n[k];
+            }
+        }
+        Moments {
+            center: new_center,
+            radius: self.radius,
+            area: self.area,
+            n: self.n,
+            m1,
+            m2,
+        }
+    }
+
+    /// Adds the coefficients of `other`, which must be expanded about the same centre.
+    pub fn accumulate(&mut self, other: &Moments) {
+        debug_assert_eq!(self.center, other.center);
+        self.area += other.area;
+        for k in 0..3 {
+            self.n[k] += other.n[k];
+        }
+        for i in 0..3 {
+            for j in 0..3 {
+                self.m1[i][j] += other.m1[i][j];
+            }
+        }
+        for s in 0..6 {
+            for k in 0..3 {
+                self.m2[s][k] += other.m2[s][k];
+            }
+        }
+    }
+
+    /// The far-field approximation of the winding number at `q` with the expansion truncated
+    /// after `order` (0: dipole, 1: + quadrupole, 2: + octupole; larger values act as 2).
+    #[inline]
+    pub fn far_field(&self, q: [f64; 3], order: u8) -> f64 {
+        let r = sub(self.center, q);
+        let d2 = dot(r, r);
+        let inv_d2 = 1.0 / d2;
+        let inv_d = inv_d2.sqrt();
+        let inv_d3 = inv_d * inv_d2;
+        let mut w = dot(self.n, r) * inv_d3;
+        if order >= 1 {
+            let m = &self.m1;
+            let tr = m[0][0] + m[1][1] + m[2][2];
+            let mut rmr = 0.0;
+            for i in 0..3 {
+                rmr += r[i] * (m[i][0] * r[0] + m[i][1] * r[1] + m[i][2] * r[2]);
+            }
+            let inv_d5 = inv_d3 * inv_d2;
+            w += tr * inv_d3 - 3.0 * rmr * inv_d5;
+            if order >= 2 {
+                let m2 = &self.m2;
+                // A = Σ_k (Σ_i M2_iik) r_k
+                let mut a = 0.0;
+                for k in 0..3 {
+                    a += (m2[0][k] + m2[1][k] + m2[2][k]) * r[k];
+                }
+                // B = Σ_ij M2_iji r_j (equal to Σ_ij M2_ijj r_i by symmetry in i, j)
+                let mut b = m2[0][0] * r[0] + m2[1][1] * r[1] + m2[2][2] * r[2];
+                for (s, &(i, j)) in SYM_PAIRS.iter().enumerate().skip(3) {
+                    b += m2[s][i] * r[j] + m2[s][j] * r[i];
+                }
+                // D = Σ_ijk M2_ijk r_i r_j r_k
+                let mut dd = 0.0;
+                for (s, &(i, j)) in SYM_PAIRS.iter().enumerate() {
+                    let mult = if i == j { 1.0 } else { 2.0 };
+                    dd +=
+                        mult * r[i] * r[j] * (m2[s][0] * r[0] + m2[s][1] * r[1] + m2[s][2] * r[2]);
+                }
+                let inv_d7 = inv_d5 * inv_d2;
+                w += 0.5 * (-3.0 * (a + 2.0 * b) * inv_d5 + 15.0 * dd * inv_d7);
+            }
+        }
+        w * INV_4PI
+    }
+}
+
+#[inline]
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+#[inline]
+fn mid(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> [f64; 3] {
+    [
+        0.5 * (a[0] + b[0]) - c[0],
+        0.5 * (a[1] + b[1]) - c[1],
+        0.5 * (a[2] + b[2]) - c[2],
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kernel::spherical::triangle_solid_angle;
+
+    /// Tensor-product Gauss–Legendre (3 points per direction) on the square mapped to the
+    /// triangle by `x = a + u(b − a) + v(1 − u)(c − a)`: exact for polynomials of degree ≤ 5 in
+    /// each of `u, v`, an independent check of the centroid and edge-midpoint rules.
+    fn quadrature(a: [f64; 3], b: [f64; 3], c: [f64; 3], f: impl Fn([f64; 3]) -> f64) -> f64 {
+        let s = (0.6_f64).sqrt();
+        let nodes = [0.5 * (1.0 - s), 0.5, 0.5 * (1.0 + s)];
+        let weights = [5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0];
+        let ab = sub(b, a);
+        let ac = sub(c, a);
+        let n = cross(ab, ac);
+        let jac = dot(n, n).sqrt(); // |∂x/∂u × ∂x/∂v| = (1 − u)·|ab × ac|
+        let mut total = 0.0;
+        for (iu, &u) in nodes.iter().enumerate() {
+            for (iv, &v) in nodes.iter().enumerate() {
+                let x = [0, 1, 2].map(|k| a[k] + u * ab[k] + v * (1.0 - u) * ac[k]);
+                total += weights[iu] * weights[iv] * (1.0 - u) * jac * f(x);
+            }
+        }
+        total
+    }
+
+    const A: [f64; 3] = [0.3, -0.2, 0.1];
+    const B: [f64; 3] = [1.4, 0.35, -0.5];
+    const C: [f64; 3] = [0.1, 0.9, 0.7];
+    const P: [f64; 3] = [0.4, 0.1, -0.3];
+
+    #[test]
+    fn triangle_moments_match_quadrature() {
+        let m = Moments::of_triangle(A, B, C, P);
+        let nn = cross(sub(B, A), sub(C, A));
+        let unit = nn.map(|v| v / dot(nn, nn).sqrt());
+        let area = quadrature(A, B, C, |_| 1.0);
+        assert!((m.area - area).abs() < 1e-14);
+        for k in 0..3 {
+            let q = quadrature(A, B, C, |_| unit[k]);
+            assert!((m.n[k] - q).abs() < 1e-14, "N[{k}]");
+        }
+        for i in 0..3 {
+            for j in 0..3 {
+                let q = quadrature(A, B, C, |x| (x[i] - P[i]) * unit[j]);
+                assert!((m.m1[i][j] - q).abs() < 1e-14, "M1[{i}][{j}] {q}");
+            }
+        }
+        for (s, &(i, j)) in SYM_PAIRS.iter().enumerate() {
+            for k in 0..3 {
+                let q = quadrature(A, B, C, |x| (x[i] - P[i]) * (x[j] - P[j]) * unit[k]);
+                assert!((m.m2[s][k] - q).abs() < 1e-14, "M2[{i}{j}][{k}] {q}");
+            }
+        }
+    }
+
+    #[test]
+    fn recentring_equals_direct_expansion() {
+        let other = [2.0, -1.0, 0.5];
+        let shifted = Moments::of_triangle(A, B, C, P).recentred(other);
+        let direct = Moments::of_triangle(A, B, C, other);
+        for i in 0..3 {
+            for j in 0..3 {
+                assert!((shifted.m1[i][j] - direct.m1[i][j]).abs() < 1e-13);
+            }
+        }
+        for s in 0..6 {
+            for k in 0..3 {
+                assert!((shifted.m2[s][k] - direct.m2[s][k]).abs() < 1e-13);
+            }
+        }
+    }
+
+    /// The error of the order-p expansion of one triangle decays like `d^-(p+3)`: doubling the
+    /// distance divides it by about `2^(p+3)`. A wrong coefficient or sign in any order shows up
+    /// as the wrong rate (the error would be dominated by a lower-order term).
+    #[test]
+    fn expansion_error_decays_with_the_right_order() {
+        // Expanded about a point off the centroid, so that no order vanishes identically (about
+        // the centroid M1 = 0 and the order-0 error would already fall like d^-4).
+        let g = [0, 1, 2].map(|k| (A[k] + B[k] + C[k]) / 3.0 + 0.1);
+        let m = Moments::of_triangle(A, B, C, g);
+        let dir = [0.48, -0.6, 0.64];
+        let exact = |d: f64| {
+            let q = [0, 1, 2].map(|k| g[k] + d * dir[k]);
+            let r = [A, B, C].map(|v| sub(v, q));
+            (triangle_solid_angle(r[0], r[1], r[2]) * INV_4PI, q)
+        };
+        for order in 0..=2u8 {
+            let err = |d: f64| {
+                let (w, q) = exact(d);
+                (m.far_field(q, order) - w).abs()
+            };
+            let (e1, e2) = (err(32.0), err(64.0));
+            let rate = (e1 / e2).log2();
+            let expected = f64::from(order) + 3.0;
+            assert!(
+                (rate - expected).abs() < 0.3,
+                "order {order}: rate {rate}, expected {expected} ({e1:e} → {e2:e})"
+            );
+        }
+    }
+
+    #[test]
+    fn dipole_sign_points_outward() {
+        // A triangle in z = 0 with normal +z: seen from below (q.z < 0) it subtends a positive
+        // solid angle (w > 0), from above a negative one. FOSSIL's published far field has the
+        // sign of (c − q) flipped; ours must agree with the exact solid angle.
+        let (a, b, c) = ([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
+        let m = Moments::of_triangle(a, b, c, [1.0 / 3.0, 1.0 / 3.0, 0.0]);
+        for z in [-20.0, 20.0] {
+            let q = [0.2, 0.3, z];
+            let exact = triangle_solid_angle(sub(a, q), sub(b, q), sub(c, q)) * INV_4PI;
+            for order in 0..=2 {
+                let w = m.far_field(q, order);
+                assert_eq!(w.signum(), exact.signum());
+                assert!((w - exact).abs() < 1e-3 * exact.abs());
+            }
+        }
+    }
+}

@@ -1,0 +1,329 @@
+//! The fast winding number of a triangle mesh or soup (Barill et al. 2018, Section 3.3).
+
+use rayon::prelude::*;
+
+use super::barnes_hut::{FastParams, Hierarchy};
+use super::moments::Moments;
+use super::tree::Tree;
+use crate::kernel::spherical::triangle_solid_angle;
+use crate::{BoundingBox, Mesh};
+
+const INV_4PI: f64 = 1.0 / (4.0 * std::f64::consts::PI);
+
+/// Largest number of triangles in a leaf (summed exactly when the leaf is near the query).
+pub const TRIANGLE_LEAF_SIZE: usize = 8;
+
+/// Barnes–Hut evaluator of the generalized winding number of a triangle mesh (connectivity is
+/// ignored: soups, open and non-manifold meshes are all fine). Owns a copy of the triangles, so it
+/// does not borrow the mesh. `Send + Sync`; evaluation is read-only.
+///
+/// ```
+/// use gwn::{Mesh, eval::fast::{FastParams, FastWindingNumber}};
+/// let tet = Mesh::from_slices(
+///     &[[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]],
+///     &[[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]],
+/// )?;
+/// let fast = FastWindingNumber::new(&tet);
+/// assert!((fast.eval([0.1, 0.1, 0.1]) - 1.0).abs() < 1e-12); // near: exact solid angles
+/// let far = fast.eval_with([30.0, 0.0, 0.0], FastParams::barill(2.0, 2));
+/// assert!(far.abs() < 1e-6);
+/// # Ok::<(), gwn::error::MeshError>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct FastWindingNumber {
+    hierarchy: Hierarchy,
+    /// Triangle corners in leaf order.
+    triangles: Vec<[[f64; 3]; 3]>,
+    params: FastParams,
+}
+
+impl FastWindingNumber {
+    /// Builds the tree and the moments with the default parameters (β = 2, order 2).
+    pub fn new(mesh: &Mesh) -> Self {
+        Self::with_params(mesh, FastParams::default())
+    }
+
+    /// Builds the tree and the moments; `params` become the defaults of [`Self::eval`].
+    pub fn with_params(mesh: &Mesh, params: FastParams) -> Self {
+        let tris: Vec<[[f64; 3]; 3]> = (0..mesh.triangles().len())
+            .map(|f| mesh.triangle_positions(f))
+            .collect();
+        Self::from_triangles(tris, params)
+    }
+
+    /// Builds from triangle corner triples (a soup).
+    pub fn from_triangles(tris: Vec<[[f64; 3]; 3]>, params: FastParams) -> Self {
+        let centroids: Vec<[f64; 3]> = tris.iter().map(centroid).collect();
+        let boxes: Vec<([f64; 3], [f64; 3])> = tris
+            .iter()
+            .map(|t| {
+                (
+                    [0, 1, 2].map(|k| t[0][k].min(t[1][k]).min(t[2][k])),
+                    [0, 1, 2].map(|k| t[0][k].max(t[1][k]).max(t[2][k])),
+                )
+            })
+            .collect();
+        let tree = Tree::build(&centroids, &boxes, TRIANGLE_LEAF_SIZE);
+        let hierarchy = Hierarchy::build(
+            tree,
+            |e| {
+                let t = &tris[e];
+                let m = Moments::of_triangle(t[0], t[1], t[2], [0.0; 3]);
+                (m.area, centroids[e])
+            },
+            |e, c| {
+                let t = &tris[e];
+                Moments::of_triangle(t[0], t[1], t[2], c)
+            },
+            |e, c| tris[e].iter().map(|&v| dist2(v, c)).fold(0.0, f64::max),
+        );
+        let triangles = hierarchy
+            .tree
+            .order
+            .iter()
+            .map(|&e| tris[e as usize])
+            .collect();
+        FastWindingNumber {
+            hierarchy,
+            triangles,
+            params,
+        }
+    }
+
+    /// The parameters [`Self::eval`] uses.
+    pub fn params(&self) -> FastParams {
+        self.params
+    }
+
+    /// Changes the parameters [`Self::eval`] uses (no rebuild needed).
+    pub fn set_params(&mut self, params: FastParams) {
+        self.params = params;
+    }
+
+    /// The approximate winding number at `q` with the stored parameters.
+    pub fn eval(&self, q: [f64; 3]) -> f64 {
+        self.eval_with(q, self.params)
+    }
+
+    /// The approximate winding number at `q` with explicit parameters (Barill's form:
+    /// `FastParams::barill(beta, order)`).
+    pub fn eval_with(&self, q: [f64; 3], params: FastParams) -> f64 {
+        let tris = &self.triangles;
+        self.hierarchy.eval(q, &params, |range, sum| {
+            for t in &tris[range] {
+                let a = sub(t[0], q);
+                let b = sub(t[1], q);
+                let c = sub(t[2], q);
+                sum.add(triangle_solid_angle(a, b, c) * INV_4PI);
+            }
+        })
+    }
+
+    /// [`Self::eval`] for many points, in parallel (rayon).
+    pub fn eval_batch(&self, points: &[[f64; 3]]) -> Vec<f64> {
+        self.eval_batch_with(points, self.params)
+    }
+
+    /// [`Self::eval_with`] for many points, in parallel (rayon).
+    pub fn eval_batch_with(&self, points: &[[f64; 3]], params: FastParams) -> Vec<f64> {
+        points
+            .par_iter()
+            .map(|&q| self.eval_with(q, params))
+            .collect()
+    }
+
+    /// Number of triangles.
+    pub fn len(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// True when there are no triangles (every query evaluates to 0).
+    pub fn is_empty(&self) -> bool {
+        self.triangles.is_empty()
+    }
+
+    /// Number of tree nodes (node 0 is the root).
+    pub fn node_count(&self) -> usize {
+        self.hierarchy.tree.len()
+    }
+
+    /// The expansion of node `id` (centre, radius, order 0–2 coefficients).
+    pub fn node_moments(&self, id: usize) -> &Moments {
+        &self.hierarchy.moments[id]
+    }
+
+    /// The two children of node `id`, `None` for a leaf.
+    pub fn node_children(&self, id: usize) -> Option<[usize; 2]> {
+        let node = &self.hierarchy.tree.nodes[id];
+        (!node.is_leaf()).then(|| [node.left as usize, node.left as usize + 1])
+    }
+
+    /// Indices (into the input triangles) of the triangles below node `id`.
+    pub fn node_triangles(&self, id: usize) -> &[u32] {
+        &self.hierarchy.tree.order[self.hierarchy.tree.nodes[id].range()]
+    }
+
+    /// Bounding box of the triangles below node `id`.
+    pub fn node_box(&self, id: usize) -> BoundingBox {
+        let n = &self.hierarchy.tree.nodes[id];
+        BoundingBox {
+            min: n.min,
+            max: n.max,
+        }
+    }
+}
+
+#[inline]
+fn centroid(t: &[[f64; 3]; 3]) -> [f64; 3] {
+    [0, 1, 2].map(|k| (t[0][k] + t[1][k] + t[2][k]) / 3.0)
+}
+
+#[inline]
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+#[inline]
+pub(crate) fn dist2(a: [f64; 3], b: [f64; 3]) -> f64 {
+    let d = sub(a, b);
+    d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eval::direct::winding_number_direct;
+
+    fn octahedron() -> Mesh {
+        let p = [
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+        ];
+        let t = [
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ];
+        Mesh::from_slices(&p, &t).unwrap()
+    }
+
+    /// A sphere-like closed mesh with many triangles (subdivided octahedron).
+    fn subdivided(levels: usize) -> Mesh {
+        let mut tris: Vec<[[f64; 3]; 3]> =
+            (0..8).map(|f| octahedron().triangle_positions(f)).collect();
+        let norm = |p: [f64; 3]| {
+            let l = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+            p.map(|v| v / l)
+        };
+        let mid = |a: [f64; 3], b: [f64; 3]| norm([0, 1, 2].map(|k| 0.5 * (a[k] + b[k])));
+        for _ in 0..levels {
+            tris = tris
+                .iter()
+                .flat_map(|&[a, b, c]| {
+                    let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
+                    [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]
+                })
+                .collect();
+        }
+        let positions: Vec<[f64; 3]> = tris.iter().flatten().copied().collect();
+        let triangles = (0..tris.len() as u32)
+            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+            .collect();
+        Mesh::new(positions, triangles).unwrap()
+    }
+
+    #[test]
+    fn evaluator_is_send_and_sync() {
+        fn check<T: Send + Sync>() {}
+        check::<FastWindingNumber>();
+    }
+
+    #[test]
+    fn empty_mesh_gives_zero() {
+        let fast = FastWindingNumber::new(&Mesh::default());
+        assert_eq!(fast.eval([0.0; 3]), 0.0);
+        assert!(fast.is_empty());
+    }
+
+    #[test]
+    fn huge_beta_is_the_direct_sum() {
+        let mesh = subdivided(4);
+        let fast = FastWindingNumber::new(&mesh);
+        for q in [[0.1, 0.2, -0.3], [0.9, 0.3, 0.1], [2.0, -1.0, 0.5]] {
+            let a = fast.eval_with(q, FastParams::barill(1e12, 2));
+            let b = winding_number_direct(&mesh, q);
+            assert!((a - b).abs() < 1e-13, "{a} vs {b}");
+        }
+    }
+
+    #[test]
+    fn node_radius_bounds_its_triangles_and_area_matches() {
+        let mesh = subdivided(3);
+        let fast = FastWindingNumber::new(&mesh);
+        for id in 0..fast.node_count() {
+            let m = fast.node_moments(id);
+            let mut area = 0.0;
+            let mut reached = 0.0_f64;
+            for &f in fast.node_triangles(id) {
+                let t = mesh.triangle_positions(f as usize);
+                area += Moments::of_triangle(t[0], t[1], t[2], m.center).area;
+                for v in t {
+                    reached = reached.max(dist2(v, m.center).sqrt());
+                }
+            }
+            assert!((m.area - area).abs() < 1e-12);
+            assert_eq!(m.radius, reached);
+        }
+    }
+
+    #[test]
+    fn far_field_matches_direct_on_a_sphere() {
+        let mesh = subdivided(4);
+        let fast = FastWindingNumber::new(&mesh);
+        for (q, w) in [([0.0, 0.1, 0.2], 1.0), ([3.0, 1.0, 0.0], 0.0)] {
+            for order in 0..=2 {
+                let v = fast.eval_with(q, FastParams::barill(2.0, order));
+                let tol = [5e-2, 1e-1, 5e-3][order as usize];
+                assert!((v - w).abs() < tol, "order {order}: {v}");
+            }
+        }
+    }
+
+    /// The root expansion of a curved open cap (assembled from its children by re-centring):
+    /// the order-p error falls like `d^-(p+3)` once far away.
+    #[test]
+    fn root_expansion_of_a_curved_cap_has_the_right_rates() {
+        let sphere = subdivided(3);
+        let tris: Vec<[[f64; 3]; 3]> = (0..sphere.triangles().len())
+            .map(|f| sphere.triangle_positions(f))
+            .filter(|t| (t[0][0] + t[1][0] + t[2][0]) / 3.0 > 0.3)
+            .collect();
+        let positions: Vec<[f64; 3]> = tris.iter().flatten().copied().collect();
+        let triangles = (0..tris.len() as u32)
+            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+            .collect();
+        let cap = Mesh::new(positions, triangles).unwrap();
+        let fast = FastWindingNumber::new(&cap);
+        assert!(fast.node_children(0).is_some());
+        let m = fast.node_moments(0);
+        let dir = [0.48, -0.6, 0.64];
+        for order in 0..=2u8 {
+            let err = |d: f64| {
+                let q = [0, 1, 2].map(|k| m.center[k] + d * m.radius * dir[k]);
+                (m.far_field(q, order) - winding_number_direct(&cap, q)).abs()
+            };
+            let rate = (err(16.0) / err(32.0)).log2();
+            let expected = f64::from(order) + 3.0;
+            assert!((rate - expected).abs() < 0.2, "order {order}: rate {rate}");
+        }
+    }
+}

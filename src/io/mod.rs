@@ -1,0 +1,236 @@
+//! Reading meshes (OBJ, STL, OFF, PLY) and query points (text, `.npy`), writing results.
+//!
+//! Every loader works on an in-memory byte slice ([`load_mesh_from_bytes`]), so fuzzing and
+//! tests need no files, and every error is a [`LoadError`] naming the file and a location (line
+//! for text, byte offset for binary data, face or vertex index for bad indices and coordinates).
+//!
+//! The loaders never repair: every face of the file is kept (degenerate, duplicated, flipped), and
+//! polygons are fan-triangulated as `(v0, vi, vi+1)`. Only STL files are welded by default
+//! (bit-identical positions merged), because STL stores every triangle's corners separately.
+//! See `docs/formats.md` for what each reader accepts and rejects.
+//!
+//! ```
+//! use gwn::io::{load_mesh_from_bytes, Format};
+//! let off = b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+//! let loaded = load_mesh_from_bytes(off, "tri.off", Some(Format::Off))?;
+//! assert_eq!(loaded.mesh.triangles().len(), 1);
+//! # Ok::<(), gwn::error::LoadError>(())
+//! ```
+
+pub mod cloud;
+pub mod detect;
+mod obj;
+mod off;
+mod ply;
+pub mod points;
+mod stl;
+
+use std::fmt;
+use std::path::Path;
+
+use crate::Mesh;
+use crate::error::{LoadError, LoadErrorKind, Location, MeshError};
+
+pub use detect::{format_from_content, format_from_extension};
+pub use points::{load_points, load_points_from_bytes};
+
+/// A mesh file format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Format {
+    /// Wavefront OBJ (text).
+    Obj,
+    /// STL, ascii or binary.
+    Stl,
+    /// Object File Format (text).
+    Off,
+    /// Stanford PLY, ascii or binary (either endianness).
+    Ply,
+}
+
+impl Format {
+    /// All formats, in a fixed order.
+    pub const ALL: [Format; 4] = [Format::Obj, Format::Stl, Format::Off, Format::Ply];
+
+    /// True for formats that are welded by default (STL).
+    pub fn welds_by_default(self) -> bool {
+        self == Format::Stl
+    }
+}
+
+impl fmt::Display for Format {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Format::Obj => "OBJ",
+            Format::Stl => "STL",
+            Format::Off => "OFF",
+            Format::Ply => "PLY",
+        })
+    }
+}
+
+/// Options for [`load_mesh_with`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LoadOptions {
+    /// Merge bit-identical positions after loading. `None`: the format's default (on for STL, off
+    /// for OBJ, OFF and PLY).
+    pub weld: Option<bool>,
+}
+
+/// A mesh as loaded from a file, with what the loader did to it.
+#[derive(Clone, Debug)]
+pub struct LoadedMesh {
+    /// The mesh.
+    pub mesh: Mesh,
+    /// The format that was read.
+    pub format: Format,
+    /// Vertices removed by welding (0 when welding was off).
+    pub welded_vertices: usize,
+    /// Polygons with more than three corners that were fan-triangulated.
+    pub polygons_triangulated: usize,
+}
+
+/// What a format reader hands back before validation: positions, triangles and the number of
+/// polygons it fan-triangulated. Indices are already checked against the vertex count.
+#[derive(Debug, Default)]
+pub(crate) struct RawMesh {
+    pub positions: Vec<[f64; 3]>,
+    pub triangles: Vec<[u32; 3]>,
+    pub polygons: usize,
+}
+
+/// A reader error before the file name is attached.
+pub(crate) type Fail = (Location, LoadErrorKind);
+
+/// Capacity for `count` elements of at least `min_bytes` each from a file of `len` bytes: never
+/// more than the file can hold, so a lying header cannot make us allocate gigabytes.
+pub(crate) fn capped_capacity(count: u64, len: usize, min_bytes: usize) -> usize {
+    let fit = (len / min_bytes.max(1)) as u64;
+    count.min(fit) as usize
+}
+
+/// Appends the fan triangulation `(v0, vi, vi+1)` of `poly` to `out`; returns true when the
+/// polygon had more than three corners. Polygons with fewer than three corners add nothing.
+pub(crate) fn fan(poly: &[u32], out: &mut Vec<[u32; 3]>) -> bool {
+    if poly.len() < 3 {
+        return false;
+    }
+    for i in 1..poly.len() - 1 {
+        out.push([poly[0], poly[i], poly[i + 1]]);
+    }
+    poly.len() > 3
+}
+
+/// The error for a face index outside the vertex range.
+pub(crate) fn index_error(face: usize, index: u64, vertex_count: usize) -> Fail {
+    (
+        Location::Face(face),
+        LoadErrorKind::Mesh(MeshError::IndexOutOfRange {
+            face,
+            index,
+            vertex_count,
+        }),
+    )
+}
+
+/// Loads a mesh, choosing the format by extension (case-insensitive) or, failing that, by
+/// content; STL is welded, other formats are not.
+pub fn load_mesh(path: impl AsRef<Path>) -> Result<LoadedMesh, LoadError> {
+    load_mesh_with(path, &LoadOptions::default())
+}
+
+/// Loads a mesh with explicit options.
+pub fn load_mesh_with(
+    path: impl AsRef<Path>,
+    options: &LoadOptions,
+) -> Result<LoadedMesh, LoadError> {
+    let path = path.as_ref();
+    let bytes = std::fs::read(path)
+        .map_err(|e| LoadError::new(path, Location::File, LoadErrorKind::Io(e)))?;
+    load_mesh_from_bytes_with(&bytes, path, format_from_extension(path), options)
+}
+
+/// Loads a mesh from bytes in memory. `name_for_errors` is what errors call the file;
+/// `format_hint` forces a format, `None` detects it from the content.
+pub fn load_mesh_from_bytes(
+    bytes: &[u8],
+    name_for_errors: impl AsRef<Path>,
+    format_hint: Option<Format>,
+) -> Result<LoadedMesh, LoadError> {
+    load_mesh_from_bytes_with(bytes, name_for_errors, format_hint, &LoadOptions::default())
+}
+
+/// [`load_mesh_from_bytes`] with explicit options.
+pub fn load_mesh_from_bytes_with(
+    bytes: &[u8],
+    name_for_errors: impl AsRef<Path>,
+    format_hint: Option<Format>,
+    options: &LoadOptions,
+) -> Result<LoadedMesh, LoadError> {
+    let name = name_for_errors.as_ref();
+    let err = |(location, kind): Fail| LoadError::new(name, location, kind);
+    if bytes.iter().all(u8::is_ascii_whitespace) {
+        return Err(err((Location::File, LoadErrorKind::Empty)));
+    }
+    let format = format_hint
+        .or_else(|| format_from_content(bytes))
+        .ok_or_else(|| err((Location::File, LoadErrorKind::UnknownFormat)))?;
+    let raw = match format {
+        Format::Obj => obj::parse(bytes),
+        Format::Stl => stl::parse(bytes),
+        Format::Off => off::parse(bytes),
+        Format::Ply => ply::parse(bytes),
+    }
+    .map_err(err)?;
+    if raw.triangles.is_empty() {
+        return Err(err((Location::File, LoadErrorKind::Empty)));
+    }
+    let polygons_triangulated = raw.polygons;
+    let mesh = Mesh::new(raw.positions, raw.triangles).map_err(|e| {
+        let location = match e {
+            MeshError::IndexOutOfRange { face, .. } => Location::Face(face),
+            MeshError::NonFiniteCoordinate { vertex, .. } => Location::Vertex(vertex),
+            MeshError::TooManyVertices { .. } => Location::File,
+        };
+        err((location, LoadErrorKind::Mesh(e)))
+    })?;
+    let (mesh, welded_vertices) = if options.weld.unwrap_or(format.welds_by_default()) {
+        mesh.welded()
+    } else {
+        (mesh, 0)
+    };
+    Ok(LoadedMesh {
+        mesh,
+        format,
+        welded_vertices,
+        polygons_triangulated,
+    })
+}
+
+/// Splits text into lines `(1-based number, line without terminator)`; accepts `\n` and `\r\n`.
+pub(crate) fn text_lines(bytes: &[u8]) -> impl Iterator<Item = (usize, &[u8])> {
+    bytes.split(|&b| b == b'\n').enumerate().map(|(i, l)| {
+        let l = l.strip_suffix(b"\r").unwrap_or(l);
+        (i + 1, l)
+    })
+}
+
+/// Whitespace-separated tokens of a line (ASCII whitespace only; other bytes are kept).
+pub(crate) fn tokens(line: &[u8]) -> impl Iterator<Item = &[u8]> {
+    line.split(|b| b.is_ascii_whitespace())
+        .filter(|t| !t.is_empty())
+}
+
+/// Parses a number token (`f64` or integer type) from bytes.
+pub(crate) fn parse_num<T: std::str::FromStr>(tok: &[u8]) -> Option<T> {
+    std::str::from_utf8(tok).ok()?.parse().ok()
+}
+
+/// A token shown in an error message (lossy, shortened).
+pub(crate) fn show(tok: &[u8]) -> String {
+    let s = String::from_utf8_lossy(tok);
+    if s.chars().count() > 40 {
+        format!("{}…", s.chars().take(40).collect::<String>())
+    } else {
+        s.into_owned()
+    }
+}

@@ -1,0 +1,99 @@
+//! NumPy `.npy` (format 1.0) writers for n-dimensional arrays in C order: `float64`, `float32`
+//! and `uint8`.
+
+use std::io::{self, Write};
+use std::path::Path;
+
+/// An element type that `.npy` can hold.
+pub trait NpyElement: Copy {
+    /// The NumPy type descriptor, e.g. `'<f8'`.
+    const DESCR: &'static str;
+    /// Appends the little-endian bytes of `self`.
+    fn put(self, out: &mut Vec<u8>);
+}
+
+impl NpyElement for f64 {
+    const DESCR: &'static str = "<f8";
+    fn put(self, out: &mut Vec<u8>) {
+        out.extend_from_slice(&self.to_le_bytes());
+    }
+}
+
+impl NpyElement for f32 {
+    const DESCR: &'static str = "<f4";
+    fn put(self, out: &mut Vec<u8>) {
+        out.extend_from_slice(&self.to_le_bytes());
+    }
+}
+
+impl NpyElement for u8 {
+    const DESCR: &'static str = "|u1";
+    fn put(self, out: &mut Vec<u8>) {
+        out.push(self);
+    }
+}
+
+/// The `.npy` header (magic, version 1.0, dictionary padded to a multiple of 64 bytes).
+pub fn header(descr: &str, shape: &[usize]) -> io::Result<Vec<u8>> {
+    let dims: Vec<String> = shape.iter().map(|d| d.to_string()).collect();
+    let shape = match dims.len() {
+        1 => format!("({},)", dims[0]),
+        _ => format!("({})", dims.join(", ")),
+    };
+    let dict = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
+    let unpadded = 10 + dict.len() + 1;
+    let pad = (64 - unpadded % 64) % 64;
+    let hlen = u16::try_from(dict.len() + pad + 1)
+        .map_err(|_| io::Error::new(io::ErrorKind::InvalidInput, "NPY header too long"))?;
+    let mut head = Vec::with_capacity(unpadded + pad);
+    head.extend_from_slice(b"\x93NUMPY\x01\x00");
+    head.extend_from_slice(&hlen.to_le_bytes());
+    head.extend_from_slice(dict.as_bytes());
+    head.resize(head.len() + pad, b' ');
+    head.push(b'\n');
+    Ok(head)
+}
+
+/// Writes `data` (C order) as an array of `shape`. Fails when the lengths disagree.
+pub fn write<T: NpyElement>(mut w: impl Write, shape: &[usize], data: &[T]) -> io::Result<()> {
+    if shape.iter().product::<usize>() != data.len() {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!("shape {shape:?} does not hold {} values", data.len()),
+        ));
+    }
+    w.write_all(&header(T::DESCR, shape)?)?;
+    let mut buf = Vec::with_capacity(1 << 16);
+    for &v in data {
+        v.put(&mut buf);
+        if buf.len() >= 1 << 16 {
+            w.write_all(&buf)?;
+            buf.clear();
+        }
+    }
+    w.write_all(&buf)?;
+    w.flush()
+}
+
+/// [`write`] to a new file at `path`.
+pub fn save<T: NpyElement>(path: impl AsRef<Path>, shape: &[usize], data: &[T]) -> io::Result<()> {
+    let f = io::BufWriter::new(std::fs::File::create(path)?);
+    write(f, shape, data)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn header_is_aligned_and_readable() {
+        let mut out = Vec::new();
+        write(&mut out, &[2, 3], &[1u8, 2, 3, 4, 5, 6]).unwrap();
+        let hlen = u16::from_le_bytes([out[8], out[9]]) as usize;
+        assert_eq!((10 + hlen) % 64, 0);
+        let text = std::str::from_utf8(&out[10..10 + hlen]).unwrap();
+        assert!(text.contains("'descr': '|u1'") && text.contains("'shape': (2, 3)"));
+        assert_eq!(&out[10 + hlen..], &[1, 2, 3, 4, 5, 6]);
+        assert!(write(&mut Vec::new(), &[4], &[1.0f32]).is_err());
+    }
+}

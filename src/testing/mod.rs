@@ -1,0 +1,63 @@
+//! A testing kit for downstream users: degenerate-mesh generators, an exact inside/outside
+//! oracle, and writers for language-neutral corpora (`gwn gen`). See `docs/testing-kit.md`.
+//!
+//! Compiled with the `testing` feature (which also enables the proptest strategies in
+//! [`strategies`]) or with `cli` (the default, without proptest: seeded generators and oracle
+//! only, for `gwn gen`).
+//!
+//! - **Generators** ([`Kind`], one [`Case`] = mesh + queries + optional closed-form truth): each
+//!   kind is a seeded function (`polycube(seed)`), a byte decoder for cargo-fuzz/arbitrary
+//!   (`polycube_from_bytes(&bytes)`) and a proptest strategy (`strategies::polycube()`). Each
+//!   kind documents its guarantee on its [`Kind`] variant.
+//! - **Exact oracle** ([`exact_winding_number_rational`], [`Oracle`]): big-integer perturbed
+//!   predicates written independently of `gwn::kernel`, plus a certified interval for the
+//!   boundary term. [`Certified::decide`] is never wrong when it answers; closed consistently
+//!   oriented meshes give exact integers.
+//! - **Fast exact evaluator** for bulk use: [`WindingNumber`] (the library's Antipodal
+//!   evaluator), via [`fast_exact`].
+//!
+//! | | guarantee | cost |
+//! |---|---|---|
+//! | [`exact_winding_number_rational`] | interval containing `w(q_ε)`; exact integer on closed meshes; decides inside/outside with certainty whenever it answers | `O(F + B)` big-integer operations per query |
+//! | [`WindingNumber`] | exact integer part (χ) on every input; fractional part within ~1e-12 of `w(q_ε)` for dyadic inputs that snap exactly (small integer/dyadic grids with the 60-bit default) | `O(B + log F)` per query, millions per second |
+
+pub mod export;
+pub mod generators;
+pub mod interval;
+pub mod oracle;
+pub mod source;
+#[cfg(feature = "testing")]
+pub mod strategies;
+
+pub use generators::{
+    Aabb, Case, Kind, boxes, boxes_from_bytes, fan, fan_from_bytes, inconsistent,
+    inconsistent_from_bytes, open, open_from_bytes, polycube, polycube_from_bytes, queries, soup,
+    soup_from_bytes, t_junction, t_junction_from_bytes, tets, tets_from_bytes,
+};
+pub use oracle::{
+    Certified, Decision, Oracle, exact_winding_number_integer, exact_winding_number_rational,
+    on_surface,
+};
+pub use source::{Source, SplitMix64};
+
+/// The fast exact evaluator (re-exported from [`crate::eval::antipodal`]).
+pub use crate::eval::antipodal::{Options, WindingNumber};
+
+use crate::Mesh;
+use crate::eval::antipodal::BuildError;
+use crate::kernel::frame::RayAxis;
+
+/// The fast exact evaluator for bulk use, with the 60-bit grid and the given ray: its value is the
+/// winding number at the same perturbed point `q_ε` as the oracle's for that ray. Its integer
+/// part is exact for every input; its fractional part is accurate to ~1e-12 (not certified).
+/// Queries are snapped to the mesh's 60-bit grid first: the kit's dyadic coordinates snap
+/// without error.
+pub fn fast_exact(mesh: &Mesh, ray: RayAxis) -> Result<WindingNumber, BuildError> {
+    WindingNumber::with_options(
+        mesh,
+        Options {
+            ray,
+            ..Options::default()
+        },
+    )
+}
