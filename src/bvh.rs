@@ -47,7 +47,14 @@ impl RayBvh {
             })
             .collect();
         let mut t = std::time::Duration::ZERO;
-        let bvh = build_bvh2(&aabbs, BvhBuildParams::fast_build(), &mut t);
+        // Small leaves: a node test is four float comparisons, a triangle test three exact
+        // orientations, so the traversal should cull down to (nearly) single triangles.
+        let params = BvhBuildParams {
+            max_prims_per_leaf: 1,
+            collapse_traversal_cost: 1.0,
+            ..BvhBuildParams::fast_build()
+        };
+        let bvh = build_bvh2(&aabbs, params, &mut t);
         let nodes = bvh
             .nodes
             .iter()

@@ -166,6 +166,17 @@ pub fn ray_crossing<W: Width>(q: [i64; 3], p: [[i64; 3]; 3]) -> i32 {
 /// the projected triangle, else 0. All three edge tests are [`perturbed_orient2d`].
 #[inline]
 pub fn projected_containment<W: Width>(q2: [i64; 2], p: [[i64; 3]; 3]) -> i32 {
+    // Exact, conservative early-out: q_ε = q + (ε1, ε2) can only be strictly inside if q lies in
+    // the closed xy-box of the projected triangle.
+    for k in 0..2 {
+        let (lo, hi) = (
+            p[0][k].min(p[1][k]).min(p[2][k]),
+            p[0][k].max(p[1][k]).max(p[2][k]),
+        );
+        if q2[k] < lo || q2[k] > hi {
+            return 0;
+        }
+    }
     let s0 = perturbed_orient2d::<W>(q2, [p[0][0], p[0][1]], [p[1][0], p[1][1]]).sign;
     if s0 == 0 {
         return 0;

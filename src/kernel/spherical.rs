@@ -46,6 +46,14 @@ pub fn triangle_solid_angle(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
     if det == 0.0 {
         return 0.0;
     }
+    // A zero-area triangle subtends no solid angle. Without this test, a collinear triangle seen
+    // from a point close to its line gives det ≈ ±tiny with den < 0, i.e. ±2π (found by the
+    // kernel fuzz target: the direct sum returned −1/4 next to a degenerate face).
+    let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+    if cross(e1, e2) == [0.0; 3] {
+        return 0.0;
+    }
     let den = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
     2.0 * det.atan2(den)
 }
@@ -204,6 +212,15 @@ mod tests {
         assert!((w - 4.0 * PI / 8.0).abs() < 1e-15);
         let w = triangle_solid_angle([1., 0., 0.], [0., 0., 1.], [0., 1., 0.]);
         assert!((w + 4.0 * PI / 8.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn degenerate_triangle_near_the_query_subtends_nothing() {
+        // Collinear corners on the x axis, query 1e-8 off the line between them.
+        let q = [0.7501, 1e-8, 1e-12];
+        let p = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [-1.0, 0.0, 0.0]];
+        let r = p.map(|v| [v[0] - q[0], v[1] - q[1], v[2] - q[2]]);
+        assert_eq!(triangle_solid_angle(r[0], r[1], r[2]), 0.0);
     }
 
     #[test]
