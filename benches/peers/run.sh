@@ -9,7 +9,10 @@
 # was produced with:
 #
 #   PEERS_NO_OPEN3D=1 benches/peers/run.sh M/cgal-anchor.off M/cgal-hand.off ... \
-#       --soups cgal-hand.off,cgal-fandisk.off,cgal-armadillo.off --sections fast
+#       --soups cgal-hand.off,cgal-fandisk.off,cgal-armadillo.off --match-beta 2.5 --sections fast
+#
+# (the full command, with the mesh list, is recorded in that section; --match-beta also times gwn
+# fast at a second beta, matched to libigl's accuracy).
 #
 # Creates benches/peers/.venv, installs requirements.txt (and requirements-open3d.txt when
 # possible; set PEERS_NO_OPEN3D=1 to skip it), builds gwn in release (honours CARGO_TARGET_DIR)

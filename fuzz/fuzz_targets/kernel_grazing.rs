@@ -29,12 +29,7 @@ fuzz_target!(|data: &[u8]| {
             if !on {
                 assert!((w - w0).abs() < 1e-10, "{ray:?} {q:?}: {w} vs {w0}");
             }
-            let t = 1e-4;
-            let d = ray.to_world([t, t * t, t * t * t]);
-            let want = gwn::eval::direct::winding_number_direct(
-                &case.mesh,
-                [q[0] + d[0], q[1] + d[1], q[2] + d[2]],
-            );
+            let want = gwn::testing::direct_at_perturbed(&case.mesh, q, ray, 1.0);
             assert!(
                 (w - want).abs() < 2e-3,
                 "{ray:?} {q:?}: {w} vs perturbed direct {want}"

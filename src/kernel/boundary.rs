@@ -134,12 +134,17 @@ impl BoundaryEdges {
             let hb = bx * bx + by * by;
             let la = (ha + az * az).sqrt();
             let lb = (hb + bz * bz).sqrt();
-            // |r| − r_z without cancellation: h²/(|r| + r_z) when r_z > 0, |r| − r_z otherwise.
-            let ma = az.cmp_gt(zero).blend(ha / (la + az), la - az);
-            let mb = bz.cmp_gt(zero).blend(hb / (lb + bz), lb - bz);
-            // Term den + i·num (num = −d carries the exact sign); identity 1 + 0i where unused.
-            let t_re = ok.blend(ma * mb + ax * bx + ay * by, one);
-            let t_im = ok.blend(zero - d, zero);
+            // den = (|a| − a_z)(|b| − b_z) + a_x b_x + a_y b_y, and num = −d, both scaled by the
+            // positive s_a·s_b with s = |r| + |r_z| (no division, no cancellation):
+            // (|r| − r_z)·s = h² when r_z > 0, and s² otherwise.
+            let sa = la + az.abs();
+            let sb = lb + bz.abs();
+            let pa = az.cmp_gt(zero).blend(ha, sa * sa);
+            let pb = bz.cmp_gt(zero).blend(hb, sb * sb);
+            let s2 = sa * sb;
+            // Term den + i·num (num carries the exact sign of −d); identity 1 + 0i where unused.
+            let t_re = ok.blend(pa * pb + (ax * bx + ay * by) * s2, one);
+            let t_im = ok.blend((zero - d) * s2, zero);
             let n_re = re * t_re - im * t_im;
             let n_im = re * t_im + im * t_re;
             // Wrap count from sign bits (as atan2 reads them): both factors in the upper half
@@ -152,8 +157,8 @@ impl BoundaryEdges {
             wraps += plus.blend(one, zero) - minus.blend(one, zero);
             re = n_re;
             im = n_im;
-            if c % 4 == 3 {
-                // Keep the accumulators near unit modulus (terms are at most ~2^124).
+            if c % 2 == 1 {
+                // Keep the accumulators near unit modulus (terms are at most ~2^250).
                 let m = re.abs().max(im.abs());
                 let inv = one / m;
                 re *= inv;

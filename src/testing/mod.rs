@@ -35,8 +35,8 @@ pub use generators::{
     soup_from_bytes, t_junction, t_junction_from_bytes, tets, tets_from_bytes,
 };
 pub use oracle::{
-    Certified, Decision, Oracle, exact_winding_number_integer, exact_winding_number_rational,
-    on_surface,
+    Certified, Decision, Oracle, direct_at_perturbed, exact_winding_number_integer,
+    exact_winding_number_rational, on_surface,
 };
 pub use source::{Source, SplitMix64};
 

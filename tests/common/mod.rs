@@ -74,16 +74,4 @@ impl Rng {
     }
 }
 
-/// The oracle for on-surface and grazing queries: the direct sum at the actual point
-/// `q + R·(t, t², t³)·scale` (R the ray frame's rotation back to world), which tends to the value
-/// at the symbolically perturbed point as `t → 0` (error `O(t)`).
-pub fn direct_at_perturbed(
-    mesh: &gwn::Mesh,
-    q: [f64; 3],
-    ray: gwn::kernel::frame::RayAxis,
-    scale: f64,
-) -> f64 {
-    let t = 1e-4;
-    let d = ray.to_world([t * scale, t * t * scale, t * t * t * scale]);
-    gwn::eval::direct::winding_number_direct(mesh, [q[0] + d[0], q[1] + d[1], q[2] + d[2]])
-}
+pub use gwn::testing::direct_at_perturbed;
