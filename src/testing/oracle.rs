@@ -610,6 +610,27 @@ fn to_frame_big(ray: RayAxis, v: &[BigInt; 3]) -> [BigInt; 3] {
         .map(|(axis, neg)| if neg { -&v[axis] } else { v[axis].clone() })
 }
 
+/// An *approximate* oracle for the value at the perturbed point, independent of both the kernel
+/// and the rational oracle: the direct solid-angle sum at the real points
+/// `q + R·(t, t², t³)·scale` (`R` the ray frame's rotation to world) for `t = 1e-3` and `1e-4`,
+/// Richardson-extrapolated to `t → 0` (the error of each sample is `O(t)`; the extrapolation
+/// removes the linear term). Good to about 1e-5 on small integer-grid meshes; use a tolerance of
+/// 1e-3 or so. Near a degenerate face the direct sum itself is the weak link, see
+/// [`crate::kernel::spherical::triangle_solid_angle`].
+pub fn direct_at_perturbed(
+    mesh: &Mesh,
+    q: [f64; 3],
+    ray: crate::kernel::frame::RayAxis,
+    scale: f64,
+) -> f64 {
+    let at = |t: f64| {
+        let d = ray.to_world([t * scale, t * t * scale, t * t * t * scale]);
+        crate::eval::direct::winding_number_direct(mesh, [q[0] + d[0], q[1] + d[1], q[2] + d[2]])
+    };
+    let (w1, w2) = (at(1e-3), at(1e-4));
+    w2 + (w2 - w1) / 9.0
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -690,25 +711,4 @@ mod tests {
         let c = exact_winding_number_integer(&pos, m.triangles(), &q, RayAxis::NegY);
         assert_eq!((c.lo, c.hi), (1.0, 1.0));
     }
-}
-
-/// An *approximate* oracle for the value at the perturbed point, independent of both the kernel
-/// and the rational oracle: the direct solid-angle sum at the real points
-/// `q + R·(t, t², t³)·scale` (`R` the ray frame's rotation to world) for `t = 1e-3` and `1e-4`,
-/// Richardson-extrapolated to `t → 0` (the error of each sample is `O(t)`; the extrapolation
-/// removes the linear term). Good to about 1e-5 on small integer-grid meshes; use a tolerance of
-/// 1e-3 or so. Near a degenerate face the direct sum itself is the weak link, see
-/// [`crate::kernel::spherical::triangle_solid_angle`].
-pub fn direct_at_perturbed(
-    mesh: &Mesh,
-    q: [f64; 3],
-    ray: crate::kernel::frame::RayAxis,
-    scale: f64,
-) -> f64 {
-    let at = |t: f64| {
-        let d = ray.to_world([t * scale, t * t * scale, t * t * t * scale]);
-        crate::eval::direct::winding_number_direct(mesh, [q[0] + d[0], q[1] + d[1], q[2] + d[2]])
-    };
-    let (w1, w2) = (at(1e-3), at(1e-4));
-    w2 + (w2 - w1) / 9.0
 }

@@ -1,5 +1,5 @@
 //! Shared test helpers: small closed-form meshes and the shared-corpus locator.
-#![allow(dead_code)]
+#![allow(dead_code, unused_imports)]
 
 use gwn::Mesh;
 

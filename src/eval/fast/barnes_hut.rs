@@ -1,9 +1,8 @@
 //! The Barnes–Hut engine shared by triangle soups and point clouds: per-node moments built
 //! bottom-up by re-centring, and the traversal of Barill et al.'s Algorithm 1.
 
-use super::moments::Moments;
+use super::moments::{FarField, Moments};
 use super::tree::{STACK, Tree};
-use crate::kernel::compensated::NeumaierSum;
 
 /// Which node size the admissibility test `‖q − p̃‖ > β · size` uses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -66,12 +65,27 @@ impl FastParams {
     }
 }
 
-/// Tree plus per-node moments and box diagonals.
+/// The per-node data the traversal reads, packed together (one cache line): the expansion
+/// centre, both admissibility sizes and the children / element range.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct HotNode {
+    pub center: [f64; 3],
+    pub radius: f64,
+    pub diag: f64,
+    /// First child (`0` for a leaf; children are `left` and `left + 1`).
+    pub left: u32,
+    pub start: u32,
+    pub end: u32,
+}
+
+/// Tree plus per-node moments and box diagonals, and the compact query-time records derived
+/// from them (`hot` for the traversal, `far` for the far-field evaluation).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Hierarchy {
     pub tree: Tree,
     pub moments: Vec<Moments>,
-    pub diag: Vec<f64>,
+    pub hot: Vec<HotNode>,
+    pub far: Vec<FarField>,
 }
 
 impl Hierarchy {
@@ -141,56 +155,99 @@ impl Hierarchy {
                 .sqrt();
             moments[id] = m;
         }
+        let hot = tree
+            .nodes
+            .iter()
+            .zip(&moments)
+            .zip(&diag)
+            .map(|((node, m), &diag)| HotNode {
+                center: m.center,
+                radius: m.radius,
+                diag,
+                left: node.left,
+                start: node.start,
+                end: node.end,
+            })
+            .collect();
+        let far = moments.iter().map(FarField::new).collect();
         Hierarchy {
             tree,
             moments,
-            diag,
+            hot,
+            far,
         }
     }
 
     /// FASTWN(q) (Algorithm 1), iteratively: a node far enough from `q` contributes its
     /// expansion, a near leaf calls `leaf(range, sum)` to add its elements' exact contributions
-    /// (`range` indexes the elements in leaf order), a near inner node is opened.
+    /// (`range` indexes the elements in leaf order), a near inner node is opened. Both children
+    /// of an opened node are tested before anything is pushed, so only near inner nodes go on
+    /// the stack. Plain `f64` accumulation: the method is approximate to far more than the
+    /// rounding of the sum.
     #[inline]
     pub fn eval(
         &self,
         q: [f64; 3],
         params: &FastParams,
-        mut leaf: impl FnMut(std::ops::Range<usize>, &mut NeumaierSum),
+        mut leaf: impl FnMut(std::ops::Range<usize>, &mut f64),
     ) -> f64 {
-        let mut sum = NeumaierSum::new();
-        if self.tree.nodes.is_empty() {
+        if self.hot.is_empty() {
             return 0.0;
         }
         let beta = params.beta;
-        let mut stack = [0u32; STACK];
-        let mut top = 1usize;
-        while top > 0 {
-            top -= 1;
-            let id = stack[top] as usize;
-            let m = &self.moments[id];
-            let size = match params.admissibility {
-                Admissibility::Radius => m.radius,
-                Admissibility::BoxDiagonal => self.diag[id],
-            };
-            let r = [m.center[0] - q[0], m.center[1] - q[1], m.center[2] - q[2]];
+        let order = params.order;
+        let use_diag = params.admissibility == Admissibility::BoxDiagonal;
+        let hot = &self.hot[..];
+        let far = &self.far[..];
+        // `Some(r)` when node `id` is admissible (`r = p̃ − q`).
+        let admissible = |n: &HotNode| -> Option<[f64; 3]> {
+            let size = if use_diag { n.diag } else { n.radius };
+            let r = [n.center[0] - q[0], n.center[1] - q[1], n.center[2] - q[2]];
             let d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
             let bs = beta * size;
             // `bs < 0` (β ≤ 0) admits everything not at the centre; NaN admits nothing.
-            if d2 > 0.0 && (bs < 0.0 || d2 > bs * bs) {
-                sum.add(m.far_field(q, params.order));
-                continue;
+            (d2 > 0.0 && (bs < 0.0 || d2 > bs * bs)).then_some(r)
+        };
+        let mut sum = 0.0;
+        let mut stack = [0u32; STACK];
+        let mut top = 0usize;
+        // The root is the only node tested after popping; every other node is tested by its
+        // parent.
+        let root = &hot[0];
+        if let Some(r) = admissible(root) {
+            return far[0].eval(r, order);
+        }
+        if root.left == 0 {
+            leaf(root.start as usize..root.end as usize, &mut sum);
+            return sum;
+        }
+        let mut id = 0usize;
+        loop {
+            let l = hot[id].left as usize;
+            let mut next = usize::MAX;
+            for c in [l, l + 1] {
+                let n = &hot[c];
+                if let Some(r) = admissible(n) {
+                    sum += far[c].eval(r, order);
+                } else if n.left == 0 {
+                    leaf(n.start as usize..n.end as usize, &mut sum);
+                } else if next == usize::MAX {
+                    next = c;
+                } else {
+                    stack[top] = c as u32;
+                    top += 1;
+                }
             }
-            let node = &self.tree.nodes[id];
-            if node.is_leaf() {
-                leaf(node.range(), &mut sum);
+            if next != usize::MAX {
+                id = next;
+            } else if top > 0 {
+                top -= 1;
+                id = stack[top] as usize;
             } else {
-                stack[top] = node.left + 1;
-                stack[top + 1] = node.left;
-                top += 2;
+                break;
             }
         }
-        sum.value()
+        sum
     }
 }
 

@@ -291,7 +291,7 @@ impl PointCloudWindingNumber {
         let (p, an) = (&self.positions, &self.weighted_normals);
         self.hierarchy.eval(q, &params, |range, sum| {
             for i in range {
-                sum.add(dipole(p[i], an[i], q));
+                *sum += dipole(p[i], an[i], q);
             }
         })
     }

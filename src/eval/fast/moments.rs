@@ -214,6 +214,115 @@ impl Moments {
     }
 }
 
+/// The far-field coefficients of one node in the form the query evaluates, precomputed from its
+/// [`Moments`] and pre-scaled by `1/(4π)`: with `r = p̃ − q` and `d = ‖r‖`,
+///
+/// ```text
+/// w̃ = n·r / d³                                       (order 0)
+///   + tr / d³ − 3 rᵀ M1 r / d⁵                          (order 1)
+///   − 3/2 v·r / d⁵ + 15/2 Σ M2ᵢⱼₖ rᵢ rⱼ rₖ / d⁷           (order 2)
+/// ```
+///
+/// where `tr = tr M1`, `vₖ = Σᵢ M2ᵢᵢₖ + 2 Σᵢ M2ᵢₖᵢ`, `M1` is kept as the six coefficients of its
+/// quadratic form and `M2` as the ten coefficients of its cubic form.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct FarField {
+    n: [f64; 3],
+    tr: f64,
+    /// Coefficients of `r0², r1², r2², r0r1, r0r2, r1r2`.
+    q: [f64; 6],
+    v: [f64; 3],
+    /// Coefficients of `r0³, r1³, r2³, r0²r1, r0²r2, r1²r0, r1²r2, r2²r0, r2²r1, r0r1r2`.
+    c: [f64; 10],
+}
+
+impl FarField {
+    pub fn new(m: &Moments) -> Self {
+        let s = INV_4PI;
+        let m1 = &m.m1;
+        let q = [
+            m1[0][0],
+            m1[1][1],
+            m1[2][2],
+            m1[0][1] + m1[1][0],
+            m1[0][2] + m1[2][0],
+            m1[1][2] + m1[2][1],
+        ];
+        // Full M2ᵢⱼₖ from the stored symmetric rows.
+        let row = |i: usize, j: usize| {
+            let s = SYM_PAIRS
+                .iter()
+                .position(|&(a, b)| (a, b) == (i.min(j), i.max(j)))
+                .unwrap_or(0);
+            m.m2[s]
+        };
+        let mut v = [0.0; 3];
+        for k in 0..3 {
+            for i in 0..3 {
+                v[k] += row(i, i)[k] + 2.0 * row(i, k)[i];
+            }
+        }
+        let mut c = [0.0; 10];
+        for i in 0..3 {
+            for j in 0..3 {
+                for k in 0..3 {
+                    let mut t = [i, j, k];
+                    t.sort_unstable();
+                    let idx = match t {
+                        [0, 0, 0] => 0,
+                        [1, 1, 1] => 1,
+                        [2, 2, 2] => 2,
+                        [0, 0, 1] => 3,
+                        [0, 0, 2] => 4,
+                        [0, 1, 1] => 5,
+                        [1, 1, 2] => 6,
+                        [0, 2, 2] => 7,
+                        [1, 2, 2] => 8,
+                        _ => 9,
+                    };
+                    c[idx] += row(i, j)[k];
+                }
+            }
+        }
+        FarField {
+            n: m.n.map(|x| x * s),
+            tr: (m1[0][0] + m1[1][1] + m1[2][2]) * s,
+            q: q.map(|x| -3.0 * s * x),
+            v: v.map(|x| -1.5 * s * x),
+            c: c.map(|x| 7.5 * s * x),
+        }
+    }
+
+    /// The same value as [`Moments::far_field`] at `q = p̃ − r`.
+    #[inline]
+    pub fn eval(&self, r: [f64; 3], order: u8) -> f64 {
+        let d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+        let inv_d2 = 1.0 / d2;
+        let inv_d = inv_d2.sqrt();
+        let inv_d3 = inv_d * inv_d2;
+        let mut w3 = self.n[0] * r[0] + self.n[1] * r[1] + self.n[2] * r[2];
+        if order == 0 {
+            return w3 * inv_d3;
+        }
+        let (x, y, z) = (r[0], r[1], r[2]);
+        let (xx, yy, zz) = (x * x, y * y, z * z);
+        let q = &self.q;
+        w3 += self.tr;
+        let mut w5 = q[0] * xx + q[1] * yy + q[2] * zz + q[3] * x * y + q[4] * x * z + q[5] * y * z;
+        let inv_d5 = inv_d3 * inv_d2;
+        if order == 1 {
+            return w3 * inv_d3 + w5 * inv_d5;
+        }
+        w5 += self.v[0] * x + self.v[1] * y + self.v[2] * z;
+        let c = &self.c;
+        let w7 = x * (c[0] * xx + c[3] * x * y + c[4] * x * z + c[5] * yy + c[7] * zz)
+            + y * (c[1] * yy + c[6] * y * z + c[8] * zz)
+            + z * (c[2] * zz + c[9] * x * y);
+        let inv_d7 = inv_d5 * inv_d2;
+        w3 * inv_d3 + w5 * inv_d5 + w7 * inv_d7
+    }
+}
+
 #[inline]
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
@@ -328,6 +437,22 @@ mod tests {
                 (rate - expected).abs() < 0.3,
                 "order {order}: rate {rate}, expected {expected} ({e1:e} → {e2:e})"
             );
+        }
+    }
+
+    #[test]
+    fn compact_far_field_equals_the_moment_form() {
+        let m = Moments::of_triangle(A, B, C, P).recentred([0.2, 0.5, -0.1]);
+        let f = FarField::new(&m);
+        for q in [[3.0, -2.0, 1.5], [-0.7, 4.0, 2.2], [0.1, 0.2, -5.0]] {
+            let r = sub(m.center, q);
+            for order in 0..=3u8 {
+                let (a, b) = (m.far_field(q, order), f.eval(r, order));
+                assert!(
+                    (a - b).abs() <= 1e-14 * a.abs().max(1e-3),
+                    "{order}: {a} vs {b}"
+                );
+            }
         }
     }
 

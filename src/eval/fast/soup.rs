@@ -11,7 +11,7 @@ use crate::{BoundingBox, Mesh};
 const INV_4PI: f64 = 1.0 / (4.0 * std::f64::consts::PI);
 
 /// Largest number of triangles in a leaf (summed exactly when the leaf is near the query).
-pub const TRIANGLE_LEAF_SIZE: usize = 8;
+pub const TRIANGLE_LEAF_SIZE: usize = 4;
 
 /// Barnes–Hut evaluator of the generalized winding number of a triangle mesh (connectivity is
 /// ignored: soups, open and non-manifold meshes are all fine). Owns a copy of the triangles, so it
@@ -114,7 +114,7 @@ impl FastWindingNumber {
                 let a = sub(t[0], q);
                 let b = sub(t[1], q);
                 let c = sub(t[2], q);
-                sum.add(triangle_solid_angle(a, b, c) * INV_4PI);
+                *sum += triangle_solid_angle(a, b, c) * INV_4PI;
             }
         })
     }
