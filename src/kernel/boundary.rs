@@ -104,6 +104,9 @@ impl BoundaryEdges {
     /// query's z lies outside the grid: `qz_units` (its z in grid units, `f64`) is used for the
     /// magnitudes and `qi[2]` (clamped) for nothing but the predicates, which do not involve z.
     pub fn area_sum<W: Width>(&self, qi: [i64; 3], z_exact: bool, qz_units: f64) -> f64 {
+        if self.a.is_empty() {
+            return 0.0;
+        }
         let qx = f64x4::splat(qi[0] as f64);
         let qy = f64x4::splat(qi[1] as f64);
         let qz = f64x4::splat(if z_exact { qi[2] as f64 } else { qz_units });

@@ -64,6 +64,7 @@ impl Snap {
 pub struct Grid {
     origin: [f64; 3],
     cell: f64,
+    inv_cell: f64,
     limit: i64,
     precision: Precision,
 }
@@ -95,7 +96,8 @@ impl Grid {
         while cell < target {
             cell *= 2.0;
         }
-        if !(cell.is_finite() && cell > 0.0) {
+        // A cell so small that its reciprocal overflows (extent below ~1e-290) is refused too.
+        if !(cell.is_finite() && cell > 0.0 && (1.0 / cell).is_finite()) {
             return Err(GridRangeError);
         }
         let origin = center.map(|c| (c / cell).round() * cell);
@@ -105,6 +107,7 @@ impl Grid {
         Ok(Grid {
             origin,
             cell,
+            inv_cell: 1.0 / cell,
             limit,
             precision,
         })
@@ -133,7 +136,8 @@ impl Grid {
     /// Snaps one coordinate along `axis`.
     #[inline]
     pub fn snap(&self, x: f64, axis: usize) -> Snap {
-        let v = ((x - self.origin[axis]) / self.cell).round();
+        // `cell` is a power of two, so multiplying by its reciprocal is exact like the division.
+        let v = ((x - self.origin[axis]) * self.inv_cell).round();
         if v > self.limit as f64 {
             Snap::High
         } else if v < -(self.limit as f64) {
