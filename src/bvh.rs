@@ -32,13 +32,16 @@ struct Node {
 
 const LEAF: u32 = 1 << 31;
 
+/// An `f32` box `(min, max)`.
+type Box3 = ([f32; 3], [f32; 3]);
+
 /// BVH over triangles given by normalized `f32` boxes.
 #[derive(Clone, Debug, Default)]
 pub struct RayBvh {
     nodes: Vec<Node>,
     prims: Vec<u32>,
     /// When the whole hierarchy is one leaf (tiny meshes): its box and primitive count.
-    root_leaf: Option<(([f32; 3], [f32; 3]), u32)>,
+    root_leaf: Option<(Box3, u32)>,
 }
 
 impl RayBvh {
