@@ -46,15 +46,18 @@ pub fn triangle_solid_angle(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
     if det == 0.0 {
         return 0.0;
     }
-    // A zero-area triangle subtends no solid angle. Without this test, a collinear triangle seen
-    // from a point close to its line gives det ≈ ±tiny with den < 0, i.e. ±2π (found by the
-    // kernel fuzz target: the direct sum returned −1/4 next to a degenerate face).
-    let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-    let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-    if cross(e1, e2) == [0.0; 3] {
-        return 0.0;
-    }
     let den = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
+    if den < 0.0 {
+        // A zero-area triangle subtends no solid angle. Without this test, a collinear triangle
+        // seen from a point close to its line gives det ≈ ±tiny with den < 0, i.e. ±2π (found by
+        // the kernel fuzz target: the direct sum returned −1/4 next to a degenerate face). Only
+        // den < 0 can turn a tiny det into a large angle, so the test costs nothing elsewhere.
+        let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+        if cross(e1, e2) == [0.0; 3] {
+            return 0.0;
+        }
+    }
     2.0 * det.atan2(den)
 }
 
