@@ -47,11 +47,12 @@ pub fn triangle_solid_angle(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
         return 0.0;
     }
     let den = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
-    if den < 0.0 {
+    if det.abs() <= 1e-12 * la * lb * lc {
         // A zero-area triangle subtends no solid angle. Without this test, a collinear triangle
-        // seen from a point close to its line gives det ≈ ±tiny with den < 0, i.e. ±2π (found by
-        // the kernel fuzz target: the direct sum returned −1/4 next to a degenerate face). Only
-        // den < 0 can turn a tiny det into a large angle, so the test costs nothing elsewhere.
+        // seen from a point close to its line gives det ≈ ±tiny against den ≤ 0 or den ≈ 0,
+        // i.e. up to ±2π (found by the kernel fuzz target: the direct sum returned −1/4 next to
+        // a degenerate face). Only a relatively tiny det can be rounding noise, so the exact
+        // zero-area test runs only then.
         let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
         let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
         if cross(e1, e2) == [0.0; 3] {
@@ -223,7 +224,15 @@ mod tests {
         let q = [0.7501, 1e-8, 1e-12];
         let p = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [-1.0, 0.0, 0.0]];
         let r = p.map(|v| [v[0] - q[0], v[1] - q[1], v[2] - q[2]]);
-        assert_eq!(triangle_solid_angle(r[0], r[1], r[2]), 0.0);
+        let w = triangle_solid_angle(r[0], r[1], r[2]);
+        assert!(w.abs() < 1e-12, "{w}");
+        // The same from the other side of the line, and with the corners in another order.
+        let q = [0.7501, -1e-8, 1e-12];
+        let r = p.map(|v| [v[0] - q[0], v[1] - q[1], v[2] - q[2]]);
+        for (i, j, k) in [(0, 1, 2), (1, 0, 2), (2, 1, 0)] {
+            let w = triangle_solid_angle(r[i], r[j], r[k]);
+            assert!(w.abs() < 1e-12, "{w}");
+        }
     }
 
     #[test]
