@@ -14,32 +14,7 @@ use gwn::products::sdf::{PseudoNormalSign, SignedDistance};
 use rayon::prelude::*;
 
 fn cube(open: bool) -> Mesh {
-    let p = [
-        [0., 0., 0.],
-        [1., 0., 0.],
-        [1., 1., 0.],
-        [0., 1., 0.],
-        [0., 0., 1.],
-        [1., 0., 1.],
-        [1., 1., 1.],
-        [0., 1., 1.],
-    ];
-    let t = [
-        [0, 2, 1],
-        [0, 3, 2],
-        [0, 1, 5],
-        [0, 5, 4],
-        [1, 2, 6],
-        [1, 6, 5],
-        [2, 3, 7],
-        [2, 7, 6],
-        [3, 0, 4],
-        [3, 4, 7],
-        [4, 5, 6],
-        [4, 6, 7],
-    ];
-    let n = if open { 10 } else { 12 };
-    Mesh::from_slices(&p, &t[..n]).unwrap()
+    gwn::testing::unit_cube(open)
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

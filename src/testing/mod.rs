@@ -61,3 +61,35 @@ pub fn fast_exact(mesh: &Mesh, ray: RayAxis) -> Result<WindingNumber, BuildError
         },
     )
 }
+
+/// The unit cube `[0, 1]³` as 12 outward-oriented triangles with the top face (`z = 1`) last:
+/// `unit_cube(false)` is closed (`w = 1` inside, 0 outside); `unit_cube(true)` lacks the top face
+/// (open, `w = 5/6` at the centre, where the missing face subtends a sixth of the sphere).
+pub fn unit_cube(open: bool) -> Mesh {
+    const V: [[f64; 3]; 8] = [
+        [0., 0., 0.],
+        [1., 0., 0.],
+        [1., 1., 0.],
+        [0., 1., 0.],
+        [0., 0., 1.],
+        [1., 0., 1.],
+        [1., 1., 1.],
+        [0., 1., 1.],
+    ];
+    const T: [[u32; 3]; 12] = [
+        [0, 2, 1],
+        [0, 3, 2],
+        [0, 1, 5],
+        [0, 5, 4],
+        [1, 2, 6],
+        [1, 6, 5],
+        [2, 3, 7],
+        [2, 7, 6],
+        [3, 0, 4],
+        [3, 4, 7],
+        [4, 5, 6],
+        [4, 6, 7],
+    ];
+    let n = if open { 10 } else { 12 };
+    Mesh::from_slices(&V, &T[..n]).expect("valid by construction")
+}

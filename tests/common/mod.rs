@@ -5,40 +5,13 @@ use gwn::Mesh;
 
 /// Unit cube [0,1]³, 12 outward-oriented triangles.
 pub fn unit_cube() -> Mesh {
-    Mesh::from_slices(&CUBE_V, &CUBE_T).unwrap()
+    gwn::testing::unit_cube(false)
 }
 
 /// Unit cube without its top face (z = 1): open, 10 triangles.
 pub fn open_cube() -> Mesh {
-    Mesh::from_slices(&CUBE_V, &CUBE_T[..10]).unwrap()
+    gwn::testing::unit_cube(true)
 }
-
-pub const CUBE_V: [[f64; 3]; 8] = [
-    [0., 0., 0.],
-    [1., 0., 0.],
-    [1., 1., 0.],
-    [0., 1., 0.],
-    [0., 0., 1.],
-    [1., 0., 1.],
-    [1., 1., 1.],
-    [0., 1., 1.],
-];
-
-/// Bottom, four sides, then the top face last (so `[..10]` removes the top).
-pub const CUBE_T: [[u32; 3]; 12] = [
-    [0, 2, 1],
-    [0, 3, 2],
-    [0, 1, 5],
-    [0, 5, 4],
-    [1, 2, 6],
-    [1, 6, 5],
-    [2, 3, 7],
-    [2, 7, 6],
-    [3, 0, 4],
-    [3, 4, 7],
-    [4, 5, 6],
-    [4, 6, 7],
-];
 
 /// `../shared/meshes` if present, else prints why the caller skips and returns `None`.
 pub fn shared_meshes() -> Option<std::path::PathBuf> {
