@@ -173,6 +173,28 @@ fn sample_point(s: &Sample, p: &[Point], eps: f64) -> Option<(Point, [f64; 2], f
     Some((x, d, l))
 }
 
+/// The three energies below expose `eval(x, want_grad) -> (energy, gradient)`; this wires one
+/// to argmin's L-BFGS (cost = the energy, gradient = the gradient).
+macro_rules! impl_argmin_problem {
+    ($problem:ident) => {
+        impl CostFunction for $problem<'_> {
+            type Param = Vec<f64>;
+            type Output = f64;
+            fn cost(&self, x: &Vec<f64>) -> Result<f64, ArgminError> {
+                Ok(self.eval(x, false).0)
+            }
+        }
+
+        impl Gradient for $problem<'_> {
+            type Param = Vec<f64>;
+            type Gradient = Vec<f64>;
+            fn gradient(&self, x: &Vec<f64>) -> Result<Vec<f64>, ArgminError> {
+                Ok(self.eval(x, true).1)
+            }
+        }
+    };
+}
+
 struct UntangleProblem<'a> {
     base: &'a Polygon,
     rest: &'a [Point],
@@ -227,21 +249,7 @@ impl UntangleProblem<'_> {
     }
 }
 
-impl CostFunction for UntangleProblem<'_> {
-    type Param = Vec<f64>;
-    type Output = f64;
-    fn cost(&self, x: &Vec<f64>) -> Result<f64, ArgminError> {
-        Ok(self.eval(x, false).0)
-    }
-}
-
-impl Gradient for UntangleProblem<'_> {
-    type Param = Vec<f64>;
-    type Gradient = Vec<f64>;
-    fn gradient(&self, x: &Vec<f64>) -> Result<Vec<f64>, ArgminError> {
-        Ok(self.eval(x, true).1)
-    }
-}
+impl_argmin_problem!(UntangleProblem);
 
 /// The untangling energy and its gradient (flattened `[x0, y0, x1, ...]`) at the vertex
 /// positions of `poly`, for rest positions `rest` (which also fix `scale`; exposed for testing).
@@ -400,21 +408,7 @@ impl OffsetProblem<'_> {
     }
 }
 
-impl CostFunction for OffsetProblem<'_> {
-    type Param = Vec<f64>;
-    type Output = f64;
-    fn cost(&self, x: &Vec<f64>) -> Result<f64, ArgminError> {
-        Ok(self.eval(x, false).0)
-    }
-}
-
-impl Gradient for OffsetProblem<'_> {
-    type Param = Vec<f64>;
-    type Gradient = Vec<f64>;
-    fn gradient(&self, x: &Vec<f64>) -> Result<Vec<f64>, ArgminError> {
-        Ok(self.eval(x, true).1)
-    }
-}
+impl_argmin_problem!(OffsetProblem);
 
 fn mean_disp(a: &[Point], b: &[Point]) -> (f64, Vec<f64>) {
     let d: Vec<f64> = a
@@ -555,21 +549,7 @@ impl BrushProblem<'_> {
     }
 }
 
-impl CostFunction for BrushProblem<'_> {
-    type Param = Vec<f64>;
-    type Output = f64;
-    fn cost(&self, x: &Vec<f64>) -> Result<f64, ArgminError> {
-        Ok(self.eval(x, false).0)
-    }
-}
-
-impl Gradient for BrushProblem<'_> {
-    type Param = Vec<f64>;
-    type Gradient = Vec<f64>;
-    fn gradient(&self, x: &Vec<f64>) -> Result<Vec<f64>, ArgminError> {
-        Ok(self.eval(x, true).1)
-    }
-}
+impl_argmin_problem!(BrushProblem);
 
 /// The in-out brush energy and its flattened gradient at the vertices of `poly`, for rest
 /// positions `rest` and brush points with target winding numbers.

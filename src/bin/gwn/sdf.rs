@@ -41,14 +41,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let secs = start.elapsed().as_secs_f64();
     let written = args.grid.write(&spec, &values, &args.out, "sdf")?;
     let inside = values.iter().filter(|v| v.is_sign_negative()).count();
-    let [w, h, d] = spec.dims;
-    println!(
-        "{} points (W×H×D = {w}×{h}×{d}, npy shape ({d}, {h}, {w})), {inside} inside, in {secs:.3} s ({:.3e} points/s)",
-        spec.len(),
-        spec.len() as f64 / secs.max(1e-9),
+    crate::voxelize::report_grid(
+        &spec,
+        secs,
+        "points",
+        &format!(", {inside} inside,"),
+        &written,
     );
-    for p in written {
-        println!("wrote {}", p.display());
-    }
     Ok(())
 }

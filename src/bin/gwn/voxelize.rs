@@ -161,14 +161,19 @@ pub fn run(args: Args) -> Result<(), CliError> {
         println!("occupancy (w > {t}): {inside} of {} voxels", occ.len());
         written.push(path);
     }
+    report_grid(&spec, secs, "voxels", "", &written);
+    Ok(())
+}
+
+/// The summary `gwn voxelize` and `gwn sdf` print: size, layout, throughput, files written.
+pub fn report_grid(spec: &GridSpec, secs: f64, noun: &str, extra: &str, written: &[PathBuf]) {
     let [w, h, d] = spec.dims;
     println!(
-        "{} voxels (W×H×D = {w}×{h}×{d}, npy shape ({d}, {h}, {w})) in {secs:.3} s ({:.3e} voxels/s)",
+        "{} {noun} (W×H×D = {w}×{h}×{d}, npy shape ({d}, {h}, {w})){extra} in {secs:.3} s ({:.3e} {noun}/s)",
         spec.len(),
         spec.len() as f64 / secs.max(1e-9),
     );
     for p in written {
         println!("wrote {}", p.display());
     }
-    Ok(())
 }
