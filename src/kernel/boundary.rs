@@ -3,11 +3,8 @@
 //!
 //! Four edges at a time (`wide::f64x4`): offsets from the query, the `f64` orientation `d` with a
 //! rigorous error bound, lengths and the cancellation-free denominator. Instead of one `atan2`
-//! per edge, the terms `den + i·num` are *multiplied* into four complex accumulators and the
-//! number of times each accumulator's argument wraps past ±π is counted from sign bits
-//! (`Σ arg z_i = arg Π z_i + 2πk`); four `atan2` calls at the end give the sum. The wrap count is
-//! decided from the signs of the computed products themselves, so rounding can move the result
-//! by rounding-sized amounts only, never by 2π. (Profiling showed `atan2` at 53 % of the time
+//! per edge, the terms `den + i·num` go into one [`AngleSum`] (a complex product with turn
+//! counting; four `atan2` calls at the end). (Profiling showed `atan2` at 53 % of the time
 //! before this change.)
 //!
 //! Lanes whose `|d|` does not clear the bound (the query is within ~1e-15·extent of the edge's
@@ -16,14 +13,9 @@
 //! [`super::spherical::antipodal_edge_area`]. Either way the numerator's sign is the exact sign of
 //! [`super::predicates::perturbed_orient2d`], so the branch agrees with the crossing test.
 
-use wide::{CmpGt, CmpLt, f64x4};
+use wide::{CmpGt, f64x4};
 
-/// Lanes whose sign bit is set (negative numbers and −0.0), as a blend mask.
-#[inline]
-fn sign_bit(v: f64x4) -> f64x4 {
-    f64x4::ONE.copysign(v).cmp_lt(f64x4::ZERO)
-}
-
+use super::angle_sum::AngleSum;
 use super::predicates::{Width, perturbed_orient2d, query_inside_segment};
 use super::spherical::{EdgeSigns, antipodal_edge_area};
 
@@ -118,7 +110,7 @@ impl BoundaryEdges {
         let rel = f64x4::splat(2.0 * 4.0 * u);
         let zero = f64x4::ZERO;
         let one = f64x4::ONE;
-        let (mut re, mut im, mut wraps) = (one, zero, zero);
+        let mut angles = AngleSum::new();
         let mut scalar = 0.0;
         for (c, (p, real)) in self.coords.iter().zip(&self.weights).enumerate() {
             let ax = p[0] - qx;
@@ -148,24 +140,10 @@ impl BoundaryEdges {
             // Term den + i·num (num carries the exact sign of −d); identity 1 + 0i where unused.
             let t_re = ok.blend(pa * pb + (ax * bx + ay * by) * s2, one);
             let t_im = ok.blend((zero - d) * s2, zero);
-            let n_re = re * t_re - im * t_im;
-            let n_im = re * t_im + im * t_re;
-            // Wrap count from sign bits (as atan2 reads them): both factors in the upper half
-            // plane and the product in the lower → +1 turn; both lower, product upper → −1.
-            let up_a = !sign_bit(im);
-            let up_t = !sign_bit(t_im);
-            let up_n = !sign_bit(n_im);
-            let plus = up_a & up_t & !up_n;
-            let minus = !up_a & !up_t & up_n;
-            wraps += plus.blend(one, zero) - minus.blend(one, zero);
-            re = n_re;
-            im = n_im;
+            angles.push(t_re, t_im);
             if c % 2 == 1 {
-                // Keep the accumulators near unit modulus (terms are at most ~2^250).
-                let m = re.abs().max(im.abs());
-                let inv = one / m;
-                re *= inv;
-                im *= inv;
+                // Terms are at most ~2^250 (grid units): two pushes stay in range.
+                angles.rescale();
             }
             let mask = ok.move_mask();
             if mask != 0b1111 {
@@ -180,12 +158,7 @@ impl BoundaryEdges {
         for i in self.simd_len..self.a.len() {
             scalar += self.weight[i] * self.exact_edge_area::<W>(i, qi, z_exact, qz_units);
         }
-        let (re, im, wraps) = (re.to_array(), im.to_array(), wraps.to_array());
-        let mut angle = 0.0;
-        for l in 0..4 {
-            angle += im[l].atan2(re[l]) + std::f64::consts::TAU * wraps[l];
-        }
-        2.0 * angle + scalar
+        2.0 * angles.total() + scalar
     }
 
     /// One edge through the exact predicate and the limit formulas.

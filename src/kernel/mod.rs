@@ -5,8 +5,11 @@
 //! - [`predicates`]: the symbolically perturbed orientation sign shared by the ray–triangle test
 //!   and the atan2 branch, and the perturbed depth test (filter + exact fallback);
 //! - [`spherical`]: the solid-angle and spherical-triangle formulas;
+//! - [`angle_sum`]: sums of many `atan2` terms as one complex product with turn counting;
+//! - [`boundary`]: the SIMD loop over the boundary edges of the Antipodal formula;
 //! - [`compensated`]: Neumaier summation.
 
+pub mod angle_sum;
 pub mod boundary;
 pub mod compensated;
 pub mod frame;

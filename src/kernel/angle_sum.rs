@@ -1,0 +1,137 @@
+//! Sums of many angles `Σ atan2(y_i, x_i)` with one `atan2` per lane instead of one per term.
+//!
+//! `Σ arg z_i = arg Π z_i + 2π·k`: the terms `z_i = x_i + i·y_i` are *multiplied* into four
+//! complex accumulators, and the number of turns `k` each accumulator's argument makes past ±π is
+//! counted from sign bits as the product proceeds (both factors in the upper half plane and the
+//! product in the lower: +1 turn; both lower and the product upper: −1). Since every factor's
+//! argument lies in (−π, π], one product step can wrap at most once, and the wrap is read from the
+//! signs of the *computed* values — exactly the quadrants `atan2` would read — so rounding moves
+//! the result by rounding-sized amounts only, never by 2π.
+//!
+//! Used by the Antipodal boundary loop (spherical-triangle areas) and by the near field of the
+//! fast evaluator (triangle solid angles), where `atan2` was about half of the time.
+
+use wide::{CmpLt, f64x4};
+
+/// Four running complex products and their turn counts.
+#[derive(Clone, Copy, Debug)]
+pub struct AngleSum {
+    re: f64x4,
+    im: f64x4,
+    turns: f64x4,
+}
+
+impl Default for AngleSum {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// Lanes whose sign bit is set (negative numbers and −0.0), as a blend mask.
+#[inline]
+fn sign_bit(v: f64x4) -> f64x4 {
+    f64x4::ONE.copysign(v).cmp_lt(f64x4::ZERO)
+}
+
+impl AngleSum {
+    /// The empty sum (four accumulators equal to 1).
+    #[inline]
+    pub fn new() -> Self {
+        AngleSum {
+            re: f64x4::ONE,
+            im: f64x4::ZERO,
+            turns: f64x4::ZERO,
+        }
+    }
+
+    /// Adds `atan2(y, x)` of each lane. A lane with `x = 1, y = 0` adds nothing (use it for
+    /// padding and masked lanes). `(x, y)` must be finite and not both zero; its magnitude is
+    /// free, but the accumulators grow by it: call [`AngleSum::rescale`] before the product of
+    /// the magnitudes pushed since the last rescale can leave the `f64` range.
+    #[inline]
+    pub fn push(&mut self, x: f64x4, y: f64x4) {
+        let n_re = self.re * x - self.im * y;
+        let n_im = self.re * y + self.im * x;
+        let up_a = !sign_bit(self.im);
+        let up_t = !sign_bit(y);
+        let up_n = !sign_bit(n_im);
+        let plus = up_a & up_t & !up_n;
+        let minus = !up_a & !up_t & up_n;
+        self.turns += plus.blend(f64x4::ONE, f64x4::ZERO) - minus.blend(f64x4::ONE, f64x4::ZERO);
+        self.re = n_re;
+        self.im = n_im;
+    }
+
+    /// Brings the accumulators back to modulus ~1 (the arguments are unchanged).
+    #[inline]
+    pub fn rescale(&mut self) {
+        let m = self.re.abs().max(self.im.abs());
+        let inv = f64x4::ONE / m;
+        self.re *= inv;
+        self.im *= inv;
+    }
+
+    /// `Σ atan2(y_i, x_i)` over every lane of every push.
+    pub fn total(&self) -> f64 {
+        let (re, im, turns) = (
+            self.re.to_array(),
+            self.im.to_array(),
+            self.turns.to_array(),
+        );
+        (0..4)
+            .map(|l| im[l].atan2(re[l]) + std::f64::consts::TAU * turns[l])
+            .sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn matches_the_sum_of_atan2_through_many_turns() {
+        // Angles near ±π (the branch cut) and of both signs, many of them: the product winds
+        // around the origin several times per lane.
+        let mut sum = AngleSum::new();
+        let mut want = 0.0;
+        let mut state = 12345_u64;
+        for i in 0..400 {
+            let mut xs = [0.0; 4];
+            let mut ys = [0.0; 4];
+            for l in 0..4 {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                let t = (state >> 11) as f64 / (1u64 << 53) as f64;
+                let angle = if i % 3 == 0 {
+                    std::f64::consts::PI * (1.0 - 1e-9 * t)
+                } else {
+                    std::f64::consts::PI * (2.0 * t - 1.0)
+                };
+                let r = 1e-3 + 1e3 * t;
+                xs[l] = r * angle.cos();
+                ys[l] = r * angle.sin();
+                want += ys[l].atan2(xs[l]);
+            }
+            sum.push(f64x4::from(xs), f64x4::from(ys));
+            sum.rescale();
+        }
+        let got = sum.total();
+        assert!((got - want).abs() < 1e-9, "{got} vs {want}");
+        assert!(
+            want.abs() > 20.0,
+            "the test should wind several times: {want}"
+        );
+    }
+
+    #[test]
+    fn identity_lanes_add_nothing() {
+        let mut sum = AngleSum::new();
+        sum.push(
+            f64x4::from([1.0, -1.0, 0.0, 1.0]),
+            f64x4::from([0.0, 0.0, 2.0, 0.0]),
+        );
+        let want = std::f64::consts::PI + std::f64::consts::FRAC_PI_2;
+        assert!((sum.total() - want).abs() < 1e-15);
+    }
+}
