@@ -7,8 +7,8 @@ use std::path::PathBuf;
 use gwn::Mesh;
 use gwn::eval::direct::winding_number_direct_batch;
 use gwn::eval::fast::{
-    FastParams, FastWindingNumber, Moments, PointCloud, PointCloudWindingNumber, SYM_PAIRS,
-    WindingNumberApi, estimate_areas,
+    Admissibility, FastParams, FastWindingNumber, Moments, PointCloud, PointCloudWindingNumber,
+    SYM_PAIRS, WindingNumberApi, estimate_areas,
 };
 
 // ---------------------------------------------------------------- helpers
@@ -496,4 +496,68 @@ fn fossil_rule_with_correct_far_field_sign_tracks_the_direct_sum() {
     let approx = fast.eval_batch_with(&qs, FastParams::fossil(2.0));
     let (rms, _) = errors(&approx, &exact);
     assert!(rms < 5e-3, "FOSSIL default: rms {rms}");
+}
+
+#[test]
+fn libigl_box_corner_rule_tracks_the_direct_sum() {
+    // libigl's node size (distance from p̃ to the farthest box corner) is ≥ the radius, so at the
+    // same β it opens at least the nodes the radius rule opens.
+    let Some(mesh) = shared_mesh("cgal-hand.off") else {
+        return;
+    };
+    let qs = queries(&mesh, 300, 17);
+    let exact = winding_number_direct_batch(&mesh, &qs);
+    let fast = FastWindingNumber::new(&mesh);
+    let corner = |beta| FastParams {
+        beta,
+        order: 2,
+        admissibility: Admissibility::BoxCorner,
+    };
+    let (rms_c, max_c) = errors(&fast.eval_batch_with(&qs, corner(2.0)), &exact);
+    let (rms_r, _) = errors(
+        &fast.eval_batch_with(&qs, FastParams::barill(2.0, 2)),
+        &exact,
+    );
+    println!("beta 2: box corner rms {rms_c:.2e} max {max_c:.2e}, radius rms {rms_r:.2e}");
+    assert!(rms_c <= rms_r && rms_c < 1e-3, "{rms_c} vs {rms_r}");
+    let (_, max) = errors(&fast.eval_batch_with(&qs, corner(1e9)), &exact);
+    assert!(max <= 1e-12, "{max:e}");
+}
+
+#[test]
+fn near_field_keeps_the_scalar_semantics_on_degenerate_and_remote_triangles() {
+    // Leaves mixing zero-area triangles (collinear, repeated corners), tiny and huge ones, far
+    // from the origin: the four-lane near field must agree with the scalar direct sum, including
+    // queries in the plane of, on the line of, and at a corner of a triangle.
+    let mut rng = Rng(99);
+    let mut tris: Vec<[[f64; 3]; 3]> = Vec::new();
+    for i in 0..60 {
+        let o = [1e6, -2e6, 3e5].map(|v| v + rng.range(-1.0, 1.0));
+        let p = |rng: &mut Rng| o.map(|v| v + rng.range(-0.5, 0.5));
+        let (a, b) = (p(&mut rng), p(&mut rng));
+        let t = match i % 5 {
+            0 => [a, b, [0, 1, 2].map(|k| 0.5 * (a[k] + b[k]))], // collinear
+            1 => [a, a, b],                                      // repeated corner
+            2 => [a, b, [0, 1, 2].map(|k| a[k] + 1e-9 * (b[k] - a[k]) + 1e-12)], // sliver
+            _ => [a, b, p(&mut rng)],
+        };
+        tris.push(t);
+    }
+    let positions: Vec<[f64; 3]> = tris.iter().flatten().copied().collect();
+    let triangles = (0..tris.len() as u32)
+        .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+        .collect();
+    let soup = Mesh::new(positions, triangles).unwrap();
+    let mut qs: Vec<[f64; 3]> = (0..100)
+        .map(|_| [1e6, -2e6, 3e5].map(|v| v + rng.range(-1.5, 1.5)))
+        .collect();
+    for t in &tris[..10] {
+        qs.push(t[0]);
+        qs.push([0, 1, 2].map(|k| 2.0 * t[1][k] - t[0][k]));
+    }
+    let exact = winding_number_direct_batch(&soup, &qs);
+    let fast = FastWindingNumber::new(&soup);
+    let approx = fast.eval_batch_with(&qs, FastParams::barill(f64::INFINITY, 2));
+    let (_, max) = errors(&approx, &exact);
+    assert!(max <= 1e-12, "{max:e}");
 }

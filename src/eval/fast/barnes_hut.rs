@@ -1,8 +1,10 @@
 //! The Barnes–Hut engine shared by triangle soups and point clouds: per-node moments built
 //! bottom-up by re-centring, and the traversal of Barill et al.'s Algorithm 1.
 
+use wide::{CmpGt, CmpLt, f32x4, f64x4};
+
 use super::moments::{FarField, Moments};
-use super::tree::{STACK, Tree};
+use super::tree::Tree;
 
 /// Which node size the admissibility test `‖q − p̃‖ > β · size` uses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -14,6 +16,9 @@ pub enum Admissibility {
     /// FOSSIL: `size` = the diagonal of the node's bounding box (always `≥ r`, so for the same β
     /// this is the more conservative test; see the module docs for the mapping).
     BoxDiagonal,
+    /// libigl / Houdini (`UT_SolidAngle`): `size` = the distance from `p̃` to the farthest corner
+    /// of the node's bounding box (always `≥ r`).
+    BoxCorner,
 }
 
 /// Parameters of the fast evaluation: the accuracy parameter `β` and the expansion order.
@@ -65,27 +70,39 @@ impl FastParams {
     }
 }
 
-/// The per-node data the traversal reads, packed together (one cache line): the expansion
-/// centre, both admissibility sizes and the children / element range.
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct HotNode {
-    pub center: [f64; 3],
-    pub radius: f64,
-    pub diag: f64,
-    /// First child (`0` for a leaf; children are `left` and `left + 1`).
-    pub left: u32,
-    pub start: u32,
-    pub end: u32,
+/// Marks a lane of a [`WideNode`] that refers to a leaf (its number in [`Hierarchy::leaves`]).
+const LEAF: u32 = 1 << 31;
+/// Marks an unused lane (always at the end of a node).
+const EMPTY: u32 = u32::MAX;
+/// Upper bound of the query stack: a visit pops one node and pushes at most four, and every
+/// level of the 4-wide tree is at least one level of the binary tree (depth ≤ 34).
+const WIDE_STACK: usize = 3 * 35 + 4;
+
+/// A node of the query tree: up to four nodes of the binary tree, one per lane, collapsed from
+/// one or two levels below a binary node, so one `f64x4` test decides four admissibilities and
+/// one `f64x4` expansion evaluates every admissible one. Structure of arrays, as the lanes want
+/// it; the far-field coefficients live apart ([`Hierarchy::wide_far`]), since most visited lanes
+/// are tested but not expanded.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct WideNode {
+    /// The lanes' expansion centres `p̃` (NaN in unused lanes: never admissible).
+    center: [f64x4; 3],
+    /// The lanes' admissibility sizes, indexed by [`Admissibility`] (`as usize`).
+    size: [f64x4; 3],
+    /// Per lane: a query-tree node, `LEAF | leaf number`, or `EMPTY`.
+    child: [u32; 4],
 }
 
-/// Tree plus per-node moments and box diagonals, and the compact query-time records derived
-/// from them (`hot` for the traversal, `far` for the far-field evaluation).
+/// Tree plus per-node moments, and the 4-wide query tree derived from them.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Hierarchy {
     pub tree: Tree,
     pub moments: Vec<Moments>,
-    pub hot: Vec<HotNode>,
-    pub far: Vec<FarField>,
+    /// Element ranges of the leaves of `tree`, in element order (`order[range]`).
+    pub leaves: Vec<std::ops::Range<usize>>,
+    /// The query tree; node 0 holds the root of `tree` in its first lane.
+    wide: Vec<WideNode>,
+    wide_far: Vec<FarField<f32x4>>,
 }
 
 impl Hierarchy {
@@ -108,17 +125,10 @@ impl Hierarchy {
     ) -> Self {
         let n = tree.len();
         let mut moments = vec![Moments::default(); n];
-        let mut diag = vec![0.0; n];
         for id in (0..n).rev() {
             let node = tree.nodes[id];
             let elems = &tree.order[node.range()];
             let box_center = [0, 1, 2].map(|k| 0.5 * (node.min[k] + node.max[k]));
-            diag[id] = [0, 1, 2]
-                .map(|k| node.max[k] - node.min[k])
-                .iter()
-                .map(|d| d * d)
-                .sum::<f64>()
-                .sqrt();
             let mut m = if node.is_leaf() {
                 let mut area = 0.0;
                 let mut acc = [0.0; 3];
@@ -155,99 +165,172 @@ impl Hierarchy {
                 .sqrt();
             moments[id] = m;
         }
-        let hot = tree
-            .nodes
-            .iter()
-            .zip(&moments)
-            .zip(&diag)
-            .map(|((node, m), &diag)| HotNode {
-                center: m.center,
-                radius: m.radius,
-                diag,
-                left: node.left,
-                start: node.start,
-                end: node.end,
-            })
-            .collect();
-        let far = moments.iter().map(FarField::new).collect();
-        Hierarchy {
+        let mut h = Hierarchy {
             tree,
             moments,
-            hot,
-            far,
-        }
+            ..Hierarchy::default()
+        };
+        h.build_wide();
+        h
     }
 
-    /// FASTWN(q) (Algorithm 1), iteratively: a node far enough from `q` contributes its
-    /// expansion, a near leaf calls `leaf(range, sum)` to add its elements' exact contributions
-    /// (`range` indexes the elements in leaf order), a near inner node is opened. Both children
-    /// of an opened node are tested before anything is pushed, so only near inner nodes go on
-    /// the stack. Plain `f64` accumulation: the method is approximate to far more than the
-    /// rounding of the sum.
+    /// Numbers the leaves and collapses the binary tree into the 4-wide query tree: a binary
+    /// node's lanes start as its two children, and the widest (largest radius) inner lane is
+    /// replaced by its own two children until there are four lanes or only leaves.
+    fn build_wide(&mut self) {
+        let nodes = &self.tree.nodes;
+        if nodes.is_empty() {
+            return;
+        }
+        let mut leaf_of = vec![u32::MAX; nodes.len()];
+        let mut leaves: Vec<usize> = (0..nodes.len()).filter(|&i| nodes[i].is_leaf()).collect();
+        leaves.sort_by_key(|&i| nodes[i].start);
+        assert!(
+            leaves.len() < LEAF as usize,
+            "too many leaves for the query tree"
+        );
+        for (k, &i) in leaves.iter().enumerate() {
+            leaf_of[i] = k as u32;
+        }
+        self.leaves = leaves.iter().map(|&i| nodes[i].range()).collect();
+        let far: Vec<FarField> = self.moments.iter().map(FarField::new).collect();
+        let empty = FarField::default();
+        // (query-tree node, lane) to link to the query-tree node of a binary inner node.
+        let mut work: Vec<(usize, usize, usize)> = Vec::new();
+        let make = |lanes: &[usize],
+                    wide: &mut Vec<WideNode>,
+                    wide_far: &mut Vec<_>,
+                    work: &mut Vec<_>| {
+            let id = wide.len();
+            let get = |f: &dyn Fn(usize) -> f64| {
+                f64x4::from(std::array::from_fn::<f64, 4, _>(|l| {
+                    lanes.get(l).map_or(f64::NAN, |&b| f(b))
+                }))
+            };
+            let m = &self.moments;
+            let corner = |b: usize| {
+                let (n, c) = (&nodes[b], m[b].center);
+                (0..3)
+                    .map(|k| (c[k] - n.min[k]).max(n.max[k] - c[k]).powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+            };
+            let diag = |b: usize| {
+                let n = &nodes[b];
+                (0..3)
+                    .map(|k| (n.max[k] - n.min[k]).powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+            };
+            let mut size = [f64x4::ZERO; 3];
+            size[Admissibility::Radius as usize] = get(&|b| m[b].radius);
+            size[Admissibility::BoxDiagonal as usize] = get(&diag);
+            size[Admissibility::BoxCorner as usize] = get(&corner);
+            let mut child = [EMPTY; 4];
+            for (l, &b) in lanes.iter().enumerate() {
+                if nodes[b].is_leaf() {
+                    child[l] = LEAF | leaf_of[b];
+                } else {
+                    work.push((id, l, b));
+                }
+            }
+            wide.push(WideNode {
+                center: [0, 1, 2].map(|k| get(&|b| m[b].center[k])),
+                size,
+                child,
+            });
+            wide_far.push(FarField::lanes(std::array::from_fn(|l| {
+                lanes.get(l).map_or(&empty, |&b| &far[b])
+            })));
+        };
+        let mut wide = Vec::with_capacity(nodes.len() / 3 + 1);
+        let mut wide_far = Vec::with_capacity(nodes.len() / 3 + 1);
+        make(&[0], &mut wide, &mut wide_far, &mut work);
+        while let Some((parent, lane, b)) = work.pop() {
+            wide[parent].child[lane] = wide.len() as u32;
+            let mut lanes = vec![nodes[b].left as usize, nodes[b].left as usize + 1];
+            while lanes.len() < 4 {
+                let widest = (0..lanes.len())
+                    .filter(|&i| !nodes[lanes[i]].is_leaf())
+                    .max_by(|&i, &j| {
+                        let r = |i: usize| self.moments[lanes[i]].radius;
+                        r(i).total_cmp(&r(j))
+                    });
+                let Some(i) = widest else { break };
+                let l = nodes[lanes[i]].left as usize;
+                lanes[i] = l;
+                lanes.push(l + 1);
+            }
+            make(&lanes, &mut wide, &mut wide_far, &mut work);
+        }
+        self.wide = wide;
+        self.wide_far = wide_far;
+    }
+
+    /// FASTWN(q) (Algorithm 1), iteratively over the 4-wide query tree: the lanes far enough
+    /// from `q` contribute their expansions (all four evaluated at once, the others masked out),
+    /// a near leaf calls `leaf(number, range, sum)` to add its elements' exact contributions
+    /// (`range` indexes the elements in leaf order), a near inner node is pushed. Plain `f64`
+    /// accumulation: the method is approximate to far more than the rounding of the sum.
     #[inline]
     pub fn eval(
         &self,
         q: [f64; 3],
         params: &FastParams,
-        mut leaf: impl FnMut(std::ops::Range<usize>, &mut f64),
+        mut leaf: impl FnMut(usize, std::ops::Range<usize>, &mut f64),
     ) -> f64 {
-        if self.hot.is_empty() {
+        if self.wide.is_empty() {
             return 0.0;
         }
-        let beta = params.beta;
+        let beta = f64x4::splat(params.beta);
         let order = params.order;
-        let use_diag = params.admissibility == Admissibility::BoxDiagonal;
-        let hot = &self.hot[..];
-        let far = &self.far[..];
-        // `Some(r)` when node `id` is admissible (`r = p̃ − q`).
-        let admissible = |n: &HotNode| -> Option<[f64; 3]> {
-            let size = if use_diag { n.diag } else { n.radius };
-            let r = [n.center[0] - q[0], n.center[1] - q[1], n.center[2] - q[2]];
-            let d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-            let bs = beta * size;
-            // `bs < 0` (β ≤ 0) admits everything not at the centre; NaN admits nothing.
-            (d2 > 0.0 && (bs < 0.0 || d2 > bs * bs)).then_some(r)
-        };
+        let which = params.admissibility as usize;
+        let qv = q.map(f64x4::splat);
+        let zero = f64x4::ZERO;
+        let mut far = zero;
         let mut sum = 0.0;
-        let mut stack = [0u32; STACK];
+        let mut stack = [0u32; WIDE_STACK];
         let mut top = 0usize;
-        // The root is the only node tested after popping; every other node is tested by its
-        // parent.
-        let root = &hot[0];
-        if let Some(r) = admissible(root) {
-            return far[0].eval(r, order);
-        }
-        if root.left == 0 {
-            leaf(root.start as usize..root.end as usize, &mut sum);
-            return sum;
-        }
         let mut id = 0usize;
         loop {
-            let l = hot[id].left as usize;
-            let mut next = usize::MAX;
-            for c in [l, l + 1] {
-                let n = &hot[c];
-                if let Some(r) = admissible(n) {
-                    sum += far[c].eval(r, order);
-                } else if n.left == 0 {
-                    leaf(n.start as usize..n.end as usize, &mut sum);
-                } else if next == usize::MAX {
-                    next = c;
+            let node = &self.wide[id];
+            let r = [0, 1, 2].map(|k| node.center[k] - qv[k]);
+            let d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+            let bs = beta * node.size[which];
+            // `bs < 0` (β ≤ 0) admits everything not at the centre; NaN admits nothing.
+            let admit = d2.cmp_gt(zero) & (bs.cmp_lt(zero) | d2.cmp_gt(bs * bs));
+            let mask = admit.move_mask();
+            if mask != 0 {
+                let r32 = r.map(|v| {
+                    let a = v.to_array();
+                    f32x4::from([a[0] as f32, a[1] as f32, a[2] as f32, a[3] as f32])
+                });
+                let w = self.wide_far[id].eval(r32, order).to_array();
+                let w = f64x4::from([w[0] as f64, w[1] as f64, w[2] as f64, w[3] as f64]);
+                far += admit.blend(w, zero);
+            }
+            for (l, &c) in node.child.iter().enumerate() {
+                if c == EMPTY {
+                    break;
+                }
+                if mask & (1 << l) != 0 {
+                    continue;
+                }
+                if c & LEAF != 0 {
+                    let k = (c & !LEAF) as usize;
+                    leaf(k, self.leaves[k].clone(), &mut sum);
                 } else {
-                    stack[top] = c as u32;
+                    stack[top] = c;
                     top += 1;
                 }
             }
-            if next != usize::MAX {
-                id = next;
-            } else if top > 0 {
-                top -= 1;
-                id = stack[top] as usize;
-            } else {
+            if top == 0 {
                 break;
             }
+            top -= 1;
+            id = stack[top] as usize;
         }
-        sum
+        sum + far.reduce_add()
     }
 }
 

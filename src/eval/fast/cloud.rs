@@ -289,7 +289,7 @@ impl PointCloudWindingNumber {
     /// The approximate winding number at `q` with explicit parameters.
     pub fn eval_with(&self, q: [f64; 3], params: FastParams) -> f64 {
         let (p, an) = (&self.positions, &self.weighted_normals);
-        self.hierarchy.eval(q, &params, |range, sum| {
+        self.hierarchy.eval(q, &params, |_, range, sum| {
             for i in range {
                 *sum += dipole(p[i], an[i], q);
             }

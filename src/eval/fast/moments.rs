@@ -22,6 +22,8 @@
 // The tensor code indexes like the formulas it transcribes (`M1[i][j] += δᵢ Nⱼ`).
 #![allow(clippy::needless_range_loop)]
 
+use wide::f32x4;
+
 use crate::kernel::spherical::{cross, dot};
 
 const INV_4PI: f64 = 1.0 / (4.0 * std::f64::consts::PI);
@@ -225,15 +227,49 @@ impl Moments {
 ///
 /// where `tr = tr M1`, `vₖ = Σᵢ M2ᵢᵢₖ + 2 Σᵢ M2ᵢₖᵢ`, `M1` is kept as the six coefficients of its
 /// quadratic form and `M2` as the ten coefficients of its cubic form.
+///
+/// The coefficients are stored for `u = r / s`, `s` the node radius: `n/s²`, `tr/s³`, `M1/s³`,
+/// `v/s⁴`, `M2/s⁴` (each term of `w̃` is homogeneous of degree 0). They are then of order 1
+/// whatever the mesh's units, so the `f32` lanes neither underflow (a mesh in metres of size
+/// 1e-2 has `M2 ≈ 1e-10`, and `M2/d⁷` runs into subnormals) nor overflow.
+///
+/// `T` is `f64` (one node) or `f32x4` (the four lanes of a node of the 4-wide query tree): one
+/// generic formula serves both. `f32` halves the arithmetic and the memory of the far field; its
+/// rounding (~1e-7 relative per node) is four orders below the truncation error of the
+/// expansion (~1e-3), and the near field, which decides the β → ∞ limit, stays `f64`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(crate) struct FarField {
-    n: [f64; 3],
-    tr: f64,
+pub(crate) struct FarField<T = f64> {
+    /// `1/s`.
+    inv_s: T,
+    n: [T; 3],
+    tr: T,
     /// Coefficients of `r0², r1², r2², r0r1, r0r2, r1r2`.
-    q: [f64; 6],
-    v: [f64; 3],
+    q: [T; 6],
+    v: [T; 3],
     /// Coefficients of `r0³, r1³, r2³, r0²r1, r0²r2, r1²r0, r1²r2, r2²r0, r2²r1, r0r1r2`.
-    c: [f64; 10],
+    c: [T; 10],
+}
+
+/// The arithmetic [`FarField::eval`] needs, for `f64` and for four lanes of it.
+pub(crate) trait Lanes:
+    Copy + std::ops::Add<Output = Self> + std::ops::Mul<Output = Self>
+{
+    /// `1/√x`.
+    fn rsqrt(self) -> Self;
+}
+
+impl Lanes for f64 {
+    #[inline]
+    fn rsqrt(self) -> Self {
+        1.0 / self.sqrt()
+    }
+}
+
+impl Lanes for f32x4 {
+    #[inline]
+    fn rsqrt(self) -> Self {
+        f32x4::ONE / self.sqrt()
+    }
 }
 
 impl FarField {
@@ -284,21 +320,61 @@ impl FarField {
                 }
             }
         }
+        // Any positive scale is exact; a zero radius (coincident points) takes 1.
+        let inv = 1.0 / m.radius;
+        let (scale, inv_s) = if m.radius > 0.0 && inv.is_finite() {
+            (m.radius, inv)
+        } else {
+            (1.0, 1.0)
+        };
+        let (s2, s3, s4) = (s / scale.powi(2), s / scale.powi(3), s / scale.powi(4));
         FarField {
-            n: m.n.map(|x| x * s),
-            tr: (m1[0][0] + m1[1][1] + m1[2][2]) * s,
-            q: q.map(|x| -3.0 * s * x),
-            v: v.map(|x| -1.5 * s * x),
-            c: c.map(|x| 7.5 * s * x),
+            inv_s,
+            n: m.n.map(|x| x * s2),
+            tr: (m1[0][0] + m1[1][1] + m1[2][2]) * s3,
+            q: q.map(|x| -3.0 * s3 * x),
+            v: v.map(|x| -1.5 * s4 * x),
+            c: c.map(|x| 7.5 * s4 * x),
         }
     }
+}
 
-    /// The same value as [`Moments::far_field`] at `q = p̃ − r`.
+impl FarField<f32x4> {
+    /// The four records side by side, one per lane, rounded to `f32`.
+    pub fn lanes(f: [&FarField; 4]) -> Self {
+        fn pack<const N: usize>(
+            f: [&FarField; 4],
+            get: impl Fn(&FarField) -> [f64; N],
+        ) -> [f32x4; N] {
+            let a = f.map(get);
+            std::array::from_fn(|i| {
+                f32x4::from([
+                    a[0][i] as f32,
+                    a[1][i] as f32,
+                    a[2][i] as f32,
+                    a[3][i] as f32,
+                ])
+            })
+        }
+        FarField {
+            inv_s: pack(f, |x| [x.inv_s])[0],
+            n: pack(f, |x| x.n),
+            tr: pack(f, |x| [x.tr])[0],
+            q: pack(f, |x| x.q),
+            v: pack(f, |x| x.v),
+            c: pack(f, |x| x.c),
+        }
+    }
+}
+
+impl<T: Lanes> FarField<T> {
+    /// The same value as [`Moments::far_field`] at `q = p̃ − r` (per lane).
     #[inline]
-    pub fn eval(&self, r: [f64; 3], order: u8) -> f64 {
+    pub fn eval(&self, r: [T; 3], order: u8) -> T {
+        let r = r.map(|v| v * self.inv_s);
         let d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-        let inv_d2 = 1.0 / d2;
-        let inv_d = inv_d2.sqrt();
+        let inv_d = d2.rsqrt();
+        let inv_d2 = inv_d * inv_d;
         let inv_d3 = inv_d * inv_d2;
         let mut w3 = self.n[0] * r[0] + self.n[1] * r[1] + self.n[2] * r[2];
         if order == 0 {
@@ -307,13 +383,13 @@ impl FarField {
         let (x, y, z) = (r[0], r[1], r[2]);
         let (xx, yy, zz) = (x * x, y * y, z * z);
         let q = &self.q;
-        w3 += self.tr;
+        w3 = w3 + self.tr;
         let mut w5 = q[0] * xx + q[1] * yy + q[2] * zz + q[3] * x * y + q[4] * x * z + q[5] * y * z;
         let inv_d5 = inv_d3 * inv_d2;
         if order == 1 {
             return w3 * inv_d3 + w5 * inv_d5;
         }
-        w5 += self.v[0] * x + self.v[1] * y + self.v[2] * z;
+        w5 = w5 + self.v[0] * x + self.v[1] * y + self.v[2] * z;
         let c = &self.c;
         let w7 = x * (c[0] * xx + c[3] * x * y + c[4] * x * z + c[5] * yy + c[7] * zz)
             + y * (c[1] * yy + c[6] * y * z + c[8] * zz)
@@ -451,6 +527,28 @@ mod tests {
                 assert!(
                     (a - b).abs() <= 1e-14 * a.abs().max(1e-3),
                     "{order}: {a} vs {b}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn four_lanes_in_f32_equal_the_scalar_far_field() {
+        let nodes = [P, [0.2, 0.5, -0.1], [-1.0, 0.3, 0.2], [0.0, 0.0, 0.0]]
+            .map(|c| Moments::of_triangle(A, B, C, P).recentred(c));
+        let far = nodes.map(|m| FarField::new(&m));
+        let lanes = FarField::<f32x4>::lanes([&far[0], &far[1], &far[2], &far[3]]);
+        let q = [3.0, -2.0, 1.5];
+        let r = nodes.map(|m| sub(m.center, q));
+        let rl = [0, 1, 2].map(|k| f32x4::from(r.map(|r| r[k] as f32)));
+        for order in 0..=2u8 {
+            let got = lanes.eval(rl, order).to_array();
+            for l in 0..4 {
+                let want = nodes[l].far_field(q, order);
+                assert!(
+                    (f64::from(got[l]) - want).abs() <= 1e-6 * want.abs().max(1e-3),
+                    "order {order}, lane {l}: {} vs {want}",
+                    got[l]
                 );
             }
         }

@@ -5,6 +5,9 @@ use rayon::prelude::*;
 use super::barnes_hut::{FastParams, Hierarchy};
 use super::moments::Moments;
 use super::tree::Tree;
+use wide::{CmpEq, CmpGt, CmpLt, f64x4};
+
+use crate::kernel::angle_sum::AngleSum;
 use crate::kernel::spherical::triangle_solid_angle;
 use crate::{BoundingBox, Mesh};
 
@@ -34,6 +37,9 @@ pub struct FastWindingNumber {
     hierarchy: Hierarchy,
     /// Triangle corners in leaf order.
     triangles: Vec<[[f64; 3]; 3]>,
+    /// The same corners leaf by leaf, one triangle per lane (`x, y, z` of `a`, `b`, `c`);
+    /// unused lanes are zero, a triangle with `det = 0` that adds nothing.
+    leaves: Vec<[f64x4; 9]>,
     params: FastParams,
 }
 
@@ -77,15 +83,28 @@ impl FastWindingNumber {
             },
             |e, c| tris[e].iter().map(|&v| dist2(v, c)).fold(0.0, f64::max),
         );
-        let triangles = hierarchy
+        let triangles: Vec<[[f64; 3]; 3]> = hierarchy
             .tree
             .order
             .iter()
             .map(|&e| tris[e as usize])
             .collect();
+        let leaves = hierarchy
+            .leaves
+            .iter()
+            .map(|range| {
+                let t = &triangles[range.clone()];
+                std::array::from_fn(|i| {
+                    f64x4::from(std::array::from_fn::<f64, 4, _>(|l| {
+                        t.get(l).map_or(0.0, |t| t[i / 3][i % 3])
+                    }))
+                })
+            })
+            .collect();
         FastWindingNumber {
             hierarchy,
             triangles,
+            leaves,
             params,
         }
     }
@@ -108,15 +127,20 @@ impl FastWindingNumber {
     /// The approximate winding number at `q` with explicit parameters (Barill's form:
     /// `FastParams::barill(beta, order)`).
     pub fn eval_with(&self, q: [f64; 3], params: FastParams) -> f64 {
-        let tris = &self.triangles;
-        self.hierarchy.eval(q, &params, |range, sum| {
-            for t in &tris[range] {
-                let a = sub(t[0], q);
-                let b = sub(t[1], q);
-                let c = sub(t[2], q);
-                *sum += triangle_solid_angle(a, b, c) * INV_4PI;
+        let mut angles = AngleSum::new();
+        let far_and_rare = self.hierarchy.eval(q, &params, |k, range, sum| {
+            let ok = push_solid_angles(&mut angles, &self.leaves[k], q);
+            if ok != 0b1111 {
+                for (l, t) in self.triangles[range].iter().enumerate() {
+                    if ok & (1 << l) == 0 {
+                        *sum += triangle_solid_angle(sub(t[0], q), sub(t[1], q), sub(t[2], q))
+                            * INV_4PI;
+                    }
+                }
             }
-        })
+        });
+        // Σ 2·atan2(det, den) / (4π).
+        far_and_rare + angles.total() * (2.0 * INV_4PI)
     }
 
     /// [`Self::eval`] for many points, in parallel (rayon).
@@ -171,6 +195,35 @@ impl FastWindingNumber {
             max: n.max,
         }
     }
+}
+
+/// Pushes `atan2(det, den)` of the Van Oosterom–Strackee formula (half the solid angle; see
+/// [`triangle_solid_angle`]) for the four triangles of a leaf seen from `q`, computed exactly as
+/// the scalar formula does, lane by lane. Returns the mask of the lanes done: the others are
+/// either `det = 0` (they contribute 0, as in the scalar formula) or need the scalar formula's
+/// zero-area test (`|det| ≤ 1e-12·|a||b||c|`) or overflowed; the caller recomputes those.
+#[inline]
+fn push_solid_angles(angles: &mut AngleSum, t: &[f64x4; 9], q: [f64; 3]) -> u32 {
+    let [qx, qy, qz] = q.map(f64x4::splat);
+    let (ax, ay, az) = (t[0] - qx, t[1] - qy, t[2] - qz);
+    let (bx, by, bz) = (t[3] - qx, t[4] - qy, t[5] - qz);
+    let (cx, cy, cz) = (t[6] - qx, t[7] - qy, t[8] - qz);
+    let la = (ax * ax + ay * ay + az * az).sqrt();
+    let lb = (bx * bx + by * by + bz * bz).sqrt();
+    let lc = (cx * cx + cy * cy + cz * cz).sqrt();
+    let det = ax * (by * cz - bz * cy) + ay * (bz * cx - bx * cz) + az * (bx * cy - by * cx);
+    let labc = la * lb * lc;
+    let den = labc
+        + (ax * bx + ay * by + az * bz) * lc
+        + (bx * cx + by * cy + bz * cz) * la
+        + (cx * ax + cy * ay + cz * az) * lb;
+    let ok = det.abs().cmp_gt(f64x4::splat(1e-12) * labc)
+        & den.abs().cmp_lt(f64x4::splat(f64::INFINITY));
+    angles.push(ok.blend(den, f64x4::ONE), ok.blend(det, f64x4::ZERO));
+    // World coordinates have any magnitude: keep the products near 1 after every factor.
+    angles.rescale();
+    let zero = det.cmp_eq(f64x4::ZERO).move_mask() as u32;
+    ok.move_mask() as u32 | zero
 }
 
 #[inline]
