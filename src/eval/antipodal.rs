@@ -297,10 +297,13 @@ impl<W: Width> Core<W> {
     /// Snaps the world query into the frame, axis by axis.
     #[inline]
     fn snap_frame(&self, q: [f64; 3]) -> [Snap; 3] {
-        self.ray.map().map(|(axis, neg)| {
+        // Written out (not `array::map`): the closure version was not inlined into the hot path.
+        let [m0, m1, m2] = self.ray.map();
+        let one = |(axis, neg): (usize, bool)| {
             let s = self.grid.snap(q[axis], axis);
             if neg { s.negated() } else { s }
-        })
+        };
+        [one(m0), one(m1), one(m2)]
     }
 
     fn parts(&self, q: [f64; 3]) -> (i64, f64) {
