@@ -12,6 +12,11 @@
 //! for [`Precision::Bits30`], `3e-18·extent` for [`Precision::Bits60`], below `f64` resolution of
 //! the mesh's own coordinates). Queries outside the padded box are *not* snapped in the
 //! offending axis: the evaluator treats them by the clamp rules in `eval::antipodal`.
+//!
+//! Queries farther than `2^30` padded-box half-widths from the origin along an axis are first
+//! moved to that distance along that axis ([`Grid::pull_in_far`]): beyond it the boundary
+//! term's products would overflow `f64` (w was NaN at 1e100), and the move changes `w` by less
+//! than `2^-60` (see there).
 
 use crate::BoundingBox;
 
@@ -133,6 +138,30 @@ impl Grid {
         self.limit
     }
 
+    /// Moves a query farther than `R = 2^30` padded-box half-widths from the origin along any
+    /// axis to distance `R` along that axis (each coordinate clamped to `origin ± R`).
+    ///
+    /// Why this is harmless: every clamped coordinate stays outside the padded box along the
+    /// whole segment from the query to the moved point, so the segment meets no triangle and `w`
+    /// is continuous along it; both ends lie at distance `≥ R` from the mesh, where `|w|` and its
+    /// change are bounded by the solid angle of the mesh, `O((extent/R)²) < 2^-60`. (Closed
+    /// meshes: `w = 0` at both ends exactly.)
+    #[inline]
+    pub fn pull_in_far(&self, q: [f64; 3]) -> [f64; 3] {
+        let r = FAR * self.limit as f64 * self.cell;
+        std::array::from_fn(|k| {
+            let o = self.origin[k];
+            // `q − o` cannot overflow in halves.
+            if 0.5 * q[k] - 0.5 * o > 0.5 * r {
+                o + r
+            } else if 0.5 * q[k] - 0.5 * o < -0.5 * r {
+                o - r
+            } else {
+                q[k]
+            }
+        })
+    }
+
     /// Snaps one coordinate along `axis`.
     #[inline]
     pub fn snap(&self, x: f64, axis: usize) -> Snap {
@@ -174,6 +203,9 @@ impl Grid {
         v as f64 * self.cell + self.origin[axis]
     }
 }
+
+/// Distance, in padded-box half-widths, beyond which queries are pulled in.
+const FAR: f64 = (1_u64 << 30) as f64;
 
 /// Below this magnitude `v as i64` is exact truncation.
 const TRUNC_EXACT: f64 = (1_u64 << 62) as f64;
