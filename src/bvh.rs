@@ -10,24 +10,49 @@
 //! so no triangle that the exact test would count is ever culled. Traversal never stops early.
 
 use obvhs::{BvhBuildParams, aabb::Aabb, bvh2::builder::build_bvh2};
+use wide::{CmpGe, CmpLe, f32x4};
 
 /// Padding of every box in normalized grid coordinates.
 const PAD: f32 = 1.0 / (1 << 20) as f32;
 
-/// An inner node holding the boxes of its two children, reduced to what an axis-aligned ray
-/// along `+z` needs: the x and y extents and the top in z. Testing both children where the
-/// parent is read halves the node loads of a plain BVH2 walk.
-#[derive(Clone, Copy, Debug, Default)]
+/// Scale applied to z before the build. The SAH cost of a box is its surface area, the
+/// probability that a *random* ray meets it; for rays along `+z` that probability is the box's
+/// projected xy area, which is what a box flattened along z measures. A small non-zero scale
+/// keeps z as a tie-breaker (it lets the `hi_z` test cull the part of a column below the
+/// query). Measured on ten shared meshes (1 thread, random-order grid queries): 1.0 → 0.1
+/// gains 3–10 % on closed meshes; 0.02 is no better.
+const Z_SCALE: f32 = 0.1;
+
+/// An inner node holding the boxes of up to four children, reduced to what an axis-aligned ray
+/// along `+z` needs: the x and y extents and the top in z, one SIMD lane per child. All four
+/// children are tested at once, so a query pays one branch per *node* instead of one per box
+/// (mispredicted branches dominated the binary walk).
+#[derive(Clone, Copy, Debug)]
 struct Node {
-    lo_x: [f32; 2],
-    hi_x: [f32; 2],
-    lo_y: [f32; 2],
-    hi_y: [f32; 2],
-    hi_z: [f32; 2],
+    lo_x: f32x4,
+    hi_x: f32x4,
+    lo_y: f32x4,
+    hi_y: f32x4,
+    hi_z: f32x4,
     /// Child `c`: an inner node index, or `LEAF | first` for a leaf whose primitives are
-    /// `prims[first..first + count[c]]`.
-    child: [u32; 2],
-    count: [u32; 2],
+    /// `prims[first..first + count[c]]`. Unused lanes have empty boxes (`lo = +∞`, `hi = −∞`).
+    child: [u32; 4],
+    count: [u32; 4],
+}
+
+impl Default for Node {
+    fn default() -> Self {
+        let inf = f32x4::splat(f32::INFINITY);
+        Node {
+            lo_x: inf,
+            hi_x: -inf,
+            lo_y: inf,
+            hi_y: -inf,
+            hi_z: -inf,
+            child: [0; 4],
+            count: [0; 4],
+        }
+    }
 }
 
 const LEAF: u32 = 1 << 31;
@@ -50,17 +75,19 @@ impl RayBvh {
         if boxes.is_empty() {
             return RayBvh::default();
         }
-        let aabbs: Vec<Aabb> = boxes
+        let padded: Vec<Box3> = boxes
+            .iter()
+            .map(|(lo, hi)| (lo.map(|v| v - PAD), hi.map(|v| v + PAD)))
+            .collect();
+        let aabbs: Vec<Aabb> = padded
             .iter()
             .map(|(lo, hi)| {
-                Aabb::new(
-                    glam::Vec3A::from_array(lo.map(|v| v - PAD)),
-                    glam::Vec3A::from_array(hi.map(|v| v + PAD)),
-                )
+                let flat = |v: &[f32; 3]| glam::Vec3A::new(v[0], v[1], v[2] * Z_SCALE);
+                Aabb::new(flat(lo), flat(hi))
             })
             .collect();
         let mut t = std::time::Duration::ZERO;
-        // Small leaves: a node test is four float comparisons, a triangle test three exact
+        // Single-triangle leaves: a node test is cheap, a triangle test three exact
         // orientations, so the traversal should cull down to (nearly) single triangles.
         let params = BvhBuildParams {
             max_prims_per_leaf: 1,
@@ -69,53 +96,74 @@ impl RayBvh {
         };
         let bvh = build_bvh2(&aabbs, params, &mut t);
         let src = &bvh.nodes;
-        let root = &src[0];
-        if root.prim_count > 0 {
+        let prims = bvh.primitive_indices;
+        // True (unflattened) padded boxes of every source node, children before parents.
+        let boxes = true_boxes(src, &prims, &padded);
+        if src[0].prim_count > 0 {
             return RayBvh {
                 nodes: Vec::new(),
-                prims: bvh.primitive_indices,
-                root_leaf: Some((
-                    (root.aabb.min.to_array(), root.aabb.max.to_array()),
-                    root.prim_count,
-                )),
+                root_leaf: Some((boxes[0], src[0].prim_count)),
+                prims,
             };
         }
-        // Re-index inner nodes only; a leaf child is referenced through LEAF | first.
-        let mut index = vec![u32::MAX; src.len()];
-        let mut inner = 0u32;
-        for (i, n) in src.iter().enumerate() {
-            if n.prim_count == 0 {
-                index[i] = inner;
-                inner += 1;
+        // Collapse the binary tree into a 4-wide one: open the inner child with the largest
+        // projected area until a node has four children (the child a ray is most likely to
+        // enter gains most from being tested together with its siblings).
+        let xy_area = |i: usize| {
+            let (lo, hi) = boxes[i];
+            (hi[0] - lo[0]) * (hi[1] - lo[1])
+        };
+        let mut nodes: Vec<Node> = vec![Node::default()];
+        let mut queue: Vec<(usize, usize)> = vec![(0, 0)];
+        while let Some((s, out)) = queue.pop() {
+            let first = src[s].first_index as usize;
+            let mut kids: Vec<usize> = vec![first, first + 1];
+            while kids.len() < 4 {
+                let open = kids
+                    .iter()
+                    .enumerate()
+                    .filter(|&(_, &k)| src[k].prim_count == 0)
+                    .max_by(|a, b| xy_area(*a.1).total_cmp(&xy_area(*b.1)))
+                    .map(|(i, _)| i);
+                let Some(i) = open else { break };
+                let k = kids.swap_remove(i);
+                let f = src[k].first_index as usize;
+                kids.extend([f, f + 1]);
             }
-        }
-        let mut nodes = vec![Node::default(); inner as usize];
-        for (i, n) in src.iter().enumerate() {
-            if n.prim_count > 0 {
-                continue;
-            }
+            let mut lanes: [[f32; 4]; 5] = [
+                [f32::INFINITY; 4],
+                [f32::NEG_INFINITY; 4],
+                [f32::INFINITY; 4],
+                [f32::NEG_INFINITY; 4],
+                [f32::NEG_INFINITY; 4],
+            ];
             let mut node = Node::default();
-            for c in 0..2 {
-                let k = n.first_index as usize + c;
-                let ch = &src[k];
-                let (lo, hi) = (ch.aabb.min.to_array(), ch.aabb.max.to_array());
-                node.lo_x[c] = lo[0];
-                node.hi_x[c] = hi[0];
-                node.lo_y[c] = lo[1];
-                node.hi_y[c] = hi[1];
-                node.hi_z[c] = hi[2];
-                if ch.prim_count > 0 {
-                    node.child[c] = LEAF | ch.first_index;
-                    node.count[c] = ch.prim_count;
+            for (c, &k) in kids.iter().enumerate() {
+                let (lo, hi) = boxes[k];
+                lanes[0][c] = lo[0];
+                lanes[1][c] = hi[0];
+                lanes[2][c] = lo[1];
+                lanes[3][c] = hi[1];
+                lanes[4][c] = hi[2];
+                if src[k].prim_count > 0 {
+                    node.child[c] = LEAF | src[k].first_index;
+                    node.count[c] = src[k].prim_count;
                 } else {
-                    node.child[c] = index[k];
+                    node.child[c] = nodes.len() as u32;
+                    queue.push((k, nodes.len()));
+                    nodes.push(Node::default());
                 }
             }
-            nodes[index[i] as usize] = node;
+            node.lo_x = f32x4::from(lanes[0]);
+            node.hi_x = f32x4::from(lanes[1]);
+            node.lo_y = f32x4::from(lanes[2]);
+            node.hi_y = f32x4::from(lanes[3]);
+            node.hi_z = f32x4::from(lanes[4]);
+            nodes[out] = node;
         }
         RayBvh {
             nodes,
-            prims: bvh.primitive_indices,
+            prims,
             root_leaf: None,
         }
     }
@@ -143,6 +191,7 @@ impl RayBvh {
         if self.nodes.is_empty() {
             return;
         }
+        let (xs, ys, zs) = (f32x4::splat(x), f32x4::splat(y), f32x4::splat(z_min));
         let mut stack = [0u32; 64];
         let mut sp = 1;
         let mut overflow: Vec<u32> = Vec::new();
@@ -156,15 +205,15 @@ impl RayBvh {
                 break;
             };
             let n = &self.nodes[idx as usize];
-            for c in 0..2 {
-                if x < n.lo_x[c]
-                    || x > n.hi_x[c]
-                    || y < n.lo_y[c]
-                    || y > n.hi_y[c]
-                    || n.hi_z[c] < z_min
-                {
-                    continue;
-                }
+            let hit = xs.cmp_ge(n.lo_x)
+                & xs.cmp_le(n.hi_x)
+                & ys.cmp_ge(n.lo_y)
+                & ys.cmp_le(n.hi_y)
+                & n.hi_z.cmp_ge(zs);
+            let mut bits = hit.move_mask() as u32;
+            while bits != 0 {
+                let c = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
                 let ch = n.child[c];
                 if ch & LEAF != 0 {
                     let s = (ch & !LEAF) as usize;
@@ -180,6 +229,37 @@ impl RayBvh {
             }
         }
     }
+}
+
+/// The padded boxes of every node of an `obvhs` hierarchy, recomputed from its primitives (the
+/// hierarchy was built on boxes flattened along z).
+fn true_boxes(src: &[obvhs::bvh2::node::Bvh2Node], prims: &[u32], padded: &[Box3]) -> Vec<Box3> {
+    let empty = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    let union = |a: Box3, b: Box3| -> Box3 {
+        (
+            std::array::from_fn(|k| a.0[k].min(b.0[k])),
+            std::array::from_fn(|k| a.1[k].max(b.1[k])),
+        )
+    };
+    let mut out = vec![empty; src.len()];
+    // Post-order without recursion: a node is finished when popped the second time.
+    let mut stack = vec![(0usize, false)];
+    while let Some((i, done)) = stack.pop() {
+        let n = &src[i];
+        if n.prim_count > 0 {
+            let s = n.first_index as usize;
+            out[i] = prims[s..s + n.prim_count as usize]
+                .iter()
+                .fold(empty, |acc, &p| union(acc, padded[p as usize]));
+        } else if done {
+            let c = n.first_index as usize;
+            out[i] = union(out[c], out[c + 1]);
+        } else {
+            let c = n.first_index as usize;
+            stack.extend([(i, true), (c, false), (c + 1, false)]);
+        }
+    }
+    out
 }
 
 #[cfg(test)]

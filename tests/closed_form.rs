@@ -138,3 +138,39 @@ fn query_on_boundary_vertices_and_edges_equals_the_perturbed_limit() {
         }
     }
 }
+
+#[test]
+fn astronomically_far_queries_are_finite_and_vanish() {
+    // Once w was NaN beyond ~1e76 along the ray axis (the boundary products overflowed).
+    let open = open_cube();
+    let closed = unit_cube();
+    let mut far = Vec::new();
+    for big in [1e12, 1e100, 1e300, f64::MAX] {
+        for axis in 0..3 {
+            for sign in [-1.0, 1.0] {
+                let mut q = [0.3, 0.6, 0.2];
+                q[axis] = sign * big;
+                far.push(q);
+            }
+        }
+        far.push([big, -big, big]);
+    }
+    for precision in [Precision::Bits30, Precision::Bits60] {
+        for ray in [RayAxis::PosZ, RayAxis::NegX] {
+            let opts = Options { precision, ray };
+            let wo = WindingNumber::with_options(&open, opts).unwrap();
+            let wc = WindingNumber::with_options(&closed, opts).unwrap();
+            for &q in &far {
+                let v = wo.eval(q);
+                assert!(v.abs() < 1e-15, "open cube at {q:?}: {v}");
+                assert_eq!(wc.eval(q), 0.0, "closed cube at {q:?}");
+                // ±1e200 along the ray axis: still far whichever coordinate of q was.
+                let col = wo.eval_column(q, &[1e200, -1e200, f64::MAX]);
+                assert!(
+                    col.iter().all(|v| v.abs() < 1e-15),
+                    "column at {q:?}: {col:?}"
+                );
+            }
+        }
+    }
+}

@@ -138,7 +138,9 @@ impl WindingNumber {
     }
 
     /// The two parts of the formula: the signed crossing count χ and the boundary sum
-    /// `Σ k·Area` (not yet divided by 4π). `(0, NaN)` for a non-finite query.
+    /// `Σ k·Area` (not yet divided by 4π). `(0, NaN)` for a non-finite query. For a query more
+    /// than `2^30` box sizes away, the parts of the point pulled in to that distance
+    /// ([`crate::kernel::quantize::Grid::pull_in_far`]; same `w` to `2^-60`).
     pub fn parts(&self, q: [f64; 3]) -> (i64, f64) {
         if q.iter().any(|c| !c.is_finite()) {
             return (0, f64::NAN);
@@ -297,13 +299,17 @@ impl<W: Width> Core<W> {
     /// Snaps the world query into the frame, axis by axis.
     #[inline]
     fn snap_frame(&self, q: [f64; 3]) -> [Snap; 3] {
-        self.ray.map().map(|(axis, neg)| {
+        // Written out (not `array::map`): the closure version was not inlined into the hot path.
+        let [m0, m1, m2] = self.ray.map();
+        let one = |(axis, neg): (usize, bool)| {
             let s = self.grid.snap(q[axis], axis);
             if neg { s.negated() } else { s }
-        })
+        };
+        [one(m0), one(m1), one(m2)]
     }
 
     fn parts(&self, q: [f64; 3]) -> (i64, f64) {
+        let q = self.grid.pull_in_far(q);
         let qf = self.ray.to_frame(q);
         let snap = self.snap_frame(q);
         let (Snap::In(x), Snap::In(y)) = (snap[0], snap[1]) else {
@@ -330,7 +336,7 @@ impl<W: Width> Core<W> {
         let at = |t: f64| {
             let mut p = q;
             p[axis] = t;
-            p
+            self.grid.pull_in_far(p)
         };
         let snap = self.snap_frame(q);
         let (Snap::In(x), Snap::In(y)) = (snap[0], snap[1]) else {

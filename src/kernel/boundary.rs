@@ -19,60 +19,92 @@ use super::angle_sum::AngleSum;
 use super::predicates::{Width, perturbed_orient2d, query_inside_segment};
 use super::spherical::{EdgeSigns, antipodal_edge_area};
 
-/// Boundary edges of one mesh in the ray frame, in grid units (structure of arrays, padded to a
-/// multiple of 4 with zero-weight edges).
+/// Boundary edges of one mesh in the ray frame, in grid units.
+///
+/// The SIMD loop walks the edges as *chains* of vertices (`v0 → v1 → v2 …`, closed loops repeat
+/// their first vertex), so the offset, length and denominator factors of each vertex are computed
+/// once per query and shared by the two edges that meet there: one `sqrt` per boundary vertex
+/// instead of two per edge. An edge of weight `k` appears `k` times. Consecutive chains are
+/// separated by a non-edge slot (`link = 0`), whose lane contributes the identity factor.
 #[derive(Clone, Debug, Default)]
 pub struct BoundaryEdges {
     a: Vec<[i64; 3]>,
     b: Vec<[i64; 3]>,
-    coords: Vec<[f64x4; 6]>,
-    /// 1 for real lanes, 0 for padding.
-    weights: Vec<f64x4>,
-    /// Edges `simd_len..` have weight ≠ 1 and take the scalar path.
-    simd_len: usize,
     weight: Vec<f64>,
+    /// Chain vertices (structure of arrays, `f64` grid coordinates), padded with copies of the
+    /// last vertex so that every block reads in bounds.
+    xs: Vec<f64>,
+    ys: Vec<f64>,
+    zs: Vec<f64>,
+    /// `link[j] = 1` when slot `j` → `j + 1` is an edge, `0` for a break or padding.
+    link: Vec<f64>,
+    /// The edge (index into `a`, `b`) of each linked slot, for the exact fallback.
+    edge_of: Vec<u32>,
+    /// Number of slots (`j → j + 1` pairs) to visit.
+    slots: usize,
     /// `2^(bits−1)`: the largest grid coordinate, for the error bound of the `f64` conversions.
     limit: f64,
 }
 
+/// Edge slots per block: the vertex pass of a block fills up to `BLOCK + 4` entries of scratch
+/// arrays on the stack, the edge pass then reads them at offsets `j` and `j + 1`.
+const BLOCK: usize = 64;
+
 impl BoundaryEdges {
-    /// Packs edges `a[i] → b[i]` with weights `weight[i]` (grid coordinates, ray frame).
+    /// Packs edges `a[i] → b[i]` with positive integer weights `weight[i]` (grid coordinates, ray
+    /// frame).
     pub fn new(a: Vec<[i64; 3]>, b: Vec<[i64; 3]>, weight: Vec<f64>, bits: u32) -> Self {
-        // Weight-1 edges first (the SIMD product path), heavier ones after (scalar path).
-        let mut order: Vec<usize> = (0..a.len()).collect();
-        order.sort_by_key(|&i| weight[i] != 1.0);
-        let a: Vec<[i64; 3]> = order.iter().map(|&i| a[i]).collect();
-        let b: Vec<[i64; 3]> = order.iter().map(|&i| b[i]).collect();
-        let weight: Vec<f64> = order.iter().map(|&i| weight[i]).collect();
-        let n = weight.iter().take_while(|&&w| w == 1.0).count();
-        let chunks = n.div_ceil(4);
-        let mut coords = Vec::with_capacity(chunks);
-        let mut weights = Vec::with_capacity(chunks);
-        for c in 0..chunks {
-            let lane = |f: &dyn Fn(usize) -> f64| -> f64x4 {
-                f64x4::from(std::array::from_fn::<f64, 4, _>(|l| {
-                    let i = 4 * c + l;
-                    if i < n { f(i) } else { 0.0 }
-                }))
+        let chains = chain_edges(&a, &b, &weight);
+        let mut xs = Vec::new();
+        let mut ys = Vec::new();
+        let mut zs = Vec::new();
+        let mut link = Vec::new();
+        let mut edge_of = Vec::new();
+        for chain in &chains {
+            let v0 = chain[0];
+            let mut push = |v: [i64; 3], l: f64, e: u32| {
+                xs.push(v[0] as f64);
+                ys.push(v[1] as f64);
+                zs.push(v[2] as f64);
+                link.push(l);
+                edge_of.push(e);
             };
-            coords.push([
-                lane(&|i| a[i][0] as f64),
-                lane(&|i| a[i][1] as f64),
-                lane(&|i| a[i][2] as f64),
-                lane(&|i| b[i][0] as f64),
-                lane(&|i| b[i][1] as f64),
-                lane(&|i| b[i][2] as f64),
-            ]);
-            // Padding lanes have weight 0: they contribute the identity factor.
-            weights.push(lane(&|_| 1.0));
+            push(a[v0 as usize], 1.0, v0);
+            for (k, &e) in chain.iter().enumerate() {
+                let last = k + 1 == chain.len();
+                let next = if last { 0 } else { chain[k + 1] };
+                push(
+                    b[e as usize],
+                    if last { 0.0 } else { 1.0 },
+                    if last { u32::MAX } else { next },
+                );
+            }
+        }
+        let slots = xs.len();
+        // Padding: the last block reads up to 7 vertices past the last slot.
+        let pad = 8;
+        let (lx, ly, lz) = (
+            xs.last().copied().unwrap_or(0.0),
+            ys.last().copied().unwrap_or(0.0),
+            zs.last().copied().unwrap_or(0.0),
+        );
+        for _ in 0..pad {
+            xs.push(lx);
+            ys.push(ly);
+            zs.push(lz);
+            link.push(0.0);
+            edge_of.push(u32::MAX);
         }
         BoundaryEdges {
             a,
             b,
-            coords,
-            weights,
-            simd_len: n,
             weight,
+            xs,
+            ys,
+            zs,
+            link,
+            edge_of,
+            slots,
             limit: (1_i64 << (bits - 1)) as f64,
         }
     }
@@ -110,53 +142,67 @@ impl BoundaryEdges {
         let rel = f64x4::splat(2.0 * 4.0 * u);
         let zero = f64x4::ZERO;
         let one = f64x4::ONE;
+        let lanes = |v: &[f64], j: usize| f64x4::from(<[f64; 4]>::try_from(&v[j..j + 4]).unwrap());
         let mut angles = AngleSum::new();
         let mut scalar = 0.0;
-        for (c, (p, real)) in self.coords.iter().zip(&self.weights).enumerate() {
-            let ax = p[0] - qx;
-            let ay = p[1] - qy;
-            let az = p[2] - qz;
-            let bx = p[3] - qx;
-            let by = p[4] - qy;
-            let bz = p[5] - qz;
-            let p1 = ax * by;
-            let p2 = ay * bx;
-            let d = p1 - p2;
-            let bound =
-                conv * (ax.abs() + ay.abs() + bx.abs() + by.abs()) + rel * (p1.abs() + p2.abs());
-            let ok = d.abs().cmp_gt(bound) & real.cmp_gt(zero);
-            let ha = ax * ax + ay * ay;
-            let hb = bx * bx + by * by;
-            let la = (ha + az * az).sqrt();
-            let lb = (hb + bz * bz).sqrt();
-            // den = (|a| − a_z)(|b| − b_z) + a_x b_x + a_y b_y, and num = −d, both scaled by the
-            // positive s_a·s_b with s = |r| + |r_z| (no division, no cancellation):
-            // (|r| − r_z)·s = h² when r_z > 0, and s² otherwise.
-            let sa = la + az.abs();
-            let sb = lb + bz.abs();
-            let pa = az.cmp_gt(zero).blend(ha, sa * sa);
-            let pb = bz.cmp_gt(zero).blend(hb, sb * sb);
-            let s2 = sa * sb;
-            // Term den + i·num (num carries the exact sign of −d); identity 1 + 0i where unused.
-            let t_re = ok.blend(pa * pb + (ax * bx + ay * by) * s2, one);
-            let t_im = ok.blend((zero - d) * s2, zero);
-            angles.push(t_re, t_im);
-            if c % 2 == 1 {
-                // Terms are at most ~2^250 (grid units): two pushes stay in range.
-                angles.rescale();
+        // Per-vertex factors of one block: offsets x, y; s = |r| + |r_z|; and p, where
+        // (|r| − r_z)·s = p: h² = x² + y² when r_z > 0, s² otherwise (no cancellation).
+        let mut ox = [0.0; BLOCK + 4];
+        let mut oy = [0.0; BLOCK + 4];
+        let mut fs = [0.0; BLOCK + 4];
+        let mut fp = [0.0; BLOCK + 4];
+        for start in (0..self.slots).step_by(BLOCK) {
+            let end = BLOCK.min(self.slots - start);
+            // The edge pass reads vertices up to `ceil4(end)`.
+            for j in (0..end.next_multiple_of(4) + 4).step_by(4) {
+                let x = lanes(&self.xs, start + j) - qx;
+                let y = lanes(&self.ys, start + j) - qy;
+                let z = lanes(&self.zs, start + j) - qz;
+                let h = x * x + y * y;
+                let s = (h + z * z).sqrt() + z.abs();
+                let p = z.cmp_gt(zero).blend(h, s * s);
+                ox[j..j + 4].copy_from_slice(&x.to_array());
+                oy[j..j + 4].copy_from_slice(&y.to_array());
+                fs[j..j + 4].copy_from_slice(&s.to_array());
+                fp[j..j + 4].copy_from_slice(&p.to_array());
             }
-            let mask = ok.move_mask();
-            if mask != 0b1111 {
-                for l in 0..4 {
-                    let i = 4 * c + l;
-                    if mask & (1 << l) == 0 && i < self.simd_len {
-                        scalar += self.exact_edge_area::<W>(i, qi, z_exact, qz_units);
+            for j in (0..end).step_by(4) {
+                let (ax, ay, sa, pa) = (lanes(&ox, j), lanes(&oy, j), lanes(&fs, j), lanes(&fp, j));
+                let (bx, by, sb, pb) = (
+                    lanes(&ox, j + 1),
+                    lanes(&oy, j + 1),
+                    lanes(&fs, j + 1),
+                    lanes(&fp, j + 1),
+                );
+                let real = lanes(&self.link, start + j);
+                let p1 = ax * by;
+                let p2 = ay * bx;
+                let d = p1 - p2;
+                let bound = conv * (ax.abs() + ay.abs() + bx.abs() + by.abs())
+                    + rel * (p1.abs() + p2.abs());
+                let ok = d.abs().cmp_gt(bound) & real.cmp_gt(zero);
+                // den = (|a| − a_z)(|b| − b_z) + a_x b_x + a_y b_y and num = −d, both scaled by
+                // the positive s_a·s_b (no division, no cancellation).
+                let s2 = sa * sb;
+                // Term den + i·num (num carries the exact sign of −d); identity where unused.
+                let t_re = ok.blend(pa * pb + (ax * bx + ay * by) * s2, one);
+                let t_im = ok.blend((zero - d) * s2, zero);
+                angles.push(t_re, t_im);
+                if j % 8 == 4 {
+                    // Terms are at most ~2^250 (grid units): two pushes stay in range.
+                    angles.rescale();
+                }
+                let undecided = real.cmp_gt(zero).move_mask() & !ok.move_mask();
+                if undecided != 0 {
+                    for l in 0..4 {
+                        if undecided & (1 << l) != 0 {
+                            let e = self.edge_of[start + j + l] as usize;
+                            scalar += self.exact_edge_area::<W>(e, qi, z_exact, qz_units);
+                        }
                     }
                 }
             }
-        }
-        for i in self.simd_len..self.a.len() {
-            scalar += self.weight[i] * self.exact_edge_area::<W>(i, qi, z_exact, qz_units);
+            angles.rescale();
         }
         2.0 * angles.total() + scalar
     }
@@ -188,4 +234,40 @@ impl BoundaryEdges {
         };
         antipodal_edge_area(ra, rb, signs)
     }
+}
+
+/// Decomposes the edges (edge `i` repeated `weight[i]` times) into chains: sequences of edges,
+/// each starting where the previous one ends. Vertices are identified by their grid coordinates.
+/// Returns, per chain, the edge indices in walking order.
+fn chain_edges(a: &[[i64; 3]], b: &[[i64; 3]], weight: &[f64]) -> Vec<Vec<u32>> {
+    use std::collections::HashMap;
+    let mut out_edges: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+    let mut in_degree: HashMap<[i64; 3], usize> = HashMap::new();
+    for i in 0..a.len() {
+        let copies = weight[i].max(0.0) as usize;
+        for _ in 0..copies {
+            out_edges.entry(a[i]).or_default().push(i as u32);
+            *in_degree.entry(b[i]).or_default() += 1;
+        }
+    }
+    // Start chains where more edges leave than arrive (open paths), then anywhere (loops); walk
+    // greedily. Any decomposition is correct; fewer chains only means fewer break slots.
+    let mut starts: Vec<[i64; 3]> = (0..a.len())
+        .map(|i| a[i])
+        .filter(|v| out_edges.get(v).map_or(0, Vec::len) > in_degree.get(v).copied().unwrap_or(0))
+        .collect();
+    starts.extend(a.iter().copied());
+    let mut chains = Vec::new();
+    for s in starts {
+        let mut v = s;
+        let mut chain = Vec::new();
+        while let Some(e) = out_edges.get_mut(&v).and_then(Vec::pop) {
+            chain.push(e);
+            v = b[e as usize];
+        }
+        if !chain.is_empty() {
+            chains.push(chain);
+        }
+    }
+    chains
 }

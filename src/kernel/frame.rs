@@ -49,8 +49,11 @@ impl RayAxis {
     /// World → frame for a value type with negation.
     #[inline]
     pub fn to_frame<T: Copy + std::ops::Neg<Output = T>>(self, v: [T; 3]) -> [T; 3] {
-        self.map()
-            .map(|(axis, neg)| if neg { -v[axis] } else { v[axis] })
+        // Written out (not `array::map`): the closure version was an out-of-line call on the
+        // per-query path, and reading its result back stalled on store forwarding.
+        let [m0, m1, m2] = self.map();
+        let one = |(axis, neg): (usize, bool)| if neg { -v[axis] } else { v[axis] };
+        [one(m0), one(m1), one(m2)]
     }
 
     /// Frame → world (the inverse rotation).

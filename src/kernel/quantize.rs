@@ -12,6 +12,11 @@
 //! for [`Precision::Bits30`], `3e-18·extent` for [`Precision::Bits60`], below `f64` resolution of
 //! the mesh's own coordinates). Queries outside the padded box are *not* snapped in the
 //! offending axis: the evaluator treats them by the clamp rules in `eval::antipodal`.
+//!
+//! Queries farther than `2^30` padded-box half-widths from the origin along an axis are first
+//! moved to that distance along that axis ([`Grid::pull_in_far`]): beyond it the boundary
+//! term's products would overflow `f64` (w was NaN at 1e100), and the move changes `w` by less
+//! than `2^-60` (see there).
 
 use crate::BoundingBox;
 
@@ -133,17 +138,53 @@ impl Grid {
         self.limit
     }
 
+    /// Moves a query farther than `R = 2^30` padded-box half-widths from the origin along any
+    /// axis to distance `R` along that axis (each coordinate clamped to `origin ± R`).
+    ///
+    /// Why this is harmless: every clamped coordinate stays outside the padded box along the
+    /// whole segment from the query to the moved point, so the segment meets no triangle and `w`
+    /// is continuous along it; both ends lie at distance `≥ R` from the mesh, where `|w|` and its
+    /// change are bounded by the solid angle of the mesh, `O((extent/R)²) < 2^-60`. (Closed
+    /// meshes: `w = 0` at both ends exactly.)
+    #[inline]
+    pub fn pull_in_far(&self, q: [f64; 3]) -> [f64; 3] {
+        let r = FAR * self.limit as f64 * self.cell;
+        std::array::from_fn(|k| {
+            let o = self.origin[k];
+            // `q − o` cannot overflow in halves.
+            if 0.5 * q[k] - 0.5 * o > 0.5 * r {
+                o + r
+            } else if 0.5 * q[k] - 0.5 * o < -0.5 * r {
+                o - r
+            } else {
+                q[k]
+            }
+        })
+    }
+
     /// Snaps one coordinate along `axis`.
     #[inline]
     pub fn snap(&self, x: f64, axis: usize) -> Snap {
         // `cell` is a power of two, so multiplying by its reciprocal is exact like the division.
-        let v = ((x - self.origin[axis]) * self.inv_cell).round();
-        if v > self.limit as f64 {
+        let v = (x - self.origin[axis]) * self.inv_cell;
+        let r = if v.abs() < TRUNC_EXACT {
+            round_half_away(v)
+        } else {
+            // Huge or NaN: no fast path needed (and `as` would saturate).
+            let r = v.round();
+            if r > self.limit as f64 {
+                return Snap::High;
+            } else if r < -(self.limit as f64) {
+                return Snap::Low;
+            }
+            r as i64
+        };
+        if r > self.limit {
             Snap::High
-        } else if v < -(self.limit as f64) {
+        } else if r < -self.limit {
             Snap::Low
         } else {
-            Snap::In(v as i64)
+            Snap::In(r)
         }
     }
 
@@ -163,9 +204,55 @@ impl Grid {
     }
 }
 
+/// Distance, in padded-box half-widths, beyond which queries are pulled in.
+const FAR: f64 = (1_u64 << 30) as f64;
+
+/// Below this magnitude `v as i64` is exact truncation.
+const TRUNC_EXACT: f64 = (1_u64 << 62) as f64;
+
+/// `v.round()` (ties away from zero) as an integer, for `|v| < 2^62`. Without SSE4.1, `round` is
+/// a libm call that was ~5 % of a closed-mesh query; truncation and an exact remainder are not:
+/// `v − trunc(v)` is exact because both lie in the same binade (or `trunc(v) = 0`).
+#[inline]
+fn round_half_away(v: f64) -> i64 {
+    let t = v as i64;
+    let frac = v - t as f64;
+    t + i64::from(frac >= 0.5) - i64::from(frac <= -0.5)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn fast_rounding_matches_round() {
+        let mut vals = vec![
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.5,
+            -1.5,
+            2.5,
+            0.49999999999999994,
+            -0.49999999999999994,
+        ];
+        for e in [
+            1.0,
+            1e3,
+            4503599627370495.5,
+            4503599627370496.0,
+            2.0f64.powi(61) + 1024.0,
+        ] {
+            for d in [-1.0, -0.5, -0.25, 0.0, 0.25, 0.5, 1.0] {
+                vals.push(e + d);
+                vals.push(-e + d);
+            }
+        }
+        for v in vals {
+            assert_eq!(round_half_away(v), v.round() as i64, "{v}");
+        }
+    }
 
     #[test]
     fn small_integer_coordinates_snap_exactly() {
