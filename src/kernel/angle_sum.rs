@@ -81,15 +81,34 @@ impl AngleSum {
     }
 
     /// `Σ atan2(y_i, x_i)` over every lane of every push.
+    ///
+    /// The four lanes are multiplied together (with the same turn counting) so that one `atan2`
+    /// serves the whole sum: on meshes with a few dozen boundary edges, four `atan2` calls were
+    /// a sixth of a query.
     pub fn total(&self) -> f64 {
+        let mut lanes = *self;
+        lanes.rescale();
         let (re, im, turns) = (
-            self.re.to_array(),
-            self.im.to_array(),
-            self.turns.to_array(),
+            lanes.re.to_array(),
+            lanes.im.to_array(),
+            lanes.turns.to_array(),
         );
-        (0..4)
-            .map(|l| im[l].atan2(re[l]) + std::f64::consts::TAU * turns[l])
-            .sum()
+        let (mut ar, mut ai) = (re[0], im[0]);
+        let mut total_turns: f64 = turns.iter().sum();
+        for l in 1..4 {
+            let (br, bi) = (re[l], im[l]);
+            let nr = ar * br - ai * bi;
+            let ni = ar * bi + ai * br;
+            let (up_a, up_b, up_n) = (
+                !ai.is_sign_negative(),
+                !bi.is_sign_negative(),
+                !ni.is_sign_negative(),
+            );
+            total_turns += f64::from(u8::from(up_a && up_b && !up_n))
+                - f64::from(u8::from(!up_a && !up_b && up_n));
+            (ar, ai) = (nr, ni);
+        }
+        ai.atan2(ar) + std::f64::consts::TAU * total_turns
     }
 }
 

@@ -16,6 +16,13 @@
 use wide::{CmpGt, f64x4};
 
 use super::angle_sum::AngleSum;
+
+/// Lanes 1, 2, 3 of `a` followed by lane 0 of `b`.
+#[inline]
+fn shift_one(a: f64x4, b: f64x4) -> f64x4 {
+    let (a, b) = (a.to_array(), b.to_array());
+    f64x4::from([a[1], a[2], a[3], b[0]])
+}
 use super::predicates::{Width, perturbed_orient2d, query_inside_segment};
 use super::spherical::{EdgeSigns, antipodal_edge_area};
 
@@ -45,10 +52,6 @@ pub struct BoundaryEdges {
     /// `2^(bits−1)`: the largest grid coordinate, for the error bound of the `f64` conversions.
     limit: f64,
 }
-
-/// Edge slots per block: the vertex pass of a block fills up to `BLOCK + 4` entries of scratch
-/// arrays on the stack, the edge pass then reads them at offsets `j` and `j + 1`.
-const BLOCK: usize = 64;
 
 impl BoundaryEdges {
     /// Packs edges `a[i] → b[i]` with positive integer weights `weight[i]` (grid coordinates, ray
@@ -81,7 +84,7 @@ impl BoundaryEdges {
             }
         }
         let slots = xs.len();
-        // Padding: the last block reads up to 7 vertices past the last slot.
+        // Padding: the loop reads up to 7 vertices past the last slot.
         let pad = 8;
         let (lx, ly, lz) = (
             xs.last().copied().unwrap_or(0.0),
@@ -143,66 +146,54 @@ impl BoundaryEdges {
         let zero = f64x4::ZERO;
         let one = f64x4::ONE;
         let lanes = |v: &[f64], j: usize| f64x4::from(<[f64; 4]>::try_from(&v[j..j + 4]).unwrap());
+        // Per-vertex factors of the 4 vertices from slot `j`: offsets x, y; s = |r| + |r_z|; and
+        // p, where (|r| − r_z)·s = p: h² = x² + y² when r_z > 0, s² otherwise (no cancellation).
+        let vertices = |j: usize| {
+            let x = lanes(&self.xs, j) - qx;
+            let y = lanes(&self.ys, j) - qy;
+            let z = lanes(&self.zs, j) - qz;
+            let h = x * x + y * y;
+            let s = (h + z * z).sqrt() + z.abs();
+            let p = z.cmp_gt(zero).blend(h, s * s);
+            [x, y, s, p]
+        };
         let mut angles = AngleSum::new();
         let mut scalar = 0.0;
-        // Per-vertex factors of one block: offsets x, y; s = |r| + |r_z|; and p, where
-        // (|r| − r_z)·s = p: h² = x² + y² when r_z > 0, s² otherwise (no cancellation).
-        let mut ox = [0.0; BLOCK + 4];
-        let mut oy = [0.0; BLOCK + 4];
-        let mut fs = [0.0; BLOCK + 4];
-        let mut fp = [0.0; BLOCK + 4];
-        for start in (0..self.slots).step_by(BLOCK) {
-            let end = BLOCK.min(self.slots - start);
-            // The edge pass reads vertices up to `ceil4(end)`.
-            for j in (0..end.next_multiple_of(4) + 4).step_by(4) {
-                let x = lanes(&self.xs, start + j) - qx;
-                let y = lanes(&self.ys, start + j) - qy;
-                let z = lanes(&self.zs, start + j) - qz;
-                let h = x * x + y * y;
-                let s = (h + z * z).sqrt() + z.abs();
-                let p = z.cmp_gt(zero).blend(h, s * s);
-                ox[j..j + 4].copy_from_slice(&x.to_array());
-                oy[j..j + 4].copy_from_slice(&y.to_array());
-                fs[j..j + 4].copy_from_slice(&s.to_array());
-                fp[j..j + 4].copy_from_slice(&p.to_array());
+        let mut cur = vertices(0);
+        for j in (0..self.slots).step_by(4) {
+            // Edge slots j..j+4 run from these vertices to the next four, i.e. to lanes
+            // shifted by one (the data is padded past the last slot).
+            let next = vertices(j + 4);
+            let [ax, ay, sa, pa] = cur;
+            let [bx, by, sb, pb] = std::array::from_fn(|k| shift_one(cur[k], next[k]));
+            cur = next;
+            let real = lanes(&self.link, j);
+            let p1 = ax * by;
+            let p2 = ay * bx;
+            let d = p1 - p2;
+            let bound =
+                conv * (ax.abs() + ay.abs() + bx.abs() + by.abs()) + rel * (p1.abs() + p2.abs());
+            let ok = d.abs().cmp_gt(bound) & real.cmp_gt(zero);
+            // den = (|a| − a_z)(|b| − b_z) + a_x b_x + a_y b_y and num = −d, both scaled by the
+            // positive s_a·s_b (no division, no cancellation).
+            let s2 = sa * sb;
+            // Term den + i·num (num carries the exact sign of −d); identity where unused.
+            let t_re = ok.blend(pa * pb + (ax * bx + ay * by) * s2, one);
+            let t_im = ok.blend((zero - d) * s2, zero);
+            angles.push(t_re, t_im);
+            if j % 8 == 4 {
+                // Terms are at most ~2^250 (grid units): two pushes stay in range.
+                angles.rescale();
             }
-            for j in (0..end).step_by(4) {
-                let (ax, ay, sa, pa) = (lanes(&ox, j), lanes(&oy, j), lanes(&fs, j), lanes(&fp, j));
-                let (bx, by, sb, pb) = (
-                    lanes(&ox, j + 1),
-                    lanes(&oy, j + 1),
-                    lanes(&fs, j + 1),
-                    lanes(&fp, j + 1),
-                );
-                let real = lanes(&self.link, start + j);
-                let p1 = ax * by;
-                let p2 = ay * bx;
-                let d = p1 - p2;
-                let bound = conv * (ax.abs() + ay.abs() + bx.abs() + by.abs())
-                    + rel * (p1.abs() + p2.abs());
-                let ok = d.abs().cmp_gt(bound) & real.cmp_gt(zero);
-                // den = (|a| − a_z)(|b| − b_z) + a_x b_x + a_y b_y and num = −d, both scaled by
-                // the positive s_a·s_b (no division, no cancellation).
-                let s2 = sa * sb;
-                // Term den + i·num (num carries the exact sign of −d); identity where unused.
-                let t_re = ok.blend(pa * pb + (ax * bx + ay * by) * s2, one);
-                let t_im = ok.blend((zero - d) * s2, zero);
-                angles.push(t_re, t_im);
-                if j % 8 == 4 {
-                    // Terms are at most ~2^250 (grid units): two pushes stay in range.
-                    angles.rescale();
-                }
-                let undecided = real.cmp_gt(zero).move_mask() & !ok.move_mask();
-                if undecided != 0 {
-                    for l in 0..4 {
-                        if undecided & (1 << l) != 0 {
-                            let e = self.edge_of[start + j + l] as usize;
-                            scalar += self.exact_edge_area::<W>(e, qi, z_exact, qz_units);
-                        }
+            let undecided = real.cmp_gt(zero).move_mask() & !ok.move_mask();
+            if undecided != 0 {
+                for l in 0..4 {
+                    if undecided & (1 << l) != 0 {
+                        let e = self.edge_of[j + l] as usize;
+                        scalar += self.exact_edge_area::<W>(e, qi, z_exact, qz_units);
                     }
                 }
             }
-            angles.rescale();
         }
         2.0 * angles.total() + scalar
     }
