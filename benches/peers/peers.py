@@ -415,7 +415,7 @@ def versions(gwn: str) -> dict:
             v[pkg] = None
     v["gwn"] = run([gwn, "--version"]).stdout.strip()
     try:
-        v["rustc"] = run(["rustc", "--version"]).stdout.strip()
+        v["rustc"] = run(["rustc", "--version"]).stdout.strip() + ", " + os.environ.get("GWN_BUILD", "build flags unknown")
     except OSError:
         v["rustc"] = "?"
     try:

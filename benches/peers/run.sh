@@ -15,7 +15,8 @@
 # fast at a second beta, matched to libigl's accuracy).
 #
 # Creates benches/peers/.venv, installs requirements.txt (and requirements-open3d.txt when
-# possible; set PEERS_NO_OPEN3D=1 to skip it), builds gwn in release (honours CARGO_TARGET_DIR)
+# possible; set PEERS_NO_OPEN3D=1 to skip it), builds gwn in release for this CPU
+# (PEERS_PORTABLE=1: the portable build; honours CARGO_TARGET_DIR)
 # and runs peers.py, which rewrites the "## Peers" and "## Fast (Barnes–Hut)" sections of
 # docs/benchmarks.md (see --sections).
 set -euo pipefail
@@ -53,8 +54,19 @@ else
   fi
 fi
 
-(cd "$repo" && cargo build --release --quiet --bin gwn)
-gwn="${CARGO_TARGET_DIR:-$repo/target}/release/gwn"
+# gwn is built for this CPU (`-C target-cpu=native`, in its own target directory so the
+# portable build is not invalidated): Open3D's Embree picks AVX2/AVX-512 at run time, and gwn's
+# `wide` SIMD types are chosen at compile time. PEERS_PORTABLE=1 times the portable build.
+if [ "${PEERS_PORTABLE:-0}" = 1 ]; then
+  target="${CARGO_TARGET_DIR:-$repo/target}"
+  export GWN_BUILD="portable x86-64 build"
+  (cd "$repo" && cargo build --release --quiet --bin gwn)
+else
+  target="${CARGO_TARGET_DIR:-$repo/target}/native"
+  export GWN_BUILD="RUSTFLAGS='-C target-cpu=native'"
+  (cd "$repo" && CARGO_TARGET_DIR="$target" RUSTFLAGS="-C target-cpu=native" cargo build --release --quiet --bin gwn)
+fi
+gwn="$target/release/gwn"
 case "$gwn" in /*) ;; *) gwn="$repo/$gwn" ;; esac
 
 cd "$repo"

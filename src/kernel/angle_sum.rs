@@ -11,26 +11,22 @@
 //! Used by the Antipodal boundary loop (spherical-triangle areas) and by the near field of the
 //! fast evaluator (triangle solid angles), where `atan2` was about half of the time.
 
-use wide::{CmpLt, f64x4, u64x4};
+use wide::{f64x4, u64x4};
 
 /// Four running complex products and their turn counts.
 #[derive(Clone, Copy, Debug)]
 pub struct AngleSum {
     re: f64x4,
     im: f64x4,
-    turns: f64x4,
+    /// Turns past +π (counterclockwise) and past −π (clockwise), per lane.
+    turns_up: u64x4,
+    turns_down: u64x4,
 }
 
 impl Default for AngleSum {
     fn default() -> Self {
         Self::new()
     }
-}
-
-/// Lanes whose sign bit is set (negative numbers and −0.0), as a blend mask.
-#[inline]
-fn sign_bit(v: f64x4) -> f64x4 {
-    f64x4::ONE.copysign(v).cmp_lt(f64x4::ZERO)
 }
 
 impl AngleSum {
@@ -40,7 +36,8 @@ impl AngleSum {
         AngleSum {
             re: f64x4::ONE,
             im: f64x4::ZERO,
-            turns: f64x4::ZERO,
+            turns_up: u64x4::ZERO,
+            turns_down: u64x4::ZERO,
         }
     }
 
@@ -52,12 +49,16 @@ impl AngleSum {
     pub fn push(&mut self, x: f64x4, y: f64x4) {
         let n_re = self.re * x - self.im * y;
         let n_im = self.re * y + self.im * x;
-        let up_a = !sign_bit(self.im);
-        let up_t = !sign_bit(y);
-        let up_n = !sign_bit(n_im);
-        let plus = up_a & up_t & !up_n;
-        let minus = !up_a & !up_t & up_n;
-        self.turns += plus.blend(f64x4::ONE, f64x4::ZERO) - minus.blend(f64x4::ONE, f64x4::ZERO);
+        // On the sign bits (as atan2 reads them, −0.0 included): a turn happens when the
+        // accumulator and the factor lie in the same half plane and the product leaves it;
+        // upwards (+1) from the upper half, downwards (−1) from the lower. Integer operations
+        // only: about half the instructions of float compares and blends.
+        let a: u64x4 = bytemuck::cast(self.im);
+        let t: u64x4 = bytemuck::cast(y);
+        let n: u64x4 = bytemuck::cast(n_im);
+        let turn = !(a ^ t) & (n ^ a);
+        self.turns_up += (turn & !a) >> 63;
+        self.turns_down += (turn & a) >> 63;
         self.re = n_re;
         self.im = n_im;
     }
@@ -88,11 +89,9 @@ impl AngleSum {
     pub fn total(&self) -> f64 {
         let mut lanes = *self;
         lanes.rescale();
-        let (re, im, turns) = (
-            lanes.re.to_array(),
-            lanes.im.to_array(),
-            lanes.turns.to_array(),
-        );
+        let (re, im) = (lanes.re.to_array(), lanes.im.to_array());
+        let (up, down) = (lanes.turns_up.to_array(), lanes.turns_down.to_array());
+        let turns: [f64; 4] = std::array::from_fn(|l| up[l] as f64 - down[l] as f64);
         let (mut ar, mut ai) = (re[0], im[0]);
         let mut total_turns: f64 = turns.iter().sum();
         for l in 1..4 {
