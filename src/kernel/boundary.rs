@@ -49,9 +49,15 @@ pub struct BoundaryEdges {
     edge_of: Vec<u32>,
     /// Number of slots (`j → j + 1` pairs) to visit.
     slots: usize,
+    /// Edges of weight above [`MAX_CHAINED_WEIGHT`]: one exact term each, times the weight.
+    heavy: Vec<u32>,
     /// `2^(bits−1)`: the largest grid coordinate, for the error bound of the `f64` conversions.
     limit: f64,
 }
+
+/// Edges up to this weight are repeated in the chains; heavier ones (stacks of duplicated faces:
+/// one shared mesh has an edge of weight 466) take one exact scalar term times the weight.
+const MAX_CHAINED_WEIGHT: f64 = 4.0;
 
 impl BoundaryEdges {
     /// Packs edges `a[i] → b[i]` with positive integer weights `weight[i]` (grid coordinates, ray
@@ -98,6 +104,9 @@ impl BoundaryEdges {
             link.push(0.0);
             edge_of.push(u32::MAX);
         }
+        let heavy = (0..weight.len() as u32)
+            .filter(|&i| weight[i as usize] > MAX_CHAINED_WEIGHT)
+            .collect();
         BoundaryEdges {
             a,
             b,
@@ -108,6 +117,7 @@ impl BoundaryEdges {
             link,
             edge_of,
             slots,
+            heavy,
             limit: (1_i64 << (bits - 1)) as f64,
         }
     }
@@ -195,6 +205,10 @@ impl BoundaryEdges {
                 }
             }
         }
+        for &e in &self.heavy {
+            let e = e as usize;
+            scalar += self.weight[e] * self.exact_edge_area::<W>(e, qi, z_exact, qz_units);
+        }
         2.0 * angles.total() + scalar
     }
 
@@ -227,7 +241,7 @@ impl BoundaryEdges {
     }
 }
 
-/// Decomposes the edges (edge `i` repeated `weight[i]` times) into chains: sequences of edges,
+/// Decomposes the edges (edge `i` repeated `weight[i]` times, heavy edges left out) into chains: sequences of edges,
 /// each starting where the previous one ends. Vertices are identified by their grid coordinates.
 /// Returns, per chain, the edge indices in walking order.
 fn chain_edges(a: &[[i64; 3]], b: &[[i64; 3]], weight: &[f64]) -> Vec<Vec<u32>> {
@@ -235,7 +249,11 @@ fn chain_edges(a: &[[i64; 3]], b: &[[i64; 3]], weight: &[f64]) -> Vec<Vec<u32>> 
     let mut out_edges: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
     let mut in_degree: HashMap<[i64; 3], usize> = HashMap::new();
     for i in 0..a.len() {
-        let copies = weight[i].max(0.0) as usize;
+        let copies = if weight[i] <= MAX_CHAINED_WEIGHT {
+            weight[i].max(0.0) as usize
+        } else {
+            0
+        };
         for _ in 0..copies {
             out_edges.entry(a[i]).or_default().push(i as u32);
             *in_degree.entry(b[i]).or_default() += 1;
