@@ -268,15 +268,61 @@ fn chain_edges(a: &[[i64; 3]], b: &[[i64; 3]], weight: &[f64]) -> Vec<Vec<u32>> 
     starts.extend(a.iter().copied());
     let mut chains = Vec::new();
     for s in starts {
-        let mut v = s;
-        let mut chain = Vec::new();
-        while let Some(e) = out_edges.get_mut(&v).and_then(Vec::pop) {
-            chain.push(e);
-            v = b[e as usize];
-        }
-        if !chain.is_empty() {
+        // A vertex can start several chains (more edges leave it than one walk uses).
+        loop {
+            let mut v = s;
+            let mut chain = Vec::new();
+            while let Some(e) = out_edges.get_mut(&v).and_then(Vec::pop) {
+                chain.push(e);
+                v = b[e as usize];
+            }
+            if chain.is_empty() {
+                break;
+            }
             chains.push(chain);
         }
     }
     chains
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chains_use_every_edge_copy_exactly_once_and_connect() {
+        // Random multigraphs on few vertices (self-loops, parallel and heavy edges included).
+        let mut state = 99_u64;
+        let mut next = |m: u64| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 33) % m
+        };
+        for _ in 0..500 {
+            let n = 1 + next(12) as usize;
+            let vert = |k: u64| [k as i64, 0, 0];
+            let a: Vec<[i64; 3]> = (0..n).map(|_| vert(next(5))).collect();
+            let b: Vec<[i64; 3]> = (0..n).map(|_| vert(next(5))).collect();
+            let weight: Vec<f64> = (0..n).map(|_| (1 + next(7)) as f64).collect();
+            let chains = chain_edges(&a, &b, &weight);
+            let mut used = vec![0.0; n];
+            for chain in &chains {
+                for w in chain.windows(2) {
+                    assert_eq!(b[w[0] as usize], a[w[1] as usize], "chain breaks");
+                }
+                for &e in chain {
+                    used[e as usize] += 1.0;
+                }
+            }
+            for i in 0..n {
+                let want = if weight[i] <= MAX_CHAINED_WEIGHT {
+                    weight[i]
+                } else {
+                    0.0
+                };
+                assert_eq!(used[i], want, "edge {i} of weight {}", weight[i]);
+            }
+        }
+    }
 }
