@@ -41,6 +41,16 @@ impl AngleSum {
         }
     }
 
+    /// The state of four accumulators computed elsewhere (the AVX2 boundary loop).
+    pub(crate) fn from_lanes(re: [f64; 4], im: [f64; 4], up: [u64; 4], down: [u64; 4]) -> Self {
+        AngleSum {
+            re: f64x4::from(re),
+            im: f64x4::from(im),
+            turns_up: u64x4::from(up),
+            turns_down: u64x4::from(down),
+        }
+    }
+
     /// Adds `atan2(y, x)` of each lane. A lane with `x = 1, y = 0` adds nothing (use it for
     /// padding and masked lanes). `(x, y)` must be finite and not both zero; its magnitude is
     /// free, but the accumulators grow by it: call [`AngleSum::rescale`] before the product of
