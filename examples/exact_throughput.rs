@@ -1,0 +1,50 @@
+//! Single-thread throughput of the exact evaluator, best of `REPS` (default 5) passes over the
+//! 32³ grid of `gwn bench` (cell centres of the bounding box enlarged by 10 %, x varying fastest,
+//! so consecutive queries take different BVH paths). Less noisy than `gwn bench` (no thread pool,
+//! best of several passes): the tool for A/B comparisons of kernel changes.
+//!
+//! ```text
+//! cargo run --release --example exact_throughput -- ../shared/meshes/cgal-lion-head.off ...
+//! ```
+
+use gwn::eval::antipodal::WindingNumber;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let reps: usize = std::env::var("REPS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(5);
+    for path in std::env::args().skip(1) {
+        let mesh = gwn::io::load_mesh(&path)?.mesh;
+        let Some(bbox) = mesh.bounding_box() else {
+            println!("{path}: empty mesh");
+            continue;
+        };
+        let w = WindingNumber::new(&mesh)?;
+        let b = bbox.enlarged(0.1);
+        let n = 32;
+        let points: Vec<[f64; 3]> = (0..n * n * n)
+            .map(|i| {
+                let idx = [i % n, (i / n) % n, i / (n * n)];
+                std::array::from_fn(|k| {
+                    b.min[k] + (b.max[k] - b.min[k]) * (idx[k] as f64 + 0.5) / n as f64
+                })
+            })
+            .collect();
+        let mut best = f64::INFINITY;
+        let mut checksum = 0.0;
+        for _ in 0..reps {
+            let t = std::time::Instant::now();
+            checksum = points.iter().map(|&p| w.eval(p)).sum::<f64>();
+            best = best.min(t.elapsed().as_secs_f64());
+        }
+        println!(
+            "{:40} F={:7} B={:5} {:8.3} M queries/s (checksum {checksum:.6})",
+            path.rsplit('/').next().unwrap_or(&path),
+            w.face_count(),
+            w.boundary_edge_count(),
+            points.len() as f64 / best / 1e6,
+        );
+    }
+    Ok(())
+}
