@@ -1,5 +1,6 @@
-//! Gradients: the exact evaluator's (antipodal Supp. Alg. 3, boundary only) against the direct
-//! Biot–Savart gradient and against central finite differences of the exact value.
+//! Gradients: the exact evaluator's (Biot–Savart over the signed boundary edges) against the
+//! direct Biot–Savart gradient over all triangle edges and against central finite differences of
+//! the exact value.
 
 mod common;
 
@@ -83,4 +84,47 @@ fn lion_head_gradient_matches_direct_and_finite_differences() {
         .take(60)
         .collect();
     check(&mesh, &qs, 1e-6 * b.diagonal());
+}
+
+#[test]
+fn far_gradients_keep_their_relative_accuracy_and_never_overflow() {
+    // Straight below and beside an open mesh, along and across the ray: the antipodal paper's
+    // Alg. 3 (used before) was wrong here by orders of magnitude from ~1e6 mesh sizes (its
+    // formula divides by 1 + A·x1, which vanishes when the boundary is seen along the ray).
+    let mesh = common::open_cube();
+    for ray in [RayAxis::PosZ, RayAxis::NegZ, RayAxis::PosX] {
+        let wn = WindingNumber::with_options(
+            &mesh,
+            Options {
+                ray,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        for d in [1e2, 1e4, 1e6, 1e8, 1e12] {
+            for q in [[0.3, 0.6, -d], [0.3, 0.6, d], [d, 0.4, 0.5], [0.7, -d, 0.2]] {
+                let g = wn.gradient(q);
+                let gd = winding_number_gradient_direct(&mesh, q);
+                let scale = gd.iter().map(|v| v.abs()).fold(0.0, f64::max);
+                assert!(scale > 0.0);
+                for k in 0..3 {
+                    assert!(
+                        (g[k] - gd[k]).abs() <= 1e-6 * scale,
+                        "{ray:?} {q:?}: {g:?} vs direct {gd:?}"
+                    );
+                }
+            }
+        }
+        for q in [
+            [0.3, 0.6, -1e300],
+            [1e300, 0.0, 0.0],
+            [-f64::MAX, f64::MAX, 1.0],
+        ] {
+            let g = wn.gradient(q);
+            assert!(
+                g.iter().all(|v| v.is_finite() && v.abs() < 1e-200),
+                "{q:?}: {g:?}"
+            );
+        }
+    }
 }

@@ -25,12 +25,13 @@ use rayon::prelude::*;
 use crate::Mesh;
 use crate::bvh::RayBvh;
 use crate::kernel::boundary::BoundaryEdges;
+use crate::kernel::compensated::NeumaierSum;
 use crate::kernel::frame::RayAxis;
 use crate::kernel::predicates::{
     W64, W128, Width, perturbed_plane_side, projected_containment, ray_crossing,
 };
 use crate::kernel::quantize::{Grid, GridRangeError, Precision, Snap};
-use crate::kernel::spherical::{EdgeSigns, antipodal_edge_area, antipodal_edge_area_gradient};
+use crate::kernel::spherical::{EdgeSigns, antipodal_edge_area, segment_gradient};
 use crate::mesh::boundary_edges;
 
 const INV_4PI: f64 = 1.0 / (4.0 * std::f64::consts::PI);
@@ -163,8 +164,11 @@ impl WindingNumber {
         }
     }
 
-    /// Gradient `∇w(q)` (antipodal paper, Supp. Alg. 3): the integer part is locally constant,
-    /// so only the boundary term contributes. Not finite on the boundary curve.
+    /// Gradient `∇w(q)`: the integer part is locally constant, so only the boundary contributes:
+    /// the Biot–Savart sum over the signed boundary edges
+    /// ([`crate::kernel::spherical::segment_gradient`]; better conditioned than the antipodal
+    /// paper's Supp. Alg. 3, see there). Not finite on the boundary curve; NaN for a non-finite
+    /// query.
     pub fn gradient(&self, q: [f64; 3]) -> [f64; 3] {
         match &self.core {
             Dispatch::Narrow(c) => c.gradient(q),
@@ -460,15 +464,29 @@ impl<W: Width> Core<W> {
     }
 
     fn gradient(&self, q: [f64; 3]) -> [f64; 3] {
+        if q.iter().any(|c| !c.is_finite()) {
+            return [f64::NAN; 3];
+        }
         let qf = self.ray.to_frame(q);
-        let mut g = [0.0; 3];
+        // ∇w is homogeneous of degree −1 in lengths: evaluate on offsets scaled by an exact power
+        // of two that brings them to ~1 and scale back, so queries at 1e300 neither overflow
+        // |r|² nor turn into NaN (the true gradient there underflows to 0).
+        let half_width = self.grid.limit() as f64 * self.cell;
+        let span = (0..3).fold(half_width, |m, k| {
+            m.max((0.5 * qf[k] - 0.5 * self.origin[k]).abs())
+        });
+        let exponent = (span.to_bits() >> 52) & 0x7ff;
+        let scale = f64::from_bits((2046 - exponent) << 52);
+        let mut g = [NeumaierSum::new(); 3];
         for i in 0..self.boundary.len() {
             let (a, b, weight) = self.boundary.edge(i);
-            let e = antipodal_edge_area_gradient(self.rel_f64(a, qf), self.rel_f64(b, qf));
+            let ra = self.rel_f64(a, qf).map(|v| v * scale);
+            let rb = self.rel_f64(b, qf).map(|v| v * scale);
+            let e = segment_gradient(ra, rb);
             for k in 0..3 {
-                g[k] += weight * e[k];
+                g[k].add(weight * e[k]);
             }
         }
-        self.ray.to_world(g.map(|v| v * INV_4PI))
+        self.ray.to_world(g.map(|s| s.value() * scale * INV_4PI))
     }
 }

@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use crate::Mesh;
 use crate::kernel::compensated::NeumaierSum;
-use crate::kernel::spherical::{cross, dot, norm, triangle_solid_angle};
+use crate::kernel::spherical::{segment_gradient, triangle_solid_angle};
 
 const INV_4PI: f64 = 1.0 / (4.0 * std::f64::consts::PI);
 
@@ -51,18 +51,6 @@ pub fn winding_number_gradient_direct(mesh: &Mesh, q: [f64; 3]) -> [f64; 3] {
         }
     }
     g.map(|s| s.value() * INV_4PI)
-}
-
-/// `∇_q` of the solid-angle contribution of the directed segment from `q + ra` to `q + rb`:
-/// `(ra × rb)(|ra| + |rb|) / (|ra||rb|(|ra||rb| + ra·rb))` (Biot–Savart for a straight segment),
-/// shared by every evaluator's gradient.
-#[inline]
-pub fn segment_gradient(ra: [f64; 3], rb: [f64; 3]) -> [f64; 3] {
-    let la = norm(ra);
-    let lb = norm(rb);
-    let c = cross(ra, rb);
-    let f = (la + lb) / (la * lb * (la * lb + dot(ra, rb)));
-    [c[0] * f, c[1] * f, c[2] * f]
 }
 
 #[inline]
