@@ -8,6 +8,7 @@
 //! ```
 
 use gwn::eval::antipodal::WindingNumber;
+use gwn::grid::GridSpec;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let reps: usize = std::env::var("REPS")
@@ -21,16 +22,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             continue;
         };
         let w = WindingNumber::new(&mesh)?;
-        let b = bbox.enlarged(0.1);
-        let n = 32;
-        let points: Vec<[f64; 3]> = (0..n * n * n)
-            .map(|i| {
-                let idx = [i % n, (i / n) % n, i / (n * n)];
-                std::array::from_fn(|k| {
-                    b.min[k] + (b.max[k] - b.min[k]) * (idx[k] as f64 + 0.5) / n as f64
-                })
-            })
-            .collect();
+        let points = GridSpec::new(bbox.enlarged(0.1), [32; 3])?.points();
         let mut best = f64::INFINITY;
         let mut checksum = 0.0;
         for _ in 0..reps {
