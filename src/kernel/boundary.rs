@@ -1,21 +1,24 @@
 //! The boundary term of the Antipodal formula for one query: `Σ_k w_k·Area(A_k, B_k, x1)` over all
 //! signed boundary edges — the hot loop (≈ 90 % of the time in the paper).
 //!
-//! Four edges at a time (`wide::f64x4`): offsets from the query, the `f64` orientation `d` with a
-//! rigorous error bound, lengths and the cancellation-free denominator. Instead of one `atan2`
-//! per edge, the terms `den + i·num` go into one [`AngleSum`] (a complex product with turn
-//! counting; four `atan2` calls at the end). (Profiling showed `atan2` at 53 % of the time
-//! before this change.)
+//! Four edges at a time (`wide::f64x4`, or AVX2 intrinsics chosen at run time): offsets from the
+//! query, the `f64` orientation `d` with a rigorous error bound, lengths and the cancellation-free
+//! denominator. Instead of one `atan2` per edge, the terms `den + i·num` go into one [`AngleSum`]
+//! (a complex product with turn counting; one `atan2` at the end). (Profiling showed `atan2` at
+//! 53 % of the time before this change.)
 //!
 //! Lanes whose `|d|` does not clear the bound (the query is within ~1e-15·extent of the edge's
-//! line through the ray, or a degenerate configuration) and edges of weight ≠ 1 are recomputed
-//! one by one with the exact integer predicate and the limit formulas of
-//! [`super::spherical::antipodal_edge_area`]. Either way the numerator's sign is the exact sign of
-//! [`super::predicates::perturbed_orient2d`], so the branch agrees with the crossing test.
+//! line through the ray, or a degenerate configuration) and edges of weight above
+//! `MAX_CHAINED_WEIGHT` are recomputed one by one with the exact integer predicate and the limit
+//! formulas of [`super::spherical::antipodal_edge_area`]. Either way the numerator's sign is the
+//! exact sign of [`super::predicates::perturbed_orient2d`], so the branch agrees with the
+//! crossing test.
 
 use wide::{CmpGt, f64x4};
 
 use super::angle_sum::AngleSum;
+use super::predicates::{Width, perturbed_orient2d, query_inside_segment};
+use super::spherical::{EdgeSigns, antipodal_edge_area};
 
 /// Four consecutive values from `v[j]`.
 #[inline(always)]
@@ -29,8 +32,6 @@ fn shift_one(a: f64x4, b: f64x4) -> f64x4 {
     let (a, b) = (a.to_array(), b.to_array());
     f64x4::from([a[1], a[2], a[3], b[0]])
 }
-use super::predicates::{Width, perturbed_orient2d, query_inside_segment};
-use super::spherical::{EdgeSigns, antipodal_edge_area};
 
 /// Boundary edges of one mesh in the ray frame, in grid units.
 ///
