@@ -75,7 +75,7 @@ pub fn write<T: NpyElement>(mut w: impl Write, shape: &[usize], data: &[T]) -> i
     w.flush()
 }
 
-/// [`write`] to a new file at `path`.
+/// [`write()`] to a new file at `path`.
 pub fn save<T: NpyElement>(path: impl AsRef<Path>, shape: &[usize], data: &[T]) -> io::Result<()> {
     let f = io::BufWriter::new(std::fs::File::create(path)?);
     write(f, shape, data)

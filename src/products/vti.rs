@@ -69,7 +69,7 @@ pub fn write(
     w.flush()
 }
 
-/// [`write`] to a new file at `path`.
+/// [`write()`] to a new file at `path`.
 pub fn save(
     path: impl AsRef<Path>,
     spec: &GridSpec,

@@ -2,7 +2,7 @@
 //! oracle, and writers for language-neutral corpora (`gwn gen`). See `docs/testing-kit.md`.
 //!
 //! Compiled with the `testing` feature (which also enables the proptest strategies in
-//! [`strategies`]) or with `cli` (the default, without proptest: seeded generators and oracle
+//! `strategies`) or with `cli` (the default, without proptest: seeded generators and oracle
 //! only, for `gwn gen`).
 //!
 //! - **Generators** ([`Kind`], one [`Case`] = mesh + queries + optional closed-form truth): each
