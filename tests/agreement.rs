@@ -4,7 +4,7 @@
 mod common;
 
 use gwn::Mesh;
-use gwn::eval::antipodal::{Options, WindingNumber};
+use gwn::eval::antipodal::{BoundaryBy, Options, WindingNumber};
 use gwn::eval::direct::winding_number_direct;
 use gwn::kernel::frame::RayAxis;
 use rayon::prelude::*;
@@ -89,6 +89,7 @@ fn exact_agrees_with_direct_and_with_other_rays_on_the_shared_corpus() {
     let mut worst = (0.0f64, String::new());
     let mut worst_dir = (0.0f64, String::new());
     let mut total_queries = 0usize;
+    let mut welded = Vec::new();
     for (fi, file) in files.iter().enumerate() {
         let mesh = gwn::io::load_mesh(dir.join(file))
             .unwrap_or_else(|e| panic!("{e}"))
@@ -129,6 +130,32 @@ fn exact_agrees_with_direct_and_with_other_rays_on_the_shared_corpus() {
                 );
             }
         }
+        // Boundary matched by vertex index (the mesh's topology) instead of position: the same
+        // values, whatever edges the welding cancelled (issue 12, part 1).
+        let by_index = WindingNumber::with_options(
+            &mesh,
+            Options {
+                boundary: BoundaryBy::Index,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert!(exact.boundary_edge_count() <= by_index.boundary_edge_count());
+        if exact.boundary_edge_count() < by_index.boundary_edge_count() {
+            welded.push(format!(
+                "{file}: B {} -> {}",
+                by_index.boundary_edge_count(),
+                exact.boundary_edge_count()
+            ));
+        }
+        for (i, &q) in queries.iter().enumerate().take(300) {
+            let v = by_index.eval(q);
+            assert!(
+                (v - w[i]).abs() <= 1e-12,
+                "{file} at {q:?}: by position {} vs by index {v}",
+                w[i]
+            );
+        }
         // Direction independence: other rays resolve every degeneracy differently.
         for ray in [RayAxis::NegZ, RayAxis::PosX] {
             let other = WindingNumber::with_options(
@@ -166,6 +193,7 @@ fn exact_agrees_with_direct_and_with_other_rays_on_the_shared_corpus() {
         "max direction dependence = {:.3e} ({})",
         worst_dir.0, worst_dir.1
     );
+    eprintln!("boundary by position vs by index: {}", welded.join("; "));
     assert!(worst.0 <= 1e-10, "exact vs direct: {}", worst.1);
     assert!(
         worst_dir.0 <= 1e-10,

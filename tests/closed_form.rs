@@ -44,7 +44,15 @@ fn exact_cube_is_integer_everywhere_off_and_on_the_surface() {
     let c = unit_cube();
     for precision in [Precision::Bits30, Precision::Bits60] {
         for ray in RayAxis::ALL {
-            let wn = WindingNumber::with_options(&c, Options { precision, ray }).unwrap();
+            let wn = WindingNumber::with_options(
+                &c,
+                Options {
+                    precision,
+                    ray,
+                    ..Default::default()
+                },
+            )
+            .unwrap();
             assert_eq!(wn.boundary_edge_count(), 0);
             assert_eq!(wn.eval([0.5, 0.5, 0.5]), 1.0);
             assert_eq!(wn.eval([1.5, 0.5, 0.5]), 0.0);
@@ -157,7 +165,11 @@ fn astronomically_far_queries_are_finite_and_vanish() {
     }
     for precision in [Precision::Bits30, Precision::Bits60] {
         for ray in [RayAxis::PosZ, RayAxis::NegX] {
-            let opts = Options { precision, ray };
+            let opts = Options {
+                precision,
+                ray,
+                ..Default::default()
+            };
             let wo = WindingNumber::with_options(&open, opts).unwrap();
             let wc = WindingNumber::with_options(&closed, opts).unwrap();
             for &q in &far {

@@ -15,7 +15,15 @@ fn check_grazing(bytes: &[u8]) -> Result<(), TestCaseError> {
     let case = decode(bytes);
     for precision in [Precision::Bits30, Precision::Bits60] {
         for ray in RayAxis::ALL {
-            let wn = WindingNumber::with_options(&case.mesh, Options { precision, ray }).unwrap();
+            let wn = WindingNumber::with_options(
+                &case.mesh,
+                Options {
+                    precision,
+                    ray,
+                    ..Default::default()
+                },
+            )
+            .unwrap();
             for &q in &case.queries {
                 let w = wn.eval(q);
                 let want = common::direct_at_perturbed(&case.mesh, q, ray, 1.0);
@@ -89,7 +97,7 @@ proptest! {
         let truth = bs.iter().filter(|(lo, hi)| (0..3).all(|k| lo[k] < q[k] && q[k] < hi[k])).count() as f64;
         for precision in [Precision::Bits30, Precision::Bits60] {
             for ray in RayAxis::ALL {
-                let wn = WindingNumber::with_options(&mesh, Options { precision, ray }).unwrap();
+                let wn = WindingNumber::with_options(&mesh, Options { precision, ray, ..Default::default() }).unwrap();
                 let w = wn.eval(q);
                 prop_assert_eq!(w.fract(), 0.0, "non-integer {} at {:?}", w, q);
                 if off_surface {

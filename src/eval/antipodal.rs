@@ -28,11 +28,11 @@ use crate::kernel::boundary::BoundaryEdges;
 use crate::kernel::compensated::NeumaierSum;
 use crate::kernel::frame::RayAxis;
 use crate::kernel::predicates::{
-    W64, W128, Width, perturbed_plane_side, projected_containment, ray_crossing,
+    W64, W128, Width, perturbed_plane_side, projected_containment, ray_crossing, ray_crossing_at,
 };
 use crate::kernel::quantize::{Grid, GridRangeError, Precision, Snap};
 use crate::kernel::spherical::{EdgeSigns, antipodal_edge_area, segment_gradient};
-use crate::mesh::boundary_edges;
+use crate::mesh::{boundary_edges, boundary_welded_by};
 
 const INV_4PI: f64 = 1.0 / (4.0 * std::f64::consts::PI);
 
@@ -43,6 +43,25 @@ pub struct Options {
     pub precision: Precision,
     /// Ray direction (default `+z`); any choice gives the same `w` off the surface.
     pub ray: RayAxis,
+    /// How boundary edges are matched (default: by position).
+    pub boundary: BoundaryBy,
+}
+
+/// Which boundary the Antipodal sum runs over. Both give the same `w` (up to rounding off the
+/// surface): opposite edges that are not matched cancel term by term. Matching by position only
+/// removes those pairs up front, which is where an open mesh's cost is: a mesh split at UV seams,
+/// or an indexed soup, has thousands of index-boundary edges and no geometric boundary at all
+/// (closed-mesh speed).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BoundaryBy {
+    /// Edges match when their endpoints have the same *quantized* position — the geometry every
+    /// predicate and term of this evaluator computes with, so the cancellation is exact (with
+    /// `Bits60` the quantization of a vertex is below `f64` resolution for any coordinate larger
+    /// than ~1/64 of the extent, i.e. this is bit-identical welding in practice).
+    #[default]
+    Position,
+    /// Edges match by vertex index (the mesh's own topology; CLI `--no-weld`).
+    Index,
 }
 
 /// Why an evaluator could not be built.
@@ -246,7 +265,10 @@ impl<W: Width> Core<W> {
             .map(|&p| ray.to_frame(grid.snap_vertex(p)))
             .collect();
         let tris = mesh.triangles();
-        let boundary = boundary_edges(mesh);
+        let boundary = match options.boundary {
+            BoundaryBy::Position => boundary_welded_by(tris, &verts),
+            BoundaryBy::Index => boundary_edges(mesh),
+        };
         let boundary = BoundaryEdges::new(
             boundary.iter().map(|e| verts[e.from as usize]).collect(),
             boundary.iter().map(|e| verts[e.to as usize]).collect(),
@@ -300,22 +322,36 @@ impl<W: Width> Core<W> {
         }
     }
 
-    /// Snaps the world query into the frame, axis by axis.
+    /// Snaps the grid-space query into the frame, axis by axis: lattice coordinates and the
+    /// exact residuals (cells).
     #[inline]
-    fn snap_frame(&self, q: [f64; 3]) -> [Snap; 3] {
+    fn snap_frame(&self, q: [f64; 3]) -> ([Snap; 3], [f64; 3]) {
         // Written out (not `array::map`): the closure version was not inlined into the hot path.
         let [m0, m1, m2] = self.ray.map();
         let one = |(axis, neg): (usize, bool)| {
-            let s = self.grid.snap(q[axis], axis);
-            if neg { s.negated() } else { s }
+            let (s, r) = self.grid.snap_with_residual(q[axis], axis);
+            if neg { (s.negated(), -r) } else { (s, r) }
         };
-        [one(m0), one(m1), one(m2)]
+        let (s0, r0) = one(m0);
+        let (s1, r1) = one(m1);
+        let (s2, r2) = one(m2);
+        if W::PRECISION == Precision::Bits30 {
+            // The 30-bit grid is the documented fast approximation: queries (like vertices) are
+            // evaluated at their lattice points, `≤ 1.5e-9·extent` away.
+            return ([s0, s1, s2], [0.0; 3]);
+        }
+        ([s0, s1, s2], [r0, r1, r2])
     }
 
+    /// The parts at a world query (finite).
     fn parts(&self, q: [f64; 3]) -> (i64, f64) {
-        let q = self.grid.pull_in_far(q);
+        self.parts_in_grid_space(self.grid.pull_in_far(self.grid.to_grid_space(q)))
+    }
+
+    /// The parts at a grid-space query already pulled in ([`Grid::pull_in_far`]).
+    fn parts_in_grid_space(&self, q: [f64; 3]) -> (i64, f64) {
         let qf = self.ray.to_frame(q);
-        let snap = self.snap_frame(q);
+        let (snap, residual) = self.snap_frame(q);
         let (Snap::In(x), Snap::In(y)) = (snap[0], snap[1]) else {
             return (0, self.far_boundary_sum(qf));
         };
@@ -326,44 +362,76 @@ impl<W: Width> Core<W> {
             Snap::High => (limit, false),
         };
         let qi = [x, y, z];
+        let r = [
+            residual[0],
+            residual[1],
+            if z_exact { residual[2] } else { 0.0 },
+        ];
         let chi = if snap[2] == Snap::High {
             0
-        } else {
+        } else if r == [0.0; 3] {
             self.signed_crossings(qi)
+        } else {
+            self.signed_crossings_at(qi, r)
         };
-        let area = self.boundary_sum(qi, z_exact, qf[2]);
+        let area = self.boundary_sum(qi, r, z_exact, qf[2]);
         (chi, area)
     }
 
     fn column(&self, q: [f64; 3], ts: &[f64]) -> Vec<f64> {
-        let axis = self.ray.map()[2].0;
-        let at = |t: f64| {
-            let mut p = q;
-            p[axis] = t;
-            self.grid.pull_in_far(p)
-        };
-        let snap = self.snap_frame(q);
-        let (Snap::In(x), Snap::In(y)) = (snap[0], snap[1]) else {
-            return ts.iter().map(|&t| self.value(at(t))).collect();
-        };
         if q.iter().any(|c| !c.is_finite()) {
             return vec![f64::NAN; ts.len()];
         }
+        let axis = self.ray.map()[2].0;
+        // Grid-space point of the column at world coordinate `t` (pulled in like `parts`).
+        let at = |t: f64| {
+            let mut p = q;
+            p[axis] = t;
+            self.grid.pull_in_far(self.grid.to_grid_space(p))
+        };
+        let (snap, residual) = self.snap_frame(self.grid.pull_in_far(self.grid.to_grid_space(q)));
+        let transverse_residual = residual[0] != 0.0 || residual[1] != 0.0;
+        let (Snap::In(x), Snap::In(y), false) = (snap[0], snap[1], transverse_residual) else {
+            return ts
+                .iter()
+                .map(|&t| {
+                    if t.is_finite() {
+                        let (chi, area) = self.parts_in_grid_space(at(t));
+                        chi as f64 + area * INV_4PI
+                    } else {
+                        f64::NAN
+                    }
+                })
+                .collect();
+        };
         let limit = self.grid.limit();
-        // Frame z of every point (integer, or clamped with a flag), sorted ascending.
+        // Frame z of every point (integer, or clamped with a flag), sorted ascending. Points off
+        // the lattice along the column (a z residual) are evaluated on their own.
+        let mut out = vec![f64::NAN; ts.len()];
         let zs: Vec<(i64, bool, f64)> = ts
             .iter()
-            .map(|&t| {
+            .zip(out.iter_mut())
+            .map(|(&t, out)| {
                 let p = at(t);
                 let qf = self.ray.to_frame(p);
-                match self.snap_frame(p)[2] {
-                    Snap::In(z) => (z, true, qf[2]),
+                let (snap, residual) = self.snap_frame(p);
+                match snap[2] {
+                    Snap::In(z) if residual[2] == 0.0 => (z, true, qf[2]),
+                    Snap::In(z) => {
+                        if t.is_finite() {
+                            let (chi, area) = self.parts_in_grid_space(p);
+                            *out = chi as f64 + area * INV_4PI;
+                        }
+                        (z, false, f64::NAN)
+                    }
                     Snap::Low => (-limit, false, qf[2]),
                     Snap::High => (limit, false, qf[2]),
                 }
             })
             .collect();
-        let mut order: Vec<usize> = (0..ts.len()).filter(|&k| ts[k].is_finite()).collect();
+        let mut order: Vec<usize> = (0..ts.len())
+            .filter(|&k| ts[k].is_finite() && !zs[k].2.is_nan())
+            .collect();
         order.sort_by_key(|&k| zs[k].0);
         // Points strictly above the grid never see a crossing.
         let active = order
@@ -395,7 +463,6 @@ impl<W: Width> Core<W> {
                 chi_diff[0] += i64::from(s);
                 chi_diff[lo] -= i64::from(s);
             });
-        let mut out = vec![f64::NAN; ts.len()];
         let mut chi = 0i64;
         for (j, &k) in order.iter().enumerate() {
             let (z, exact, qz) = zs[k];
@@ -405,17 +472,9 @@ impl<W: Width> Core<W> {
             } else {
                 0
             };
-            out[k] = c as f64 + self.boundary_sum([x, y, z], exact, qz) * INV_4PI;
+            out[k] = c as f64 + self.boundary_sum([x, y, z], [0.0; 3], exact, qz) * INV_4PI;
         }
         out
-    }
-
-    fn value(&self, q: [f64; 3]) -> f64 {
-        if q.iter().any(|c| !c.is_finite()) {
-            return f64::NAN;
-        }
-        let (chi, area) = self.parts(q);
-        chi as f64 + area * INV_4PI
     }
 
     /// χ: signed crossings of the ray from `q_ε` along `+z` (every candidate, no early exit).
@@ -428,11 +487,29 @@ impl<W: Width> Core<W> {
         chi
     }
 
-    /// `Σ k·Area(A, B, x1)` with exact branch signs. `z_exact` is false when the query's frame z
-    /// lies outside the grid (then `qz` is used in floating point for the magnitudes).
-    fn boundary_sum(&self, qi: [i64; 3], z_exact: bool, qz: f64) -> f64 {
+    /// χ from the exact query `qi + r` (off the lattice): the same candidates (a triangle
+    /// whose box contains `qi + r` contains `qi`, by monotone rounding), the `_at` predicates.
+    fn signed_crossings_at(&self, qi: [i64; 3], r: [f64; 3]) -> i64 {
+        let mut chi = 0i64;
+        let u = |v: i64| (v as f64 * self.to_unit) as f32;
+        self.bvh.for_each_on_ray(u(qi[0]), u(qi[1]), u(qi[2]), |f| {
+            chi += i64::from(ray_crossing_at::<W>(qi, r, self.tri_pts[f as usize]));
+        });
+        chi
+    }
+
+    /// `Σ k·Area(A, B, x1)` with exact branch signs at the query `qi + r` (lattice point and
+    /// residual). `z_exact` is false when the query's frame z lies outside the grid (then `qz`
+    /// is used in floating point for the magnitudes). Queries near a boundary edge, or whose
+    /// residual matters for a sign, take the double-double path.
+    fn boundary_sum(&self, qi: [i64; 3], r: [f64; 3], z_exact: bool, qz: f64) -> f64 {
         let qz_units = (qz - self.origin[2]) / self.cell;
-        self.boundary.area_sum::<W>(qi, z_exact, qz_units)
+        if self.boundary.needs_accurate_sum::<W>(qi, r, z_exact) {
+            self.boundary
+                .area_sum_accurate::<W>(qi, r, z_exact, qz_units)
+        } else {
+            self.boundary.area_sum::<W>(qi, z_exact, qz_units)
+        }
     }
 
     /// Boundary sum for a query whose ray cannot approach the mesh: plain floating point.
@@ -467,7 +544,13 @@ impl<W: Width> Core<W> {
         if q.iter().any(|c| !c.is_finite()) {
             return [f64::NAN; 3];
         }
-        let qf = self.ray.to_frame(q);
+        let qg = self.grid.to_grid_space(q);
+        if qg.iter().any(|c| !c.is_finite()) {
+            // Beyond `f64::MAX` in grid space (extent ≥ 1): the world gradient is below
+            // `1e-616 / extent`, i.e. it underflows.
+            return [0.0; 3];
+        }
+        let qf = self.ray.to_frame(qg);
         // ∇w is homogeneous of degree −1 in lengths: evaluate on offsets scaled by an exact power
         // of two that brings them to ~1 and scale back, so queries at 1e300 neither overflow
         // |r|² nor turn into NaN (the true gradient there underflows to 0).
@@ -487,6 +570,7 @@ impl<W: Width> Core<W> {
                 g[k].add(weight * e[k]);
             }
         }
-        self.ray.to_world(g.map(|s| s.value() * scale * INV_4PI))
+        let g = self.ray.to_world(g.map(|s| s.value() * scale * INV_4PI));
+        self.grid.gradient_to_world(g)
     }
 }

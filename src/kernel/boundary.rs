@@ -17,8 +17,13 @@
 use wide::{CmpGt, f64x4};
 
 use super::angle_sum::AngleSum;
-use super::predicates::{Width, perturbed_orient2d, query_inside_segment};
-use super::spherical::{EdgeSigns, antipodal_edge_area};
+use super::compensated::NeumaierSum;
+use super::double_double::DoubleDouble;
+use super::predicates::{
+    Width, perturbed_orient2d, perturbed_orient2d_at, query_inside_segment, query_inside_segment_at,
+};
+use super::spherical::{EdgeSigns, antipodal_edge_area, antipodal_edge_area_accurate};
+use crate::bvh::RayBvh;
 
 /// Four consecutive values from `v[j]`.
 #[inline(always)]
@@ -60,7 +65,20 @@ pub struct BoundaryEdges {
     heavy: Vec<u32>,
     /// `2^(bits−1)`: the largest grid coordinate, for the error bound of the `f64` conversions.
     limit: f64,
+    /// The edges' boxes grown by [`NEAR_EDGE_FRACTION`] of the grid half-width, in normalized
+    /// coordinates: finds the edges near a query (see [`BoundaryEdges::needs_accurate_sum`]).
+    near: RayBvh,
+    /// That growth in grid units.
+    near_pad: i64,
 }
+
+/// A query closer than this fraction of the grid half-width (`1.5–3×` the mesh extent `E`) to a
+/// boundary edge gets the double-double term. Error model of the `f64` term at distance `d` from
+/// the edge: the offsets are exact integers rounded once (relative `u = 2^-53`), and both `atan2`
+/// arguments are `≈ |a−q||b−q|·d/len`, so the term errs by `≲ 4u·len/d ≤ 4u·1.8E/d`: at
+/// `d ≥ 2^-9·1.5E` that is `≤ 2.5e-13`. Closer queries are rare (a thin tube around the boundary
+/// curves), so the extended precision costs nothing measurable on grids.
+const NEAR_EDGE_FRACTION: f64 = 1.0 / 512.0;
 
 /// Edges up to this weight are repeated in the chains; heavier ones (stacks of duplicated faces:
 /// one shared mesh has an edge of weight 466) take one exact scalar term times the weight.
@@ -114,6 +132,21 @@ impl BoundaryEdges {
         let heavy = (0..weight.len() as u32)
             .filter(|&i| weight[i as usize] > MAX_CHAINED_WEIGHT)
             .collect();
+        let limit = (1_i64 << (bits - 1)) as f64;
+        let near_pad = (limit * NEAR_EDGE_FRACTION) as i64;
+        let to_unit = 1.0 / limit;
+        let near_boxes: Vec<([f32; 3], [f32; 3])> = a
+            .iter()
+            .zip(&b)
+            .map(|(p, q)| {
+                let lo =
+                    std::array::from_fn(|k| ((p[k].min(q[k]) - near_pad) as f64 * to_unit) as f32);
+                let hi =
+                    std::array::from_fn(|k| ((p[k].max(q[k]) + near_pad) as f64 * to_unit) as f32);
+                (lo, hi)
+            })
+            .collect();
+        let near = RayBvh::build(&near_boxes);
         BoundaryEdges {
             a,
             b,
@@ -125,7 +158,9 @@ impl BoundaryEdges {
             edge_of,
             slots,
             heavy,
-            limit: (1_i64 << (bits - 1)) as f64,
+            limit,
+            near,
+            near_pad,
         }
     }
 
@@ -178,6 +213,95 @@ impl BoundaryEdges {
             scalar += self.weight[e] * self.exact_edge_area::<W>(e, qi, z_exact, qz_units);
         }
         2.0 * angles.total() + scalar
+    }
+
+    /// Whether the query `qi + r` (lattice point, residual in cells; `r[2] = 0` when `z_exact` is
+    /// false) needs [`BoundaryEdges::area_sum_accurate`] instead of [`BoundaryEdges::area_sum`]:
+    /// - it lies within the near-edge distance of some edge (ill-conditioned `f64` term), or
+    /// - it has a residual and some edge's projected line passes so close to the lattice point
+    ///   that the residual could change the exact sign of that edge's numerator (or the
+    ///   orientation is degenerate, where the segment test needs the exact z).
+    ///
+    /// Otherwise the lattice evaluation has every sign of the exact query, and magnitudes within
+    /// half a cell: `≤ 2^-60·E/d` relative, negligible at `d ≥` the near-edge distance.
+    pub fn needs_accurate_sum<W: Width>(&self, qi: [i64; 3], r: [f64; 3], z_exact: bool) -> bool {
+        if self.a.is_empty() {
+            return false;
+        }
+        let residual = r != [0.0; 3];
+        if !residual && !z_exact {
+            // Beyond the padded box along the ray: farther than the mesh extent from every edge.
+            return false;
+        }
+        let u = |v: i64| (v as f64 / self.limit) as f32;
+        let z_min = if residual {
+            f32::NEG_INFINITY
+        } else {
+            u(qi[2])
+        };
+        let pad = self.near_pad;
+        let mut flagged = false;
+        self.near.for_each_on_ray(u(qi[0]), u(qi[1]), z_min, |e| {
+            if flagged {
+                return;
+            }
+            let (a, b) = (self.a[e as usize], self.b[e as usize]);
+            if z_exact
+                && (0..3).all(|k| qi[k] >= a[k].min(b[k]) - pad && qi[k] <= a[k].max(b[k]) + pad)
+            {
+                flagged = true;
+                return;
+            }
+            if residual {
+                let (u0, u1, v0, v1) = (a[0] - qi[0], a[1] - qi[1], b[0] - qi[0], b[1] - qi[1]);
+                let lattice = i128::from(u0) * i128::from(v1) - i128::from(u1) * i128::from(v0);
+                // |D(q + r) − D(q)| ≤ |e_x||r_y| + |e_y||r_x|; generous margins (a soft test).
+                let slack =
+                    ((b[0] - a[0]) as f64 * r[1]).abs() + ((b[1] - a[1]) as f64 * r[0]).abs();
+                flagged = (lattice as f64).abs() <= 2.0 * slack + 2.0;
+            }
+        });
+        flagged
+    }
+
+    /// `Σ w·Area` at the exact query `qi + r` (see [`BoundaryEdges::needs_accurate_sum`]): every
+    /// sign from the `_at` predicates, every magnitude from double-double offsets. `O(B)` scalar.
+    #[cold]
+    pub fn area_sum_accurate<W: Width>(
+        &self,
+        qi: [i64; 3],
+        r: [f64; 3],
+        z_exact: bool,
+        qz_units: f64,
+    ) -> f64 {
+        let offset = |p: [i64; 3]| -> [DoubleDouble; 3] {
+            let along =
+                |k: usize| DoubleDouble::from_i64(p[k] - qi[k]) - DoubleDouble::from_f64(r[k]);
+            let z = if z_exact {
+                along(2)
+            } else {
+                DoubleDouble::from_i64(p[2]) - DoubleDouble::from_f64(qz_units)
+            };
+            [along(0), along(1), z]
+        };
+        let mut sum = NeumaierSum::new();
+        for i in 0..self.a.len() {
+            let (a, b) = (self.a[i], self.b[i]);
+            let o = perturbed_orient2d_at::<W>(
+                [qi[0], qi[1]],
+                [r[0], r[1]],
+                [a[0], a[1]],
+                [b[0], b[1]],
+            );
+            let signs = EdgeSigns {
+                numerator: -o.sign,
+                query_inside_segment: o.degenerate
+                    && z_exact
+                    && query_inside_segment_at(qi, r, a, b),
+            };
+            sum.add(self.weight[i] * antipodal_edge_area_accurate(offset(a), offset(b), signs));
+        }
+        sum.value()
     }
 
     /// The bound constants of the `f64` orientation filter: error of an offset: conversions of a

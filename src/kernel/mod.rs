@@ -7,11 +7,13 @@
 //! - [`spherical`]: the solid-angle and spherical-triangle formulas;
 //! - [`angle_sum`]: sums of many `atan2` terms as one complex product with turn counting;
 //! - [`boundary`]: the SIMD loop over the boundary edges of the Antipodal formula;
-//! - [`compensated`]: Neumaier summation.
+//! - [`compensated`]: Neumaier summation;
+//! - [`double_double`]: the extended precision of ill-conditioned near-edge terms.
 
 pub mod angle_sum;
 pub mod boundary;
 pub mod compensated;
+pub mod double_double;
 pub mod frame;
 pub mod predicates;
 pub mod quantize;

@@ -14,7 +14,7 @@
 
 use num_bigint::BigInt;
 
-use super::quantize::Precision;
+use super::quantize::{Precision, decompose};
 
 /// Integer width of the predicates: `i64` arithmetic on a 30-bit grid, `i128` on a 60-bit grid.
 pub trait Width: Copy + Send + Sync + std::fmt::Debug + 'static {
@@ -217,6 +217,211 @@ pub fn perturbed_plane_side<W: Width>(q: [i64; 3], p: [[i64; 3]; 3]) -> i32 {
         }
     }
     0
+}
+
+/// The query's exact position is `q + r` (lattice point `q`, residual `r` in cells, dyadic,
+/// `|r_k| ≤ 1/2`; see [`super::quantize::Grid::snap_with_residual`]). The `_at` predicates below
+/// are the predicates above evaluated at that exact point, perturbed the same way: every predicate
+/// is affine in the query, so its ε coefficients do not depend on `r` and a query with `r = 0`
+/// takes the lattice code path unchanged. This is what makes `w` exact to the last bit of the
+/// query's coordinates, not only up to half a cell.
+///
+/// `sign(det(a − q − r, b − q − r))` perturbed: `det` is affine in the query,
+/// `D(q + r) = D(q) + (b_x − a_x)·r_y − (b_y − a_y)·r_x`.
+#[inline]
+pub fn perturbed_orient2d_at<W: Width>(
+    q: [i64; 2],
+    r: [f64; 2],
+    a: [i64; 2],
+    b: [i64; 2],
+) -> Orient2d {
+    if r == [0.0, 0.0] {
+        return perturbed_orient2d::<W>(q, a, b);
+    }
+    let (u0, u1, v0, v1) = (a[0] - q[0], a[1] - q[1], b[0] - q[0], b[1] - q[1]);
+    // Exact: |u|, |v| < 2^61, products < 2^122.
+    let lattice = i128::from(u0) * i128::from(v1) - i128::from(u1) * i128::from(v0);
+    let e = [b[0] - a[0], b[1] - a[1]];
+    let c0 = e[0] as f64 * r[1];
+    let c1 = e[1] as f64 * r[0];
+    let lf = lattice as f64;
+    let total = lf + (c0 - c1);
+    // Conversions (u each), two products, two sums: 4u of the permanent covers them; ×2.
+    let bound = RESIDUAL_FILTER * (lf.abs() + c0.abs() + c1.abs());
+    let s = if total > bound {
+        1
+    } else if total < -bound {
+        -1
+    } else {
+        exact_sign_with_residual(
+            BigInt::from(lattice),
+            &[i128::from(e[0]), -i128::from(e[1])],
+            &[r[1], r[0]],
+        )
+    };
+    if s != 0 {
+        return Orient2d {
+            sign: s,
+            degenerate: false,
+        };
+    }
+    let s1 = (a[1] - b[1]).signum() as i32;
+    let sign = if s1 != 0 {
+        s1
+    } else {
+        (b[0] - a[0]).signum() as i32
+    };
+    Orient2d {
+        sign,
+        degenerate: true,
+    }
+}
+
+/// Relative bound of the residual predicates' `f64` filters: `8u`, twice the `4u` that covers
+/// the conversions, products and sums of a permanent of at most six terms (`u = 2^-53`).
+const RESIDUAL_FILTER: f64 = 8.0 * (f64::EPSILON * 0.5);
+
+/// [`perturbed_plane_side`] at the exact query `q + r`: `(q + r − p0)·n = (q − p0)·n + r·n`.
+#[inline]
+pub fn perturbed_plane_side_at<W: Width>(q: [i64; 3], r: [f64; 3], p: [[i64; 3]; 3]) -> i32 {
+    if r == [0.0; 3] {
+        return perturbed_plane_side::<W>(q, p);
+    }
+    let e1 = sub(p[1], p[0]);
+    let e2 = sub(p[2], p[0]);
+    let n = cross_exact(e1, e2);
+    let d = sub(q, p[0]);
+    let mut total = 0.0;
+    let mut permanent = 0.0;
+    for k in 0..3 {
+        let nk = n[k] as f64;
+        let t = d[k] as f64 * nk + r[k] * nk;
+        total += t;
+        permanent += (d[k] as f64).abs() * nk.abs() + (r[k] * nk).abs();
+    }
+    let bound = RESIDUAL_FILTER * permanent;
+    let s = if total > bound {
+        1
+    } else if total < -bound {
+        -1
+    } else {
+        let lattice: BigInt = (0..3)
+            .map(|k| BigInt::from(d[k]) * BigInt::from(n[k]))
+            .sum();
+        exact_sign_with_residual(lattice, &n, &r)
+    };
+    if s != 0 {
+        return s;
+    }
+    for c in n {
+        if c != 0 {
+            return c.signum() as i32;
+        }
+    }
+    0
+}
+
+/// [`ray_crossing`] from the exact query `q + r`.
+#[inline]
+pub fn ray_crossing_at<W: Width>(q: [i64; 3], r: [f64; 3], p: [[i64; 3]; 3]) -> i32 {
+    let s0 = projected_containment_at::<W>([q[0], q[1]], [r[0], r[1]], p);
+    if s0 == 0 {
+        return 0;
+    }
+    if perturbed_plane_side_at::<W>(q, r, p) == -s0 {
+        s0
+    } else {
+        0
+    }
+}
+
+/// [`projected_containment`] of the exact query `q + r`.
+#[inline]
+pub fn projected_containment_at<W: Width>(q2: [i64; 2], r2: [f64; 2], p: [[i64; 3]; 3]) -> i32 {
+    if r2 == [0.0, 0.0] {
+        return projected_containment::<W>(q2, p);
+    }
+    for k in 0..2 {
+        let (lo, hi) = (
+            p[0][k].min(p[1][k]).min(p[2][k]),
+            p[0][k].max(p[1][k]).max(p[2][k]),
+        );
+        // `q + r < lo` ⟺ `q < lo`, or `q = lo` and `r < 0` (|r| ≤ 1/2, lattice integers).
+        if q2[k] < lo || q2[k] > hi || (q2[k] == lo && r2[k] < 0.0) || (q2[k] == hi && r2[k] > 0.0)
+        {
+            return 0;
+        }
+    }
+    let edge = |i: usize, j: usize| {
+        perturbed_orient2d_at::<W>(q2, r2, [p[i][0], p[i][1]], [p[j][0], p[j][1]]).sign
+    };
+    let s0 = edge(0, 1);
+    if s0 == 0 || edge(1, 2) != s0 || edge(2, 0) != s0 {
+        return 0;
+    }
+    s0
+}
+
+/// [`query_inside_segment`] for the exact query `q + r` (exact big-integer arithmetic on the
+/// offsets scaled to integers; only reached for degenerate orientations).
+pub fn query_inside_segment_at(q: [i64; 3], r: [f64; 3], a: [i64; 3], b: [i64; 3]) -> bool {
+    if r == [0.0; 3] {
+        return query_inside_segment(q, a, b);
+    }
+    // With r ≠ 0 the query is not a lattice point, so neither offset is zero.
+    let shift = residual_scale(&r);
+    let offset = |p: [i64; 3]| -> [BigInt; 3] {
+        std::array::from_fn(|k| (BigInt::from(p[k] - q[k]) << shift) - scaled_dyadic(r[k], shift))
+    };
+    let (ra, rb) = (offset(a), offset(b));
+    let zero = BigInt::from(0);
+    for (i, j) in [(1, 2), (2, 0), (0, 1)] {
+        if &ra[i] * &rb[j] - &ra[j] * &rb[i] != zero {
+            return false;
+        }
+    }
+    let dot: BigInt = (0..3).map(|k| &ra[k] * &rb[k]).sum();
+    dot < zero
+}
+
+/// Exact sign of `lattice + Σ c_k·r_k` for integers `lattice`, `c_k` and dyadic `r_k`: everything
+/// is scaled by the power of two that makes every `r_k` an integer.
+#[cold]
+pub fn exact_sign_with_residual(lattice: BigInt, c: &[i128], r: &[f64]) -> i32 {
+    let shift = residual_scale(r);
+    let mut v = lattice << shift;
+    for (ck, rk) in c.iter().zip(r) {
+        v += BigInt::from(*ck) * scaled_dyadic(*rk, shift);
+    }
+    match v.sign() {
+        num_bigint::Sign::Plus => 1,
+        num_bigint::Sign::Minus => -1,
+        num_bigint::Sign::NoSign => 0,
+    }
+}
+
+/// The smallest `s ≥ 0` with every `r_k·2^s` an integer.
+fn residual_scale(r: &[f64]) -> usize {
+    r.iter()
+        .filter(|x| **x != 0.0)
+        .map(|&x| {
+            let (m, e) = decompose(x);
+            let e = e + m.trailing_zeros() as i32;
+            (-e).max(0) as usize
+        })
+        .max()
+        .unwrap_or(0)
+}
+
+/// `x·2^shift` as an integer (exact when `shift ≥ residual_scale(x)`).
+fn scaled_dyadic(x: f64, shift: usize) -> BigInt {
+    let (m, e) = decompose(x);
+    let total = e + shift as i32;
+    if total >= 0 {
+        BigInt::from(m) << total as usize
+    } else {
+        BigInt::from(m) >> (-total) as usize
+    }
 }
 
 /// Exact cross product of grid differences (< 2^61 each ⇒ components < 2^123).

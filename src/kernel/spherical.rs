@@ -8,6 +8,9 @@
 //!   ray fixed to `+z` (so `x1 = −z`), its numerator's sign supplied by the exact perturbed
 //!   predicate and the symbolic limits of the degenerate configurations written out.
 
+use super::double_double::{DoubleDouble, dot3};
+use super::quantize::decompose;
+
 /// `2·atan2(s·mag, den)` where the sign `s ∈ {−1, 0, 1}` of the numerator was decided exactly.
 ///
 /// Never lets a rounding-signed `±0.0` choose the branch: a zero magnitude with `den < 0` gives
@@ -31,7 +34,11 @@ pub fn signed_double_atan2(s: i32, mag: f64, den: f64) -> f64 {
 /// Signed solid angle subtended at the origin by the triangle with corners `a, b, c` (positions
 /// relative to the query point), in `[-2π, 2π]`.
 ///
-/// Van Oosterom & Strackee: `tan(Ω/2) = a·(b×c) / (|a||b||c| + (a·b)|c| + (b·c)|a| + (c·a)|b|)`.
+/// Van Oosterom & Strackee on the unit vectors `â, b̂, ĉ`:
+/// `tan(Ω/2) = â·(b̂×ĉ) / (1 + â·b̂ + b̂·ĉ + ĉ·â)`. Normalizing first (each vector scaled by a power
+/// of two before its norm) makes the formula indifferent to magnitude: the unnormalized form's
+/// `|a||b||c|` overflowed for meshes at 1e103 and underflowed for a query 1e-300 from a vertex
+/// (issue 11, section 4).
 ///
 /// On-surface semantics: when the triple product is exactly zero (the query lies in the plane of
 /// the triangle, on an edge, or on a vertex) the result is 0, the principal value. This is what
@@ -39,15 +46,38 @@ pub fn signed_double_atan2(s: i32, mag: f64, den: f64) -> f64 {
 /// (e.g. 1/8) at a convex corner. Never NaN for finite input.
 #[inline]
 pub fn triangle_solid_angle(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
-    let la = norm(a);
-    let lb = norm(b);
-    let lc = norm(c);
-    let det = dot(a, cross(b, c));
-    if det == 0.0 {
-        return 0.0;
+    match solid_angle_parts(a, b, c) {
+        Some((sign, det, den)) => signed_double_atan2(sign, det.abs(), den),
+        None => 0.0,
     }
-    let den = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
-    if det.abs() <= 1e-12 * la * lb * lc {
+}
+
+/// `(sign, â·(b̂×ĉ), 1 + â·b̂ + b̂·ĉ + ĉ·â)`, or `None` when the triangle subtends nothing
+/// (coplanar query, zero-area triangle). `sign` is the exact sign of `a·(b×c)`, which the `f64`
+/// triple product may have lost to underflow (a query `5e-324` off a face).
+#[inline]
+fn solid_angle_parts(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> Option<(i32, f64, f64)> {
+    // The exact-zero test on the raw offsets (brought to magnitude ~1 by one common power of
+    // two, so that it neither underflows nor overflows), before normalizing rounds it away.
+    let m = [a, b, c]
+        .iter()
+        .flatten()
+        .fold(0.0_f64, |m, x| m.max(x.abs()));
+    let s = power_of_two_scale(m);
+    let scaled = |v: [f64; 3]| v.map(|x| x * s[0] * s[1]);
+    let raw = dot(scaled(a), cross(scaled(b), scaled(c)));
+    let sign = if raw != 0.0 {
+        if raw > 0.0 { 1 } else { -1 }
+    } else {
+        exact_triple_product_sign(a, b, c)
+    };
+    if sign == 0 {
+        return None;
+    }
+    let (a, b, c) = (unit(a), unit(b), unit(c));
+    let det = dot(a, cross(b, c));
+    let den = 1.0 + dot(a, b) + dot(b, c) + dot(c, a);
+    if det.abs() <= 1e-12 {
         // A zero-area triangle subtends no solid angle. Without this test, a collinear triangle
         // seen from a point close to its line gives det ≈ ±tiny against den ≤ 0 or den ≈ 0,
         // i.e. up to ±2π (found by the kernel fuzz target: the direct sum returned −1/4 next to
@@ -56,10 +86,107 @@ pub fn triangle_solid_angle(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
         let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
         let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
         if cross(e1, e2) == [0.0; 3] {
-            return 0.0;
+            return None;
         }
     }
-    2.0 * det.atan2(den)
+    Some((sign, det, den))
+}
+
+/// Exact sign of `a·(b×c)` for any finite `f64` vectors (every `f64` is `m·2^e`: scaled to
+/// integers, big-integer arithmetic). The rare path of an underflowed `f64` triple product.
+#[cold]
+fn exact_triple_product_sign(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> i32 {
+    use num_bigint::BigInt;
+    let min_exp = [a, b, c]
+        .iter()
+        .flatten()
+        .filter(|x| **x != 0.0)
+        .map(|&x| decompose(x).1)
+        .min()
+        .unwrap_or(0);
+    let big = |v: [f64; 3]| -> [BigInt; 3] {
+        v.map(|x| {
+            let (m, e) = decompose(x);
+            BigInt::from(m) << (e - min_exp) as usize
+        })
+    };
+    let (a, b, c) = (big(a), big(b), big(c));
+    let cx = &b[1] * &c[2] - &b[2] * &c[1];
+    let cy = &b[2] * &c[0] - &b[0] * &c[2];
+    let cz = &b[0] * &c[1] - &b[1] * &c[0];
+    let d = &a[0] * cx + &a[1] * cy + &a[2] * cz;
+    match d.sign() {
+        num_bigint::Sign::Plus => 1,
+        num_bigint::Sign::Minus => -1,
+        num_bigint::Sign::NoSign => 0,
+    }
+}
+
+/// Below this `√(det² + den²)` (unit vectors) the `f64` solid angle is ill-conditioned: both
+/// arguments cancel when the query is near an edge (`≈` distance / edge scale), and the `f64`
+/// result errs by `≈ 8u / √(det² + den²)`, `u = 2^-53`; above it by less than `1e-13`.
+pub const SOLID_ANGLE_CONDITION: f64 = 1.0 / 64.0;
+
+/// [`triangle_solid_angle`] of the triangle with corners `p` seen from `q` (world coordinates),
+/// accurate to `~1e-15` down to distances `~1e-14` of the triangle's size from its edges: the
+/// offsets `p − q` are exact double-doubles (no loss when `|p| ≫ |p − q|`), and ill-conditioned
+/// triangles ([`SOLID_ANGLE_CONDITION`]) are evaluated in double-double.
+#[inline]
+pub fn triangle_solid_angle_at(p: [[f64; 3]; 3], q: [f64; 3]) -> f64 {
+    let r: [[DoubleDouble; 3]; 3] =
+        p.map(|v| std::array::from_fn(|k| DoubleDouble::diff(v[k], q[k])));
+    let f = r.map(|v| v.map(|c| c.hi));
+    let Some((sign, det, den)) = solid_angle_parts(f[0], f[1], f[2]) else {
+        return 0.0;
+    };
+    if det.hypot(den) >= SOLID_ANGLE_CONDITION {
+        return signed_double_atan2(sign, det.abs(), den);
+    }
+    let [a, b, c] = r.map(unit_dd);
+    let cross_bc = [
+        b[1] * c[2] - b[2] * c[1],
+        b[2] * c[0] - b[0] * c[2],
+        b[0] * c[1] - b[1] * c[0],
+    ];
+    let det = dot3(&a, &cross_bc);
+    let den = DoubleDouble::from_f64(1.0) + dot3(&a, &b) + dot3(&b, &c) + dot3(&c, &a);
+    signed_double_atan2(sign, det.value().abs(), den.value())
+}
+
+/// `v/|v|`, scaled by a power of two first so that neither `|v|²` overflows nor underflows.
+#[inline]
+fn unit(v: [f64; 3]) -> [f64; 3] {
+    let s = power_of_two_scale(v[0].abs().max(v[1].abs()).max(v[2].abs()));
+    let v = v.map(|c| c * s[0] * s[1]);
+    normalized(v)
+}
+
+/// [`unit`] in double-double.
+fn unit_dd(v: [DoubleDouble; 3]) -> [DoubleDouble; 3] {
+    let s = power_of_two_scale(v[0].hi.abs().max(v[1].hi.abs()).max(v[2].hi.abs()));
+    let v = v.map(|c| DoubleDouble {
+        hi: c.hi * s[0] * s[1],
+        lo: c.lo * s[0] * s[1],
+    });
+    let len = dot3(&v, &v).sqrt();
+    v.map(|c| c / len)
+}
+
+/// Two powers of two whose product brings `m > 0` to `[1, 2)` (`[1, 1]` for `m = 0`).
+#[inline]
+fn power_of_two_scale(m: f64) -> [f64; 2] {
+    if m == 0.0 || !m.is_finite() {
+        return [1.0, 1.0];
+    }
+    let e = if m >= f64::MIN_POSITIVE {
+        ((m.to_bits() >> 52) & 0x7ff) as i32 - 1023
+    } else {
+        // Subnormal: exponent from the leading bit of the significand.
+        -1023 - (m.to_bits().leading_zeros() as i32 - 12)
+    };
+    let half = -e / 2;
+    let pow = |k: i32| f64::from_bits(((k + 1023) as u64) << 52);
+    [pow(half), pow(-e - half)]
 }
 
 /// What the exact predicates established about one boundary edge `a → b` relative to the
@@ -131,6 +258,42 @@ pub fn antipodal_edge_area(ra: [f64; 3], rb: [f64; 3], signs: EdgeSigns) -> f64 
     let n = ra[0] * rb[1] - ra[1] * rb[0];
     let den = len_minus_z(ra, la) * len_minus_z(rb, lb) + ra[0] * rb[0] + ra[1] * rb[1];
     signed_double_atan2(s, n.abs(), den)
+}
+
+/// [`antipodal_edge_area`] with the offsets given exactly as double-doubles (`a − q − r` from the
+/// integer lattice and the query's residual), for the edges the `f64` loop cannot serve to 1e-12:
+/// the query within a small fraction of the edge's length from the edge, where both `atan2`
+/// arguments cancel (`|n|, den ≈ |a−q||b−q|·θ` with `θ ≈ distance/length`, so `f64` loses
+/// `log2(1/θ)` bits; double-double keeps ~106 − log2(1/θ)). The degenerate limits (exact zero
+/// components) are directions only and take the `f64` formulas.
+pub fn antipodal_edge_area_accurate(
+    ra: [DoubleDouble; 3],
+    rb: [DoubleDouble; 3],
+    signs: EdgeSigns,
+) -> f64 {
+    let hi = |r: &[DoubleDouble; 3]| r.map(|c| c.hi);
+    let (fa, fb) = (hi(&ra), hi(&rb));
+    let degenerate = signs.numerator == 0
+        || signs.query_inside_segment
+        || fa == [0.0; 3]
+        || fb == [0.0; 3]
+        || (fa[0] == 0.0 && fa[1] == 0.0)
+        || (fb[0] == 0.0 && fb[1] == 0.0);
+    if degenerate {
+        return antipodal_edge_area(fa, fb, signs);
+    }
+    let la = dot3(&ra, &ra).sqrt();
+    let lb = dot3(&rb, &rb).sqrt();
+    let len_minus_z = |r: &[DoubleDouble; 3], len: DoubleDouble| {
+        if r[2].hi > 0.0 {
+            (r[0] * r[0] + r[1] * r[1]) / (len + r[2])
+        } else {
+            len - r[2]
+        }
+    };
+    let n = ra[0] * rb[1] - ra[1] * rb[0];
+    let den = len_minus_z(&ra, la) * len_minus_z(&rb, lb) + ra[0] * rb[0] + ra[1] * rb[1];
+    signed_double_atan2(signs.numerator, n.value().abs(), den.value())
 }
 
 /// `∇_q` of the solid-angle contribution of the directed segment from `q + ra` to `q + rb`:

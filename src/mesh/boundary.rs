@@ -35,9 +35,58 @@ pub struct BoundaryEdge {
 /// # Ok::<(), gwn::error::MeshError>(())
 /// ```
 pub fn boundary_edges(mesh: &Mesh) -> Vec<BoundaryEdge> {
+    signed_boundary(mesh.triangles().iter().copied())
+}
+
+/// The signed boundary *by position*: vertices at bit-identical positions (`-0.0 = 0.0`) are one
+/// vertex, so a mesh split at UV seams, or an indexed soup whose triangles each own their three
+/// vertices, has the boundary of its geometry (a closed surface: none). This is the boundary
+/// that the winding number sees: two directed edges with the same endpoint positions and opposite
+/// directions cancel in every formula, whatever their indices. Edges name the first vertex of each
+/// position.
+///
+/// ```
+/// use gwn::{Mesh, mesh::{boundary_edges, geometric_boundary_edges}};
+/// // The same square as two triangles with their own vertices (a soup).
+/// let m = Mesh::from_slices(
+///     &[[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 1., 0.], [1., 0., 0.], [1., 1., 0.]],
+///     &[[0, 1, 2], [3, 4, 5]],
+/// )?;
+/// assert_eq!(boundary_edges(&m).len(), 6);
+/// assert_eq!(geometric_boundary_edges(&m).len(), 4);
+/// # Ok::<(), gwn::error::MeshError>(())
+/// ```
+pub fn geometric_boundary_edges(mesh: &Mesh) -> Vec<BoundaryEdge> {
+    let keys: Vec<[u64; 3]> = mesh
+        .positions()
+        .iter()
+        .map(|p| p.map(|c| (c + 0.0).to_bits()))
+        .collect();
+    boundary_welded_by(mesh.triangles(), &keys)
+}
+
+/// The signed boundary of `triangles` after merging the vertices with equal `keys[v]` (e.g. the
+/// quantized positions the exact evaluator computes with): edges name the first vertex of each key.
+pub fn boundary_welded_by<K: std::hash::Hash + Eq>(
+    triangles: &[[u32; 3]],
+    keys: &[K],
+) -> Vec<BoundaryEdge> {
+    let mut first: std::collections::HashMap<&K, u32> =
+        std::collections::HashMap::with_capacity(keys.len());
+    let canonical: Vec<u32> = keys
+        .iter()
+        .enumerate()
+        .map(|(v, k)| *first.entry(k).or_insert(v as u32))
+        .collect();
+    signed_boundary(triangles.iter().map(|t| t.map(|v| canonical[v as usize])))
+}
+
+/// The signed boundary of a list of triangles (vertex indices).
+pub fn signed_boundary(triangles: impl Iterator<Item = [u32; 3]>) -> Vec<BoundaryEdge> {
+    let (lower, _) = triangles.size_hint();
     // (lo, hi, +1 if traversed lo→hi else −1); sorting groups each undirected edge.
-    let mut directed: Vec<(u32, u32, i8)> = Vec::with_capacity(mesh.triangles().len() * 3);
-    for t in mesh.triangles() {
+    let mut directed: Vec<(u32, u32, i8)> = Vec::with_capacity(lower * 3);
+    for t in triangles {
         for (u, v) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
             if u == v {
                 continue;

@@ -9,7 +9,9 @@
 pub mod boundary;
 pub mod stats;
 
-pub use boundary::{BoundaryEdge, boundary_edges};
+pub use boundary::{
+    BoundaryEdge, boundary_edges, boundary_welded_by, geometric_boundary_edges, signed_boundary,
+};
 
 use crate::error::MeshError;
 

@@ -174,8 +174,10 @@ pub fn big(x: &BigInt, shift: i64) -> Iv {
         let v = i64::try_from(x).expect("53-bit integer fits i64") as f64; // exact
         return Iv::point(v).scale2(-shift);
     }
-    // |x| ∈ [y, y + 1]·2^drop with y = floor(|x| / 2^drop) < 2^60.
-    let drop = bits - 60;
+    // |x| ∈ [y, y + 1]·2^drop with y = floor(|x| / 2^drop) < 2^60. (54 to 60 bits: drop = 0;
+    // a negative drop used to shift everything out and enclose 0, which made the rational oracle
+    // wrong for queries with 27–31 significant bits on small integer meshes.)
+    let drop = (bits - 60).max(0);
     let y = u64::try_from(&(x.magnitude() >> (drop as usize))).expect("60-bit integer fits u64");
     let lo = Iv::rounded(y as f64, y as f64).lo;
     let hi = Iv::rounded((y + 1) as f64, (y + 1) as f64).hi;
@@ -243,6 +245,15 @@ mod tests {
         let e = big(&x, 0);
         let xf = (3u128 << 62) + 1;
         assert!(e.lo <= xf as f64 && xf as f64 <= e.hi);
+        // 54 to 60 bits (the range that enclosed 0 before): tight and containing the value.
+        for bits in 54..=60 {
+            let x = (1i64 << (bits - 1)) + 12345;
+            let e = big(&BigInt::from(-x), 0);
+            assert!(
+                e.lo <= -(x as f64) && -(x as f64) <= e.hi && e.hi - e.lo <= 512.0,
+                "{bits}"
+            );
+        }
         let e = big(&BigInt::from(-5), 2);
         assert_eq!(e, Iv::point(-1.25));
         assert!(pi().lo < pi().hi);

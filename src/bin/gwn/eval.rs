@@ -148,6 +148,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 Options {
                     precision,
                     ray: args.ray.into(),
+                    ..Default::default()
                 },
             )
             .map_err(|e| CliError(format!("{}: {e}", args.mesh.display())))?;

@@ -6,11 +6,13 @@ use std::fmt;
 
 use rayon::prelude::*;
 
+use super::InputScale;
 use super::area::estimate_areas;
 use super::barnes_hut::{FastParams, Hierarchy};
 use super::moments::Moments;
 use super::soup::dist2;
 use super::tree::Tree;
+use crate::BoundingBox;
 use crate::kernel::compensated::NeumaierSum;
 
 const INV_4PI: f64 = 1.0 / (4.0 * std::f64::consts::PI);
@@ -215,6 +217,8 @@ pub struct PointCloudWindingNumber {
     weighted_normals: Vec<[f64; 3]>,
     areas: Vec<f64>,
     params: FastParams,
+    /// World → the scaled coordinates positions and normals are stored in.
+    scale: InputScale,
 }
 
 impl PointCloudWindingNumber {
@@ -241,10 +245,14 @@ impl PointCloudWindingNumber {
         params: FastParams,
     ) -> Self {
         assert!(positions.len() == normals.len() && positions.len() == areas.len());
+        let scale = InputScale::new(BoundingBox::of_points(positions));
+        let positions: Vec<[f64; 3]> = positions.iter().map(|&p| scale.point(p)).collect();
+        let positions = &positions[..];
+        // Areas scale with the square of lengths (so each dipole term is scale-invariant).
         let an: Vec<[f64; 3]> = normals
             .iter()
             .zip(&areas)
-            .map(|(n, &a)| n.map(|v| v * a))
+            .map(|(n, &a)| scale.point(scale.point(n.map(|v| v * a))))
             .collect();
         let boxes: Vec<_> = positions.iter().map(|&p| (p, p)).collect();
         let tree = Tree::build(positions, &boxes, POINT_LEAF_SIZE);
@@ -263,6 +271,7 @@ impl PointCloudWindingNumber {
             weighted_normals,
             areas,
             params,
+            scale,
         }
     }
 
@@ -288,6 +297,7 @@ impl PointCloudWindingNumber {
 
     /// The approximate winding number at `q` with explicit parameters.
     pub fn eval_with(&self, q: [f64; 3], params: FastParams) -> f64 {
+        let q = self.scale.query(q);
         let (p, an) = (&self.positions, &self.weighted_normals);
         self.hierarchy.eval(q, &params, |_, range, sum| {
             for i in range {

@@ -75,3 +75,53 @@ pub use cloud::{
 };
 pub use moments::{Moments, SYM_PAIRS};
 pub use soup::{FastWindingNumber, TRIANGLE_LEAF_SIZE};
+
+use crate::BoundingBox;
+use crate::kernel::quantize::{Rescale, pull_in};
+
+/// How the fast evaluators keep their `f64`/`f32` arithmetic in range (issue 11, section 4): the
+/// input is scaled by a power of two to extent `[1, 2)` (exact; the expansions overflowed for
+/// meshes at 1e103 and underflowed at 1e-110), and queries farther than `2^30` extents are pulled
+/// in to that distance (the `f32` far field overflowed beyond ~1e19), which changes `w` by less
+/// than `2^-60` (see `kernel::quantize::Grid::pull_in_far`).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct InputScale {
+    rescale: Rescale,
+    center: [f64; 3],
+    far: f64,
+}
+
+impl InputScale {
+    /// The scaling for input points with bounding box `b` (world coordinates).
+    pub(crate) fn new(b: Option<BoundingBox>) -> Self {
+        let Some(b) = b else {
+            return InputScale {
+                rescale: Rescale::for_box(&BoundingBox {
+                    min: [0.0; 3],
+                    max: [0.0; 3],
+                }),
+                center: [0.0; 3],
+                far: f64::INFINITY,
+            };
+        };
+        let rescale = Rescale::for_box(&b);
+        let (lo, hi) = (rescale.apply(b.min), rescale.apply(b.max));
+        InputScale {
+            rescale,
+            center: std::array::from_fn(|k| 0.5 * lo[k] + 0.5 * hi[k]),
+            far: (1u64 << 31) as f64,
+        }
+    }
+
+    /// An input point (or a normal-times-area vector's length scale: see the callers).
+    #[inline]
+    pub(crate) fn point(&self, p: [f64; 3]) -> [f64; 3] {
+        self.rescale.apply(p)
+    }
+
+    /// A query: scaled, then pulled in.
+    #[inline]
+    pub(crate) fn query(&self, q: [f64; 3]) -> [f64; 3] {
+        pull_in(self.rescale.apply(q), self.center, self.far)
+    }
+}

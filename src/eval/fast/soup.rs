@@ -2,10 +2,11 @@
 
 use rayon::prelude::*;
 
+use super::InputScale;
 use super::barnes_hut::{FastParams, Hierarchy};
 use super::moments::Moments;
 use super::tree::Tree;
-use wide::{CmpEq, CmpGt, CmpLt, f64x4};
+use wide::{CmpGt, CmpLt, f64x4};
 
 use crate::kernel::angle_sum::AngleSum;
 use crate::kernel::spherical::triangle_solid_angle;
@@ -41,6 +42,8 @@ pub struct FastWindingNumber {
     /// unused lanes are zero, a triangle with `det = 0` that adds nothing.
     leaves: Vec<[f64x4; 9]>,
     params: FastParams,
+    /// World → the scaled coordinates everything above is stored in.
+    scale: InputScale,
 }
 
 impl FastWindingNumber {
@@ -59,6 +62,8 @@ impl FastWindingNumber {
 
     /// Builds from triangle corner triples (a soup).
     pub fn from_triangles(tris: Vec<[[f64; 3]; 3]>, params: FastParams) -> Self {
+        let scale = InputScale::new(BoundingBox::of_points(tris.iter().flatten()));
+        let tris: Vec<[[f64; 3]; 3]> = tris.iter().map(|t| t.map(|v| scale.point(v))).collect();
         let centroids: Vec<[f64; 3]> = tris.iter().map(centroid).collect();
         let boxes: Vec<([f64; 3], [f64; 3])> = tris
             .iter()
@@ -106,6 +111,7 @@ impl FastWindingNumber {
             triangles,
             leaves,
             params,
+            scale,
         }
     }
 
@@ -127,6 +133,7 @@ impl FastWindingNumber {
     /// The approximate winding number at `q` with explicit parameters (Barill's form:
     /// `FastParams::barill(beta, order)`).
     pub fn eval_with(&self, q: [f64; 3], params: FastParams) -> f64 {
+        let q = self.scale.query(q);
         let mut angles = AngleSum::new();
         let far_and_rare = self.hierarchy.eval(q, &params, |k, range, sum| {
             let ok = push_solid_angles(&mut angles, &self.leaves[k], q);
@@ -156,6 +163,12 @@ impl FastWindingNumber {
             .collect()
     }
 
+    /// A world point in the coordinates of [`Self::node_box`] and [`Self::node_moments`]: the
+    /// input scaled by a power of two to extent `[1, 2)` (exact; see `InputScale`).
+    pub fn internal_point(&self, p: [f64; 3]) -> [f64; 3] {
+        self.scale.point(p)
+    }
+
     /// Number of triangles.
     pub fn len(&self) -> usize {
         self.triangles.len()
@@ -171,7 +184,8 @@ impl FastWindingNumber {
         self.hierarchy.tree.len()
     }
 
-    /// The expansion of node `id` (centre, radius, order 0–2 coefficients).
+    /// The expansion of node `id` (centre, radius, order 0–2 coefficients), in the coordinates of
+    /// [`Self::internal_point`].
     pub fn node_moments(&self, id: usize) -> &Moments {
         &self.hierarchy.moments[id]
     }
@@ -187,7 +201,7 @@ impl FastWindingNumber {
         &self.hierarchy.tree.order[self.hierarchy.tree.nodes[id].range()]
     }
 
-    /// Bounding box of the triangles below node `id`.
+    /// Bounding box of the triangles below node `id` ([`Self::internal_point`] coordinates).
     pub fn node_box(&self, id: usize) -> BoundingBox {
         let n = &self.hierarchy.tree.nodes[id];
         BoundingBox {
@@ -217,13 +231,19 @@ fn push_solid_angles(angles: &mut AngleSum, t: &[f64x4; 9], q: [f64; 3]) -> u32 
         + (ax * bx + ay * by + az * bz) * lc
         + (bx * cx + by * cy + bz * cz) * la
         + (cx * ax + cy * ay + cz * az) * lb;
+    // Coordinates are scaled to extent ~1 (`InputScale`), so only a query within ~1e-140 of a
+    // vertex can underflow `|r|²` (then `|r| = 0` with `r ≠ 0` corrupts `den`): such lanes go to
+    // the magnitude-free scalar formula.
+    let tiny = f64x4::splat(1e-140);
     let ok = det.abs().cmp_gt(f64x4::splat(1e-12) * labc)
-        & den.abs().cmp_lt(f64x4::splat(f64::INFINITY));
+        & den.abs().cmp_lt(f64x4::splat(f64::INFINITY))
+        & la.min(lb).min(lc).cmp_gt(tiny);
     angles.push(ok.blend(den, f64x4::ONE), ok.blend(det, f64x4::ZERO));
     // World coordinates have any magnitude: keep the products near 1 after every factor.
     angles.rescale();
-    let zero = det.cmp_eq(f64x4::ZERO).move_mask() as u32;
-    ok.move_mask() as u32 | zero
+    // Lanes with `det = 0` (query in the plane, zero-area triangle, or a product that underflowed
+    // for a query ~1e-300 off a face) go to the scalar formula too, which tells them apart.
+    ok.move_mask() as u32
 }
 
 #[inline]
@@ -327,7 +347,9 @@ mod tests {
             let mut area = 0.0;
             let mut reached = 0.0_f64;
             for &f in fast.node_triangles(id) {
-                let t = mesh.triangle_positions(f as usize);
+                let t = mesh
+                    .triangle_positions(f as usize)
+                    .map(|v| fast.internal_point(v));
                 area += Moments::of_triangle(t[0], t[1], t[2], m.center).area;
                 for v in t {
                     reached = reached.max(dist2(v, m.center).sqrt());
