@@ -11,7 +11,7 @@
 //! Ascii: any number of `solid … endsolid` blocks; facets with more than three vertices are
 //! fan-triangulated; a facet with fewer than three is an error; the file must end after a
 //! complete `endsolid` (anything else is truncated). Keywords are case-insensitive; the facet
-//! normal is ignored. Every triangle gets its own three vertices (weld afterwards).
+//! normal is ignored. A `vertex` line holds exactly three numbers. Every triangle gets its own three vertices (weld afterwards).
 
 use super::{Fail, RawMesh, capped_capacity, parse_num, show, text_lines, tokens};
 use crate::error::{LoadErrorKind, Location};
@@ -92,7 +92,7 @@ fn parse_binary(bytes: &[u8]) -> Result<RawMesh, Fail> {
     Ok(RawMesh {
         positions,
         triangles,
-        polygons: 0,
+        ..RawMesh::default()
     })
 }
 
@@ -145,6 +145,12 @@ fn parse_ascii(bytes: &[u8]) -> Result<RawMesh, Fail> {
                         .ok_or_else(|| syntax(ln, "vertex needs three coordinates".into()))?;
                     *c = parse_num(tok)
                         .ok_or_else(|| syntax(ln, format!("invalid coordinate `{}`", show(tok))))?;
+                }
+                if let Some(extra) = toks.next() {
+                    return Err(syntax(
+                        ln,
+                        format!("vertex has more than three coordinates (`{}`)", show(extra)),
+                    ));
                 }
                 corners.push(p);
             }

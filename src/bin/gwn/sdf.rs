@@ -30,6 +30,7 @@ pub struct Args {
 
 /// Runs `gwn sdf`.
 pub fn run(args: Args) -> Result<(), CliError> {
+    args.grid.check()?;
     let mesh = load_mesh_for_cli(&args.mesh, args.no_weld)?;
     let spec = args.grid.spec(&mesh, &args.mesh)?;
     let sdf = SignedDistance::new(&mesh)?;
@@ -47,6 +48,5 @@ pub fn run(args: Args) -> Result<(), CliError> {
         "points",
         &format!(", {inside} inside,"),
         &written,
-    );
-    Ok(())
+    )
 }

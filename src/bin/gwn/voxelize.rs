@@ -8,7 +8,7 @@ use gwn::grid::GridSpec;
 use gwn::products::{npy, vti};
 use gwn::{BoundingBox, Mesh};
 
-use crate::common::{CliError, load_mesh_for_cli, progress};
+use crate::common::{CliError, load_mesh_for_cli, outln, progress};
 
 /// Element type of the `.npy` output.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -44,6 +44,42 @@ pub struct GridArgs {
 }
 
 impl GridArgs {
+    /// Checks the options that do not depend on the mesh, so that bad values fail before the
+    /// mesh is loaded.
+    pub fn check(&self) -> Result<(), CliError> {
+        if !(self.margin.is_finite() && self.margin >= 0.0) {
+            return Err(CliError(format!(
+                "--margin {}: expected a non-negative number",
+                self.margin
+            )));
+        }
+        if let Some(b) = &self.bounds {
+            if let Some(bad) = b.iter().find(|c| !c.is_finite()) {
+                return Err(CliError(format!("--bounds: {bad} is not a finite number")));
+            }
+            for k in 0..3 {
+                let extent = b[k + 3] - b[k];
+                if !(extent >= 0.0) {
+                    return Err(CliError(format!(
+                        "--bounds: {} max {} is below min {}",
+                        ["x", "y", "z"][k],
+                        b[k + 3],
+                        b[k]
+                    )));
+                }
+                if !extent.is_finite() {
+                    return Err(CliError(format!(
+                        "--bounds: the {} extent {} - ({}) overflows",
+                        ["x", "y", "z"][k],
+                        b[k + 3],
+                        b[k]
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// The grid for `mesh`.
     pub fn spec(&self, mesh: &Mesh, name: &Path) -> Result<GridSpec, CliError> {
         let bounds = match &self.bounds {
@@ -52,9 +88,7 @@ impl GridArgs {
                 max: [b[3], b[4], b[5]],
             },
             None => {
-                if !(self.margin.is_finite() && self.margin >= 0.0) {
-                    return Err(CliError::msg("--margin must be a non-negative number"));
-                }
+                self.check()?;
                 mesh.bounding_box()
                     .ok_or_else(|| {
                         CliError::msg(format!("{}: mesh has no triangles", name.display()))
@@ -103,7 +137,7 @@ impl GridArgs {
 }
 
 fn io_err(p: &Path, e: std::io::Error) -> CliError {
-    CliError::msg(format!("{}: {e}", p.display()))
+    CliError::msg(format!("{}: cannot write: {e}", p.display()))
 }
 
 /// Winding numbers on a voxel grid, written as `.npy` (and optionally `.vti`).
@@ -133,6 +167,15 @@ pub struct Args {
 
 /// Runs `gwn voxelize`.
 pub fn run(args: Args) -> Result<(), CliError> {
+    if let Some(t) = args.occupancy {
+        crate::common::check_threshold(t, "--occupancy")?;
+    }
+    if args.occupancy_out.is_some() && args.occupancy.is_none() {
+        return Err(CliError::msg(
+            "--occupancy-out needs --occupancy T (the threshold)",
+        ));
+    }
+    args.grid.check()?;
     let mesh = load_mesh_for_cli(&args.mesh, args.no_weld)?;
     let spec = args.grid.spec(&mesh, &args.mesh)?;
     let wn = WindingNumber::new(&mesh)?;
@@ -155,25 +198,30 @@ pub fn run(args: Args) -> Result<(), CliError> {
             args.out.with_file_name(format!("{stem}-occupancy.npy"))
         });
         let occ: Vec<u8> = values.iter().map(|&w| u8::from(w > t)).collect();
-        npy::save(&path, &spec.shape(), &occ)
-            .map_err(|e| CliError::msg(format!("{}: {e}", path.display())))?;
+        npy::save(&path, &spec.shape(), &occ).map_err(|e| io_err(&path, e))?;
         let inside = occ.iter().filter(|&&o| o == 1).count();
-        println!("occupancy (w > {t}): {inside} of {} voxels", occ.len());
+        outln!("occupancy (w > {t}): {inside} of {} voxels", occ.len())?;
         written.push(path);
     }
-    report_grid(&spec, secs, "voxels", "", &written);
-    Ok(())
+    report_grid(&spec, secs, "voxels", "", &written)
 }
 
 /// The summary `gwn voxelize` and `gwn sdf` print: size, layout, throughput, files written.
-pub fn report_grid(spec: &GridSpec, secs: f64, noun: &str, extra: &str, written: &[PathBuf]) {
+pub fn report_grid(
+    spec: &GridSpec,
+    secs: f64,
+    noun: &str,
+    extra: &str,
+    written: &[PathBuf],
+) -> Result<(), CliError> {
     let [w, h, d] = spec.dims;
-    println!(
+    outln!(
         "{} {noun} (W×H×D = {w}×{h}×{d}, npy shape ({d}, {h}, {w})){extra} in {secs:.3} s ({:.3e} {noun}/s)",
         spec.len(),
         spec.len() as f64 / secs.max(1e-9),
-    );
+    )?;
     for p in written {
-        println!("wrote {}", p.display());
+        outln!("wrote {}", p.display())?;
     }
+    Ok(())
 }
