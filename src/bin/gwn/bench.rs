@@ -37,7 +37,7 @@ pub struct Args {
     pub direct_sample: usize,
     /// Accuracy of the fast method (Barill et al.'s β: a node is approximated beyond β times
     /// its radius).
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
     pub beta: f64,
     /// Expansion order of the fast method (0, 1 or 2).
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(0..=2))]
@@ -52,7 +52,7 @@ pub struct Args {
 }
 
 /// Largest `--grid`: the N³ query points and two value arrays take 40 bytes per point, so 256
-/// (16.8 million points) needs about 670 MB; `--grid 1000` would need 40 GB.
+/// (16.8 million points) needs about 640 MiB; `--grid 1000` would need 40 GB.
 pub const MAX_GRID: usize = 256;
 
 /// Runs `gwn bench`.

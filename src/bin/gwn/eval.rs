@@ -94,7 +94,7 @@ pub struct Args {
     pub ray: Ray,
     /// Accuracy of the fast method: a tree node is approximated when its distance exceeds
     /// beta times its radius (Barill et al. 2018); larger is more accurate.
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
     pub beta: f64,
     /// Expansion order of the fast method (0, 1 or 2).
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(0..=2))]

@@ -61,7 +61,7 @@ impl GridArgs {
                 let extent = b[k + 3] - b[k];
                 if !(extent >= 0.0) {
                     return Err(CliError(format!(
-                        "--bounds: {} max {} is below min {}",
+                        "--bounds: {} max {:?} is below min {:?}",
                         ["x", "y", "z"][k],
                         b[k + 3],
                         b[k]
@@ -69,7 +69,7 @@ impl GridArgs {
                 }
                 if !extent.is_finite() {
                     return Err(CliError(format!(
-                        "--bounds: the {} extent {} - ({}) overflows",
+                        "--bounds: the {} extent {:?} - ({:?}) overflows",
                         ["x", "y", "z"][k],
                         b[k + 3],
                         b[k]
