@@ -68,6 +68,14 @@ const REPRODUCERS: &[(&str, Result<&str, &str>)] = &[
         "repro_stl_vertex_four_values",
         Err("fuzz: line 4: vertex has more than three coordinates (`7`)"),
     ),
+    (
+        "repro_off_vertex_trailing_word",
+        Err("fuzz: line 3: invalid value `abc` after the data"),
+    ),
+    (
+        "repro_stl_facet_normal_word",
+        Err("fuzz: line 2: expected `facet normal NX NY NZ` with three numbers"),
+    ),
     ("repro_points_header_only", Err("fuzz: contains no points")),
     ("repro_points_empty", Err("fuzz: contains no points")),
 ];

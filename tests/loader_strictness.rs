@@ -139,7 +139,7 @@ fn unknown_ply_header_lines_are_warnings() {
 }
 
 #[test]
-fn obj_and_stl_vertex_lines_are_checked_to_the_end() {
+fn obj_stl_and_off_lines_are_checked_to_the_end() {
     let obj = |v0: &str| format!("{v0}\nv 0 1 0\nv 0 0 1\nf 1 2 3\n");
     for good in [
         "v 1 0 0",
@@ -161,6 +161,31 @@ fn obj_and_stl_vertex_lines_are_checked_to_the_end() {
         )
     };
     load_mesh_from_bytes(stl("vertex 1 0 0").as_bytes(), "a.stl", None).unwrap();
+    for facet in [
+        "facet normal 0 0 x",
+        "facet normal 0 0",
+        "facet normal 0 0 1 2",
+        "facet x",
+    ] {
+        let text = stl("vertex 1 0 0").replace("facet normal 0 0 1", facet);
+        let e = load_mesh_from_bytes(text.as_bytes(), "a.stl", None).unwrap_err();
+        assert_eq!(e.location, Location::Line(2), "{facet}: {e}");
+    }
+    let bare = stl("vertex 1 0 0").replace("facet normal 0 0 1", "facet");
+    load_mesh_from_bytes(bare.as_bytes(), "a.stl", None).unwrap();
+    // OFF: colours after coordinates or indices are fine, words are not.
+    let off = |v0: &str, f0: &str| format!("OFF\n3 1 0\n{v0}\n0 1 0\n0 0 1\n{f0}\n");
+    load_mesh_from_bytes(
+        off("1 0 0 255 0 0 255", "3 0 1 2 0.5 0.5 0.5").as_bytes(),
+        "a.off",
+        None,
+    )
+    .unwrap();
+    for (v0, f0, line) in [("1 0 0 red", "3 0 1 2", 3), ("1 0 0", "3 0 1 2 red", 6)] {
+        let e = load_mesh_from_bytes(off(v0, f0).as_bytes(), "a.off", None).unwrap_err();
+        assert_eq!(e.location, Location::Line(line), "{e}");
+        assert!(e.to_string().contains("invalid value `red`"), "{e}");
+    }
     let e = load_mesh_from_bytes(stl("vertex 1 0 0 7").as_bytes(), "a.stl", None).unwrap_err();
     assert_eq!(e.location, Location::Line(4), "{e}");
     assert!(e.to_string().contains("more than three coordinates"), "{e}");

@@ -63,7 +63,7 @@ pub fn run(mut args: Args) -> Result<(), CliError> {
              points take about {} MB)",
             args.grid,
             MAX_GRID.pow(3),
-            MAX_GRID.pow(3) * 40 >> 20
+            (MAX_GRID.pow(3) * 40) >> 20
         )));
     }
     if args.direct_sample == 0 {

@@ -59,7 +59,7 @@ impl GridArgs {
             }
             for k in 0..3 {
                 let extent = b[k + 3] - b[k];
-                if !(extent >= 0.0) {
+                if extent < 0.0 {
                     return Err(CliError(format!(
                         "--bounds: {} max {:?} is below min {:?}",
                         ["x", "y", "z"][k],
