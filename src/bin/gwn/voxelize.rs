@@ -80,8 +80,14 @@ impl GridArgs {
         Ok(())
     }
 
-    /// The grid for `mesh`.
-    pub fn spec(&self, mesh: &Mesh, name: &Path) -> Result<GridSpec, CliError> {
+    /// The grid for `mesh`; refused when its `bytes_per_cell` (what the subcommand holds per
+    /// cell at its peak) exceed the memory available.
+    pub fn spec(
+        &self,
+        mesh: &Mesh,
+        name: &Path,
+        bytes_per_cell: usize,
+    ) -> Result<GridSpec, CliError> {
         let bounds = match &self.bounds {
             Some(b) => BoundingBox {
                 min: [b[0], b[1], b[2]],
@@ -108,6 +114,7 @@ impl GridArgs {
                 spec.dims
             )));
         }
+        check_memory(spec.len(), bytes_per_cell, available_memory())?;
         Ok(spec)
     }
 
@@ -133,6 +140,51 @@ impl GridArgs {
             written.push(p.clone());
         }
         Ok(written)
+    }
+}
+
+/// Peak bytes per cell of `gwn voxelize`: the per-column `f64` results and the grid they are
+/// copied into, the `f32` copy for `.npy` and the occupancy.
+pub const VOXELIZE_BYTES_PER_CELL: usize = 8 + 8 + 4 + 1;
+
+/// The memory the system can still give (Linux `MemAvailable`), `None` where unknown.
+fn available_memory() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib.saturating_mul(1024))
+}
+
+/// Refuses a grid whose arrays would not fit in the available memory: allocating them would
+/// abort the process (or wake the OOM killer) after the mesh is loaded, with no useful message.
+fn check_memory(
+    cells: usize,
+    bytes_per_cell: usize,
+    available: Option<u64>,
+) -> Result<(), CliError> {
+    let need = (cells as u64).saturating_mul(bytes_per_cell as u64);
+    match available {
+        Some(have) if need > have => Err(CliError(format!(
+            "a grid of {cells} cells needs about {:.1} GiB of memory, more than the {:.1} GiB \
+             available; lower --res or --dims",
+            need as f64 / f64::from(1 << 30),
+            have as f64 / f64::from(1 << 30)
+        ))),
+        _ => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::check_memory;
+
+    #[test]
+    fn grids_larger_than_the_available_memory_are_refused() {
+        assert!(check_memory(1 << 20, 13, Some(1 << 30)).is_ok());
+        let e = check_memory(1 << 30, 13, Some(8 << 30)).unwrap_err();
+        assert!(e.0.contains("13.0 GiB") && e.0.contains("8.0 GiB"), "{e}");
+        assert!(check_memory(usize::MAX, 44, Some(u64::MAX - 1)).is_err());
+        assert!(check_memory(1 << 31, 44, None).is_ok());
     }
 }
 
@@ -177,7 +229,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     args.grid.check()?;
     let mesh = load_mesh_for_cli(&args.mesh, args.no_weld)?;
-    let spec = args.grid.spec(&mesh, &args.mesh)?;
+    let spec = args.grid.spec(&mesh, &args.mesh, VOXELIZE_BYTES_PER_CELL)?;
     let wn = WindingNumber::new(&mesh)?;
     let pb = progress(
         spec.column_count(gwn::grid::ray_world_axis(&wn)) as u64,
