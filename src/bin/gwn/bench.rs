@@ -26,7 +26,7 @@ pub struct Args {
     /// Mesh files or folders (every .obj/.stl/.off/.ply inside, sorted).
     #[arg(required = true)]
     pub paths: Vec<PathBuf>,
-    /// Grid resolution per axis.
+    /// Grid resolution per axis (1 to 256: the grid has N³ points).
     #[arg(long, default_value_t = 32)]
     pub grid: usize,
     /// Thread counts to measure.

@@ -93,7 +93,7 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = Ray::PosZ, allow_hyphen_values = true)]
     pub ray: Ray,
     /// Accuracy of the fast method: a tree node is approximated when its distance exceeds
-    /// beta times its radius (Barill et al. 2018); larger is more accurate.
+    /// beta times its radius (Barill et al. 2018); larger is more accurate. Positive, finite.
     #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
     pub beta: f64,
     /// Expansion order of the fast method (0, 1 or 2).
@@ -105,8 +105,8 @@ pub struct Args {
     /// Output file for values (.csv or .npy); stdout when absent.
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Output file for gradients (.csv or .npy, shape (N, 3)); with --gradient and no file, the
-    /// gradient is printed after the value on each stdout line.
+    /// Output file for gradients (.csv or .npy, shape (N, 3)); needs --gradient. With
+    /// --gradient and no file, the gradient is printed after the value on each stdout line.
     #[arg(long)]
     pub gradient_out: Option<PathBuf>,
     /// Do not weld bit-identical vertices of STL files.

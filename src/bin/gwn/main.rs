@@ -26,7 +26,7 @@ mod voxelize;
 #[derive(Parser)]
 #[command(name = "gwn", version, about, long_about)]
 struct Cli {
-    /// Worker threads for batch evaluation (default: all cores).
+    /// Worker threads for batch evaluation (default: all cores; more than 4 per core are capped).
     #[arg(long, global = true)]
     threads: Option<usize>,
     #[command(subcommand)]
