@@ -36,7 +36,7 @@ pub struct Args {
     #[arg(long, default_value_t = 256)]
     pub direct_sample: usize,
     /// Accuracy of the fast method (Barill et al.'s β: a node is approximated beyond β times
-    /// its radius).
+    /// its radius; positive, finite).
     #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
     pub beta: f64,
     /// Expansion order of the fast method (0, 1 or 2).
