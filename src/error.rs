@@ -135,8 +135,34 @@ pub enum LoadErrorKind {
     Syntax(String),
     /// The data parsed but does not form a valid mesh.
     Mesh(MeshError),
-    /// The file holds no triangles (or no points).
+    /// The mesh file holds no triangles (including empty files).
     Empty,
+    /// The points or point-cloud file holds no points (empty, or only comments and a header).
+    NoPoints,
+    /// A file that is not a regular file (pipe, device) gave more bytes than the reader takes
+    /// from such a source (`/dev/zero` never ends).
+    TooLong {
+        /// The limit in bytes.
+        limit: u64,
+    },
+}
+
+/// Something a loader accepted but the user may want to know, e.g. an ignored PLY header line.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct LoadWarning {
+    /// Where in the file.
+    pub location: Location,
+    /// What was ignored or assumed.
+    pub message: String,
+}
+
+impl fmt::Display for LoadWarning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.location {
+            Location::File => write!(f, "{}", self.message),
+            ref l => write!(f, "{l}: {}", self.message),
+        }
+    }
 }
 
 impl LoadError {
@@ -150,22 +176,33 @@ impl LoadError {
     }
 }
 
+impl fmt::Display for LoadErrorKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            LoadErrorKind::Io(e) => write!(f, "cannot read: {e}"),
+            LoadErrorKind::UnknownFormat => {
+                f.write_str("unknown format (expected .obj, .stl, .off or .ply)")
+            }
+            LoadErrorKind::Truncated(s) => write!(f, "truncated: {s}"),
+            LoadErrorKind::Syntax(s) => f.write_str(s),
+            LoadErrorKind::Mesh(e) => write!(f, "{e}"),
+            LoadErrorKind::Empty => f.write_str("contains no triangles"),
+            LoadErrorKind::NoPoints => f.write_str("contains no points"),
+            LoadErrorKind::TooLong { limit } => write!(
+                f,
+                "not a regular file and longer than {limit} bytes (the limit for pipes and \
+                 devices)"
+            ),
+        }
+    }
+}
+
 impl fmt::Display for LoadError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let p = self.path.display();
-        let what = match &self.kind {
-            LoadErrorKind::Io(e) => format!("cannot read: {e}"),
-            LoadErrorKind::UnknownFormat => {
-                "unknown format (expected .obj, .stl, .off or .ply)".to_string()
-            }
-            LoadErrorKind::Truncated(s) => format!("truncated: {s}"),
-            LoadErrorKind::Syntax(s) => s.clone(),
-            LoadErrorKind::Mesh(e) => e.to_string(),
-            LoadErrorKind::Empty => "contains no triangles".to_string(),
-        };
         match self.location {
-            Location::File => write!(f, "{p}: {what}"),
-            ref l => write!(f, "{p}: {l}: {what}"),
+            Location::File => write!(f, "{p}: {}", self.kind),
+            ref l => write!(f, "{p}: {l}: {}", self.kind),
         }
     }
 }

@@ -67,7 +67,8 @@ impl GridSpec {
         dims.iter()
             .try_fold(1usize, |a, &d| a.checked_mul(d))
             .ok_or(GridError::TooLarge)?;
-        let finite = bounds.min.iter().chain(&bounds.max).all(|c| c.is_finite());
+        // The extent, not only the corners, must be finite: [-1e308, 1e308] overflows.
+        let finite = (0..3).all(|k| (bounds.max[k] - bounds.min[k]).is_finite());
         if !finite || (0..3).any(|k| bounds.min[k] > bounds.max[k]) {
             return Err(GridError::BadBounds);
         }

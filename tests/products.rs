@@ -667,7 +667,7 @@ fn cli_filter_tets() {
             .arg("--out")
             .arg(&out),
     );
-    assert!(e.contains("bad.node:3"), "{e}");
+    assert!(e.contains("bad.node: line 3: "), "{e}");
     let bad = d.join("bad.mesh");
     std::fs::write(&bad, "MeshVersionFormatted 2\nDimension 3\nVertices\n1\n0 0 0 0\nTetrahedra\n1\n1 2 3 4 0\nEnd\n").unwrap();
     let e = run_err(
@@ -677,7 +677,7 @@ fn cli_filter_tets() {
             .arg("--out")
             .arg(&med),
     );
-    assert!(e.contains("bad.mesh:8"), "{e}");
+    assert!(e.contains("bad.mesh: line 8: "), "{e}");
     let e = run_err(
         gwn()
             .args([

@@ -33,6 +33,7 @@ pub fn check_load_mesh(data: &[u8]) {
         Err(e) => {
             let msg = e.to_string();
             assert!(msg.starts_with("fuzz"));
+            assert!(!msg.contains('\n'), "not one line: {msg}");
         }
     }
 }

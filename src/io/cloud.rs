@@ -5,18 +5,15 @@
 //!   and lines starting with `#` or `//` are skipped, and so is one header line before the first
 //!   point if it does not parse as numbers. Every point must have the column count of the first
 //!   (6 or 7).
-//! - PLY (ascii or binary, via `ply-rs-bw`): the `vertex` element with `x y z nx ny nz` and an
-//!   optional `area` property (any scalar types).
+//! - PLY (ascii or binary, read by the mesh loader's PLY reader): the `vertex` element with
+//!   `x y z nx ny nz` and an optional `area` property (any scalar types); faces are not read.
 //!
 //! Errors name the file and the line (text), or the vertex (PLY values).
 
 use std::path::Path;
 
-use ply_rs_bw::parser::Parser;
-use ply_rs_bw::ply::{DefaultElement, Property};
-
-use super::{parse_num, show, text_lines};
-use crate::error::{LoadError, LoadErrorKind, Location};
+use super::{COLUMN_SEPARATORS, parse_num, show, text_lines, tokens_separated_by};
+use crate::error::{LoadError, LoadErrorKind, LoadWarning, Location};
 use crate::eval::fast::PointCloud;
 
 /// A point-cloud file format.
@@ -41,10 +38,16 @@ pub fn cloud_format_from_extension(path: impl AsRef<Path>) -> Option<CloudFormat
 
 /// Loads an oriented point cloud (format from the extension, else from the content).
 pub fn load_point_cloud(path: impl AsRef<Path>) -> Result<PointCloud, LoadError> {
+    load_point_cloud_with_warnings(path).map(|(cloud, _)| cloud)
+}
+
+/// [`load_point_cloud`], also returning what the reader ignored (e.g. unknown PLY header lines).
+pub fn load_point_cloud_with_warnings(
+    path: impl AsRef<Path>,
+) -> Result<(PointCloud, Vec<LoadWarning>), LoadError> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path)
-        .map_err(|e| LoadError::new(path, Location::File, LoadErrorKind::Io(e)))?;
-    load_point_cloud_from_bytes(&bytes, path, cloud_format_from_extension(path))
+    let bytes = super::read_input(path)?;
+    parse_cloud(&bytes, path, cloud_format_from_extension(path))
 }
 
 /// Parses an oriented point cloud from bytes; `format: None` detects PLY by its `ply` magic
@@ -54,23 +57,35 @@ pub fn load_point_cloud_from_bytes(
     name_for_errors: impl AsRef<Path>,
     format: Option<CloudFormat>,
 ) -> Result<PointCloud, LoadError> {
-    let name = name_for_errors.as_ref();
+    parse_cloud(bytes, name_for_errors.as_ref(), format).map(|(cloud, _)| cloud)
+}
+
+fn parse_cloud(
+    bytes: &[u8],
+    name: &Path,
+    format: Option<CloudFormat>,
+) -> Result<(PointCloud, Vec<LoadWarning>), LoadError> {
     let format = format.unwrap_or(if bytes.starts_with(b"ply") {
         CloudFormat::Ply
     } else {
         CloudFormat::Text
     });
     let parsed = match format {
-        CloudFormat::Text => parse_text(bytes),
+        CloudFormat::Text => parse_text(bytes).map(|c| (c, Vec::new())),
         CloudFormat::Ply => parse_ply(bytes),
     };
-    let (positions, normals, areas) =
+    let ((positions, normals, areas), warnings) =
         parsed.map_err(|(location, kind)| LoadError::new(name, location, kind))?;
     if positions.is_empty() {
-        return Err(LoadError::new(name, Location::File, LoadErrorKind::Empty));
+        return Err(LoadError::new(
+            name,
+            Location::File,
+            LoadErrorKind::NoPoints,
+        ));
     }
-    PointCloud::new(positions, normals, areas)
-        .map_err(|e| LoadError::new(name, Location::File, LoadErrorKind::Syntax(e.to_string())))
+    let cloud = PointCloud::new(positions, normals, areas)
+        .map_err(|e| LoadError::new(name, Location::File, LoadErrorKind::Syntax(e.to_string())))?;
+    Ok((cloud, warnings))
 }
 
 type Columns = (Vec<[f64; 3]>, Vec<[f64; 3]>, Option<Vec<f64>>);
@@ -91,10 +106,7 @@ fn parse_text(bytes: &[u8]) -> Result<Columns, Fail> {
         if trimmed.is_empty() || trimmed.starts_with(b"#") || trimmed.starts_with(b"//") {
             continue;
         }
-        let toks: Vec<&[u8]> = trimmed
-            .split(|&b| b.is_ascii_whitespace() || b == b',' || b == b';')
-            .filter(|t| !t.is_empty())
-            .collect();
+        let toks: Vec<&[u8]> = tokens_separated_by(trimmed, COLUMN_SEPARATORS).collect();
         let values: Option<Vec<f64>> = toks.iter().map(|t| parse_num::<f64>(t)).collect();
         let at = Location::Line(line_no);
         let values = match values {
@@ -142,69 +154,40 @@ fn parse_text(bytes: &[u8]) -> Result<Columns, Fail> {
     Ok((positions, normals, areas))
 }
 
-fn scalar(p: &Property) -> Option<f64> {
-    Some(match *p {
-        Property::Char(v) => f64::from(v),
-        Property::UChar(v) => f64::from(v),
-        Property::Short(v) => f64::from(v),
-        Property::UShort(v) => f64::from(v),
-        Property::Int(v) => f64::from(v),
-        Property::UInt(v) => f64::from(v),
-        Property::Float(v) => f64::from(v),
-        Property::Double(v) => v,
-        _ => return None,
-    })
-}
-
-fn parse_ply(bytes: &[u8]) -> Result<Columns, Fail> {
-    let parser = Parser::<DefaultElement>::new();
-    let mut src = bytes;
-    let ply = parser.read_ply(&mut src).map_err(|e| {
-        let at = e.line().map_or(Location::File, Location::Line);
-        syntax(at, format!("invalid PLY: {e}"))
-    })?;
-    let Some(vertices) = ply.payload.get("vertex") else {
-        return Err(syntax(Location::File, "PLY has no `vertex` element".into()));
-    };
-    let def = &ply.header.elements["vertex"];
-    for key in ["x", "y", "z", "nx", "ny", "nz"] {
-        if !def.properties.contains_key(key) {
-            return Err(syntax(
-                Location::File,
-                format!(
-                    "PLY `vertex` element has no `{key}` property (a point cloud needs x y z nx ny nz)"
-                ),
-            ));
+fn parse_ply(bytes: &[u8]) -> Result<(Columns, Vec<LoadWarning>), Fail> {
+    const NAMES: [&str; 7] = ["x", "y", "z", "nx", "ny", "nz", "area"];
+    let data = super::ply::read(
+        bytes,
+        &super::ply::Request {
+            vertex: &NAMES.map(|c| (c, c != "area")),
+            faces: false,
+        },
+    )?;
+    let mut columns = data.columns.into_iter();
+    let mut next = || columns.next().flatten().unwrap_or_default();
+    let [x, y, z, nx, ny, nz]: [Vec<f64>; 6] = std::array::from_fn(|_| next());
+    let area = columns.next().flatten();
+    let all: Vec<&Vec<f64>> = [&x, &y, &z, &nx, &ny, &nz]
+        .into_iter()
+        .chain(area.as_ref())
+        .collect();
+    for i in 0..x.len() {
+        for (name, col) in NAMES.iter().zip(&all) {
+            let v = col[i];
+            if !v.is_finite() {
+                return Err(syntax(
+                    Location::Vertex(i),
+                    format!("property `{name}` is {v}"),
+                ));
+            }
+            if *name == "area" && v < 0.0 {
+                return Err(syntax(Location::Vertex(i), format!("negative area {v}")));
+            }
         }
     }
-    let has_area = def.properties.contains_key("area");
-    let mut positions = Vec::with_capacity(vertices.len());
-    let mut normals = Vec::with_capacity(vertices.len());
-    let mut areas = Vec::with_capacity(if has_area { vertices.len() } else { 0 });
-    for (i, v) in vertices.iter().enumerate() {
-        let at = || Location::Vertex(i);
-        let get = |key: &str| -> Result<f64, Fail> {
-            let x = v
-                .get(key)
-                .and_then(scalar)
-                .ok_or_else(|| syntax(at(), format!("property `{key}` is not a scalar")))?;
-            if x.is_finite() {
-                Ok(x)
-            } else {
-                Err(syntax(at(), format!("property `{key}` is {x}")))
-            }
-        };
-        positions.push([get("x")?, get("y")?, get("z")?]);
-        normals.push([get("nx")?, get("ny")?, get("nz")?]);
-        if has_area {
-            let a = get("area")?;
-            if a < 0.0 {
-                return Err(syntax(at(), format!("negative area {a}")));
-            }
-            areas.push(a);
-        }
-    }
-    Ok((positions, normals, has_area.then_some(areas)))
+    let positions = (0..x.len()).map(|i| [x[i], y[i], z[i]]).collect();
+    let normals = (0..x.len()).map(|i| [nx[i], ny[i], nz[i]]).collect();
+    Ok(((positions, normals, area), data.warnings))
 }
 
 #[cfg(test)]
@@ -241,7 +224,8 @@ mod tests {
         let e = load_point_cloud_from_bytes(b"1 2 3\n", "p.xyz", None).unwrap_err();
         assert_eq!(e.location, Location::Line(1));
         let e = load_point_cloud_from_bytes(b"# nothing\n", "p.xyz", None).unwrap_err();
-        assert!(matches!(e.kind, LoadErrorKind::Empty));
+        assert!(matches!(e.kind, LoadErrorKind::NoPoints));
+        assert!(e.to_string().ends_with("contains no points"), "{e}");
     }
 
     #[test]

@@ -29,7 +29,7 @@ use std::fmt;
 use std::path::Path;
 
 use crate::Mesh;
-use crate::error::{LoadError, LoadErrorKind, Location, MeshError};
+use crate::error::{LoadError, LoadErrorKind, LoadWarning, Location, MeshError};
 
 pub use detect::{format_from_content, format_from_extension};
 pub use points::{load_points, load_points_from_bytes};
@@ -87,6 +87,8 @@ pub struct LoadedMesh {
     pub welded_vertices: usize,
     /// Polygons with more than three corners that were fan-triangulated.
     pub polygons_triangulated: usize,
+    /// What the reader accepted but ignored (e.g. unknown PLY header lines).
+    pub warnings: Vec<LoadWarning>,
 }
 
 /// What a format reader hands back before validation: positions, triangles and the number of
@@ -96,6 +98,7 @@ pub(crate) struct RawMesh {
     pub positions: Vec<[f64; 3]>,
     pub triangles: Vec<[u32; 3]>,
     pub polygons: usize,
+    pub warnings: Vec<LoadWarning>,
 }
 
 /// A reader error before the file name is attached.
@@ -144,9 +147,41 @@ pub fn load_mesh_with(
     options: &LoadOptions,
 ) -> Result<LoadedMesh, LoadError> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path)
-        .map_err(|e| LoadError::new(path, Location::File, LoadErrorKind::Io(e)))?;
+    let bytes = read_input(path)?;
     load_mesh_from_bytes_with(&bytes, path, format_from_extension(path), options)
+}
+
+/// The most bytes read from a file that is not a regular file (a pipe, a device): such a file has
+/// no size to check first, and some never end (`/dev/zero`). Regular files are read whole.
+pub const MAX_STREAM_BYTES: u64 = 1 << 28;
+
+/// Reads a whole input file for a loader. Regular files are read whole; anything else (pipes,
+/// devices, `/dev/stdin`) at most [`MAX_STREAM_BYTES`], beyond which it is a
+/// [`LoadErrorKind::TooLong`] error instead of reading until memory runs out.
+pub fn read_input(path: &Path) -> Result<Vec<u8>, LoadError> {
+    use std::io::Read;
+    let io_err = |e| LoadError::new(path, Location::File, LoadErrorKind::Io(e));
+    let file = std::fs::File::open(path).map_err(io_err)?;
+    let meta = file.metadata().map_err(io_err)?;
+    let mut bytes = Vec::new();
+    if meta.is_file() {
+        bytes.reserve(usize::try_from(meta.len()).unwrap_or(0));
+        (&file).read_to_end(&mut bytes).map_err(io_err)?;
+    } else {
+        file.take(MAX_STREAM_BYTES + 1)
+            .read_to_end(&mut bytes)
+            .map_err(io_err)?;
+        if bytes.len() as u64 > MAX_STREAM_BYTES {
+            return Err(LoadError::new(
+                path,
+                Location::File,
+                LoadErrorKind::TooLong {
+                    limit: MAX_STREAM_BYTES,
+                },
+            ));
+        }
+    }
+    Ok(bytes)
 }
 
 /// Loads a mesh from bytes in memory. `name_for_errors` is what errors call the file;
@@ -185,6 +220,7 @@ pub fn load_mesh_from_bytes_with(
         return Err(err((Location::File, LoadErrorKind::Empty)));
     }
     let polygons_triangulated = raw.polygons;
+    let warnings = raw.warnings;
     let mesh = Mesh::new(raw.positions, raw.triangles).map_err(|e| {
         let location = match e {
             MeshError::IndexOutOfRange { face, .. } => Location::Face(face),
@@ -203,6 +239,7 @@ pub fn load_mesh_from_bytes_with(
         format,
         welded_vertices,
         polygons_triangulated,
+        warnings,
     })
 }
 
@@ -214,9 +251,21 @@ pub(crate) fn text_lines(bytes: &[u8]) -> impl Iterator<Item = (usize, &[u8])> {
     })
 }
 
-/// Whitespace-separated tokens of a line (ASCII whitespace only; other bytes are kept).
+/// Whitespace-separated tokens of a line (ASCII whitespace only; other bytes are kept): the
+/// tokenizer of the mesh formats, and of the column files with [`COLUMN_SEPARATORS`].
 pub(crate) fn tokens(line: &[u8]) -> impl Iterator<Item = &[u8]> {
-    line.split(|b| b.is_ascii_whitespace())
+    tokens_separated_by(line, b"")
+}
+
+/// What separates values in query-point and point-cloud text files besides whitespace.
+pub(crate) const COLUMN_SEPARATORS: &[u8] = b",;";
+
+/// Tokens of a line separated by ASCII whitespace or any byte of `extra`.
+pub(crate) fn tokens_separated_by<'a>(
+    line: &'a [u8],
+    extra: &'a [u8],
+) -> impl Iterator<Item = &'a [u8]> {
+    line.split(move |b| b.is_ascii_whitespace() || extra.contains(b))
         .filter(|t| !t.is_empty())
 }
 

@@ -9,9 +9,9 @@
 //! - `v x y z w` divides by `w`, and its errors carry no line number.
 //!
 //! This reader keeps one global vertex list exactly as stored. `v` lines use their first three
-//! numbers (a `w` or colour values after them are ignored). `f` corners may be `i`, `i/t`,
-//! `i//n` or `i/t/n`; negative indices are relative to the vertices read so far; indices may
-//! refer to vertices defined later in the file (checked at the end). Faces are
+//! numbers (a `w` or colour values after them are ignored, but must be numbers). `f` corners
+//! may be `i`, `i/t`, `i//n` or `i/t/n`; negative indices are relative to the vertices read so
+//! far; indices may refer to vertices defined later in the file (checked at the end). Faces are
 //! fan-triangulated; faces with fewer than three corners, `l`, `p` and every other statement are
 //! ignored. A trailing `\` continues a line.
 
@@ -56,6 +56,14 @@ pub(crate) fn parse(bytes: &[u8]) -> Result<RawMesh, Fail> {
                         .ok_or_else(|| syntax(ln, "`v` needs three coordinates".into()))?;
                     *c = parse_num(tok)
                         .ok_or_else(|| syntax(ln, format!("invalid coordinate `{}`", show(tok))))?;
+                }
+                // A `w` or colours may follow, but only numbers: `v 1 0 0 abc` is a broken line,
+                // not a vertex with a comment.
+                if let Some(bad) = toks.find(|t| parse_num::<f64>(t).is_none()) {
+                    return Err(syntax(
+                        ln,
+                        format!("invalid value `{}` after the coordinates", show(bad)),
+                    ));
                 }
                 out.positions.push(p);
             }

@@ -4,7 +4,8 @@
 //! first three coordinates of a vertex are used, colours/normals/texture coordinates after them
 //! are ignored). The counts `V F E` may follow the keyword on the same line or come on the next
 //! line. `#` starts a comment anywhere; blank lines are skipped. One vertex per line, one face
-//! per line (`n i0 … i(n-1)` followed by optional colour values, ignored). Polygons are
+//! per line (`n i0 … i(n-1)` followed by optional colour values, ignored; values after the
+//! coordinates or indices must be numbers). Polygons are
 //! fan-triangulated; faces with fewer than 3 corners add no triangle. Binary OFF and `nOFF`
 //! are rejected. Content after the last face is ignored.
 
@@ -82,6 +83,7 @@ pub(crate) fn parse(bytes: &[u8]) -> Result<RawMesh, Fail> {
             *c = parse_num(tok)
                 .ok_or_else(|| syntax(ln, format!("invalid coordinate `{}`", show(tok))))?;
         }
+        trailing_numbers(&mut t, ln)?;
         positions.push(p);
     }
     if nv > u64::from(u32::MAX) {
@@ -119,12 +121,28 @@ pub(crate) fn parse(bytes: &[u8]) -> Result<RawMesh, Fail> {
             }
             poly.push(i as u32);
         }
+        trailing_numbers(&mut t, ln)?;
         if fan(&poly, &mut out.triangles) {
             out.polygons += 1;
         }
     }
     out.positions = positions;
     Ok(out)
+}
+
+/// Colours, normals and texture coordinates may follow a vertex or face, but only as numbers:
+/// anything else means the line is not what the counts say it is.
+fn trailing_numbers<'a>(
+    rest: &mut impl Iterator<Item = &'a [u8]>,
+    line: usize,
+) -> Result<(), Fail> {
+    match rest.find(|t| parse_num::<f64>(t).is_none()) {
+        Some(bad) => Err((
+            Location::Line(line),
+            LoadErrorKind::Syntax(format!("invalid value `{}` after the data", show(bad))),
+        )),
+        None => Ok(()),
+    }
 }
 
 #[cfg(test)]

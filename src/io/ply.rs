@@ -1,20 +1,25 @@
-//! PLY reader (own code): ascii, binary little-endian and binary big-endian.
+//! PLY reader (own code): ascii, binary little-endian and binary big-endian. The one PLY reader
+//! of the crate: meshes ([`parse`]) and point clouds ([`read_vertices`], used by `io::cloud`)
+//! both go through [`read`].
 //!
-//! We do not use `ply-rs-bw`, although it is a dependency: it builds a hash map per element
-//! (slow and memory-hungry for 200k-face meshes), its errors carry no byte offset or line, and
-//! making it panic-free on untrusted input would need a full header validation of our own
-//! anyway — which is most of a reader. This one validates the header completely, then streams
-//! the body without allocating from untrusted counts.
+//! We do not use `ply-rs-bw`: it builds a hash map per element (slow and memory-hungry for
+//! 200k-face meshes), its errors carry no byte offset or line, and making it panic-free on
+//! untrusted input would need a full header validation of our own anyway — which is most of a
+//! reader. This one validates the header completely, then streams the body without allocating
+//! from untrusted counts.
 //!
 //! Accepted: any elements in any order (e.g. `camera` before `vertex`; unknown elements and
 //! properties are skipped, lists included); `vertex` needs scalar `x`, `y`, `z` of any numeric
 //! type; `face` needs a list `vertex_indices` or `vertex_index` with any integer count and item
 //! type. Polygons are fan-triangulated; faces with fewer than 3 corners add no triangle. A body
 //! that ends early is [`LoadErrorKind::Truncated`] (byte offset for binary, line for ascii);
-//! data after the last element is ignored.
+//! data after the last element is ignored. In ascii, every element instance is one line holding
+//! exactly its values (blank lines are skipped), and every integer value must fit its declared
+//! type. Header lines that are not `format`/`element`/`property`/`comment`/`obj_info` (such as
+//! Blender 2.47's `Created by Blender3D 247 …`) are ignored with a warning.
 
-use super::{Fail, RawMesh, capped_capacity, fan, index_error, show};
-use crate::error::{LoadErrorKind, Location};
+use super::{Fail, RawMesh, capped_capacity, fan, index_error, show, text_lines, tokens};
+use crate::error::{LoadErrorKind, LoadWarning, Location};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Scalar {
@@ -52,8 +57,34 @@ impl Scalar {
         }
     }
 
+    /// The inclusive value range of an integer type; `None` for floating-point types.
+    fn int_range(self) -> Option<(f64, f64)> {
+        Some(match self {
+            Scalar::I8 => (i8::MIN.into(), i8::MAX.into()),
+            Scalar::U8 => (0.0, u8::MAX.into()),
+            Scalar::I16 => (i16::MIN.into(), i16::MAX.into()),
+            Scalar::U16 => (0.0, u16::MAX.into()),
+            Scalar::I32 => (i32::MIN.into(), i32::MAX.into()),
+            Scalar::U32 => (0.0, u32::MAX.into()),
+            Scalar::F32 | Scalar::F64 => return None,
+        })
+    }
+
     fn is_int(self) -> bool {
-        !matches!(self, Scalar::F32 | Scalar::F64)
+        self.int_range().is_some()
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Scalar::I8 => "char",
+            Scalar::U8 => "uchar",
+            Scalar::I16 => "short",
+            Scalar::U16 => "ushort",
+            Scalar::I32 => "int",
+            Scalar::U32 => "uint",
+            Scalar::F32 => "float",
+            Scalar::F64 => "double",
+        }
     }
 }
 
@@ -80,7 +111,11 @@ enum Encoding {
 struct Header {
     encoding: Encoding,
     elements: Vec<Element>,
+    /// Byte offset of the body.
     body: usize,
+    /// Number of header lines (the body starts on the next line).
+    lines: usize,
+    warnings: Vec<LoadWarning>,
 }
 
 fn syntax(line: usize, msg: String) -> Fail {
@@ -92,6 +127,7 @@ fn parse_header(bytes: &[u8]) -> Result<Header, Fail> {
     let mut ln = 0;
     let mut encoding = None;
     let mut elements: Vec<Element> = Vec::new();
+    let mut warnings = Vec::new();
     loop {
         ln += 1;
         let Some(nl) = bytes[pos..].iter().position(|&b| b == b'\n') else {
@@ -161,12 +197,12 @@ fn parse_header(bytes: &[u8]) -> Result<Header, Fail> {
                 el.props.push((name.to_string(), prop));
             }
             Some("end_header") => break,
-            Some(other) => {
-                return Err(syntax(
-                    ln,
-                    format!("unknown header keyword `{}`", show(other.as_bytes())),
-                ));
-            }
+            // Not a keyword that shapes the body, so ignoring it cannot misread the data (Blender
+            // 2.47 writes `Created by Blender3D 247 - www.blender.org, source file: …` here).
+            Some(_) => warnings.push(LoadWarning {
+                location: Location::Line(ln),
+                message: format!("unknown PLY header line `{}` ignored", show(raw)),
+            }),
         }
     }
     let encoding = encoding.ok_or_else(|| syntax(ln, "PLY header has no `format` line".into()))?;
@@ -174,16 +210,22 @@ fn parse_header(bytes: &[u8]) -> Result<Header, Fail> {
         encoding,
         elements,
         body: pos,
+        lines: ln,
+        warnings,
     })
 }
 
-/// A stream of scalar values from the body.
+/// A stream of scalar values from the body, read one element instance at a time.
 trait Source {
+    /// Starts element instance `what()`. In ascii this takes the instance's line.
+    fn begin(&mut self, what: &dyn Fn() -> String) -> Result<(), Fail>;
     /// The next value of type `t` (integers are exact in `f64`), or a truncation/syntax error
     /// whose message is completed with `what`.
     fn next(&mut self, t: Scalar, what: &dyn Fn() -> String) -> Result<f64, Fail>;
     /// Skips `n` values of type `t`.
     fn skip(&mut self, t: Scalar, n: u64, what: &dyn Fn() -> String) -> Result<(), Fail>;
+    /// Ends the instance. In ascii the line must hold nothing more.
+    fn end(&mut self, what: &dyn Fn() -> String) -> Result<(), Fail>;
     /// Bytes left (a bound for capacities).
     fn remaining(&self) -> usize;
 }
@@ -204,6 +246,10 @@ impl Binary<'_> {
 }
 
 impl Source for Binary<'_> {
+    fn begin(&mut self, _: &dyn Fn() -> String) -> Result<(), Fail> {
+        Ok(())
+    }
+
     fn next(&mut self, t: Scalar, what: &dyn Fn() -> String) -> Result<f64, Fail> {
         let n = t.size();
         let Some(b) = self.bytes.get(self.pos..self.pos + n) else {
@@ -237,52 +283,63 @@ impl Source for Binary<'_> {
         Ok(())
     }
 
+    fn end(&mut self, _: &dyn Fn() -> String) -> Result<(), Fail> {
+        Ok(())
+    }
+
     fn remaining(&self) -> usize {
         self.bytes.len() - self.pos
     }
 }
 
-struct Ascii<'a> {
-    bytes: &'a [u8],
-    pos: usize,
+/// The ascii body: one element instance per line, values separated by whitespace.
+struct Ascii<'a, L: Iterator<Item = (usize, &'a [u8])>> {
+    lines: L,
+    /// The current instance's line number and the tokens not consumed yet.
     line: usize,
+    toks: Vec<&'a [u8]>,
+    next_tok: usize,
+    /// Bytes of the body not yet reached (a capacity bound).
+    remaining: usize,
 }
 
-impl Source for Ascii<'_> {
+impl<'a, L: Iterator<Item = (usize, &'a [u8])>> Source for Ascii<'a, L> {
+    fn begin(&mut self, what: &dyn Fn() -> String) -> Result<(), Fail> {
+        for (ln, l) in self.lines.by_ref() {
+            self.remaining = self.remaining.saturating_sub(l.len() + 1);
+            self.toks.clear();
+            self.toks.extend(tokens(l));
+            if !self.toks.is_empty() {
+                self.line = ln;
+                self.next_tok = 0;
+                return Ok(());
+            }
+        }
+        Err((
+            Location::Line(self.line),
+            LoadErrorKind::Truncated(format!("file ends before {}", what())),
+        ))
+    }
+
     fn next(&mut self, t: Scalar, what: &dyn Fn() -> String) -> Result<f64, Fail> {
-        while let Some(&b) = self.bytes.get(self.pos) {
-            if !b.is_ascii_whitespace() {
-                break;
-            }
-            if b == b'\n' {
-                self.line += 1;
-            }
-            self.pos += 1;
-        }
-        let start = self.pos;
-        while self
-            .bytes
-            .get(self.pos)
-            .is_some_and(|b| !b.is_ascii_whitespace())
-        {
-            self.pos += 1;
-        }
-        let tok = &self.bytes[start..self.pos];
-        if tok.is_empty() {
-            return Err((
-                Location::Line(self.line),
-                LoadErrorKind::Truncated(format!("file ends in {}", what())),
+        let Some(&tok) = self.toks.get(self.next_tok) else {
+            return Err(syntax(
+                self.line,
+                format!("line ends too early in {}", what()),
             ));
-        }
+        };
+        self.next_tok += 1;
         let bad = || {
             syntax(
                 self.line,
-                format!("invalid value `{}` in {}", show(tok), what()),
+                format!("invalid {} value `{}` in {}", t.name(), show(tok), what()),
             )
         };
         let v: f64 = super::parse_num(tok).ok_or_else(bad)?;
-        if t.is_int() && v.fract() != 0.0 {
-            return Err(bad());
+        if let Some((lo, hi)) = t.int_range() {
+            if v.fract() != 0.0 || v < lo || v > hi {
+                return Err(bad());
+            }
         }
         Ok(v)
     }
@@ -294,30 +351,89 @@ impl Source for Ascii<'_> {
         Ok(())
     }
 
+    fn end(&mut self, what: &dyn Fn() -> String) -> Result<(), Fail> {
+        let extra = self.toks.len() - self.next_tok;
+        if extra > 0 {
+            return Err(syntax(
+                self.line,
+                format!(
+                    "{extra} value(s) after the end of {} (first `{}`)",
+                    what(),
+                    show(self.toks[self.next_tok])
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     fn remaining(&self) -> usize {
-        self.bytes.len() - self.pos
+        self.remaining
     }
 }
 
+/// What to read from a PLY file.
+pub(crate) struct Request<'r> {
+    /// Scalar properties of the `vertex` element to return, in this order; a name with `true`
+    /// is required, one with `false` is returned as `None` when absent.
+    pub vertex: &'r [(&'r str, bool)],
+    /// Whether to read the `face` element's vertex index lists.
+    pub faces: bool,
+}
+
+/// What [`read`] returns.
+#[derive(Debug, Default)]
+pub(crate) struct PlyData {
+    /// One column per requested vertex property (`None`: optional and absent).
+    pub columns: Vec<Option<Vec<f64>>>,
+    /// Fan-triangulated faces (empty unless requested).
+    pub triangles: Vec<[u32; 3]>,
+    /// Faces with more than three corners.
+    pub polygons: usize,
+    /// Header lines that were ignored.
+    pub warnings: Vec<LoadWarning>,
+}
+
+/// Reads a PLY mesh: vertex positions and triangles.
 pub(crate) fn parse(bytes: &[u8]) -> Result<RawMesh, Fail> {
+    let data = read(
+        bytes,
+        &Request {
+            vertex: &[("x", true), ("y", true), ("z", true)],
+            faces: true,
+        },
+    )?;
+    let column = |k: usize| data.columns[k].as_deref().unwrap_or(&[]);
+    let (x, y, z) = (column(0), column(1), column(2));
+    Ok(RawMesh {
+        positions: (0..x.len()).map(|i| [x[i], y[i], z[i]]).collect(),
+        triangles: data.triangles,
+        polygons: data.polygons,
+        warnings: data.warnings,
+    })
+}
+
+/// Reads the requested vertex properties and (optionally) the faces of a PLY file.
+pub(crate) fn read(bytes: &[u8], request: &Request) -> Result<PlyData, Fail> {
     let h = parse_header(bytes)?;
     let vertex = h.elements.iter().find(|e| e.name == "vertex");
     let nv = vertex.map_or(0, |e| e.count);
-    let mut xyz = [usize::MAX; 3];
-    if let Some(v) = vertex {
-        for (k, axis) in ["x", "y", "z"].iter().enumerate() {
-            match v.props.iter().position(|(n, _)| n == axis) {
-                Some(i) if matches!(v.props[i].1, Prop::Scalar(_)) => xyz[k] = i,
-                _ => {
-                    return Err((
-                        Location::File,
-                        LoadErrorKind::Syntax(format!(
-                            "PLY `vertex` element has no scalar property `{axis}`"
-                        )),
-                    ));
-                }
-            }
+    // For each requested property, its position among the vertex element's properties.
+    let mut wanted: Vec<Option<usize>> = Vec::with_capacity(request.vertex.len());
+    for &(name, required) in request.vertex {
+        let found = vertex.and_then(|v| {
+            v.props
+                .iter()
+                .position(|(n, p)| n == name && matches!(p, Prop::Scalar(_)))
+        });
+        if found.is_none() && required && vertex.is_some() {
+            return Err((
+                Location::File,
+                LoadErrorKind::Syntax(format!(
+                    "PLY `vertex` element has no scalar property `{name}`"
+                )),
+            ));
         }
+        wanted.push(if vertex.is_some() { found } else { None });
     }
     if nv > u64::from(u32::MAX) {
         return Err((
@@ -326,7 +442,12 @@ pub(crate) fn parse(bytes: &[u8]) -> Result<RawMesh, Fail> {
         ));
     }
     let mut face_list = None;
-    if let Some(f) = h.elements.iter().find(|e| e.name == "face") {
+    if let Some(f) = h
+        .elements
+        .iter()
+        .find(|e| e.name == "face")
+        .filter(|_| request.faces)
+    {
         face_list = f.props.iter().position(|(n, p)| {
             (n == "vertex_indices" || n == "vertex_index") && matches!(p, Prop::List(..))
         });
@@ -340,15 +461,21 @@ pub(crate) fn parse(bytes: &[u8]) -> Result<RawMesh, Fail> {
         }
     }
     let body = &bytes[h.body..];
-    match h.encoding {
+    let plan = Plan {
+        nv,
+        wanted: &wanted,
+        face_list,
+    };
+    let mut data = match h.encoding {
         Encoding::Ascii => {
-            let header_lines = bytes[..h.body].iter().filter(|&&b| b == b'\n').count();
             let mut src = Ascii {
-                bytes: body,
-                pos: 0,
-                line: header_lines + 1,
+                lines: text_lines(body).map(|(n, l)| (n + h.lines, l)),
+                line: h.lines,
+                toks: Vec::new(),
+                next_tok: 0,
+                remaining: body.len(),
             };
-            read_body(&h, &mut src, nv, xyz, face_list, 2)
+            read_body(&h, &mut src, &plan, 2)
         }
         e => {
             let mut src = Binary {
@@ -356,12 +483,21 @@ pub(crate) fn parse(bytes: &[u8]) -> Result<RawMesh, Fail> {
                 pos: 0,
                 big: e == Encoding::Big,
             };
-            read_body(&h, &mut src, nv, xyz, face_list, 0).map_err(|(loc, kind)| match loc {
+            read_body(&h, &mut src, &plan, 0).map_err(|(loc, kind)| match loc {
                 Location::Byte(b) => (Location::Byte(b + h.body as u64), kind),
                 l => (l, kind),
             })
         }
-    }
+    }?;
+    data.warnings = h.warnings;
+    Ok(data)
+}
+
+/// Which values of the body are kept.
+struct Plan<'p> {
+    nv: u64,
+    wanted: &'p [Option<usize>],
+    face_list: Option<usize>,
 }
 
 /// Reads all elements. `ascii_min` is the minimum bytes per value in ascii (0 for binary, where
@@ -369,12 +505,13 @@ pub(crate) fn parse(bytes: &[u8]) -> Result<RawMesh, Fail> {
 fn read_body(
     h: &Header,
     src: &mut dyn Source,
-    nv: u64,
-    xyz: [usize; 3],
-    face_list: Option<usize>,
+    plan: &Plan,
     ascii_min: usize,
-) -> Result<RawMesh, Fail> {
-    let mut out = RawMesh::default();
+) -> Result<PlyData, Fail> {
+    let mut out = PlyData {
+        columns: plan.wanted.iter().map(|w| w.map(|_| Vec::new())).collect(),
+        ..PlyData::default()
+    };
     let mut poly: Vec<u32> = Vec::new();
     let mut seen_vertex = false;
     let mut seen_face = false;
@@ -389,25 +526,36 @@ fn read_body(
             .sum();
         let cap = capped_capacity(el.count, src.remaining(), min_bytes);
         let is_vertex = el.name == "vertex" && !seen_vertex;
-        let is_face = el.name == "face" && !seen_face;
+        let is_face = el.name == "face" && !seen_face && plan.face_list.is_some();
         if is_vertex {
             seen_vertex = true;
-            out.positions.reserve(cap);
+            for c in out.columns.iter_mut().flatten() {
+                c.reserve(cap);
+            }
         }
         if is_face {
             seen_face = true;
             out.triangles.reserve(cap);
         }
+        if el.props.is_empty() {
+            // No values, so no bytes and (in ascii) no lines: nothing to read, however large
+            // the count.
+            continue;
+        }
         for i in 0..el.count {
             let what = || format!("element `{}` {i} of {}", el.name, el.count);
-            let mut p = [0.0; 3];
+            src.begin(&what)?;
             for (k, (_, prop)) in el.props.iter().enumerate() {
                 match *prop {
                     Prop::Scalar(t) => {
                         let v = src.next(t, &what)?;
                         if is_vertex {
-                            if let Some(axis) = xyz.iter().position(|&j| j == k) {
-                                p[axis] = v;
+                            for (col, w) in out.columns.iter_mut().zip(plan.wanted) {
+                                if let (Some(col), Some(j)) = (col, w) {
+                                    if *j == k {
+                                        col.push(v);
+                                    }
+                                }
                             }
                         }
                     }
@@ -423,7 +571,7 @@ fn read_body(
                             ));
                         }
                         let n = n as u64;
-                        if is_face && face_list == Some(k) {
+                        if is_face && plan.face_list == Some(k) {
                             poly.clear();
                             for _ in 0..n {
                                 let v = src.next(it, &what)?;
@@ -433,8 +581,12 @@ fn read_body(
                                         LoadErrorKind::Syntax(format!("invalid vertex index {v}")),
                                     ));
                                 }
-                                if v >= nv as f64 {
-                                    return Err(index_error(i as usize, v as u64, nv as usize));
+                                if v >= plan.nv as f64 {
+                                    return Err(index_error(
+                                        i as usize,
+                                        v as u64,
+                                        plan.nv as usize,
+                                    ));
                                 }
                                 poly.push(v as u32);
                             }
@@ -447,9 +599,7 @@ fn read_body(
                     }
                 }
             }
-            if is_vertex {
-                out.positions.push(p);
-            }
+            src.end(&what)?;
         }
     }
     Ok(out)

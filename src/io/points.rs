@@ -1,6 +1,6 @@
 //! Query points in and results out.
 //!
-//! Input: text with one point `x y z` or `x,y,z` per line (`#` comments and blank lines skipped,
+//! Input: text with one point `x y z`, `x,y,z` or `x;y;z` per line (`#` comments and blank lines skipped,
 //! one header line before the first point skipped if it does not parse as numbers), or NumPy
 //! `.npy` (`float64` or `float32`, either byte order, C or Fortran order, shape `(N, 3)`).
 //!
@@ -11,7 +11,7 @@
 use std::io::{self, Write};
 use std::path::Path;
 
-use super::{parse_num, show, text_lines};
+use super::{COLUMN_SEPARATORS, parse_num, show, text_lines, tokens_separated_by};
 use crate::error::{LoadError, LoadErrorKind, Location};
 
 const NPY_MAGIC: &[u8] = b"\x93NUMPY";
@@ -19,8 +19,7 @@ const NPY_MAGIC: &[u8] = b"\x93NUMPY";
 /// Loads query points from a text file or a `.npy` file (detected by the magic bytes).
 pub fn load_points(path: impl AsRef<Path>) -> Result<Vec<[f64; 3]>, LoadError> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path)
-        .map_err(|e| LoadError::new(path, Location::File, LoadErrorKind::Io(e)))?;
+    let bytes = super::read_input(path)?;
     load_points_from_bytes(&bytes, path)
 }
 
@@ -36,7 +35,11 @@ pub fn load_points_from_bytes(
         parse_text(bytes)
     };
     match r {
-        Ok(p) if p.is_empty() => Err(LoadError::new(name, Location::File, LoadErrorKind::Empty)),
+        Ok(p) if p.is_empty() => Err(LoadError::new(
+            name,
+            Location::File,
+            LoadErrorKind::NoPoints,
+        )),
         Ok(p) => Ok(p),
         Err((location, kind)) => Err(LoadError::new(name, location, kind)),
     }
@@ -47,10 +50,7 @@ fn parse_text(bytes: &[u8]) -> Result<Vec<[f64; 3]>, super::Fail> {
     let mut header_allowed = true;
     for (ln, line) in text_lines(bytes) {
         let line = line.split(|&b| b == b'#').next().unwrap_or(&[]);
-        let toks: Vec<&[u8]> = line
-            .split(|&b| b == b',' || b.is_ascii_whitespace())
-            .filter(|t| !t.is_empty())
-            .collect();
+        let toks: Vec<&[u8]> = tokens_separated_by(line, COLUMN_SEPARATORS).collect();
         if toks.is_empty() {
             continue;
         }

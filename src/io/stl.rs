@@ -11,7 +11,8 @@
 //! Ascii: any number of `solid … endsolid` blocks; facets with more than three vertices are
 //! fan-triangulated; a facet with fewer than three is an error; the file must end after a
 //! complete `endsolid` (anything else is truncated). Keywords are case-insensitive; the facet
-//! normal is ignored. Every triangle gets its own three vertices (weld afterwards).
+//! normal is ignored (but `facet normal` must carry three numbers). A `vertex` line holds
+//! exactly three numbers. Every triangle gets its own three vertices (weld afterwards).
 
 use super::{Fail, RawMesh, capped_capacity, parse_num, show, text_lines, tokens};
 use crate::error::{LoadErrorKind, Location};
@@ -92,7 +93,7 @@ fn parse_binary(bytes: &[u8]) -> Result<RawMesh, Fail> {
     Ok(RawMesh {
         positions,
         triangles,
-        polygons: 0,
+        ..RawMesh::default()
     })
 }
 
@@ -129,7 +130,21 @@ fn parse_ascii(bytes: &[u8]) -> Result<RawMesh, Fail> {
         match (state, kw_l.as_slice()) {
             (State::Outside, b"solid") => state = State::Solid,
             (State::Outside, _) => return Err(expect("`solid`")),
-            (State::Solid, b"facet") => state = State::Facet,
+            (State::Solid, b"facet") => {
+                // The normal is ignored, but `facet normal` must carry exactly three numbers:
+                // anything else is not a facet line this reader understands.
+                let rest: Vec<&[u8]> = toks.collect();
+                let numbers = rest.iter().skip(1).all(|t| parse_num::<f64>(t).is_some());
+                let ok = rest.is_empty()
+                    || rest[0].eq_ignore_ascii_case(b"normal") && rest.len() == 4 && numbers;
+                if !ok {
+                    return Err(syntax(
+                        ln,
+                        "expected `facet normal NX NY NZ` with three numbers".into(),
+                    ));
+                }
+                state = State::Facet;
+            }
             (State::Solid, b"endsolid") => state = State::Outside,
             (State::Solid, _) => return Err(expect("`facet` or `endsolid`")),
             (State::Facet, b"outer") => {
@@ -145,6 +160,12 @@ fn parse_ascii(bytes: &[u8]) -> Result<RawMesh, Fail> {
                         .ok_or_else(|| syntax(ln, "vertex needs three coordinates".into()))?;
                     *c = parse_num(tok)
                         .ok_or_else(|| syntax(ln, format!("invalid coordinate `{}`", show(tok))))?;
+                }
+                if let Some(extra) = toks.next() {
+                    return Err(syntax(
+                        ln,
+                        format!("vertex has more than three coordinates (`{}`)", show(extra)),
+                    ));
                 }
                 corners.push(p);
             }

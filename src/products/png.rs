@@ -311,8 +311,10 @@ impl RgbImage {
 
     /// [`RgbImage::write_png`] to a new file.
     pub fn save_png(&self, path: impl AsRef<Path>) -> io::Result<()> {
-        let f = io::BufWriter::new(std::fs::File::create(path)?);
-        self.write_png(f)
+        let mut f = io::BufWriter::new(std::fs::File::create(path)?);
+        self.write_png(&mut f)?;
+        // Dropping a BufWriter discards its flush error: a full disk would go unnoticed.
+        f.flush()
     }
 }
 

@@ -108,7 +108,13 @@ pub struct TetError {
 impl fmt::Display for TetError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         if self.line > 0 {
-            write!(f, "{}:{}: {}", self.path.display(), self.line, self.message)
+            write!(
+                f,
+                "{}: line {}: {}",
+                self.path.display(),
+                self.line,
+                self.message
+            )
         } else {
             write!(f, "{}: {}", self.path.display(), self.message)
         }
@@ -122,31 +128,18 @@ pub type Fail = (usize, String);
 
 /// Whitespace tokens with their 1-based line numbers; `#` comments removed.
 fn tokens(bytes: &[u8]) -> Vec<(usize, &[u8])> {
-    let mut out = Vec::new();
-    for (i, line) in bytes.split(|&b| b == b'\n').enumerate() {
-        let line = line.split(|&b| b == b'#').next().unwrap_or(&[]);
-        for t in line.split(|b| b.is_ascii_whitespace()) {
-            if !t.is_empty() {
-                out.push((i + 1, t));
-            }
-        }
-    }
-    out
+    token_lines(bytes)
+        .flat_map(|(n, toks)| toks.into_iter().map(move |t| (n, t)))
+        .collect()
 }
 
 /// Non-empty lines (comments stripped) as token lists with their line numbers.
 fn token_lines(bytes: &[u8]) -> impl Iterator<Item = (usize, Vec<&[u8]>)> {
-    bytes
-        .split(|&b| b == b'\n')
-        .enumerate()
-        .filter_map(|(i, line)| {
-            let line = line.split(|&b| b == b'#').next().unwrap_or(&[]);
-            let toks: Vec<&[u8]> = line
-                .split(|b| b.is_ascii_whitespace())
-                .filter(|t| !t.is_empty())
-                .collect();
-            (!toks.is_empty()).then_some((i + 1, toks))
-        })
+    crate::io::text_lines(bytes).filter_map(|(n, line)| {
+        let line = line.split(|&b| b == b'#').next().unwrap_or(&[]);
+        let toks: Vec<&[u8]> = crate::io::tokens(line).collect();
+        (!toks.is_empty()).then_some((n, toks))
+    })
 }
 
 fn show(t: &[u8]) -> String {
@@ -377,10 +370,10 @@ pub fn parse_medit(bytes: &[u8]) -> Result<TetMesh, Fail> {
 }
 
 fn read(path: &Path) -> Result<Vec<u8>, TetError> {
-    std::fs::read(path).map_err(|e| TetError {
+    crate::io::read_input(path).map_err(|e| TetError {
         path: path.to_path_buf(),
         line: 0,
-        message: e.to_string(),
+        message: e.kind.to_string(),
     })
 }
 
@@ -467,20 +460,30 @@ pub fn write_ele(mut w: impl Write, tets: &[[u32; 4]]) -> io::Result<()> {
 }
 
 /// Saves by extension: `.mesh` → MEDIT; `.node` or `.ele` → the TetGen pair. Returns the
-/// files written.
+/// files written. Error messages start with the name of the file concerned.
 pub fn save_tets(path: impl AsRef<Path>, mesh: &TetMesh) -> io::Result<Vec<PathBuf>> {
     let path = path.as_ref();
-    let create = |p: &Path| std::fs::File::create(p).map(io::BufWriter::new);
+    // Every error names the file it concerns (with `.node`/`.ele` pairs that is not always
+    // `path`), so callers need not and must not add it again.
+    let named = |p: &Path| {
+        let p = p.to_path_buf();
+        move |e: io::Error| io::Error::new(e.kind(), format!("{}: {e}", p.display()))
+    };
+    let create = |p: &Path| {
+        std::fs::File::create(p)
+            .map(io::BufWriter::new)
+            .map_err(named(p))
+    };
     match ext(path).as_str() {
         "mesh" => {
-            write_medit(create(path)?, mesh)?;
+            write_medit(create(path)?, mesh).map_err(named(path))?;
             Ok(vec![path.to_path_buf()])
         }
         "node" | "ele" => {
             let node = path.with_extension("node");
             let ele = path.with_extension("ele");
-            write_node(create(&node)?, &mesh.points)?;
-            write_ele(create(&ele)?, &mesh.tets)?;
+            write_node(create(&node)?, &mesh.points).map_err(named(&node))?;
+            write_ele(create(&ele)?, &mesh.tets).map_err(named(&ele))?;
             Ok(vec![node, ele])
         }
         _ => Err(io::Error::new(

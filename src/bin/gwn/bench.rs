@@ -10,7 +10,7 @@ use gwn::eval::direct::winding_number_direct;
 use gwn::eval::fast::{FastParams, FastWindingNumber};
 use rayon::prelude::*;
 
-use crate::common::{CliError, load_mesh_for_cli};
+use crate::common::{CliError, check_beta, checked_threads, load_mesh_for_cli, outln};
 
 /// Benchmark the evaluators on meshes: per mesh, faces, boundary edges, precompute time of
 /// `exact`, tree build time of `fast`, and queries/s of `exact`, `direct` and `fast`
@@ -26,7 +26,7 @@ pub struct Args {
     /// Mesh files or folders (every .obj/.stl/.off/.ply inside, sorted).
     #[arg(required = true)]
     pub paths: Vec<PathBuf>,
-    /// Grid resolution per axis.
+    /// Grid resolution per axis (1 to 256: the grid has N³ points).
     #[arg(long, default_value_t = 32)]
     pub grid: usize,
     /// Thread counts to measure.
@@ -36,8 +36,8 @@ pub struct Args {
     #[arg(long, default_value_t = 256)]
     pub direct_sample: usize,
     /// Accuracy of the fast method (Barill et al.'s β: a node is approximated beyond β times
-    /// its radius).
-    #[arg(long, default_value_t = 2.0)]
+    /// its radius; positive, finite).
+    #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
     pub beta: f64,
     /// Expansion order of the fast method (0, 1 or 2).
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(0..=2))]
@@ -51,8 +51,30 @@ pub struct Args {
     pub markdown: bool,
 }
 
+/// Largest `--grid`: the N³ query points and two value arrays take 40 bytes per point, so 256
+/// (16.8 million points) needs about 640 MiB; `--grid 1000` would need 40 GB.
+pub const MAX_GRID: usize = 256;
+
 /// Runs `gwn bench`.
-pub fn run(args: Args) -> Result<(), CliError> {
+pub fn run(mut args: Args) -> Result<(), CliError> {
+    if !(1..=MAX_GRID).contains(&args.grid) {
+        return Err(CliError(format!(
+            "--grid {}: expected 1 to {MAX_GRID} (the grid has N³ points; {MAX_GRID}³ = {} \
+             points take about {} MB)",
+            args.grid,
+            MAX_GRID.pow(3),
+            (MAX_GRID.pow(3) * 40) >> 20
+        )));
+    }
+    if args.direct_sample == 0 {
+        return Err(CliError::msg(
+            "--direct-sample 0: expected at least 1 point",
+        ));
+    }
+    check_beta(args.beta)?;
+    for t in &mut args.threads_list {
+        *t = checked_threads(*t, "--threads-list")?;
+    }
     let mut files = Vec::new();
     for p in &args.paths {
         if p.is_dir() {
@@ -83,10 +105,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     header += " | fast/direct | fast max err";
     if args.markdown {
-        println!("| {header} |");
-        println!("|{}", "---|".repeat(header.matches('|').count() + 1));
+        outln!("| {header} |")?;
+        outln!("|{}", "---|".repeat(header.matches('|').count() + 1))?;
     } else {
-        println!("{}", header.replace(" | ", "\t"));
+        outln!("{}", header.replace(" | ", "\t"))?;
     }
     for f in files {
         let mesh = load_mesh_for_cli(&f, false)?;
@@ -99,9 +121,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
             .unwrap_or_default();
         let line = format!("{name} | {row}");
         if args.markdown {
-            println!("| {line} |");
+            outln!("| {line} |")?;
         } else {
-            println!("{}", line.replace(" | ", "\t"));
+            outln!("{}", line.replace(" | ", "\t"))?;
         }
     }
     Ok(())
@@ -112,7 +134,7 @@ fn bench_mesh(mesh: &Mesh, args: &Args) -> Result<Option<String>, CliError> {
         return Ok(None);
     };
     let b = bbox.enlarged(0.1);
-    let n = args.grid.max(1);
+    let n = args.grid;
     let points: Vec<[f64; 3]> = (0..n * n * n)
         .map(|i| {
             let idx = [i % n, (i / n) % n, i / (n * n)];
@@ -121,7 +143,7 @@ fn bench_mesh(mesh: &Mesh, args: &Args) -> Result<Option<String>, CliError> {
             })
         })
         .collect();
-    let step = (points.len() / args.direct_sample.max(1)).max(1);
+    let step = (points.len() / args.direct_sample).max(1);
     let sample: Vec<[f64; 3]> = points.iter().step_by(step).copied().collect();
     let t0 = Instant::now();
     let wn = WindingNumber::new(mesh).map_err(|e| CliError(e.to_string()))?;

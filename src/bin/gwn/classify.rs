@@ -6,7 +6,7 @@ use clap::{Args as ClapArgs, ValueEnum};
 use gwn::eval::antipodal::WindingNumber;
 use gwn::products::classify::{Select, classify_faces, select, submesh, write_obj};
 
-use crate::common::{CliError, load_mesh_for_cli};
+use crate::common::{CliError, check_threshold, load_mesh_for_cli, outln};
 
 /// Which faces to select.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -47,13 +47,14 @@ pub struct Args {
 
 /// Runs `gwn classify`.
 pub fn run(args: Args) -> Result<(), CliError> {
+    check_threshold(args.threshold, "--threshold")?;
     let a = load_mesh_for_cli(&args.a, args.no_weld)?;
     let b = load_mesh_for_cli(&args.b, args.no_weld)?;
     let wn = WindingNumber::new(&b)?;
     let values = classify_faces(&a, &wn);
     gwn::io::points::save_values(&args.out, &values)
-        .map_err(|e| CliError::msg(format!("{}: {e}", args.out.display())))?;
-    println!("wrote {} ({} faces)", args.out.display(), values.len());
+        .map_err(|e| CliError::msg(format!("{}: cannot write: {e}", args.out.display())))?;
+    outln!("wrote {} ({} faces)", args.out.display(), values.len())?;
     let which = args
         .select
         .or(args.mesh_out.as_ref().map(|_| Which::Inside));
@@ -64,7 +65,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         };
         let keep = select(&values, sel, args.threshold);
         let n = keep.iter().filter(|&&k| k).count();
-        println!(
+        outln!(
             "{n} of {} faces {} (threshold {})",
             keep.len(),
             match which {
@@ -72,7 +73,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 Which::Outside => "outside",
             },
             args.threshold
-        );
+        )?;
         if let Some(p) = &args.mesh_out {
             let is_obj = p
                 .extension()
@@ -84,11 +85,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
                     p.display()
                 )));
             }
-            let f = std::fs::File::create(p)
-                .map_err(|e| CliError::msg(format!("{}: {e}", p.display())))?;
-            write_obj(std::io::BufWriter::new(f), &submesh(&a, &keep))
-                .map_err(|e| CliError::msg(format!("{}: {e}", p.display())))?;
-            println!("wrote {}", p.display());
+            let cannot_write = |e| CliError::msg(format!("{}: cannot write: {e}", p.display()));
+            let f = std::fs::File::create(p).map_err(cannot_write)?;
+            write_obj(std::io::BufWriter::new(f), &submesh(&a, &keep)).map_err(cannot_write)?;
+            outln!("wrote {}", p.display())?;
         }
     }
     Ok(())

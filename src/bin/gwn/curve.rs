@@ -192,11 +192,15 @@ fn field(
     }
     let file = std::fs::File::create(out)
         .map_err(|e| CliError::msg(format!("{}: cannot create: {e}", out.display())))?;
-    let mut enc = png::Encoder::new(std::io::BufWriter::new(file), w as u32, h as u32);
+    let mut buffered = std::io::BufWriter::new(file);
+    let mut enc = png::Encoder::new(&mut buffered, w as u32, h as u32);
     enc.set_color(png::ColorType::Rgb);
     enc.set_depth(png::BitDepth::Eight);
     enc.write_header()
-        .and_then(|mut wr| wr.write_image_data(&img))
+        .and_then(|mut wr| wr.write_image_data(&img).and_then(|()| wr.finish()))
+        .map_err(|e| CliError::msg(format!("{}: cannot write PNG: {e}", out.display())))?;
+    // Dropping a BufWriter discards its flush error: a full disk would go unnoticed.
+    std::io::Write::flush(&mut buffered)
         .map_err(|e| CliError::msg(format!("{}: cannot write PNG: {e}", out.display())))?;
     eprintln!("wrote {} ({w}×{h}, σ = {sigma})", out.display());
     Ok(())

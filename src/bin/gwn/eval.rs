@@ -10,7 +10,7 @@ use gwn::kernel::frame::RayAxis;
 use gwn::kernel::quantize::Precision;
 use rayon::prelude::*;
 
-use crate::common::{CliError, load_mesh_for_cli, progress};
+use crate::common::{CliError, check_beta, load_mesh_for_cli, progress, stdout_error};
 
 /// Evaluation method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -93,8 +93,8 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = Ray::PosZ, allow_hyphen_values = true)]
     pub ray: Ray,
     /// Accuracy of the fast method: a tree node is approximated when its distance exceeds
-    /// beta times its radius (Barill et al. 2018); larger is more accurate.
-    #[arg(long, default_value_t = 2.0)]
+    /// beta times its radius (Barill et al. 2018); larger is more accurate. Positive, finite.
+    #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
     pub beta: f64,
     /// Expansion order of the fast method (0, 1 or 2).
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(0..=2))]
@@ -105,8 +105,8 @@ pub struct Args {
     /// Output file for values (.csv or .npy); stdout when absent.
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Output file for gradients (.csv or .npy, shape (N, 3)); with --gradient and no file, the
-    /// gradient is printed after the value on each stdout line.
+    /// Output file for gradients (.csv or .npy, shape (N, 3)); needs --gradient. With
+    /// --gradient and no file, the gradient is printed after the value on each stdout line.
     #[arg(long)]
     pub gradient_out: Option<PathBuf>,
     /// Do not weld bit-identical vertices of STL files.
@@ -124,6 +124,12 @@ fn parse_precision(s: &str) -> Result<u32, String> {
 
 /// Runs `gwn eval`.
 pub fn run(args: Args) -> Result<(), CliError> {
+    check_beta(args.beta)?;
+    if args.gradient_out.is_some() && !args.gradient {
+        return Err(CliError::msg(
+            "--gradient-out needs --gradient (no gradient is computed without it)",
+        ));
+    }
     if is_point_cloud(&args.mesh) {
         return run_cloud(&args);
     }
@@ -215,7 +221,8 @@ fn run_cloud(args: &Args) -> Result<(), CliError> {
             "--gradient is not available for point clouds",
         ));
     }
-    let cloud = gwn::io::cloud::load_point_cloud(&args.mesh)?;
+    let (cloud, warnings) = gwn::io::cloud::load_point_cloud_with_warnings(&args.mesh)?;
+    crate::common::print_load_warnings(&args.mesh, &warnings);
     let points = gwn::io::points::load_points(&args.points)?;
     let params = FastParams::barill(args.beta, args.order);
     let wn = PointCloudWindingNumber::with_params(&cloud, params);
@@ -234,18 +241,16 @@ fn write_outputs(args: &Args, values: &[f64], grads: Option<&[[f64; 3]]>) -> Res
         gwn::io::points::save_points(p, g).map_err(|e| save_err(p, e))?;
     }
     if args.out.is_none() {
-        let stdout = std::io::stdout();
-        let mut w = std::io::BufWriter::new(stdout.lock());
+        let mut w = std::io::BufWriter::new(std::io::stdout().lock());
         for (i, v) in values.iter().enumerate() {
-            let r = match (grads, &args.gradient_out) {
+            match (grads, &args.gradient_out) {
                 (Some(g), None) => writeln!(w, "{v:?},{:?},{:?},{:?}", g[i][0], g[i][1], g[i][2]),
                 _ => writeln!(w, "{v:?}"),
-            };
-            if r.is_err() {
-                // Broken pipe (e.g. `| head`): stop quietly.
-                return Ok(());
             }
+            .map_err(stdout_error)?;
         }
+        // An explicit flush: dropping the BufWriter would discard the error of the last write.
+        w.flush().map_err(stdout_error)?;
     }
     Ok(())
 }

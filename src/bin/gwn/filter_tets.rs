@@ -6,7 +6,7 @@ use clap::Args as ClapArgs;
 use gwn::eval::antipodal::WindingNumber;
 use gwn::products::tets::{DEFAULT_THRESHOLD, filter_tets, load_tets, save_tets};
 
-use crate::common::{CliError, load_mesh_for_cli};
+use crate::common::{CliError, check_threshold, load_mesh_for_cli, outln};
 
 /// Keep the tets of TETS whose centroid has w(MESH) > threshold, and write them to OUT.
 ///
@@ -31,21 +31,22 @@ pub struct Args {
 
 /// Runs `gwn filter-tets`.
 pub fn run(args: Args) -> Result<(), CliError> {
+    check_threshold(args.threshold, "--threshold")?;
     let mesh = load_mesh_for_cli(&args.mesh, args.no_weld)?;
     let tets = load_tets(&args.tets)?;
     let wn = WindingNumber::new(&mesh)?;
     let keep = filter_tets(&tets.points, &tets.tets, &wn, args.threshold);
     let kept = tets.select(&keep);
-    let written = save_tets(&args.out, &kept)
-        .map_err(|e| CliError::msg(format!("{}: {e}", args.out.display())))?;
-    println!(
+    // `save_tets` errors already start with the file they concern.
+    let written = save_tets(&args.out, &kept).map_err(|e| CliError::msg(e.to_string()))?;
+    outln!(
         "kept {} of {} tets (w > {} at the centroid)",
         kept.tets.len(),
         tets.tets.len(),
         args.threshold
-    );
+    )?;
     for p in written {
-        println!("wrote {}", p.display());
+        outln!("wrote {}", p.display())?;
     }
     Ok(())
 }

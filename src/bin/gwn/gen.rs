@@ -58,8 +58,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
         })?;
         vec![k]
     };
-    std::fs::create_dir_all(&args.out)
-        .map_err(|e| CliError(format!("{}: {e}", args.out.display())))?;
+    std::fs::create_dir_all(&args.out).map_err(|e| {
+        CliError(format!(
+            "{}: cannot create directory: {e}",
+            args.out.display()
+        ))
+    })?;
     let ray: RayAxis = args.ray.into();
     let mut manifest = String::from("name,kind,seed,vertices,triangles,queries,undecided\n");
     for kind in kinds {
@@ -106,7 +110,7 @@ fn write(
     body: impl FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
 ) -> Result<(), CliError> {
     let path = dir.join(name);
-    let err = |e: std::io::Error| CliError(format!("{}: {e}", path.display()));
+    let err = |e: std::io::Error| CliError(format!("{}: cannot write: {e}", path.display()));
     let mut w = BufWriter::new(File::create(&path).map_err(err)?);
     body(&mut w).map_err(err)?;
     w.flush().map_err(err)

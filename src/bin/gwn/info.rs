@@ -1,5 +1,6 @@
 //! `gwn info MESH`: format, size and topology of a mesh file.
 
+use std::io::Write;
 use std::path::PathBuf;
 
 use gwn::io::{LoadOptions, load_mesh_with};
@@ -28,8 +29,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
         _ => None,
     };
     let loaded = load_mesh_with(&args.mesh, &LoadOptions { weld })?;
+    crate::common::print_load_warnings(&args.mesh, &loaded.warnings);
     let s = MeshStats::compute(&loaded.mesh);
-    print!("{}", report(&args.mesh, &loaded, &s));
+    std::io::stdout()
+        .write_all(report(&args.mesh, &loaded, &s).as_bytes())
+        .map_err(crate::common::stdout_error)?;
     Ok(())
 }
 

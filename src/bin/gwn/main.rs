@@ -1,6 +1,8 @@
 //! The `gwn` command-line tool: a thin shell over the library. One file per subcommand; each
 //! exposes `Args` (clap) and `run(args) -> Result<(), CliError>`.
 
+use std::io::Write;
+
 use clap::{Parser, Subcommand};
 
 mod bench;
@@ -24,7 +26,7 @@ mod voxelize;
 #[derive(Parser)]
 #[command(name = "gwn", version, about, long_about)]
 struct Cli {
-    /// Worker threads for batch evaluation (default: all cores).
+    /// Worker threads for batch evaluation (default: all cores; more than 4 per core are capped).
     #[arg(long, global = true)]
     threads: Option<usize>,
     #[command(subcommand)]
@@ -58,16 +60,23 @@ enum Command {
 
 fn main() {
     let cli = Cli::parse();
+    let result = run(cli).and_then(|()| common::flush_stdout());
+    if let Err(e) = result {
+        // Ignore a failed write to stderr: the exit code still reports the failure.
+        let _ = writeln!(std::io::stderr(), "gwn: {e}");
+        std::process::exit(1);
+    }
+}
+
+fn run(cli: Cli) -> Result<(), common::CliError> {
     if let Some(n) = cli.threads {
-        if let Err(e) = rayon::ThreadPoolBuilder::new()
+        let n = common::checked_threads(n, "--threads")?;
+        rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build_global()
-        {
-            eprintln!("gwn: cannot set --threads {n}: {e}");
-            std::process::exit(2);
-        }
+            .map_err(|e| common::CliError(format!("cannot set --threads {n}: {e}")))?;
     }
-    let result: Result<(), common::CliError> = match cli.command {
+    match cli.command {
         // DISPATCH: one arm per variant.
         Some(Command::Bench(a)) => bench::run(a),
         Some(Command::Classify(a)) => classify::run(a),
@@ -80,9 +89,5 @@ fn main() {
         Some(Command::Slice(a)) => slice::run(a),
         Some(Command::Voxelize(a)) => voxelize::run(a),
         None => slice::run_default(),
-    };
-    if let Err(e) = result {
-        eprintln!("gwn: {e}");
-        std::process::exit(1);
     }
 }

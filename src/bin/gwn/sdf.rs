@@ -28,10 +28,15 @@ pub struct Args {
     pub no_weld: bool,
 }
 
+/// Peak bytes per cell of `gwn sdf`: the winding numbers (with the per-column results they are
+/// copied from), the sample points, the distances and their `f32` copy.
+const SDF_BYTES_PER_CELL: usize = 8 + 8 + 24 + 8 + 4;
+
 /// Runs `gwn sdf`.
 pub fn run(args: Args) -> Result<(), CliError> {
+    args.grid.check()?;
     let mesh = load_mesh_for_cli(&args.mesh, args.no_weld)?;
-    let spec = args.grid.spec(&mesh, &args.mesh)?;
+    let spec = args.grid.spec(&mesh, &args.mesh, SDF_BYTES_PER_CELL)?;
     let sdf = SignedDistance::new(&mesh)?;
     let cols = spec.column_count(gwn::grid::ray_world_axis(sdf.winding_number()));
     let pb = progress((cols + spec.len()) as u64, "sdf");
@@ -47,6 +52,5 @@ pub fn run(args: Args) -> Result<(), CliError> {
         "points",
         &format!(", {inside} inside,"),
         &written,
-    );
-    Ok(())
+    )
 }

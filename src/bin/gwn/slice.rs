@@ -8,7 +8,7 @@ use gwn::eval::antipodal::{Options, WindingNumber};
 use gwn::products::png::Slice;
 use gwn::{BoundingBox, Mesh};
 
-use crate::common::{CliError, load_mesh_for_cli, progress};
+use crate::common::{CliError, load_mesh_for_cli, outln, progress};
 
 /// The bundled example mesh (`data/lion-head.off`, CGAL demo data, CC0-1.0): an open lion head
 /// with holes, so the slice shows fractional winding numbers.
@@ -143,14 +143,14 @@ fn render(mesh: &Mesh, args: &Args) -> Result<(), CliError> {
         .map_err(|e| CliError::msg(format!("{}: cannot write: {e}", args.out.display())))?;
     let shown = absolute(&args.out);
     let axis_name = ["x", "y", "z"][axis];
-    println!(
+    outln!(
         "wrote {} ({}×{} slice at {axis_name} = {coord}, w in [{:.3}, {:.3}])",
         shown.display(),
         slice.width,
         slice.height,
         values.iter().copied().fold(f64::INFINITY, f64::min),
         values.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-    );
+    )?;
     Ok(())
 }
 

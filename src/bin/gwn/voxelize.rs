@@ -8,7 +8,7 @@ use gwn::grid::GridSpec;
 use gwn::products::{npy, vti};
 use gwn::{BoundingBox, Mesh};
 
-use crate::common::{CliError, load_mesh_for_cli, progress};
+use crate::common::{CliError, load_mesh_for_cli, outln, progress};
 
 /// Element type of the `.npy` output.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -44,17 +44,57 @@ pub struct GridArgs {
 }
 
 impl GridArgs {
-    /// The grid for `mesh`.
-    pub fn spec(&self, mesh: &Mesh, name: &Path) -> Result<GridSpec, CliError> {
+    /// Checks the options that do not depend on the mesh, so that bad values fail before the
+    /// mesh is loaded.
+    pub fn check(&self) -> Result<(), CliError> {
+        if !(self.margin.is_finite() && self.margin >= 0.0) {
+            return Err(CliError(format!(
+                "--margin {}: expected a non-negative number",
+                self.margin
+            )));
+        }
+        if let Some(b) = &self.bounds {
+            if let Some(bad) = b.iter().find(|c| !c.is_finite()) {
+                return Err(CliError(format!("--bounds: {bad} is not a finite number")));
+            }
+            for k in 0..3 {
+                let extent = b[k + 3] - b[k];
+                if extent < 0.0 {
+                    return Err(CliError(format!(
+                        "--bounds: {} max {:?} is below min {:?}",
+                        ["x", "y", "z"][k],
+                        b[k + 3],
+                        b[k]
+                    )));
+                }
+                if !extent.is_finite() {
+                    return Err(CliError(format!(
+                        "--bounds: the {} extent {:?} - ({:?}) overflows",
+                        ["x", "y", "z"][k],
+                        b[k + 3],
+                        b[k]
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The grid for `mesh`; refused when its `bytes_per_cell` (what the subcommand holds per
+    /// cell at its peak) exceed the memory available.
+    pub fn spec(
+        &self,
+        mesh: &Mesh,
+        name: &Path,
+        bytes_per_cell: usize,
+    ) -> Result<GridSpec, CliError> {
         let bounds = match &self.bounds {
             Some(b) => BoundingBox {
                 min: [b[0], b[1], b[2]],
                 max: [b[3], b[4], b[5]],
             },
             None => {
-                if !(self.margin.is_finite() && self.margin >= 0.0) {
-                    return Err(CliError::msg("--margin must be a non-negative number"));
-                }
+                self.check()?;
                 mesh.bounding_box()
                     .ok_or_else(|| {
                         CliError::msg(format!("{}: mesh has no triangles", name.display()))
@@ -74,6 +114,7 @@ impl GridArgs {
                 spec.dims
             )));
         }
+        check_memory(spec.len(), bytes_per_cell, available_memory())?;
         Ok(spec)
     }
 
@@ -102,8 +143,53 @@ impl GridArgs {
     }
 }
 
+/// Peak bytes per cell of `gwn voxelize`: the per-column `f64` results and the grid they are
+/// copied into, the `f32` copy for `.npy` and the occupancy.
+pub const VOXELIZE_BYTES_PER_CELL: usize = 8 + 8 + 4 + 1;
+
+/// The memory the system can still give (Linux `MemAvailable`), `None` where unknown.
+fn available_memory() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib.saturating_mul(1024))
+}
+
+/// Refuses a grid whose arrays would not fit in the available memory: allocating them would
+/// abort the process (or wake the OOM killer) after the mesh is loaded, with no useful message.
+fn check_memory(
+    cells: usize,
+    bytes_per_cell: usize,
+    available: Option<u64>,
+) -> Result<(), CliError> {
+    let need = (cells as u64).saturating_mul(bytes_per_cell as u64);
+    match available {
+        Some(have) if need > have => Err(CliError(format!(
+            "a grid of {cells} cells needs about {:.1} GiB of memory, more than the {:.1} GiB \
+             available; lower --res or --dims",
+            need as f64 / f64::from(1 << 30),
+            have as f64 / f64::from(1 << 30)
+        ))),
+        _ => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::check_memory;
+
+    #[test]
+    fn grids_larger_than_the_available_memory_are_refused() {
+        assert!(check_memory(1 << 20, 13, Some(1 << 30)).is_ok());
+        let e = check_memory(1 << 30, 13, Some(8 << 30)).unwrap_err();
+        assert!(e.0.contains("13.0 GiB") && e.0.contains("8.0 GiB"), "{e}");
+        assert!(check_memory(usize::MAX, 44, Some(u64::MAX - 1)).is_err());
+        assert!(check_memory(1 << 31, 44, None).is_ok());
+    }
+}
+
 fn io_err(p: &Path, e: std::io::Error) -> CliError {
-    CliError::msg(format!("{}: {e}", p.display()))
+    CliError::msg(format!("{}: cannot write: {e}", p.display()))
 }
 
 /// Winding numbers on a voxel grid, written as `.npy` (and optionally `.vti`).
@@ -133,8 +219,17 @@ pub struct Args {
 
 /// Runs `gwn voxelize`.
 pub fn run(args: Args) -> Result<(), CliError> {
+    if let Some(t) = args.occupancy {
+        crate::common::check_threshold(t, "--occupancy")?;
+    }
+    if args.occupancy_out.is_some() && args.occupancy.is_none() {
+        return Err(CliError::msg(
+            "--occupancy-out needs --occupancy T (the threshold)",
+        ));
+    }
+    args.grid.check()?;
     let mesh = load_mesh_for_cli(&args.mesh, args.no_weld)?;
-    let spec = args.grid.spec(&mesh, &args.mesh)?;
+    let spec = args.grid.spec(&mesh, &args.mesh, VOXELIZE_BYTES_PER_CELL)?;
     let wn = WindingNumber::new(&mesh)?;
     let pb = progress(
         spec.column_count(gwn::grid::ray_world_axis(&wn)) as u64,
@@ -155,25 +250,30 @@ pub fn run(args: Args) -> Result<(), CliError> {
             args.out.with_file_name(format!("{stem}-occupancy.npy"))
         });
         let occ: Vec<u8> = values.iter().map(|&w| u8::from(w > t)).collect();
-        npy::save(&path, &spec.shape(), &occ)
-            .map_err(|e| CliError::msg(format!("{}: {e}", path.display())))?;
+        npy::save(&path, &spec.shape(), &occ).map_err(|e| io_err(&path, e))?;
         let inside = occ.iter().filter(|&&o| o == 1).count();
-        println!("occupancy (w > {t}): {inside} of {} voxels", occ.len());
+        outln!("occupancy (w > {t}): {inside} of {} voxels", occ.len())?;
         written.push(path);
     }
-    report_grid(&spec, secs, "voxels", "", &written);
-    Ok(())
+    report_grid(&spec, secs, "voxels", "", &written)
 }
 
 /// The summary `gwn voxelize` and `gwn sdf` print: size, layout, throughput, files written.
-pub fn report_grid(spec: &GridSpec, secs: f64, noun: &str, extra: &str, written: &[PathBuf]) {
+pub fn report_grid(
+    spec: &GridSpec,
+    secs: f64,
+    noun: &str,
+    extra: &str,
+    written: &[PathBuf],
+) -> Result<(), CliError> {
     let [w, h, d] = spec.dims;
-    println!(
+    outln!(
         "{} {noun} (W×H×D = {w}×{h}×{d}, npy shape ({d}, {h}, {w})){extra} in {secs:.3} s ({:.3e} {noun}/s)",
         spec.len(),
         spec.len() as f64 / secs.max(1e-9),
-    );
+    )?;
     for p in written {
-        println!("wrote {}", p.display());
+        outln!("wrote {}", p.display())?;
     }
+    Ok(())
 }
