@@ -33,7 +33,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .filter(|p| gwn::io::load_mesh(p).is_ok())
         .collect();
     files.sort();
-    println!("| mesh | F | B by index | B by position | index q/s | position q/s | speed-up | max diff |");
+    println!(
+        "| mesh | F | B by index | B by position | index q/s | position q/s | speed-up | max diff |"
+    );
     println!("|---|---|---|---|---|---|---|---|");
     for path in files {
         let mesh = gwn::io::load_mesh(&path)?.mesh;

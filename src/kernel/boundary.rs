@@ -65,20 +65,26 @@ pub struct BoundaryEdges {
     heavy: Vec<u32>,
     /// `2^(bits−1)`: the largest grid coordinate, for the error bound of the `f64` conversions.
     limit: f64,
-    /// The edges' boxes grown by [`NEAR_EDGE_FRACTION`] of the grid half-width, in normalized
-    /// coordinates: finds the edges near a query (see [`BoundaryEdges::needs_accurate_sum`]).
+    /// The edges' boxes grown by [`near_edge_pad`], in normalized coordinates: finds the edges
+    /// near a query (see [`BoundaryEdges::needs_accurate_sum`]).
     near: RayBvh,
-    /// That growth in grid units.
-    near_pad: i64,
 }
 
-/// A query closer than this fraction of the grid half-width (`1.5–3×` the mesh extent `E`) to a
-/// boundary edge gets the double-double term. Error model of the `f64` term at distance `d` from
-/// the edge: the offsets are exact integers rounded once (relative `u = 2^-53`), and both `atan2`
-/// arguments are `≈ |a−q||b−q|·d/len`, so the term errs by `≲ 4u·len/d ≤ 4u·1.8E/d`: at
-/// `d ≥ 2^-9·1.5E` that is `≤ 2.5e-13`. Closer queries are rare (a thin tube around the boundary
-/// curves), so the extended precision costs nothing measurable on grids.
-const NEAR_EDGE_FRACTION: f64 = 1.0 / 512.0;
+/// How far around edge `a b` (grid units) a query gets the double-double term: `2^-7` of the
+/// edge's largest extent, at least 16 cells (which also covers the one-cell reach of a residual,
+/// see [`BoundaryEdges::needs_accurate_sum`]).
+///
+/// Error model of the `f64` term at distance `d` from the edge: the offsets are exact integers
+/// rounded once (relative `u = 2^-53`); near the segment both `atan2` arguments are
+/// `≈ |a−q||b−q|·θ`, `θ ≈ d·len/(|a−q||b−q|)`, while their rounding errors are `≈ 2u·|a−q||b−q|`,
+/// so the term errs by `≲ 2u/θ ≤ u·len/(2d)` (`|a−q||b−q| ≤ len²/4` on the segment, less
+/// elsewhere; we allow `4u·len/d`). At `d ≥ 2^-7·len/√3` that is `≤ 900u = 1e-13`. Only a thin
+/// tube around each boundary edge, proportional to its length, takes the slower path.
+#[inline]
+fn near_edge_pad(a: [i64; 3], b: [i64; 3]) -> i64 {
+    let len = (0..3).map(|k| (a[k] - b[k]).abs()).max().unwrap_or(0);
+    (len >> 7).max(16)
+}
 
 /// Edges up to this weight are repeated in the chains; heavier ones (stacks of duplicated faces:
 /// one shared mesh has an edge of weight 466) take one exact scalar term times the weight.
@@ -133,16 +139,14 @@ impl BoundaryEdges {
             .filter(|&i| weight[i as usize] > MAX_CHAINED_WEIGHT)
             .collect();
         let limit = (1_i64 << (bits - 1)) as f64;
-        let near_pad = (limit * NEAR_EDGE_FRACTION) as i64;
         let to_unit = 1.0 / limit;
         let near_boxes: Vec<([f32; 3], [f32; 3])> = a
             .iter()
             .zip(&b)
-            .map(|(p, q)| {
-                let lo =
-                    std::array::from_fn(|k| ((p[k].min(q[k]) - near_pad) as f64 * to_unit) as f32);
-                let hi =
-                    std::array::from_fn(|k| ((p[k].max(q[k]) + near_pad) as f64 * to_unit) as f32);
+            .map(|(&p, &q)| {
+                let pad = near_edge_pad(p, q);
+                let lo = std::array::from_fn(|k| ((p[k].min(q[k]) - pad) as f64 * to_unit) as f32);
+                let hi = std::array::from_fn(|k| ((p[k].max(q[k]) + pad) as f64 * to_unit) as f32);
                 (lo, hi)
             })
             .collect();
@@ -160,7 +164,6 @@ impl BoundaryEdges {
             heavy,
             limit,
             near,
-            near_pad,
         }
     }
 
@@ -239,13 +242,13 @@ impl BoundaryEdges {
         } else {
             u(qi[2])
         };
-        let pad = self.near_pad;
         let mut flagged = false;
         self.near.for_each_on_ray(u(qi[0]), u(qi[1]), z_min, |e| {
             if flagged {
                 return;
             }
             let (a, b) = (self.a[e as usize], self.b[e as usize]);
+            let pad = near_edge_pad(a, b);
             if z_exact
                 && (0..3).all(|k| qi[k] >= a[k].min(b[k]) - pad && qi[k] <= a[k].max(b[k]) + pad)
             {
