@@ -1,8 +1,12 @@
-//! Evaluators of the winding number. Each offers `eval(q)` and `eval_batch(points)` (parallel).
+//! Evaluators of the winding number, all behind one interface, [`Evaluator`]:
 //!
-//! - [`antipodal`]: the exact Antipodal method (default);
+//! - [`antipodal`]: the exact Antipodal method (default), `O(B + log F)` per query;
 //! - [`direct`]: the solid-angle sum over all triangles (ground truth, `O(F)`);
+//! - [`fast`]: Barnes–Hut approximations for triangle soups and oriented point clouds.
 
 pub mod antipodal;
 pub mod direct;
+mod evaluator;
 pub mod fast;
+
+pub use evaluator::{Evaluator, NoGradient};

@@ -11,6 +11,7 @@ mod eval;
 mod filter_tets;
 mod r#gen;
 mod info;
+mod method;
 mod sdf;
 mod slice;
 mod voxelize;

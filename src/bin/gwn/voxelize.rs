@@ -3,12 +3,13 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args as ClapArgs, ValueEnum};
-use gwn::eval::antipodal::WindingNumber;
+use gwn::BoundingBox;
+use gwn::eval::antipodal::Options;
 use gwn::grid::GridSpec;
 use gwn::products::{npy, vti};
-use gwn::{BoundingBox, Mesh};
 
-use crate::common::{CliError, load_mesh_for_cli, progress};
+use crate::common::{CliError, progress};
+use crate::method::{Input, MethodArgs};
 
 /// Element type of the `.npy` output.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -44,8 +45,8 @@ pub struct GridArgs {
 }
 
 impl GridArgs {
-    /// The grid for `mesh`.
-    pub fn spec(&self, mesh: &Mesh, name: &Path) -> Result<GridSpec, CliError> {
+    /// The grid for `input`.
+    pub fn spec(&self, input: &Input, name: &Path) -> Result<GridSpec, CliError> {
         let bounds = match &self.bounds {
             Some(b) => BoundingBox {
                 min: [b[0], b[1], b[2]],
@@ -55,9 +56,10 @@ impl GridArgs {
                 if !(self.margin.is_finite() && self.margin >= 0.0) {
                     return Err(CliError::msg("--margin must be a non-negative number"));
                 }
-                mesh.bounding_box()
+                input
+                    .bounding_box()
                     .ok_or_else(|| {
-                        CliError::msg(format!("{}: mesh has no triangles", name.display()))
+                        CliError::msg(format!("{}: has no triangles or points", name.display()))
                     })?
                     .enlarged(self.margin)
             }
@@ -109,14 +111,16 @@ fn io_err(p: &Path, e: std::io::Error) -> CliError {
 /// Winding numbers on a voxel grid, written as `.npy` (and optionally `.vti`).
 ///
 /// The `.npy` is C order with shape (D, H, W), indexed [z, y, x]; samples are at cell centres.
-/// One ray per grid column along z is shared by all voxels of the column (ray reuse); values
-/// equal per-point evaluation exactly.
+/// With the exact method one ray per grid column along z is shared by all voxels of the column
+/// (ray reuse); values equal per-point evaluation exactly. Point clouds use the fast method.
 #[derive(ClapArgs, Debug)]
 pub struct Args {
-    /// Mesh file (OBJ, STL, OFF, PLY).
+    /// Mesh file (OBJ, STL, OFF, PLY) or oriented point cloud (.xyz, .csv, .pts, .ply).
     pub mesh: PathBuf,
     #[command(flatten)]
     pub grid: GridArgs,
+    #[command(flatten)]
+    pub method: MethodArgs,
     /// Output `.npy` with the winding numbers.
     #[arg(long, short, default_value = "winding.npy")]
     pub out: PathBuf,
@@ -133,11 +137,11 @@ pub struct Args {
 
 /// Runs `gwn voxelize`.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let mesh = load_mesh_for_cli(&args.mesh, args.no_weld)?;
-    let spec = args.grid.spec(&mesh, &args.mesh)?;
-    let wn = WindingNumber::new(&mesh)?;
+    let input = Input::load(&args.mesh, args.no_weld)?;
+    let spec = args.grid.spec(&input, &args.mesh)?;
+    let wn = args.method.build(&input, &args.mesh, Options::default())?;
     let pb = progress(
-        spec.column_count(gwn::grid::ray_world_axis(&wn)) as u64,
+        spec.column_count(gwn::grid::column_axis(&wn)) as u64,
         "voxelize",
     );
     let start = std::time::Instant::now();

@@ -193,6 +193,19 @@ fn dipole(p: [f64; 3], an: [f64; 3], q: [f64; 3]) -> f64 {
     (an[0] * r[0] + an[1] * r[1] + an[2] * r[2]) / d3 * INV_4PI
 }
 
+/// `∇_q` of [`dipole`]: with `r = p − q`, `−(a n/d³ − 3 (a n·r) r/d⁵)/(4π)`; 0 at the point.
+#[inline]
+fn dipole_gradient(p: [f64; 3], an: [f64; 3], q: [f64; 3]) -> [f64; 3] {
+    let r = [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
+    let d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+    if d2 == 0.0 {
+        return [0.0; 3];
+    }
+    let inv_d3 = 1.0 / (d2 * d2.sqrt());
+    let nr = an[0] * r[0] + an[1] * r[1] + an[2] * r[2];
+    std::array::from_fn(|k| -(an[k] - 3.0 * nr * r[k] / d2) * inv_d3 * INV_4PI)
+}
+
 /// Barnes–Hut evaluator of the winding number of an oriented point cloud (Barill et al. 2018,
 /// Sections 3.1–3.2). `Send + Sync`.
 ///
@@ -299,6 +312,26 @@ impl PointCloudWindingNumber {
     /// [`Self::eval`] for many points, in parallel (rayon).
     pub fn eval_batch(&self, points: &[[f64; 3]]) -> Vec<f64> {
         self.eval_batch_with(points, self.params)
+    }
+
+    /// Gradient of the approximation at `q` with the stored parameters.
+    pub fn gradient(&self, q: [f64; 3]) -> [f64; 3] {
+        self.gradient_with(q, self.params)
+    }
+
+    /// Gradient of the approximation [`Self::eval_with`] computes: each admissible node's
+    /// expansion differentiated ([`Moments::far_field_gradient`]) and near points by the exact
+    /// dipole gradient. Tends to the gradient of the dipole sum as β grows.
+    pub fn gradient_with(&self, q: [f64; 3], params: FastParams) -> [f64; 3] {
+        let (p, an) = (&self.positions, &self.weighted_normals);
+        self.hierarchy.gradient(q, &params, |range, g| {
+            for i in range {
+                let e = dipole_gradient(p[i], an[i], q);
+                for k in 0..3 {
+                    g[k] += e[k];
+                }
+            }
+        })
     }
 
     /// [`Self::eval_with`] for many points, in parallel (rayon).
