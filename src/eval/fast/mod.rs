@@ -1,6 +1,7 @@
 //! Fast approximate winding numbers: the Barnes–Hut method of Barill, Dickson, Schmidt, Levin &
 //! Jacobson, *Fast Winding Numbers for Soups and Clouds* (SIGGRAPH 2018), for triangle soups and
-//! oriented point clouds, and the FOSSIL-style `winding_number(point, beta)` API.
+//! oriented point clouds (the FOSSIL-style `winding_number(point, beta)` API that picks fast or
+//! exact is [`crate::eval::fossil`]).
 //!
 //! # Method
 //!
@@ -42,7 +43,7 @@
 //! of the node's box, `≥ r`) is Barill's with the per-node β `β·ρ/r ≥ β`. Against libigl's default
 //! (accuracy_scale 2), Barill β = 2.35 is the smallest β that was at least as accurate on all the
 //! meshes of `docs/benchmarks.md` (see `docs/fast.md`).
-//! [`WindingNumberApi::winding_number`] interprets `beta` as Barill's `β_B` (order 2); [`FastParams::fossil`] reproduces FOSSIL's rule
+//! [`FastOrExact::winding_number`](crate::eval::fossil::FastOrExact::winding_number) interprets `beta` as Barill's `β_B` (order 2); [`FastParams::fossil`] reproduces FOSSIL's rule
 //! (with the far field's sign right: FOSSIL's published dipole takes `c − q` with the wrong sign;
 //! ours is tested against the direct sum).
 //!
@@ -58,7 +59,6 @@
 //! | oriented point clouds | fast ([`PointCloudWindingNumber`]), β = 2.3, order 2 |
 //! | ground truth for tests | `eval::direct` |
 
-mod api;
 mod area;
 mod barnes_hut;
 mod cloud;
@@ -66,7 +66,6 @@ mod moments;
 mod soup;
 mod tree;
 
-pub use api::WindingNumberApi;
 pub use area::estimate_areas;
 pub use barnes_hut::{Admissibility, FastParams};
 pub use cloud::{
@@ -75,3 +74,8 @@ pub use cloud::{
 };
 pub use moments::{Moments, SYM_PAIRS};
 pub use soup::{FastWindingNumber, TRIANGLE_LEAF_SIZE};
+
+/// The former name of [`FastOrExact`](crate::eval::fossil::FastOrExact), kept so that code
+/// written against it still builds.
+#[deprecated(note = "renamed to gwn::eval::fossil::FastOrExact")]
+pub type WindingNumberApi<'m> = crate::eval::fossil::FastOrExact<'m>;
