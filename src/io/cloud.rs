@@ -17,7 +17,7 @@ use ply_rs_bw::ply::{DefaultElement, Property};
 
 use super::{parse_num, show, text_lines};
 use crate::error::{LoadError, LoadErrorKind, Location};
-use crate::eval::fast::PointCloud;
+use crate::mesh::PointCloud;
 
 /// A point-cloud file format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

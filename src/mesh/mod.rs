@@ -7,9 +7,11 @@
 //! users of this crate feed exactly such meshes.
 
 pub mod boundary;
+mod point_cloud;
 pub mod stats;
 
 pub use boundary::{BoundaryEdge, boundary_edges};
+pub use point_cloud::{PointCloud, PointCloudError};
 
 use crate::error::MeshError;
 

@@ -66,11 +66,12 @@ mod moments;
 mod soup;
 mod tree;
 
+/// The cloud itself lives in the mesh model; re-exported here, where it was first defined.
+pub use crate::mesh::{PointCloud, PointCloudError};
 pub use area::estimate_areas;
 pub use barnes_hut::{Admissibility, FastParams};
 pub use cloud::{
-    DEFAULT_AREA_NEIGHBOURS, POINT_LEAF_SIZE, PointCloud, PointCloudError, PointCloudWindingNumber,
-    winding_number_points_direct,
+    DEFAULT_AREA_NEIGHBOURS, POINT_LEAF_SIZE, PointCloudWindingNumber, winding_number_points_direct,
 };
 pub use moments::{Moments, SYM_PAIRS};
 pub use soup::{FastWindingNumber, TRIANGLE_LEAF_SIZE};
