@@ -226,6 +226,7 @@ impl PointCloudWindingNumber {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::PointCloudError;
 
     #[test]
     fn validation_rejects_bad_input() {
