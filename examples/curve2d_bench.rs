@@ -99,7 +99,7 @@ fn main() {
         let sub: Vec<Point> = full
             .iter()
             .enumerate()
-            .filter(|(k, _)| (k % RES) % s == 0 && (k / RES) % s == 0)
+            .filter(|(k, _)| (k % RES).is_multiple_of(s) && (k / RES).is_multiple_of(s))
             .map(|(_, &q)| q)
             .collect();
         let g = GauWn::new(sigma);

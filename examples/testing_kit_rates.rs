@@ -7,7 +7,7 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use gwn::kernel::frame::RayAxis;
-use gwn::testing::{Kind, Oracle, fast_exact};
+use gwn::testing::{Kind, Oracle, exact_evaluator};
 
 fn main() {
     println!(
@@ -42,7 +42,7 @@ fn main() {
         // Fast exact evaluator: build + every query.
         let t = Instant::now();
         for c in &cases {
-            let wn = fast_exact(&c.mesh, RayAxis::PosZ).expect("small meshes grid");
+            let wn = exact_evaluator(&c.mesh, RayAxis::PosZ).expect("small meshes grid");
             for &q in &c.queries {
                 black_box(wn.eval(q));
             }

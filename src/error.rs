@@ -60,30 +60,6 @@ impl fmt::Display for MeshError {
 
 impl std::error::Error for MeshError {}
 
-/// A query point that cannot be evaluated.
-#[derive(Clone, Debug, PartialEq)]
-pub enum QueryError {
-    /// A query coordinate is NaN or infinite.
-    NonFinite {
-        /// Query index in the batch (0 for a single query).
-        index: usize,
-        /// The point.
-        point: [f64; 3],
-    },
-}
-
-impl fmt::Display for QueryError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            QueryError::NonFinite { index, point } => {
-                write!(f, "query {index} has a non-finite coordinate: {point:?}")
-            }
-        }
-    }
-}
-
-impl std::error::Error for QueryError {}
-
 /// Where in a file a problem was found.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Location {

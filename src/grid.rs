@@ -12,18 +12,23 @@
 //! `values[(k·H + j)·W + i]`. `numpy.load` therefore gives an array indexed `a[z, y, x]`, and the
 //! order is also VTK ImageData's point order (see [`crate::products::vti`]).
 //!
-//! # Ray reuse
-//! All samples with the same two coordinates transverse to the evaluator's ray axis
-//! ([`Options::ray`](crate::eval::antipodal::Options), default `+z`) form one *column*. Each
-//! column is evaluated by a single [`WindingNumber::eval_column`] call: one BVH traversal
-//! collects the column's crossings, their exact (perturbed) order along the ray gives χ for every
-//! sample, and the boundary term is added per sample. The result is identical to
-//! [`WindingNumber::eval`] at every sample (same perturbation rule for samples exactly on the
-//! surface). Columns are evaluated in parallel (rayon).
+//! # Columns and ray reuse
+//! Any [`Evaluator`] fills a grid. All samples with the same two coordinates transverse to the
+//! evaluator's [`Evaluator::column_axis`] (z when it has none) form one *column*, evaluated by one
+//! [`Evaluator::eval_column`] call; columns are evaluated in parallel (rayon).
+//!
+//! For the exact evaluator ([`WindingNumber`]) the column axis is its ray
+//! ([`Options::ray`](crate::eval::antipodal::Options), default `+z`), and a column costs one
+//! BVH traversal ([`WindingNumber::eval_column`]): the column's crossings, in their exact
+//! (perturbed) order along the ray, give χ for every sample, and the boundary term is added per
+//! sample. The result is identical to [`WindingNumber::eval`] at every sample (same perturbation
+//! rule for samples exactly on the surface).
 
 use rayon::prelude::*;
 
 use crate::BoundingBox;
+use crate::eval::Evaluator;
+#[cfg(doc)]
 use crate::eval::antipodal::WindingNumber;
 
 /// A regular grid of cell-centre samples (see the [module documentation](self) for the layout).
@@ -149,21 +154,21 @@ impl GridSpec {
     }
 }
 
-/// The world axis of the evaluator's ray (the axis columns run along).
-pub fn ray_world_axis(wn: &WindingNumber) -> usize {
-    wn.options().ray.map()[2].0
+/// The world axis grid columns run along for `evaluator`: its [`Evaluator::column_axis`], or z.
+pub fn column_axis<E: Evaluator + ?Sized>(evaluator: &E) -> usize {
+    evaluator.column_axis().unwrap_or(2)
 }
 
-/// Winding numbers at every sample of `spec`, with one ray per column (see the
+/// Winding numbers at every sample of `spec`, column by column (see the
 /// [module documentation](self)). Storage order as [`GridSpec::index`].
-pub fn evaluate(wn: &WindingNumber, spec: &GridSpec) -> Vec<f64> {
-    evaluate_with_progress(wn, spec, |_| {})
+pub fn evaluate<E: Evaluator + ?Sized>(evaluator: &E, spec: &GridSpec) -> Vec<f64> {
+    evaluate_with_progress(evaluator, spec, |_| {})
 }
 
 /// [`evaluate`], calling `progress(n)` after every finished batch of `n` columns (from worker
 /// threads).
-pub fn evaluate_with_progress(
-    wn: &WindingNumber,
+pub fn evaluate_with_progress<E: Evaluator + ?Sized>(
+    evaluator: &E,
     spec: &GridSpec,
     progress: impl Fn(usize) + Sync,
 ) -> Vec<f64> {
@@ -171,7 +176,7 @@ pub fn evaluate_with_progress(
     if n == 0 {
         return Vec::new();
     }
-    let axis = ray_world_axis(wn);
+    let axis = column_axis(evaluator);
     // The two transverse axes, in increasing order; a column is addressed by (a, b).
     let (ta, tb) = match axis {
         0 => (1, 2),
@@ -194,7 +199,7 @@ pub fn evaluate_with_progress(
                 q[ta] = spec.coord(ta, a);
                 q[tb] = spec.coord(tb, b);
                 q[axis] = ts[0];
-                out.extend(wn.eval_column(q, &ts));
+                out.extend(evaluator.eval_column(q, axis, &ts));
             }
             progress(cols.len());
             out
@@ -218,10 +223,10 @@ pub fn evaluate_with_progress(
     values
 }
 
-/// The same grid evaluated point by point ([`WindingNumber::eval_batch`], one ray per sample):
-/// the reference for [`evaluate`] and the baseline of its speed-up.
-pub fn evaluate_per_point(wn: &WindingNumber, spec: &GridSpec) -> Vec<f64> {
-    wn.eval_batch(&spec.points())
+/// The same grid evaluated point by point ([`Evaluator::eval_batch`]; for the exact evaluator one
+/// ray per sample): the reference for [`evaluate`] and the baseline of its speed-up.
+pub fn evaluate_per_point<E: Evaluator + ?Sized>(evaluator: &E, spec: &GridSpec) -> Vec<f64> {
+    evaluator.eval_batch(&spec.points())
 }
 
 #[cfg(test)]

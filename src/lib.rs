@@ -28,18 +28,23 @@
 #![warn(missing_docs)]
 
 pub mod bvh;
+#[cfg(feature = "curve2d")]
 pub mod curve2d;
 pub mod error;
 pub mod eval;
 pub mod grid;
+#[cfg(feature = "io")]
 pub mod io;
 pub mod kernel;
 pub mod mesh;
+mod one_shot;
+#[cfg(feature = "products")]
 pub mod products;
 #[cfg(any(feature = "testing", feature = "cli"))]
 pub mod testing;
 
 pub use mesh::{BoundingBox, Mesh};
+pub use one_shot::{Position, TriangleIndices, WindingNumberError, winding_number};
 
 /// The README's library example, compiled and run as a doctest.
 #[doc = include_str!("../README.md")]

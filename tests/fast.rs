@@ -8,7 +8,7 @@ use gwn::Mesh;
 use gwn::eval::direct::winding_number_direct_batch;
 use gwn::eval::fast::{
     Admissibility, FastParams, FastWindingNumber, Moments, PointCloud, PointCloudWindingNumber,
-    SYM_PAIRS, WindingNumberApi, estimate_areas,
+    SYM_PAIRS, estimate_areas,
 };
 
 // ---------------------------------------------------------------- helpers
@@ -451,7 +451,7 @@ fn fossil_api_dispatches_on_beta() {
     let Some(mesh) = shared_mesh("cgal-anchor.off") else {
         return;
     };
-    let api = WindingNumberApi::new(&mesh);
+    let api = gwn::eval::fossil::FastOrExact::new(&mesh);
     let fast = FastWindingNumber::new(&mesh);
     let qs = queries(&mesh, 60, 9);
     // beta <= 0 is the exact Antipodal evaluator (bit for bit), which agrees with the direct sum.

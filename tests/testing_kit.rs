@@ -8,7 +8,7 @@ use gwn::Mesh;
 use gwn::eval::direct::winding_number_direct;
 use gwn::kernel::frame::RayAxis;
 use gwn::mesh::boundary_edges;
-use gwn::testing::{Case, Decision, Kind, Oracle, fast_exact, on_surface, strategies};
+use gwn::testing::{Case, Decision, Kind, Oracle, exact_evaluator, on_surface, strategies};
 use proptest::prelude::*;
 
 // ---------------------------------------------------------------------------------------------
@@ -399,7 +399,7 @@ fn check_oracle(c: &Case, t: &mut Tally) {
     let on: Vec<bool> = c.queries.iter().map(|&q| on_surface(&c.mesh, q)).collect();
     for ray in RayAxis::ALL {
         let oracle = Oracle::new(&c.mesh, ray);
-        let wn = fast_exact(&c.mesh, ray).unwrap();
+        let wn = exact_evaluator(&c.mesh, ray).unwrap();
         for (i, &q) in c.queries.iter().enumerate() {
             let cert = oracle.eval(q);
             let w = wn.eval(q);
@@ -448,7 +448,7 @@ fn check_oracle(c: &Case, t: &mut Tally) {
 }
 
 #[test]
-fn oracle_agrees_with_the_fast_exact_evaluator_on_every_kind() {
+fn oracle_agrees_with_the_exact_evaluator_on_every_kind() {
     for kind in Kind::ALL {
         let mut t = Tally::default();
         for seed in 0..60 {
@@ -723,7 +723,7 @@ fn rates() {
     let t = std::time::Instant::now();
     let mut fast = 0usize;
     for c in &cases {
-        let wn = fast_exact(&c.mesh, RayAxis::PosZ).unwrap();
+        let wn = exact_evaluator(&c.mesh, RayAxis::PosZ).unwrap();
         for &q in &c.queries {
             std::hint::black_box(wn.eval(q));
             fast += 1;

@@ -61,3 +61,22 @@ pub fn winding_number_gradient_direct(mesh: &Mesh, q: [f64; 3]) -> [f64; 3] {
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
+
+/// The direct sum as an [`Evaluator`](crate::eval::Evaluator): owns a copy of the mesh (the sum
+/// visits every triangle per query anyway), so it does not borrow it.
+#[derive(Clone, Debug)]
+pub struct DirectWindingNumber {
+    mesh: Mesh,
+}
+
+impl DirectWindingNumber {
+    /// Wraps a copy of `mesh`.
+    pub fn new(mesh: &Mesh) -> Self {
+        DirectWindingNumber { mesh: mesh.clone() }
+    }
+
+    /// The mesh summed over.
+    pub fn mesh(&self) -> &Mesh {
+        &self.mesh
+    }
+}

@@ -14,7 +14,7 @@ use std::path::Path;
 
 use super::{COLUMN_SEPARATORS, parse_num, show, text_lines, tokens_separated_by};
 use crate::error::{LoadError, LoadErrorKind, LoadWarning, Location};
-use crate::eval::fast::PointCloud;
+use crate::mesh::PointCloud;
 
 /// A point-cloud file format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -7,11 +7,13 @@
 //! users of this crate feed exactly such meshes.
 
 pub mod boundary;
+mod point_cloud;
 pub mod stats;
 
 pub use boundary::{
     BoundaryEdge, boundary_edges, boundary_welded_by, geometric_boundary_edges, signed_boundary,
 };
+pub use point_cloud::{PointCloud, PointCloudError};
 
 use crate::error::MeshError;
 

@@ -16,7 +16,7 @@
 use rayon::prelude::*;
 
 use crate::Mesh;
-use crate::eval::antipodal::WindingNumber;
+use crate::eval::Evaluator;
 
 /// Centroid of face `f` of `mesh`; a coordinate equal on all three corners is copied exactly.
 pub fn face_centroid(mesh: &Mesh, f: usize) -> [f64; 3] {
@@ -30,8 +30,9 @@ pub fn face_centroid(mesh: &Mesh, f: usize) -> [f64; 3] {
     })
 }
 
-/// `w_B` at the centroid of every face of `a` (in face order), `b_evaluator` built from B.
-pub fn classify_faces(a: &Mesh, b_evaluator: &WindingNumber) -> Vec<f64> {
+/// `w_B` at the centroid of every face of `a` (in face order), `b_evaluator` built from B (any
+/// evaluator; the coplanar-face rule above is the exact one's).
+pub fn classify_faces<E: Evaluator + ?Sized>(a: &Mesh, b_evaluator: &E) -> Vec<f64> {
     (0..a.triangles().len())
         .into_par_iter()
         .map(|f| b_evaluator.eval(face_centroid(a, f)))

@@ -19,7 +19,7 @@
 use std::io::{self, Write};
 use std::path::Path;
 
-use crate::eval::antipodal::WindingNumber;
+use crate::eval::Evaluator;
 use crate::grid::GridSpec;
 use crate::kernel::frame::RayAxis;
 use crate::{BoundingBox, Mesh};
@@ -138,19 +138,19 @@ impl Slice {
     }
 
     /// Winding numbers at the pixel centres, row-major from the top row (`width·height`).
-    pub fn evaluate(&self, wn: &WindingNumber) -> Vec<f64> {
-        self.evaluate_with_progress(wn, |_| {})
+    pub fn evaluate<E: Evaluator + ?Sized>(&self, evaluator: &E) -> Vec<f64> {
+        self.evaluate_with_progress(evaluator, |_| {})
     }
 
     /// [`Slice::evaluate`] with a progress callback (see
     /// [`crate::grid::evaluate_with_progress`]).
-    pub fn evaluate_with_progress(
+    pub fn evaluate_with_progress<E: Evaluator + ?Sized>(
         &self,
-        wn: &WindingNumber,
+        evaluator: &E,
         progress: impl Fn(usize) + Sync,
     ) -> Vec<f64> {
         let g = self.grid();
-        let values = crate::grid::evaluate_with_progress(wn, &g, progress);
+        let values = crate::grid::evaluate_with_progress(evaluator, &g, progress);
         let (u, v) = plane_axes(self.axis);
         let mut out = vec![0.0; self.width * self.height];
         for py in 0..self.height {

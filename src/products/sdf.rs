@@ -29,6 +29,7 @@ use obvhs::{BvhBuildParams, aabb::Aabb, bvh2::builder::build_bvh2};
 use rayon::prelude::*;
 
 use crate::Mesh;
+use crate::eval::Evaluator;
 use crate::eval::antipodal::{BuildError, Options, WindingNumber};
 use crate::grid::GridSpec;
 
@@ -64,33 +65,20 @@ struct Node {
     count: u32,
 }
 
-/// Signed distance evaluator: build once, query from many threads.
+/// Signed distance evaluator: build once, query from many threads. The sign comes from any
+/// [`Evaluator`] (by default the exact one).
 #[derive(Clone, Debug)]
-pub struct SignedDistance {
+pub struct SignedDistance<E = WindingNumber> {
     tris: Vec<[[f64; 3]; 3]>,
     nodes: Vec<Node>,
     prims: Vec<u32>,
-    wn: WindingNumber,
+    wn: E,
 }
 
 impl SignedDistance {
     /// Builds the distance BVH and the exact winding-number evaluator (default options).
     pub fn new(mesh: &Mesh) -> Result<Self, BuildError> {
         Ok(Self::with_evaluator(mesh, WindingNumber::new(mesh)?))
-    }
-
-    /// Builds the distance BVH around an existing evaluator of the same mesh.
-    pub fn with_evaluator(mesh: &Mesh, wn: WindingNumber) -> Self {
-        let tris: Vec<[[f64; 3]; 3]> = (0..mesh.triangles().len())
-            .map(|f| mesh.triangle_positions(f))
-            .collect();
-        let (nodes, prims) = build_tree(&tris);
-        SignedDistance {
-            tris,
-            nodes,
-            prims,
-            wn,
-        }
     }
 
     /// Builds with explicit evaluator options.
@@ -100,9 +88,35 @@ impl SignedDistance {
             WindingNumber::with_options(mesh, options)?,
         ))
     }
+}
+
+impl<E: Evaluator> SignedDistance<E> {
+    /// Builds the distance BVH around an existing evaluator of the same mesh.
+    pub fn with_evaluator(mesh: &Mesh, wn: E) -> Self {
+        let tris: Vec<[[f64; 3]; 3]> = (0..mesh.triangles().len())
+            .map(|f| mesh.triangle_positions(f))
+            .collect();
+        Self::from_triangles(tris, wn)
+    }
+
+    /// Distance to a set of points (e.g. an oriented point cloud), signed by `wn`: each point is
+    /// stored as a triangle with three equal corners, whose closest point is the point itself.
+    pub fn with_points(points: &[[f64; 3]], wn: E) -> Self {
+        Self::from_triangles(points.iter().map(|&p| [p; 3]).collect(), wn)
+    }
+
+    fn from_triangles(tris: Vec<[[f64; 3]; 3]>, wn: E) -> Self {
+        let (nodes, prims) = build_tree(&tris);
+        SignedDistance {
+            tris,
+            nodes,
+            prims,
+            wn,
+        }
+    }
 
     /// The winding-number evaluator used for the sign.
-    pub fn winding_number(&self) -> &WindingNumber {
+    pub fn winding_number(&self) -> &E {
         &self.wn
     }
 

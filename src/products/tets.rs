@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
-use crate::eval::antipodal::WindingNumber;
+use crate::eval::Evaluator;
 
 /// The default inside threshold on `w`.
 pub const DEFAULT_THRESHOLD: f64 = 0.5;
@@ -42,15 +42,15 @@ pub struct TetMesh {
 
 /// Marks each tet by `w` at its centroid: `true` when `w > threshold`. A tet with a corner index
 /// outside `tet_vertices` is never kept.
-pub fn filter_tets(
+pub fn filter_tets<E: Evaluator + ?Sized>(
     tet_vertices: &[[f64; 3]],
     tets: &[[u32; 4]],
-    wn: &WindingNumber,
+    evaluator: &E,
     threshold: f64,
 ) -> Vec<bool> {
     tets.par_iter()
         .map(|t| match centroid(tet_vertices, t) {
-            Some(c) => wn.eval(c) > threshold,
+            Some(c) => evaluator.eval(c) > threshold,
             None => false,
         })
         .collect()

@@ -13,8 +13,8 @@
 //!   predicates written independently of `gwn::kernel`, plus a certified interval for the
 //!   boundary term. [`Certified::decide`] is never wrong when it answers; closed consistently
 //!   oriented meshes give exact integers.
-//! - **Fast exact evaluator** for bulk use: [`WindingNumber`] (the library's Antipodal
-//!   evaluator), via [`fast_exact`].
+//! - **The exact evaluator** for bulk use: [`WindingNumber`] (the library's Antipodal
+//!   evaluator), via [`exact_evaluator`].
 //!
 //! | | guarantee | cost |
 //! |---|---|---|
@@ -47,12 +47,12 @@ use crate::Mesh;
 use crate::eval::antipodal::BuildError;
 use crate::kernel::frame::RayAxis;
 
-/// The fast exact evaluator for bulk use, with the 60-bit grid and the given ray: its value is the
+/// The library's exact evaluator for bulk use (fast next to the oracle), with the 60-bit grid and the given ray: its value is the
 /// winding number at the same perturbed point `q_ε` as the oracle's for that ray. Its integer
 /// part is exact for every input; its fractional part is accurate to ~1e-12 (not certified).
 /// Queries are snapped to the mesh's 60-bit grid first: the kit's dyadic coordinates snap
 /// without error.
-pub fn fast_exact(mesh: &Mesh, ray: RayAxis) -> Result<WindingNumber, BuildError> {
+pub fn exact_evaluator(mesh: &Mesh, ray: RayAxis) -> Result<WindingNumber, BuildError> {
     WindingNumber::with_options(
         mesh,
         Options {

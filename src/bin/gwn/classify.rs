@@ -3,10 +3,11 @@
 use std::path::PathBuf;
 
 use clap::{Args as ClapArgs, ValueEnum};
-use gwn::eval::antipodal::WindingNumber;
+use gwn::eval::antipodal::Options;
 use gwn::products::classify::{Select, classify_faces, select, submesh, write_obj};
 
-use crate::common::{CliError, check_threshold, load_mesh_for_cli, outln};
+use crate::common::{CliError, check_threshold, outln};
+use crate::method::{Input, MethodArgs};
 
 /// Which faces to select.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -17,7 +18,8 @@ pub enum Which {
     Outside,
 }
 
-/// Classify each face of A by the winding number of B at its centroid (exact method).
+/// Classify each face of A by the winding number of B at its centroid (exact method by default;
+/// B may be an oriented point cloud, evaluated with the fast method).
 ///
 /// Writes one value per face of A (CSV, or `.npy` by extension). With --select, also reports
 /// the selected faces and writes them as OBJ with --mesh-out. Faces of A lying on B's surface get
@@ -26,8 +28,10 @@ pub enum Which {
 pub struct Args {
     /// Mesh A: the faces to classify.
     pub a: PathBuf,
-    /// Mesh B: the solid they are classified against.
+    /// Mesh B (or oriented point cloud): the solid they are classified against.
     pub b: PathBuf,
+    #[command(flatten)]
+    pub method: MethodArgs,
     /// Per-face values of w_B (`.npy` float64 of shape (F,), otherwise CSV one per line).
     #[arg(long, short)]
     pub out: PathBuf,
@@ -48,10 +52,11 @@ pub struct Args {
 /// Runs `gwn classify`.
 pub fn run(args: Args) -> Result<(), CliError> {
     check_threshold(args.threshold, "--threshold")?;
-    let a = load_mesh_for_cli(&args.a, args.no_weld)?;
-    let b = load_mesh_for_cli(&args.b, args.no_weld)?;
-    let wn = WindingNumber::new(&b)?;
-    let values = classify_faces(&a, &wn);
+    let a_input = Input::load(&args.a, args.no_weld)?;
+    let a = a_input.mesh(&args.a, "classify (its faces are classified)")?;
+    let b = Input::load(&args.b, args.no_weld)?;
+    let wn = args.method.build(&b, &args.b, Options::default())?;
+    let values = classify_faces(a, &wn);
     gwn::io::points::save_values(&args.out, &values)
         .map_err(|e| CliError::msg(format!("{}: cannot write: {e}", args.out.display())))?;
     outln!("wrote {} ({} faces)", args.out.display(), values.len())?;
@@ -87,7 +92,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             }
             let cannot_write = |e| CliError::msg(format!("{}: cannot write: {e}", p.display()));
             let f = std::fs::File::create(p).map_err(cannot_write)?;
-            write_obj(std::io::BufWriter::new(f), &submesh(&a, &keep)).map_err(cannot_write)?;
+            write_obj(std::io::BufWriter::new(f), &submesh(a, &keep)).map_err(cannot_write)?;
             outln!("wrote {}", p.display())?;
         }
     }

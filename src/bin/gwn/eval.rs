@@ -3,25 +3,12 @@
 use std::path::PathBuf;
 
 use clap::{Args as ClapArgs, ValueEnum};
-use gwn::eval::antipodal::{Options, WindingNumber};
-use gwn::eval::direct::{winding_number_direct, winding_number_gradient_direct};
-use gwn::eval::fast::{FastParams, FastWindingNumber, PointCloudWindingNumber};
+use gwn::eval::antipodal::Options;
 use gwn::kernel::frame::RayAxis;
 use gwn::kernel::quantize::Precision;
-use rayon::prelude::*;
 
-use crate::common::{CliError, check_beta, load_mesh_for_cli, progress, stdout_error};
-
-/// Evaluation method.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum Method {
-    /// Exact Antipodal method (integer predicates; O(boundary + log faces) per query).
-    Exact,
-    /// Direct solid-angle sum over all faces (O(faces) per query; the reference).
-    Direct,
-    /// Barnes-Hut approximation (orders 0-2, accuracy --beta); the method for point clouds.
-    Fast,
-}
+use crate::common::{CliError, check_beta, progress, stdout_error};
+use crate::method::{Input, Method, MethodArgs};
 
 /// Ray direction of the exact method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -62,7 +49,9 @@ impl From<Ray> for RayAxis {
 /// Evaluate the winding number of MESH (or of an oriented point cloud) at query points.
 ///
 /// A point cloud (.xyz/.csv/.txt/.pts with `x y z nx ny nz [area]`, or a PLY with normals and no
-/// faces) is evaluated with the fast dipole sum; areas are estimated when absent.
+/// faces) is evaluated with the fast dipole sum (--method fast; areas are estimated when absent).
+/// An option that does not apply to the method or input (--beta with exact, --precision with
+/// fast, --method exact on a cloud) is an error.
 ///
 /// Points come from a text file (one `x y z` or `x,y,z` per line; `#` comments and a header line
 /// are skipped) or a `.npy` float64/float32 array of shape (N, 3). Values go to stdout (one per
@@ -82,31 +71,23 @@ pub struct Args {
     /// Query points file (.csv/.txt/.xyz text or .npy).
     #[arg(long)]
     pub points: PathBuf,
-    /// Evaluation method.
-    #[arg(long, value_enum, default_value_t = Method::Exact)]
-    pub method: Method,
-    /// Grid bits of the exact method (30: i64 predicates; 60: i128 predicates).
-    #[arg(long, default_value_t = 60, value_parser = parse_precision)]
-    pub precision: u32,
+    #[command(flatten)]
+    pub method: MethodArgs,
+    /// Grid bits of the exact method (30: i64 predicates; 60: i128 predicates) [default: 60].
+    #[arg(long, value_parser = parse_precision)]
+    pub precision: Option<u32>,
     /// Ray direction of the exact method (any gives the same value off the surface; on the
-    /// surface the value is taken at the point perturbed along this ray's frame).
-    #[arg(long, value_enum, default_value_t = Ray::PosZ, allow_hyphen_values = true)]
-    pub ray: Ray,
-    /// Accuracy of the fast method: a tree node is approximated when its distance exceeds
-    /// beta times its radius (Barill et al. 2018); larger is more accurate. Positive, finite.
-    #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
-    pub beta: f64,
-    /// Expansion order of the fast method (0, 1 or 2).
-    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(0..=2))]
-    pub order: u8,
-    /// Also compute the gradient ∇w (exact and direct methods).
+    /// surface the value is taken at the point perturbed along this ray's frame) [default: +z].
+    #[arg(long, value_enum, allow_hyphen_values = true)]
+    pub ray: Option<Ray>,
+    /// Also compute the gradient ∇w (every method; for fast, the derivative of its expansion).
     #[arg(long)]
     pub gradient: bool,
     /// Output file for values (.csv or .npy); stdout when absent.
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Output file for gradients (.csv or .npy, shape (N, 3)); needs --gradient. With
-    /// --gradient and no file, the gradient is printed after the value on each stdout line.
+    /// Output file for gradients (.csv or .npy, shape (N, 3)); with --gradient and no file, the
+    /// gradient is printed after the value on each stdout line.
     #[arg(long)]
     pub gradient_out: Option<PathBuf>,
     /// Do not weld bit-identical vertices of STL files.
@@ -124,110 +105,52 @@ fn parse_precision(s: &str) -> Result<u32, String> {
 
 /// Runs `gwn eval`.
 pub fn run(args: Args) -> Result<(), CliError> {
-    check_beta(args.beta)?;
+    if let Some(beta) = args.method.beta {
+        check_beta(beta)?;
+    }
     if args.gradient_out.is_some() && !args.gradient {
         return Err(CliError::msg(
             "--gradient-out needs --gradient (no gradient is computed without it)",
         ));
     }
-    if is_point_cloud(&args.mesh) {
-        return run_cloud(&args);
+    let input = Input::load(&args.mesh, args.no_weld)?;
+    let method = args.method.method(&input);
+    if method != Method::Exact {
+        for (given, flag) in [
+            (args.precision.is_some(), "--precision"),
+            (args.ray.is_some(), "--ray"),
+        ] {
+            if given {
+                return Err(CliError::msg(format!(
+                    "{flag} applies to --method exact only"
+                )));
+            }
+        }
     }
-    let mesh = load_mesh_for_cli(&args.mesh, args.no_weld)?;
-    let points = gwn::io::points::load_points(&args.points)?;
-    if args.gradient && args.method == Method::Fast {
-        return Err(CliError::msg(
-            "--gradient is available with --method exact or direct, not fast",
-        ));
-    }
-    let pb = progress(points.len() as u64, "evaluating");
-    let chunk = 4096;
-    let (values, grads): (Vec<f64>, Option<Vec<[f64; 3]>>) = match args.method {
-        Method::Exact => {
-            let precision = if args.precision == 30 {
-                Precision::Bits30
-            } else {
-                Precision::Bits60
-            };
-            let wn = WindingNumber::with_options(
-                &mesh,
-                Options {
-                    precision,
-                    ray: args.ray.into(),
-                    ..Default::default()
-                },
-            )
-            .map_err(|e| CliError(format!("{}: {e}", args.mesh.display())))?;
-            let mut values = Vec::with_capacity(points.len());
-            for c in points.chunks(chunk) {
-                values.extend(wn.eval_batch(c));
-                pb.inc(c.len() as u64);
-            }
-            let grads = args.gradient.then(|| wn.gradient_batch(&points));
-            (values, grads)
-        }
-        Method::Direct => {
-            let mut values = Vec::with_capacity(points.len());
-            for c in points.chunks(chunk) {
-                values.par_extend(c.par_iter().map(|&q| winding_number_direct(&mesh, q)));
-                pb.inc(c.len() as u64);
-            }
-            let grads = args.gradient.then(|| {
-                points
-                    .par_iter()
-                    .map(|&q| winding_number_gradient_direct(&mesh, q))
-                    .collect()
-            });
-            (values, grads)
-        }
-        Method::Fast => {
-            let params = FastParams::barill(args.beta, args.order);
-            let f = FastWindingNumber::with_params(&mesh, params);
-            let mut values = Vec::with_capacity(points.len());
-            for c in points.chunks(chunk) {
-                values.extend(f.eval_batch(c));
-                pb.inc(c.len() as u64);
-            }
-            (values, None)
-        }
+    let options = Options {
+        precision: if args.precision == Some(30) {
+            Precision::Bits30
+        } else {
+            Precision::Bits60
+        },
+        ray: args.ray.unwrap_or(Ray::PosZ).into(),
+        ..Default::default()
     };
-    pb.finish_and_clear();
-    write_outputs(&args, &values, grads.as_deref())
-}
-
-/// Text point formats are clouds; a PLY is a cloud when it has no faces.
-fn is_point_cloud(path: &std::path::Path) -> bool {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(|e| e.to_ascii_lowercase())
-        .unwrap_or_default();
-    match ext.as_str() {
-        "xyz" | "csv" | "txt" | "pts" => true,
-        "ply" => matches!(
-            gwn::io::load_mesh(path),
-            Err(gwn::error::LoadError {
-                kind: gwn::error::LoadErrorKind::Empty,
-                ..
-            })
-        ),
-        _ => false,
-    }
-}
-
-fn run_cloud(args: &Args) -> Result<(), CliError> {
-    if args.method == Method::Exact && args.gradient {
-        return Err(CliError::msg(
-            "--gradient is not available for point clouds",
-        ));
-    }
-    let (cloud, warnings) = gwn::io::cloud::load_point_cloud_with_warnings(&args.mesh)?;
-    crate::common::print_load_warnings(&args.mesh, &warnings);
+    let wn = args.method.build(&input, &args.mesh, options)?;
     let points = gwn::io::points::load_points(&args.points)?;
-    let params = FastParams::barill(args.beta, args.order);
-    let wn = PointCloudWindingNumber::with_params(&cloud, params);
-    let values = wn.eval_batch(&points);
-    write_outputs(args, &values, None)
+    let pb = progress(points.len() as u64, "evaluating");
+    let mut values = Vec::with_capacity(points.len());
+    for c in points.chunks(4096) {
+        values.extend(wn.eval_batch(c));
+        pb.inc(c.len() as u64);
+    }
+    pb.finish_and_clear();
+    let grads = if args.gradient {
+        Some(wn.try_gradient_batch(&points)?)
+    } else {
+        None
+    };
+    write_outputs(&args, &values, grads.as_deref())
 }
 
 fn write_outputs(args: &Args, values: &[f64], grads: Option<&[[f64; 3]]>) -> Result<(), CliError> {

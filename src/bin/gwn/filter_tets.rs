@@ -3,10 +3,11 @@
 use std::path::PathBuf;
 
 use clap::Args as ClapArgs;
-use gwn::eval::antipodal::WindingNumber;
+use gwn::eval::antipodal::Options;
 use gwn::products::tets::{DEFAULT_THRESHOLD, filter_tets, load_tets, save_tets};
 
-use crate::common::{CliError, check_threshold, load_mesh_for_cli, outln};
+use crate::common::{CliError, check_threshold, outln};
+use crate::method::{Input, MethodArgs};
 
 /// Keep the tets of TETS whose centroid has w(MESH) > threshold, and write them to OUT.
 ///
@@ -14,8 +15,10 @@ use crate::common::{CliError, check_threshold, load_mesh_for_cli, outln};
 /// Unreferenced points are dropped from the output.
 #[derive(ClapArgs, Debug)]
 pub struct Args {
-    /// Surface mesh (OBJ, STL, OFF, PLY).
+    /// Surface mesh (OBJ, STL, OFF, PLY) or oriented point cloud (.xyz, .csv, .pts, .ply).
     pub mesh: PathBuf,
+    #[command(flatten)]
+    pub method: MethodArgs,
     /// Tet mesh (.mesh, .node or .ele).
     pub tets: PathBuf,
     /// Output tet mesh (.mesh, .node or .ele).
@@ -32,9 +35,9 @@ pub struct Args {
 /// Runs `gwn filter-tets`.
 pub fn run(args: Args) -> Result<(), CliError> {
     check_threshold(args.threshold, "--threshold")?;
-    let mesh = load_mesh_for_cli(&args.mesh, args.no_weld)?;
+    let input = Input::load(&args.mesh, args.no_weld)?;
     let tets = load_tets(&args.tets)?;
-    let wn = WindingNumber::new(&mesh)?;
+    let wn = args.method.build(&input, &args.mesh, Options::default())?;
     let keep = filter_tets(&tets.points, &tets.tets, &wn, args.threshold);
     let kept = tets.select(&keep);
     // `save_tets` errors already start with the file they concern.

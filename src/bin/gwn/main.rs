@@ -13,6 +13,7 @@ mod eval;
 mod filter_tets;
 mod r#gen;
 mod info;
+mod method;
 mod sdf;
 mod slice;
 mod voxelize;

@@ -3,23 +3,27 @@
 use std::path::PathBuf;
 
 use clap::Args as ClapArgs;
+use gwn::eval::antipodal::Options;
 use gwn::products::sdf::SignedDistance;
 
-use crate::common::{CliError, load_mesh_for_cli, progress};
+use crate::common::{CliError, progress};
+use crate::method::{Input, MethodArgs};
 use crate::voxelize::GridArgs;
 
 /// Signed distance to the mesh on a voxel grid, signed by the winding number (`.npy`, `.vti`).
 ///
 /// The `.npy` is C order with shape (D, H, W), indexed [z, y, x]; samples are at cell centres.
-/// The distance is to the closest point of the triangles; the sign is negative where the exact
-/// winding number is above 0.5, which stays correct on open and dirty meshes where
-/// pseudo-normal signs fail.
+/// The distance is to the closest point of the triangles (of a point cloud: to the closest
+/// point); the sign is negative where the winding number (exact by default) is above 0.5, which
+/// stays correct on open and dirty meshes where pseudo-normal signs fail.
 #[derive(ClapArgs, Debug)]
 pub struct Args {
-    /// Mesh file (OBJ, STL, OFF, PLY).
+    /// Mesh file (OBJ, STL, OFF, PLY) or oriented point cloud (.xyz, .csv, .pts, .ply).
     pub mesh: PathBuf,
     #[command(flatten)]
     pub grid: GridArgs,
+    #[command(flatten)]
+    pub method: MethodArgs,
     /// Output `.npy`.
     #[arg(long, short, default_value = "sdf.npy")]
     pub out: PathBuf,
@@ -35,10 +39,14 @@ const SDF_BYTES_PER_CELL: usize = 8 + 8 + 24 + 8 + 4;
 /// Runs `gwn sdf`.
 pub fn run(args: Args) -> Result<(), CliError> {
     args.grid.check()?;
-    let mesh = load_mesh_for_cli(&args.mesh, args.no_weld)?;
-    let spec = args.grid.spec(&mesh, &args.mesh, SDF_BYTES_PER_CELL)?;
-    let sdf = SignedDistance::new(&mesh)?;
-    let cols = spec.column_count(gwn::grid::ray_world_axis(sdf.winding_number()));
+    let input = Input::load(&args.mesh, args.no_weld)?;
+    let spec = args.grid.spec(&input, &args.mesh, SDF_BYTES_PER_CELL)?;
+    let wn = args.method.build(&input, &args.mesh, Options::default())?;
+    let sdf = match &input {
+        Input::Mesh(mesh) => SignedDistance::with_evaluator(mesh, wn),
+        Input::Cloud(cloud) => SignedDistance::with_points(cloud.positions(), wn),
+    };
+    let cols = spec.column_count(gwn::grid::column_axis(sdf.winding_number()));
     let pb = progress((cols + spec.len()) as u64, "sdf");
     let start = std::time::Instant::now();
     let values = sdf.eval_grid_with_progress(&spec, |n| pb.inc(n as u64));

@@ -4,11 +4,12 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args as ClapArgs, ValueEnum};
-use gwn::eval::antipodal::{Options, WindingNumber};
+use gwn::BoundingBox;
+use gwn::eval::antipodal::Options;
 use gwn::products::png::Slice;
-use gwn::{BoundingBox, Mesh};
 
-use crate::common::{CliError, load_mesh_for_cli, outln, progress};
+use crate::common::{CliError, outln, progress};
+use crate::method::{Input, MethodArgs};
 
 /// The bundled example mesh (`data/lion-head.off`, CGAL demo data, CC0-1.0): an open lion head
 /// with holes, so the slice shows fractional winding numbers.
@@ -44,8 +45,10 @@ impl Axis {
 /// (x right, y up).
 #[derive(ClapArgs, Debug)]
 pub struct Args {
-    /// Mesh file (OBJ, STL, OFF, PLY).
+    /// Mesh file (OBJ, STL, OFF, PLY) or oriented point cloud (.xyz, .csv, .pts, .ply).
     pub mesh: PathBuf,
+    #[command(flatten)]
+    pub method: MethodArgs,
     /// Normal axis of the slice plane.
     #[arg(long, value_enum, default_value_t = Axis::Z)]
     pub axis: Axis,
@@ -74,8 +77,8 @@ pub struct Args {
 
 /// Runs `gwn slice`.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let mesh = load_mesh_for_cli(&args.mesh, args.no_weld)?;
-    render(&mesh, &args)
+    let input = Input::load(&args.mesh, args.no_weld)?;
+    render(&input, &args)
 }
 
 /// `gwn` without a subcommand: slice the bundled lion head to `slice.png`.
@@ -84,6 +87,7 @@ pub fn run_default() -> Result<(), CliError> {
         gwn::io::load_mesh_from_bytes(LION_HEAD, "data/lion-head.off", Some(gwn::io::Format::Off))?;
     let args = Args {
         mesh: PathBuf::from("data/lion-head.off"),
+        method: MethodArgs::default(),
         axis: Axis::X,
         at: 0.5,
         at_coord: None,
@@ -97,10 +101,10 @@ pub fn run_default() -> Result<(), CliError> {
         "gwn: no subcommand given; rendering the bundled lion head (an open mesh with holes) \
          like `gwn slice data/lion-head.off --axis x --at 0.5 --outline` (see `gwn --help`)"
     );
-    render(&loaded.mesh, &args)
+    render(&Input::Mesh(loaded.mesh), &args)
 }
 
-fn render(mesh: &Mesh, args: &Args) -> Result<(), CliError> {
+fn render(input: &Input, args: &Args) -> Result<(), CliError> {
     if args.res == 0 || args.res > 1 << 15 {
         return Err(CliError::msg(format!(
             "--res {} must be between 1 and 32768",
@@ -110,9 +114,14 @@ fn render(mesh: &Mesh, args: &Args) -> Result<(), CliError> {
     if !(args.margin.is_finite() && args.margin >= 0.0) {
         return Err(CliError::msg("--margin must be a non-negative number"));
     }
-    let Some(bbox) = mesh.bounding_box() else {
+    let outline = if args.outline {
+        Some(input.mesh(&args.mesh, "--outline")?)
+    } else {
+        None
+    };
+    let Some(bbox) = input.bounding_box() else {
         return Err(CliError::msg(format!(
-            "{}: mesh has no triangles",
+            "{}: has no triangles or points",
             args.mesh.display()
         )));
     };
@@ -125,20 +134,19 @@ fn render(mesh: &Mesh, args: &Args) -> Result<(), CliError> {
     };
     let region: BoundingBox = bbox.enlarged(args.margin);
     let slice = Slice::new(&region, axis, coord, args.res);
-    let wn = WindingNumber::with_options(
-        mesh,
-        Options {
-            ray: slice.ray(),
-            ..Options::default()
-        },
-    )?;
+    // A ray in the plane: one ray serves a whole image column or row.
+    let exact = Options {
+        ray: slice.ray(),
+        ..Options::default()
+    };
+    let wn = args.method.build(input, &args.mesh, exact)?;
     let pb = progress(
-        slice.grid().column_count(gwn::grid::ray_world_axis(&wn)) as u64,
+        slice.grid().column_count(gwn::grid::column_axis(&wn)) as u64,
         "slice",
     );
     let values = slice.evaluate_with_progress(&wn, |n| pb.inc(n as u64));
     pb.finish_and_clear();
-    let img = slice.render(&values, args.outline.then_some(mesh));
+    let img = slice.render(&values, outline);
     img.save_png(&args.out)
         .map_err(|e| CliError::msg(format!("{}: cannot write: {e}", args.out.display())))?;
     let shown = absolute(&args.out);

@@ -3,12 +3,13 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args as ClapArgs, ValueEnum};
-use gwn::eval::antipodal::WindingNumber;
+use gwn::BoundingBox;
+use gwn::eval::antipodal::Options;
 use gwn::grid::GridSpec;
 use gwn::products::{npy, vti};
-use gwn::{BoundingBox, Mesh};
 
-use crate::common::{CliError, load_mesh_for_cli, outln, progress};
+use crate::common::{CliError, outln, progress};
+use crate::method::{Input, MethodArgs};
 
 /// Element type of the `.npy` output.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -80,11 +81,11 @@ impl GridArgs {
         Ok(())
     }
 
-    /// The grid for `mesh`; refused when its `bytes_per_cell` (what the subcommand holds per
+    /// The grid for `input`; refused when its `bytes_per_cell` (what the subcommand holds per
     /// cell at its peak) exceed the memory available.
     pub fn spec(
         &self,
-        mesh: &Mesh,
+        input: &Input,
         name: &Path,
         bytes_per_cell: usize,
     ) -> Result<GridSpec, CliError> {
@@ -95,9 +96,10 @@ impl GridArgs {
             },
             None => {
                 self.check()?;
-                mesh.bounding_box()
+                input
+                    .bounding_box()
                     .ok_or_else(|| {
-                        CliError::msg(format!("{}: mesh has no triangles", name.display()))
+                        CliError::msg(format!("{}: has no triangles or points", name.display()))
                     })?
                     .enlarged(self.margin)
             }
@@ -141,6 +143,10 @@ impl GridArgs {
         }
         Ok(written)
     }
+}
+
+fn io_err(p: &Path, e: std::io::Error) -> CliError {
+    CliError::msg(format!("{}: cannot write: {e}", p.display()))
 }
 
 /// Peak bytes per cell of `gwn voxelize`: the per-column `f64` results and the grid they are
@@ -188,21 +194,19 @@ mod tests {
     }
 }
 
-fn io_err(p: &Path, e: std::io::Error) -> CliError {
-    CliError::msg(format!("{}: cannot write: {e}", p.display()))
-}
-
 /// Winding numbers on a voxel grid, written as `.npy` (and optionally `.vti`).
 ///
 /// The `.npy` is C order with shape (D, H, W), indexed [z, y, x]; samples are at cell centres.
-/// One ray per grid column along z is shared by all voxels of the column (ray reuse); values
-/// equal per-point evaluation exactly.
+/// With the exact method one ray per grid column along z is shared by all voxels of the column
+/// (ray reuse); values equal per-point evaluation exactly. Point clouds use the fast method.
 #[derive(ClapArgs, Debug)]
 pub struct Args {
-    /// Mesh file (OBJ, STL, OFF, PLY).
+    /// Mesh file (OBJ, STL, OFF, PLY) or oriented point cloud (.xyz, .csv, .pts, .ply).
     pub mesh: PathBuf,
     #[command(flatten)]
     pub grid: GridArgs,
+    #[command(flatten)]
+    pub method: MethodArgs,
     /// Output `.npy` with the winding numbers.
     #[arg(long, short, default_value = "winding.npy")]
     pub out: PathBuf,
@@ -228,11 +232,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
         ));
     }
     args.grid.check()?;
-    let mesh = load_mesh_for_cli(&args.mesh, args.no_weld)?;
-    let spec = args.grid.spec(&mesh, &args.mesh, VOXELIZE_BYTES_PER_CELL)?;
-    let wn = WindingNumber::new(&mesh)?;
+    let input = Input::load(&args.mesh, args.no_weld)?;
+    let spec = args
+        .grid
+        .spec(&input, &args.mesh, VOXELIZE_BYTES_PER_CELL)?;
+    let wn = args.method.build(&input, &args.mesh, Options::default())?;
     let pb = progress(
-        spec.column_count(gwn::grid::ray_world_axis(&wn)) as u64,
+        spec.column_count(gwn::grid::column_axis(&wn)) as u64,
         "voxelize",
     );
     let start = std::time::Instant::now();

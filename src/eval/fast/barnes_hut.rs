@@ -103,6 +103,9 @@ pub(crate) struct Hierarchy {
     /// The query tree; node 0 holds the root of `tree` in its first lane.
     wide: Vec<WideNode>,
     wide_far: Vec<FarField<f32x4>>,
+    /// Per query-tree node, the binary node of each lane (`EMPTY` when unused): the gradient
+    /// differentiates the `f64` [`Moments`] of exactly the nodes the value expands.
+    wide_binary: Vec<[u32; 4]>,
 }
 
 impl Hierarchy {
@@ -200,6 +203,7 @@ impl Hierarchy {
         let make = |lanes: &[usize],
                     wide: &mut Vec<WideNode>,
                     wide_far: &mut Vec<_>,
+                    wide_binary: &mut Vec<[u32; 4]>,
                     work: &mut Vec<_>| {
             let id = wide.len();
             let get = |f: &dyn Fn(usize) -> f64| {
@@ -242,10 +246,14 @@ impl Hierarchy {
             wide_far.push(FarField::lanes(std::array::from_fn(|l| {
                 lanes.get(l).map_or(&empty, |&b| &far[b])
             })));
+            wide_binary.push(std::array::from_fn(|l| {
+                lanes.get(l).map_or(EMPTY, |&b| b as u32)
+            }));
         };
         let mut wide = Vec::with_capacity(nodes.len() / 3 + 1);
         let mut wide_far = Vec::with_capacity(nodes.len() / 3 + 1);
-        make(&[0], &mut wide, &mut wide_far, &mut work);
+        let mut wide_binary = Vec::with_capacity(nodes.len() / 3 + 1);
+        make(&[0], &mut wide, &mut wide_far, &mut wide_binary, &mut work);
         while let Some((parent, lane, b)) = work.pop() {
             wide[parent].child[lane] = wide.len() as u32;
             let mut lanes = vec![nodes[b].left as usize, nodes[b].left as usize + 1];
@@ -261,10 +269,17 @@ impl Hierarchy {
                 lanes[i] = l;
                 lanes.push(l + 1);
             }
-            make(&lanes, &mut wide, &mut wide_far, &mut work);
+            make(
+                &lanes,
+                &mut wide,
+                &mut wide_far,
+                &mut wide_binary,
+                &mut work,
+            );
         }
         self.wide = wide;
         self.wide_far = wide_far;
+        self.wide_binary = wide_binary;
     }
 
     /// FASTWN(q) (Algorithm 1), iteratively over the 4-wide query tree: the lanes far enough
@@ -331,6 +346,61 @@ impl Hierarchy {
             id = stack[top] as usize;
         }
         sum + far.reduce_add()
+    }
+}
+
+impl Hierarchy {
+    /// The gradient of [`Hierarchy::eval`]'s approximation: the same traversal and the same
+    /// admissibility decisions, with each admissible node's expansion differentiated
+    /// ([`Moments::far_field_gradient`], in `f64`) and `leaf(range, gradient)` adding the exact
+    /// gradients of a near leaf's elements.
+    pub fn gradient(
+        &self,
+        q: [f64; 3],
+        params: &FastParams,
+        mut leaf: impl FnMut(std::ops::Range<usize>, &mut [f64; 3]),
+    ) -> [f64; 3] {
+        let mut g = [0.0; 3];
+        if self.wide.is_empty() {
+            return g;
+        }
+        let beta = f64x4::splat(params.beta);
+        let which = params.admissibility as usize;
+        let qv = q.map(f64x4::splat);
+        let zero = f64x4::ZERO;
+        let mut stack = [0u32; WIDE_STACK];
+        let mut top = 0usize;
+        let mut id = 0usize;
+        loop {
+            let node = &self.wide[id];
+            let r = [0, 1, 2].map(|k| node.center[k] - qv[k]);
+            let d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+            let bs = beta * node.size[which];
+            let mask = (d2.cmp_gt(zero) & (bs.cmp_lt(zero) | d2.cmp_gt(bs * bs))).move_mask();
+            for (l, &c) in node.child.iter().enumerate() {
+                if c == EMPTY {
+                    break;
+                }
+                if mask & (1 << l) != 0 {
+                    let b = self.wide_binary[id][l] as usize;
+                    let e = self.moments[b].far_field_gradient(q, params.order);
+                    for k in 0..3 {
+                        g[k] += e[k];
+                    }
+                } else if c & LEAF != 0 {
+                    leaf(self.leaves[(c & !LEAF) as usize].clone(), &mut g);
+                } else {
+                    stack[top] = c;
+                    top += 1;
+                }
+            }
+            if top == 0 {
+                break;
+            }
+            top -= 1;
+            id = stack[top] as usize;
+        }
+        g
     }
 }
 

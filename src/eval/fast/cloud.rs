@@ -2,8 +2,6 @@
 //! `w(q) = Σᵢ aᵢ (pᵢ − q)·n̂ᵢ / (4π ‖pᵢ − q‖³)`, and its Barnes–Hut evaluation with the same tree
 //! and expansions as triangle soups.
 
-use std::fmt;
-
 use rayon::prelude::*;
 
 use super::InputScale;
@@ -14,6 +12,7 @@ use super::soup::dist2;
 use super::tree::Tree;
 use crate::BoundingBox;
 use crate::kernel::compensated::NeumaierSum;
+use crate::mesh::PointCloud;
 
 const INV_4PI: f64 = 1.0 / (4.0 * std::f64::consts::PI);
 
@@ -23,147 +22,12 @@ pub const POINT_LEAF_SIZE: usize = 4;
 /// Neighbours used by the area estimation (Barill et al.: `k = 20`).
 pub const DEFAULT_AREA_NEIGHBOURS: usize = 20;
 
-/// A point cloud that cannot be used as given.
-#[derive(Clone, Debug, PartialEq)]
-pub enum PointCloudError {
-    /// `normals` (or `areas`) do not have one entry per point.
-    LengthMismatch {
-        /// What has the wrong length: `"normals"` or `"areas"`.
-        what: &'static str,
-        /// Number of points.
-        points: usize,
-        /// Number of entries found.
-        found: usize,
-    },
-    /// A coordinate, normal component or area is NaN or infinite, or an area is negative.
-    InvalidValue {
-        /// What: `"position"`, `"normal"` or `"area"`.
-        what: &'static str,
-        /// Point index (0-based).
-        index: usize,
-    },
-}
-
-impl fmt::Display for PointCloudError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            PointCloudError::LengthMismatch {
-                what,
-                points,
-                found,
-            } => write!(f, "{points} points but {found} {what}"),
-            PointCloudError::InvalidValue { what, index } => {
-                write!(
-                    f,
-                    "point {index} has an invalid {what} (NaN, infinite or negative)"
-                )
-            }
-        }
-    }
-}
-
-impl std::error::Error for PointCloudError {}
-
-/// An oriented point cloud: positions, normals (normalised on construction; a zero normal makes
-/// the point inert) and optional per-point areas `aᵢ`.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct PointCloud {
-    positions: Vec<[f64; 3]>,
-    normals: Vec<[f64; 3]>,
-    areas: Option<Vec<f64>>,
-}
-
 impl PointCloud {
-    /// Validates and stores the cloud. Normals are normalised (their length is ignored: the
-    /// strength of a point is its area).
-    pub fn new(
-        positions: Vec<[f64; 3]>,
-        normals: Vec<[f64; 3]>,
-        areas: Option<Vec<f64>>,
-    ) -> Result<Self, PointCloudError> {
-        let n = positions.len();
-        if normals.len() != n {
-            return Err(PointCloudError::LengthMismatch {
-                what: "normals",
-                points: n,
-                found: normals.len(),
-            });
-        }
-        if let Some(a) = &areas {
-            if a.len() != n {
-                return Err(PointCloudError::LengthMismatch {
-                    what: "areas",
-                    points: n,
-                    found: a.len(),
-                });
-            }
-            if let Some(index) = a.iter().position(|v| !v.is_finite() || *v < 0.0) {
-                return Err(PointCloudError::InvalidValue {
-                    what: "area",
-                    index,
-                });
-            }
-        }
-        if let Some(index) = positions
-            .iter()
-            .position(|p| p.iter().any(|v| !v.is_finite()))
-        {
-            return Err(PointCloudError::InvalidValue {
-                what: "position",
-                index,
-            });
-        }
-        let mut unit = normals;
-        for (index, nrm) in unit.iter_mut().enumerate() {
-            let l2 = nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2];
-            if !l2.is_finite() {
-                return Err(PointCloudError::InvalidValue {
-                    what: "normal",
-                    index,
-                });
-            }
-            if l2 > 0.0 {
-                let l = l2.sqrt();
-                *nrm = nrm.map(|v| v / l);
-            }
-        }
-        Ok(PointCloud {
-            positions,
-            normals: unit,
-            areas,
-        })
-    }
-
-    /// Number of points.
-    pub fn len(&self) -> usize {
-        self.positions.len()
-    }
-
-    /// True when the cloud has no points.
-    pub fn is_empty(&self) -> bool {
-        self.positions.is_empty()
-    }
-
-    /// Positions.
-    pub fn positions(&self) -> &[[f64; 3]] {
-        &self.positions
-    }
-
-    /// Unit normals (zero for a point given a zero normal).
-    pub fn normals(&self) -> &[[f64; 3]] {
-        &self.normals
-    }
-
-    /// Per-point areas, when given.
-    pub fn areas(&self) -> Option<&[f64]> {
-        self.areas.as_deref()
-    }
-
     /// The given areas, or areas estimated with `k` neighbours ([`estimate_areas`]).
     pub fn areas_or_estimate(&self, k: usize) -> Vec<f64> {
-        match &self.areas {
-            Some(a) => a.clone(),
-            None => estimate_areas(&self.positions, &self.normals, k),
+        match self.areas() {
+            Some(a) => a.to_vec(),
+            None => estimate_areas(self.positions(), self.normals(), k),
         }
     }
 }
@@ -193,6 +57,19 @@ fn dipole(p: [f64; 3], an: [f64; 3], q: [f64; 3]) -> f64 {
     }
     let d3 = d2 * d2.sqrt();
     (an[0] * r[0] + an[1] * r[1] + an[2] * r[2]) / d3 * INV_4PI
+}
+
+/// `∇_q` of [`dipole`]: with `r = p − q`, `−(a n/d³ − 3 (a n·r) r/d⁵)/(4π)`; 0 at the point.
+#[inline]
+fn dipole_gradient(p: [f64; 3], an: [f64; 3], q: [f64; 3]) -> [f64; 3] {
+    let r = [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
+    let d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+    if d2 == 0.0 {
+        return [0.0; 3];
+    }
+    let inv_d3 = 1.0 / (d2 * d2.sqrt());
+    let nr = an[0] * r[0] + an[1] * r[1] + an[2] * r[2];
+    std::array::from_fn(|k| -(an[k] - 3.0 * nr * r[k] / d2) * inv_d3 * INV_4PI)
 }
 
 /// Barnes–Hut evaluator of the winding number of an oriented point cloud (Barill et al. 2018,
@@ -311,6 +188,28 @@ impl PointCloudWindingNumber {
         self.eval_batch_with(points, self.params)
     }
 
+    /// Gradient of the approximation at `q` with the stored parameters.
+    pub fn gradient(&self, q: [f64; 3]) -> [f64; 3] {
+        self.gradient_with(q, self.params)
+    }
+
+    /// Gradient of the approximation [`Self::eval_with`] computes: each admissible node's
+    /// expansion differentiated ([`Moments::far_field_gradient`]) and near points by the exact
+    /// dipole gradient. Tends to the gradient of the dipole sum as β grows.
+    pub fn gradient_with(&self, q: [f64; 3], params: FastParams) -> [f64; 3] {
+        let (p, an) = (&self.positions, &self.weighted_normals);
+        self.scale.gradient(q, |q| {
+            self.hierarchy.gradient(q, &params, |range, g| {
+                for i in range {
+                    let e = dipole_gradient(p[i], an[i], q);
+                    for k in 0..3 {
+                        g[k] += e[k];
+                    }
+                }
+            })
+        })
+    }
+
     /// [`Self::eval_with`] for many points, in parallel (rayon).
     pub fn eval_batch_with(&self, points: &[[f64; 3]], params: FastParams) -> Vec<f64> {
         points
@@ -339,6 +238,7 @@ impl PointCloudWindingNumber {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::PointCloudError;
 
     #[test]
     fn validation_rejects_bad_input() {

@@ -1,6 +1,7 @@
 //! Fast approximate winding numbers: the Barnes–Hut method of Barill, Dickson, Schmidt, Levin &
 //! Jacobson, *Fast Winding Numbers for Soups and Clouds* (SIGGRAPH 2018), for triangle soups and
-//! oriented point clouds, and the FOSSIL-style `winding_number(point, beta)` API.
+//! oriented point clouds (the FOSSIL-style `winding_number(point, beta)` API that picks fast or
+//! exact is [`crate::eval::fossil`]).
 //!
 //! # Method
 //!
@@ -42,7 +43,7 @@
 //! of the node's box, `≥ r`) is Barill's with the per-node β `β·ρ/r ≥ β`. Against libigl's default
 //! (accuracy_scale 2), Barill β = 2.35 is the smallest β that was at least as accurate on all the
 //! meshes of `docs/benchmarks.md` (see `docs/fast.md`).
-//! [`WindingNumberApi::winding_number`] interprets `beta` as Barill's `β_B` (order 2); [`FastParams::fossil`] reproduces FOSSIL's rule
+//! [`FastOrExact::winding_number`](crate::eval::fossil::FastOrExact::winding_number) interprets `beta` as Barill's `β_B` (order 2); [`FastParams::fossil`] reproduces FOSSIL's rule
 //! (with the far field's sign right: FOSSIL's published dipole takes `c − q` with the wrong sign;
 //! ours is tested against the direct sum).
 //!
@@ -58,7 +59,6 @@
 //! | oriented point clouds | fast ([`PointCloudWindingNumber`]), β = 2.3, order 2 |
 //! | ground truth for tests | `eval::direct` |
 
-mod api;
 mod area;
 mod barnes_hut;
 mod cloud;
@@ -66,12 +66,12 @@ mod moments;
 mod soup;
 mod tree;
 
-pub use api::WindingNumberApi;
+/// The cloud itself lives in the mesh model; re-exported here, where it was first defined.
+pub use crate::mesh::{PointCloud, PointCloudError};
 pub use area::estimate_areas;
 pub use barnes_hut::{Admissibility, FastParams};
 pub use cloud::{
-    DEFAULT_AREA_NEIGHBOURS, POINT_LEAF_SIZE, PointCloud, PointCloudError, PointCloudWindingNumber,
-    winding_number_points_direct,
+    DEFAULT_AREA_NEIGHBOURS, POINT_LEAF_SIZE, PointCloudWindingNumber, winding_number_points_direct,
 };
 pub use moments::{Moments, SYM_PAIRS};
 pub use soup::{FastWindingNumber, TRIANGLE_LEAF_SIZE};
@@ -124,4 +124,30 @@ impl InputScale {
     pub(crate) fn query(&self, q: [f64; 3]) -> [f64; 3] {
         pull_in(self.rescale.apply(q), self.center, self.far)
     }
+
+    /// The gradient at world query `q` from `gradient`, which evaluates it in the scaled
+    /// coordinates: `∇w` has degree −1 in lengths, so it scales back by the same power of two.
+    /// Beyond the pull-in distance (`2^31` extents) the gradient is below `2^-62/extent` and
+    /// returned as 0 (the expansions would overflow there).
+    #[inline]
+    pub(crate) fn gradient(
+        &self,
+        q: [f64; 3],
+        gradient: impl FnOnce([f64; 3]) -> [f64; 3],
+    ) -> [f64; 3] {
+        let s = self.rescale.apply(q);
+        if (0..3).any(|k| !((0.5 * s[k] - 0.5 * self.center[k]).abs() <= 0.5 * self.far)) {
+            return if q.iter().all(|c| c.is_finite()) {
+                [0.0; 3]
+            } else {
+                [f64::NAN; 3]
+            };
+        }
+        self.rescale.apply(gradient(s))
+    }
 }
+
+/// The former name of [`FastOrExact`](crate::eval::fossil::FastOrExact), kept so that code
+/// written against it still builds.
+#[deprecated(note = "renamed to gwn::eval::fossil::FastOrExact")]
+pub type WindingNumberApi<'m> = crate::eval::fossil::FastOrExact<'m>;

@@ -216,6 +216,86 @@ impl Moments {
     }
 }
 
+impl Moments {
+    /// `∇_q` of [`Moments::far_field`]: the expansion differentiated term by term (Barill et
+    /// al. 2018 expand `w` in derivatives of `G`; the gradient is the next derivative of each).
+    /// With `r = p̃ − q`, `d = ‖r‖` and `∇_q = −∇_r`:
+    ///
+    /// ```text
+    /// ∇_r (N·r/d³)          = N/d³ − 3 (N·r) r/d⁵
+    /// ∇_r (tr/d³)           = −3 tr r/d⁵
+    /// ∇_r (rᵀM1r/d⁵)        = (M1 + M1ᵀ) r/d⁵ − 5 (rᵀM1r) r/d⁷
+    /// ∇_r ((a+2b)·r/d⁵)     = (a+2b)/d⁵ − 5 ((a+2b)·r) r/d⁷
+    /// ∇_r (D/d⁷)            = ∇D/d⁷ − 7 D r/d⁹,   ∂D/∂rₘ = 2 Σⱼₖ M2ₘⱼₖ rⱼ rₖ + Σᵢⱼ M2ᵢⱼₘ rᵢ rⱼ
+    /// ```
+    ///
+    /// (`aₖ = Σᵢ M2ᵢᵢₖ`, `bⱼ = Σᵢ M2ᵢⱼᵢ`, `D = Σ M2ᵢⱼₖ rᵢrⱼrₖ`, the terms of `far_field`).
+    pub fn far_field_gradient(&self, q: [f64; 3], order: u8) -> [f64; 3] {
+        let r = sub(self.center, q);
+        let d2 = dot(r, r);
+        let inv_d2 = 1.0 / d2;
+        let inv_d = inv_d2.sqrt();
+        let inv_d3 = inv_d * inv_d2;
+        let inv_d5 = inv_d3 * inv_d2;
+        let inv_d7 = inv_d5 * inv_d2;
+        let nr = dot(self.n, r);
+        let mut g: [f64; 3] =
+            std::array::from_fn(|k| self.n[k] * inv_d3 - 3.0 * nr * r[k] * inv_d5);
+        if order >= 1 {
+            let m = &self.m1;
+            let tr = m[0][0] + m[1][1] + m[2][2];
+            let mut rmr = 0.0;
+            let mut sym_r = [0.0; 3];
+            for i in 0..3 {
+                for j in 0..3 {
+                    rmr += r[i] * m[i][j] * r[j];
+                    sym_r[i] += (m[i][j] + m[j][i]) * r[j];
+                }
+            }
+            for k in 0..3 {
+                g[k] += -3.0 * tr * r[k] * inv_d5
+                    - 3.0 * (sym_r[k] * inv_d5 - 5.0 * rmr * r[k] * inv_d7);
+            }
+            if order >= 2 {
+                let full = |i: usize, j: usize| {
+                    let s = SYM_PAIRS
+                        .iter()
+                        .position(|&(a, b)| (a, b) == (i.min(j), i.max(j)))
+                        .unwrap_or(0);
+                    self.m2[s]
+                };
+                let mut ab = [0.0; 3];
+                for k in 0..3 {
+                    for i in 0..3 {
+                        ab[k] += full(i, i)[k] + 2.0 * full(i, k)[i];
+                    }
+                }
+                let ab_r = dot(ab, r);
+                let mut cubic = 0.0;
+                let mut grad_cubic = [0.0; 3];
+                for i in 0..3 {
+                    for j in 0..3 {
+                        let row = full(i, j);
+                        for k in 0..3 {
+                            cubic += row[k] * r[i] * r[j] * r[k];
+                            // 2 Σⱼₖ M2ₘⱼₖ rⱼ rₖ with m = i, and Σᵢⱼ M2ᵢⱼₘ rᵢ rⱼ with m = k.
+                            grad_cubic[i] += 2.0 * row[k] * r[j] * r[k];
+                            grad_cubic[k] += row[k] * r[i] * r[j];
+                        }
+                    }
+                }
+                let inv_d9 = inv_d7 * inv_d2;
+                for k in 0..3 {
+                    g[k] += 0.5
+                        * (-3.0 * (ab[k] * inv_d5 - 5.0 * ab_r * r[k] * inv_d7)
+                            + 15.0 * (grad_cubic[k] * inv_d7 - 7.0 * cubic * r[k] * inv_d9));
+                }
+            }
+        }
+        g.map(|v| -v * INV_4PI)
+    }
+}
+
 /// The far-field coefficients of one node in the form the query evaluates, precomputed from its
 /// [`Moments`] and pre-scaled by `1/(4π)`: with `r = p̃ − q` and `d = ‖r‖`,
 ///
@@ -550,6 +630,31 @@ mod tests {
                     "order {order}, lane {l}: {} vs {want}",
                     got[l]
                 );
+            }
+        }
+    }
+
+    #[test]
+    fn far_field_gradient_matches_finite_differences() {
+        let (a, b, c) = ([0.1, -0.2, 0.05], [0.4, 0.3, -0.1], [-0.2, 0.25, 0.3]);
+        let mut m = Moments::of_triangle(a, b, c, [0.05, 0.0, 0.02]);
+        m.accumulate(&Moments::of_triangle(c, b, [0.3, -0.3, 0.4], m.center));
+        for order in 0..=2u8 {
+            for q in [[2.0, 1.0, -0.5], [-1.3, 0.4, 1.7], [0.2, -2.5, 0.1]] {
+                let g = m.far_field_gradient(q, order);
+                let h = 1e-5;
+                for k in 0..3 {
+                    let (mut hi, mut lo) = (q, q);
+                    hi[k] += h;
+                    lo[k] -= h;
+                    let fd = (m.far_field(hi, order) - m.far_field(lo, order)) / (2.0 * h);
+                    let scale = g.iter().map(|v| v.abs()).fold(0.0, f64::max);
+                    assert!(
+                        (fd - g[k]).abs() <= 1e-7 * scale,
+                        "order {order}, q {q:?}, axis {k}: {fd} vs {}",
+                        g[k]
+                    );
+                }
             }
         }
     }

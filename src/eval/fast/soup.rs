@@ -9,7 +9,7 @@ use super::tree::Tree;
 use wide::{CmpGt, CmpLt, f64x4};
 
 use crate::kernel::angle_sum::AngleSum;
-use crate::kernel::spherical::triangle_solid_angle;
+use crate::kernel::spherical::{segment_gradient, triangle_solid_angle};
 use crate::{BoundingBox, Mesh};
 
 const INV_4PI: f64 = 1.0 / (4.0 * std::f64::consts::PI);
@@ -153,6 +153,34 @@ impl FastWindingNumber {
     /// [`Self::eval`] for many points, in parallel (rayon).
     pub fn eval_batch(&self, points: &[[f64; 3]]) -> Vec<f64> {
         self.eval_batch_with(points, self.params)
+    }
+
+    /// Gradient of the approximation at `q` with the stored parameters.
+    pub fn gradient(&self, q: [f64; 3]) -> [f64; 3] {
+        self.gradient_with(q, self.params)
+    }
+
+    /// Gradient of the approximation [`Self::eval_with`] computes: each admissible node's
+    /// expansion differentiated ([`Moments::far_field_gradient`]), and near triangles by the
+    /// Biot–Savart segment sum of the direct gradient
+    /// ([`crate::kernel::spherical::segment_gradient`]). Tends to the exact gradient as β
+    /// grows; not finite on the triangles' edges.
+    pub fn gradient_with(&self, q: [f64; 3], params: FastParams) -> [f64; 3] {
+        self.scale.gradient(q, |q| {
+            self.hierarchy.gradient(q, &params, |range, g| {
+                for t in &self.triangles[range] {
+                    for (i, j) in [(0, 1), (1, 2), (2, 0)] {
+                        if t[i] == t[j] {
+                            continue;
+                        }
+                        let e = segment_gradient(sub(t[i], q), sub(t[j], q));
+                        for k in 0..3 {
+                            g[k] += e[k] * INV_4PI;
+                        }
+                    }
+                }
+            })
+        })
     }
 
     /// [`Self::eval_with`] for many points, in parallel (rayon).

@@ -1,44 +1,45 @@
-//! The FOSSIL-style entry point `winding_number(point, beta)`.
+//! The FOSSIL-style entry point `winding_number(point, beta)`: one object that answers with the
+//! fast evaluator or the exact one depending on `beta`. It sits above both evaluators (neither
+//! imports the other).
 
-use super::barnes_hut::FastParams;
-use super::soup::FastWindingNumber;
 use std::sync::OnceLock;
 
 use crate::Mesh;
 use crate::eval::antipodal::WindingNumber;
+use crate::eval::fast::{FastParams, FastWindingNumber};
 
 /// A mesh prepared for FOSSIL-style queries: `winding_number(point, beta)` evaluates with the
 /// Barnes–Hut approximation when `beta > 0` and exactly when `beta <= 0` (or NaN).
 ///
 /// `beta` is Barill's accuracy parameter (admissibility `‖q − p̃‖ > β r`, `r` the node radius)
 /// with the order-2 expansion, not FOSSIL's diagonal-based one; see the [module
-/// docs](super#choosing-β-fossil-vs-barill) for how the two map. For FOSSIL's own rule use
+/// docs](crate::eval::fast#choosing-β-fossil-vs-barill) for how the two map. For FOSSIL's own rule use
 /// [`FastParams::fossil`] with [`Self::winding_number_with`].
 ///
 /// ```
-/// use gwn::{Mesh, eval::fast::WindingNumberApi};
+/// use gwn::{Mesh, eval::fossil::FastOrExact};
 /// let tet = Mesh::from_slices(
 ///     &[[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]],
 ///     &[[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]],
 /// )?;
-/// let api = WindingNumberApi::new(&tet);
+/// let api = FastOrExact::new(&tet);
 /// let fast = api.winding_number([0.2, 0.2, 0.2], 2.0);
 /// let exact = api.winding_number([0.2, 0.2, 0.2], -1.0);
 /// assert!((fast - exact).abs() < 1e-12);
 /// # Ok::<(), gwn::error::MeshError>(())
 /// ```
 #[derive(Clone, Debug)]
-pub struct WindingNumberApi<'m> {
+pub struct FastOrExact<'m> {
     mesh: &'m Mesh,
     fast: FastWindingNumber,
     /// The exact (Antipodal) evaluator, built on the first `beta <= 0` query.
     exact: OnceLock<Option<WindingNumber>>,
 }
 
-impl<'m> WindingNumberApi<'m> {
+impl<'m> FastOrExact<'m> {
     /// Prepares the fast evaluator (tree and moments) for `mesh`.
     pub fn new(mesh: &'m Mesh) -> Self {
-        WindingNumberApi {
+        FastOrExact {
             mesh,
             fast: FastWindingNumber::new(mesh),
             exact: OnceLock::new(),
