@@ -136,7 +136,9 @@ impl InputScale {
         gradient: impl FnOnce([f64; 3]) -> [f64; 3],
     ) -> [f64; 3] {
         let s = self.rescale.apply(q);
-        if (0..3).any(|k| !((0.5 * s[k] - 0.5 * self.center[k]).abs() <= 0.5 * self.far)) {
+        // (NaN compares as far.)
+        let within = |k: usize| (0.5 * s[k] - 0.5 * self.center[k]).abs() <= 0.5 * self.far;
+        if !(within(0) && within(1) && within(2)) {
             return if q.iter().all(|c| c.is_finite()) {
                 [0.0; 3]
             } else {
