@@ -28,6 +28,9 @@ pub struct MeshStats {
     pub signed_boundary_edges: usize,
     /// Signed boundary edges whose net multiplicity is greater than 1.
     pub signed_boundary_heavy_edges: usize,
+    /// Edges of the signed boundary by position ([`super::geometric_boundary_edges`]): the
+    /// boundary of the geometry, which the exact evaluator's cost depends on.
+    pub geometric_boundary_edges: usize,
     /// Undirected edges used by more than two triangles.
     pub nonmanifold_edges: usize,
     /// Vertex-connected components of the triangles.
@@ -145,6 +148,7 @@ impl MeshStats {
             boundary_edges: boundary,
             signed_boundary_edges: signed.len(),
             signed_boundary_heavy_edges: heavy,
+            geometric_boundary_edges: super::geometric_boundary_edges(mesh).len(),
             nonmanifold_edges: nonmanifold,
             components,
             degenerate_faces: degenerate,

@@ -111,7 +111,7 @@ pub fn run(mut args: Args) -> Result<(), CliError> {
         outln!("{}", header.replace(" | ", "\t"))?;
     }
     for f in files {
-        let mesh = load_mesh_for_cli(&f, false)?;
+        let mesh = load_mesh_for_cli(&f, Default::default())?;
         let Some(row) = bench_mesh(&mesh, &args)? else {
             continue;
         };

@@ -3,7 +3,6 @@
 use std::path::PathBuf;
 
 use clap::{Args as ClapArgs, ValueEnum};
-use gwn::eval::antipodal::Options;
 use gwn::products::classify::{Select, classify_faces, select, submesh, write_obj};
 
 use crate::common::{CliError, check_threshold, outln};
@@ -44,18 +43,17 @@ pub struct Args {
     /// Write the selected faces of A as OBJ.
     #[arg(long)]
     pub mesh_out: Option<PathBuf>,
-    /// Do not weld STL vertices.
-    #[arg(long)]
-    pub no_weld: bool,
+    #[command(flatten)]
+    pub weld: crate::common::WeldArgs,
 }
 
 /// Runs `gwn classify`.
 pub fn run(args: Args) -> Result<(), CliError> {
     check_threshold(args.threshold, "--threshold")?;
-    let a_input = Input::load(&args.a, args.no_weld)?;
+    let a_input = Input::load(&args.a, args.weld)?;
     let a = a_input.mesh(&args.a, "classify (its faces are classified)")?;
-    let b = Input::load(&args.b, args.no_weld)?;
-    let wn = args.method.build(&b, &args.b, Options::default())?;
+    let b = Input::load(&args.b, args.weld)?;
+    let wn = args.method.build(&b, &args.b, args.weld.exact_options())?;
     let values = classify_faces(a, &wn);
     gwn::io::points::save_values(&args.out, &values)
         .map_err(|e| CliError::msg(format!("{}: cannot write: {e}", args.out.display())))?;

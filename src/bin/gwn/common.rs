@@ -45,11 +45,52 @@ pub fn progress(len: u64, what: &str) -> indicatif::ProgressBar {
     pb
 }
 
-/// Loads a mesh for a subcommand: STL files are welded unless `no_weld`; errors name the file.
-pub fn load_mesh_for_cli(path: &std::path::Path, no_weld: bool) -> Result<gwn::Mesh, CliError> {
-    let opts = gwn::io::LoadOptions {
-        weld: if no_weld { Some(false) } else { None },
-    };
+/// `--weld` / `--no-weld`, shared by every subcommand that reads a mesh.
+#[derive(clap::Args, Debug, Clone, Copy, Default)]
+pub struct WeldArgs {
+    /// Merge bit-identical vertices of every format when loading (default: STL only).
+    #[arg(long, conflicts_with = "no_weld")]
+    pub weld: bool,
+    /// Keep the file's vertices as they are (no STL welding), and match the exact method's
+    /// boundary edges by vertex index instead of by position (same values; slower on meshes split
+    /// at seams or stored as indexed soups, whose index boundary is large).
+    #[arg(long)]
+    pub no_weld: bool,
+}
+
+impl WeldArgs {
+    /// What the loader merges.
+    pub fn load_options(&self) -> gwn::io::LoadOptions {
+        gwn::io::LoadOptions {
+            weld: match (self.weld, self.no_weld) {
+                (true, _) => Some(true),
+                (_, true) => Some(false),
+                _ => None,
+            },
+        }
+    }
+
+    /// How the exact method matches boundary edges.
+    pub fn boundary(&self) -> gwn::eval::antipodal::BoundaryBy {
+        if self.no_weld {
+            gwn::eval::antipodal::BoundaryBy::Index
+        } else {
+            gwn::eval::antipodal::BoundaryBy::Position
+        }
+    }
+
+    /// The exact method's options for these flags.
+    pub fn exact_options(&self) -> gwn::eval::antipodal::Options {
+        gwn::eval::antipodal::Options {
+            boundary: self.boundary(),
+            ..Default::default()
+        }
+    }
+}
+
+/// Loads a mesh for a subcommand, welded as `weld` says; errors name the file.
+pub fn load_mesh_for_cli(path: &std::path::Path, weld: WeldArgs) -> Result<gwn::Mesh, CliError> {
+    let opts = weld.load_options();
     let loaded = gwn::io::load_mesh_with(path, &opts)?;
     print_load_warnings(path, &loaded.warnings);
     Ok(loaded.mesh)

@@ -90,9 +90,8 @@ pub struct Args {
     /// gradient is printed after the value on each stdout line.
     #[arg(long)]
     pub gradient_out: Option<PathBuf>,
-    /// Do not weld bit-identical vertices of STL files.
-    #[arg(long)]
-    pub no_weld: bool,
+    #[command(flatten)]
+    pub weld: crate::common::WeldArgs,
 }
 
 fn parse_precision(s: &str) -> Result<u32, String> {
@@ -113,7 +112,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             "--gradient-out needs --gradient (no gradient is computed without it)",
         ));
     }
-    let input = Input::load(&args.mesh, args.no_weld)?;
+    let input = Input::load(&args.mesh, args.weld)?;
     let method = args.method.method(&input);
     if method != Method::Exact {
         for (given, flag) in [
@@ -134,7 +133,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             Precision::Bits60
         },
         ray: args.ray.unwrap_or(Ray::PosZ).into(),
-        ..Default::default()
+        ..args.weld.exact_options()
     };
     let wn = args.method.build(&input, &args.mesh, options)?;
     let points = gwn::io::points::load_points(&args.points)?;

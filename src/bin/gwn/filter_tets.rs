@@ -3,7 +3,6 @@
 use std::path::PathBuf;
 
 use clap::Args as ClapArgs;
-use gwn::eval::antipodal::Options;
 use gwn::products::tets::{DEFAULT_THRESHOLD, filter_tets, load_tets, save_tets};
 
 use crate::common::{CliError, check_threshold, outln};
@@ -27,17 +26,18 @@ pub struct Args {
     /// Keep tets with w at the centroid above this value.
     #[arg(long, default_value_t = DEFAULT_THRESHOLD, allow_negative_numbers = true)]
     pub threshold: f64,
-    /// Do not weld STL vertices.
-    #[arg(long)]
-    pub no_weld: bool,
+    #[command(flatten)]
+    pub weld: crate::common::WeldArgs,
 }
 
 /// Runs `gwn filter-tets`.
 pub fn run(args: Args) -> Result<(), CliError> {
     check_threshold(args.threshold, "--threshold")?;
-    let input = Input::load(&args.mesh, args.no_weld)?;
+    let input = Input::load(&args.mesh, args.weld)?;
     let tets = load_tets(&args.tets)?;
-    let wn = args.method.build(&input, &args.mesh, Options::default())?;
+    let wn = args
+        .method
+        .build(&input, &args.mesh, args.weld.exact_options())?;
     let keep = filter_tets(&tets.points, &tets.tets, &wn, args.threshold);
     let kept = tets.select(&keep);
     // `save_tets` errors already start with the file they concern.

@@ -3,7 +3,7 @@
 use std::io::Write;
 use std::path::PathBuf;
 
-use gwn::io::{LoadOptions, load_mesh_with};
+use gwn::io::load_mesh_with;
 use gwn::mesh::stats::MeshStats;
 
 use crate::common::CliError;
@@ -13,22 +13,13 @@ use crate::common::CliError;
 pub struct Args {
     /// Mesh file (.obj, .stl, .off, .ply; detected by content if the extension is unknown).
     pub mesh: PathBuf,
-    /// Do not merge bit-identical vertices (default: merge for STL only).
-    #[arg(long, conflicts_with = "weld")]
-    pub no_weld: bool,
-    /// Merge bit-identical vertices for every format.
-    #[arg(long)]
-    pub weld: bool,
+    #[command(flatten)]
+    pub weld: crate::common::WeldArgs,
 }
 
 /// Loads the mesh and prints its statistics.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let weld = match (args.weld, args.no_weld) {
-        (true, _) => Some(true),
-        (_, true) => Some(false),
-        _ => None,
-    };
-    let loaded = load_mesh_with(&args.mesh, &LoadOptions { weld })?;
+    let loaded = load_mesh_with(&args.mesh, &args.weld.load_options())?;
     crate::common::print_load_warnings(&args.mesh, &loaded.warnings);
     let s = MeshStats::compute(&loaded.mesh);
     std::io::stdout()
@@ -67,6 +58,10 @@ fn report(path: &std::path::Path, l: &gwn::io::LoadedMesh, s: &MeshStats) -> Str
                 s.signed_boundary_edges, s.signed_boundary_heavy_edges
             ),
         ),
+        (
+            "signed boundary by position",
+            s.geometric_boundary_edges.to_string(),
+        ),
         ("degenerate faces", s.degenerate_faces.to_string()),
         ("duplicate faces", s.duplicate_faces.to_string()),
         ("closed", yes(s.closed).to_string()),
@@ -84,6 +79,11 @@ fn report(path: &std::path::Path, l: &gwn::io::LoadedMesh, s: &MeshStats) -> Str
     }
     if s.oriented_closed {
         out.push_str("signed boundary is empty: w is an integer off the surface\n");
+    } else if s.geometric_boundary_edges == 0 {
+        out.push_str(
+            "signed boundary by position is empty: w is an integer off the surface (the index \
+             boundary cancels geometrically: split vertices)\n",
+        );
     } else {
         out.push_str("signed boundary is not empty: w varies continuously near the boundary\n");
     }

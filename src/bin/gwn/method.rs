@@ -11,7 +11,7 @@ use gwn::eval::direct::DirectWindingNumber;
 use gwn::eval::fast::{FastParams, FastWindingNumber, PointCloud, PointCloudWindingNumber};
 use gwn::{BoundingBox, Mesh};
 
-use crate::common::{CliError, load_mesh_for_cli};
+use crate::common::{CliError, WeldArgs, load_mesh_for_cli};
 
 /// Evaluation method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -61,13 +61,13 @@ pub enum Input {
 
 impl Input {
     /// Loads `path` as a point cloud when it is one ([`is_point_cloud`]), as a mesh otherwise.
-    pub fn load(path: &Path, no_weld: bool) -> Result<Input, CliError> {
+    pub fn load(path: &Path, weld: WeldArgs) -> Result<Input, CliError> {
         if is_point_cloud(path) {
             let (cloud, warnings) = gwn::io::cloud::load_point_cloud_with_warnings(path)?;
             crate::common::print_load_warnings(path, &warnings);
             Ok(Input::Cloud(cloud))
         } else {
-            Ok(Input::Mesh(load_mesh_for_cli(path, no_weld)?))
+            Ok(Input::Mesh(load_mesh_for_cli(path, weld)?))
         }
     }
 

@@ -3,7 +3,6 @@
 use std::path::PathBuf;
 
 use clap::Args as ClapArgs;
-use gwn::eval::antipodal::Options;
 use gwn::products::sdf::SignedDistance;
 
 use crate::common::{CliError, progress};
@@ -27,9 +26,8 @@ pub struct Args {
     /// Output `.npy`.
     #[arg(long, short, default_value = "sdf.npy")]
     pub out: PathBuf,
-    /// Do not weld STL vertices.
-    #[arg(long)]
-    pub no_weld: bool,
+    #[command(flatten)]
+    pub weld: crate::common::WeldArgs,
 }
 
 /// Peak bytes per cell of `gwn sdf`: the winding numbers (with the per-column results they are
@@ -39,9 +37,11 @@ const SDF_BYTES_PER_CELL: usize = 8 + 8 + 24 + 8 + 4;
 /// Runs `gwn sdf`.
 pub fn run(args: Args) -> Result<(), CliError> {
     args.grid.check()?;
-    let input = Input::load(&args.mesh, args.no_weld)?;
+    let input = Input::load(&args.mesh, args.weld)?;
     let spec = args.grid.spec(&input, &args.mesh, SDF_BYTES_PER_CELL)?;
-    let wn = args.method.build(&input, &args.mesh, Options::default())?;
+    let wn = args
+        .method
+        .build(&input, &args.mesh, args.weld.exact_options())?;
     let sdf = match &input {
         Input::Mesh(mesh) => SignedDistance::with_evaluator(mesh, wn),
         Input::Cloud(cloud) => SignedDistance::with_points(cloud.positions(), wn),

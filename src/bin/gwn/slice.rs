@@ -70,14 +70,13 @@ pub struct Args {
     /// Output PNG.
     #[arg(long, short, default_value = "slice.png")]
     pub out: PathBuf,
-    /// Do not weld STL vertices.
-    #[arg(long)]
-    pub no_weld: bool,
+    #[command(flatten)]
+    pub weld: crate::common::WeldArgs,
 }
 
 /// Runs `gwn slice`.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let input = Input::load(&args.mesh, args.no_weld)?;
+    let input = Input::load(&args.mesh, args.weld)?;
     render(&input, &args)
 }
 
@@ -95,7 +94,7 @@ pub fn run_default() -> Result<(), CliError> {
         margin: 0.1,
         outline: true,
         out: PathBuf::from("slice.png"),
-        no_weld: false,
+        weld: Default::default(),
     };
     eprintln!(
         "gwn: no subcommand given; rendering the bundled lion head (an open mesh with holes) \
@@ -137,7 +136,7 @@ fn render(input: &Input, args: &Args) -> Result<(), CliError> {
     // A ray in the plane: one ray serves a whole image column or row.
     let exact = Options {
         ray: slice.ray(),
-        ..Options::default()
+        ..args.weld.exact_options()
     };
     let wn = args.method.build(input, &args.mesh, exact)?;
     let pb = progress(

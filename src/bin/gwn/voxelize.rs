@@ -4,7 +4,6 @@ use std::path::{Path, PathBuf};
 
 use clap::{Args as ClapArgs, ValueEnum};
 use gwn::BoundingBox;
-use gwn::eval::antipodal::Options;
 use gwn::grid::GridSpec;
 use gwn::products::{npy, vti};
 
@@ -216,9 +215,8 @@ pub struct Args {
     /// Path of the occupancy `.npy` (default: OUT with `-occupancy` appended to its stem).
     #[arg(long)]
     pub occupancy_out: Option<PathBuf>,
-    /// Do not weld STL vertices.
-    #[arg(long)]
-    pub no_weld: bool,
+    #[command(flatten)]
+    pub weld: crate::common::WeldArgs,
 }
 
 /// Runs `gwn voxelize`.
@@ -232,11 +230,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
         ));
     }
     args.grid.check()?;
-    let input = Input::load(&args.mesh, args.no_weld)?;
+    let input = Input::load(&args.mesh, args.weld)?;
     let spec = args
         .grid
         .spec(&input, &args.mesh, VOXELIZE_BYTES_PER_CELL)?;
-    let wn = args.method.build(&input, &args.mesh, Options::default())?;
+    let wn = args
+        .method
+        .build(&input, &args.mesh, args.weld.exact_options())?;
     let pb = progress(
         spec.column_count(gwn::grid::column_axis(&wn)) as u64,
         "voxelize",
