@@ -89,7 +89,8 @@ pub fn with_points<const N: usize, R>(
     rows_of(&a, name, N)?;
     if let Ok(arr) = a.downcast::<PyArray2<f64>>() {
         let ro = arr.readonly();
-        if let Ok(flat) = ro.as_slice() {
+        // `as_slice` also accepts Fortran order, whose flat memory is not row after row.
+        if let (true, Ok(flat)) = (ro.is_c_contiguous(), ro.as_slice()) {
             let points: &[[f64; N]] = bytemuck::cast_slice(flat);
             check_finite(points, name)?;
             return f(points);
