@@ -2,6 +2,7 @@
 
 import pickle
 import threading
+import time
 
 import numpy as np
 import pytest
@@ -43,6 +44,33 @@ def test_two_python_threads_on_one_object(lion):
     for i, b in enumerate(batches):
         np.testing.assert_array_equal(results[i][0], expected[i])
         np.testing.assert_array_equal(results[i][1], wn.gradient(b[:100]))
+
+
+def test_gil_is_released_during_evaluation(lion):
+    # The main thread needs the GIL to record a time stamp; stamps well inside the worker's call
+    # prove that the call released it (a held GIL allows stamps only near its start and end).
+    v, f = lion
+    wn = gwn.WindingNumber(v, f, method="direct")  # O(F) per query: a long call
+    q = random_points(1500, lo=v.min(), hi=v.max(), seed=24)
+    span = {}
+
+    def work():
+        span["start"] = time.perf_counter()
+        wn(q, threads=1)
+        span["end"] = time.perf_counter()
+
+    worker = threading.Thread(target=work)
+    stamps = []
+    worker.start()
+    while worker.is_alive():
+        stamps.append(time.perf_counter())
+        time.sleep(0.001)
+    worker.join()
+    duration = span["end"] - span["start"]
+    assert duration > 0.05, "the call is too short to tell"
+    margin = min(0.05, duration / 4)
+    inside = [t for t in stamps if span["start"] + margin < t < span["end"] - margin]
+    assert len(inside) > 3
 
 
 @pytest.mark.parametrize("method", ["exact", "direct", "fast"])
