@@ -156,7 +156,7 @@ impl fmt::Display for LoadError {
         let what = match &self.kind {
             LoadErrorKind::Io(e) => format!("cannot read: {e}"),
             LoadErrorKind::UnknownFormat => {
-                "unknown format (expected .obj, .stl, .off or .ply)".to_string()
+                "unknown format (expected .obj, .stl, .off, .ply, .gltf or .glb)".to_string()
             }
             LoadErrorKind::Truncated(s) => format!("truncated: {s}"),
             LoadErrorKind::Syntax(s) => s.clone(),
