@@ -11,6 +11,7 @@ mod eval;
 mod filter_tets;
 mod r#gen;
 mod info;
+mod label;
 mod sdf;
 mod slice;
 mod voxelize;
@@ -48,6 +49,8 @@ enum Command {
     Gen(r#gen::Args),
     /// Print format, size and topology of a mesh (boundary, non-manifold edges, components…).
     Info(info::Args),
+    /// Label a dataset: sample points per mesh, write w / occupancy / SDF as .npz and a manifest.
+    Label(label::Args),
     /// Signed distance on a voxel grid, signed by the winding number (inside where w > 1/2).
     Sdf(sdf::Args),
     /// Write a PNG slice of the winding-number field (the default job when no subcommand is given).
@@ -76,6 +79,7 @@ fn main() {
         Some(Command::FilterTets(a)) => filter_tets::run(a),
         Some(Command::Gen(a)) => r#gen::run(a),
         Some(Command::Info(a)) => info::run(a),
+        Some(Command::Label(a)) => label::run(a),
         Some(Command::Sdf(a)) => sdf::run(a),
         Some(Command::Slice(a)) => slice::run(a),
         Some(Command::Voxelize(a)) => voxelize::run(a),
