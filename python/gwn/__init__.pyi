@@ -1,0 +1,183 @@
+"""Type stubs of gwn (the functions live in the compiled module gwn._gwn)."""
+
+from os import PathLike
+from typing import Literal, Optional, Sequence, Tuple, Union, overload
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+_Path = Union[str, PathLike[str]]
+_Floats = npt.ArrayLike
+"""float32/float64 array-like of shape (n, 3) (or (n, 2) in 2D), any strides."""
+_Indices = npt.ArrayLike
+"""int32/int64/uint32/uint64 array-like of shape (m, 3) (tets: (t, 4))."""
+_F64 = npt.NDArray[np.float64]
+_I64 = npt.NDArray[np.int64]
+_Method = Literal["exact", "direct", "fast"]
+_Ray = Literal["+x", "-x", "+y", "-y", "+z", "-z"]
+_Grid = Tuple[_F64, _F64, _F64]
+
+class WindingNumber:
+    """Winding-number evaluator of one mesh or oriented point cloud, built once.
+
+    ``method``: "exact" (Antipodal method, default), "direct" (solid-angle sum) or "fast"
+    (Barnes-Hut with accuracy ``beta`` and expansion ``order``). ``precision`` (30 or 60 bits)
+    and ``ray`` are options of the exact method. Calls release the GIL; one object may be used
+    from several Python threads at once. Picklable (rebuilt from its arrays).
+    """
+
+    def __init__(
+        self,
+        V: _Floats,
+        F: _Indices,
+        method: _Method = "exact",
+        beta: float = 2.0,
+        order: int = 2,
+        precision: int = 60,
+        ray: _Ray = "+z",
+    ) -> None: ...
+    @staticmethod
+    def from_point_cloud(
+        P: _Floats, N: _Floats, A: Optional[_Floats] = None, beta: float = 2.3, order: int = 2
+    ) -> "WindingNumber":
+        """Barnes-Hut evaluator of an oriented point cloud; areas estimated when ``A`` is None."""
+    def __call__(self, Q: _Floats, threads: Optional[int] = None) -> _F64:
+        """Winding numbers at the rows of ``Q`` (n, 3): float64 (n,)."""
+    def gradient(self, Q: _Floats, threads: Optional[int] = None) -> _F64:
+        """Gradients at the rows of ``Q``: float64 (n, 3). Exact and direct methods only."""
+    def parts(self, Q: _Floats, threads: Optional[int] = None) -> Tuple[_I64, _F64]:
+        """``(chi, fraction)`` with ``chi + fraction == self(Q)`` bit for bit. Exact method only."""
+    @property
+    def method(self) -> _Method:
+        """The evaluation method."""
+    @property
+    def face_count(self) -> int:
+        """Number of triangles (0 for a point cloud)."""
+    @property
+    def boundary_edge_count(self) -> Optional[int]:
+        """Signed boundary edges of the exact method (None for the other methods)."""
+
+def winding_number(
+    V: _Floats, F: _Indices, O: _Floats, threads: Optional[int] = None
+) -> _F64:
+    """Exact winding numbers of mesh (V, F) at the rows of O; drop-in for igl.winding_number."""
+
+@overload
+def fast_winding_number(
+    V: _Floats,
+    F: _Indices,
+    Q: _Floats,
+    *,
+    beta: float = 2.0,
+    order: Optional[int] = None,
+    expansion_order: Optional[int] = None,
+    threads: Optional[int] = None,
+) -> _F64: ...
+@overload
+def fast_winding_number(
+    P: _Floats,
+    N: _Floats,
+    A: Optional[_Floats],
+    Q: _Floats,
+    *,
+    beta: float = 2.0,
+    order: Optional[int] = None,
+    expansion_order: Optional[int] = None,
+    threads: Optional[int] = None,
+) -> _F64:
+    """Barnes-Hut winding numbers of a mesh (V, F, Q) or point cloud (P, N, A, Q); libigl's forms."""
+
+def voxelize(
+    V: _Floats,
+    F: _Indices,
+    res: int = 64,
+    *,
+    dims: Optional[Tuple[int, int, int]] = None,
+    bounds: Optional[Tuple[float, float, float, float, float, float]] = None,
+    margin: float = 0.05,
+    threads: Optional[int] = None,
+) -> _Grid:
+    """Exact winding numbers on a voxel grid: (values (D, H, W) indexed [z, y, x], origin, spacing)."""
+
+def sdf(
+    V: _Floats,
+    F: _Indices,
+    res: int = 64,
+    *,
+    dims: Optional[Tuple[int, int, int]] = None,
+    bounds: Optional[Tuple[float, float, float, float, float, float]] = None,
+    margin: float = 0.05,
+    threads: Optional[int] = None,
+) -> _Grid:
+    """Signed distance on a voxel grid, negative where w > 1/2; same layout as voxelize."""
+
+def signed_distance(
+    V: _Floats, F: _Indices, Q: _Floats, threads: Optional[int] = None
+) -> _F64:
+    """Signed distance at the rows of Q, negative where w > 1/2."""
+
+def slice(
+    V: _Floats,
+    F: _Indices,
+    axis: Literal["x", "y", "z"] = "z",
+    at: float = 0.5,
+    *,
+    at_coord: Optional[float] = None,
+    res: int = 1024,
+    margin: float = 0.1,
+    outline: bool = False,
+    threads: Optional[int] = None,
+) -> Tuple[_F64, bytes]:
+    """Winding numbers on an axis-aligned plane: (image (height, width), PNG bytes)."""
+
+def classify(
+    VA: _Floats, FA: _Indices, VB: _Floats, FB: _Indices, threads: Optional[int] = None
+) -> _F64:
+    """Exact winding number of mesh B at each face centroid of mesh A."""
+
+def filter_tets(
+    V: _Floats,
+    F: _Indices,
+    points: _Floats,
+    tets: _Indices,
+    threshold: float = 0.5,
+    threads: Optional[int] = None,
+) -> npt.NDArray[np.bool_]:
+    """Mask of the tets whose centroid has exact winding number above threshold."""
+
+@overload
+def gauwn(
+    polygon: Union[_Floats, Sequence[_Floats]],
+    sigma: float,
+    Q: _Floats,
+    *,
+    gradient: Literal[False] = False,
+    threads: Optional[int] = None,
+) -> _F64: ...
+@overload
+def gauwn(
+    polygon: Union[_Floats, Sequence[_Floats]],
+    sigma: float,
+    Q: _Floats,
+    *,
+    gradient: Literal[True],
+    threads: Optional[int] = None,
+) -> Tuple[_F64, _F64]:
+    """Gaussian-smoothed winding number of a polygon at the rows of Q (k, 2) (and its gradient)."""
+
+def load(path: _Path, weld: Optional[bool] = None) -> Tuple[_F64, _I64]:
+    """Reads a mesh (OBJ, STL, OFF, PLY) as (V float64 (n, 3), F int64 (m, 3))."""
+
+def load_point_cloud(path: _Path) -> Tuple[_F64, _F64, Optional[_F64]]:
+    """Reads an oriented point cloud as (P, N, A or None)."""
+
+def load_points(path: _Path) -> _F64:
+    """Reads query points (text or .npy) as float64 (n, 3)."""
+
+def load_tets(path: _Path) -> Tuple[_F64, _I64, _I64]:
+    """Reads a tet mesh (MEDIT .mesh, TetGen .node/.ele) as (points, tets, refs)."""
+
+def load_polygon(path: _Path) -> list[_F64]:
+    """Reads a 2D polygon (text or SVG) as a list of float64 (n_i, 2) loops."""

@@ -1,0 +1,200 @@
+//! The evaluators behind `gwn.WindingNumber`, behind one small enum so that moving to the
+//! library's `Evaluator` trait (issue 13) changes this file only.
+
+use std::sync::Arc;
+
+use gwn::Mesh;
+use gwn::eval::antipodal::{Options, WindingNumber};
+use gwn::eval::direct::{winding_number_direct_batch, winding_number_gradient_direct};
+use gwn::eval::fast::{FastParams, FastWindingNumber, PointCloudWindingNumber};
+use gwn::kernel::frame::RayAxis;
+use gwn::kernel::quantize::Precision;
+use rayon::prelude::*;
+
+/// `1/4π` exactly as `WindingNumber::eval` multiplies the boundary sum with, so that
+/// `chi + fraction` is bit-identical to the value (the library keeps its copy private; issue 13
+/// gives the constant one public home).
+const INV_4PI: f64 = 1.0 / (4.0 * std::f64::consts::PI);
+
+/// The evaluation method a user asked for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Method {
+    /// The exact Antipodal method.
+    Exact,
+    /// The compensated solid-angle sum over all triangles.
+    Direct,
+    /// Barnes–Hut (Barill et al. 2018).
+    Fast,
+}
+
+impl Method {
+    /// Parses `"exact"`, `"direct"` or `"fast"`.
+    pub fn parse(s: &str) -> Result<Self, String> {
+        match s {
+            "exact" => Ok(Method::Exact),
+            "direct" => Ok(Method::Direct),
+            "fast" => Ok(Method::Fast),
+            _ => Err(format!(
+                "method must be \"exact\", \"direct\" or \"fast\", got {s:?}"
+            )),
+        }
+    }
+
+    /// The name `parse` accepts.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Exact => "exact",
+            Method::Direct => "direct",
+            Method::Fast => "fast",
+        }
+    }
+}
+
+/// Parses a ray direction `"+z"`, `"-x"`, ... (the CLI's `--ray` values).
+pub fn parse_ray(s: &str) -> Result<RayAxis, String> {
+    Ok(match s {
+        "+z" | "z" => RayAxis::PosZ,
+        "-z" => RayAxis::NegZ,
+        "+x" | "x" => RayAxis::PosX,
+        "-x" => RayAxis::NegX,
+        "+y" | "y" => RayAxis::PosY,
+        "-y" => RayAxis::NegY,
+        _ => return Err(format!("ray must be one of +x -x +y -y +z -z, got {s:?}")),
+    })
+}
+
+/// Parses the grid precision in bits (30 or 60).
+pub fn parse_precision(bits: u32) -> Result<Precision, String> {
+    match bits {
+        30 => Ok(Precision::Bits30),
+        60 => Ok(Precision::Bits60),
+        _ => Err(format!("precision must be 30 or 60, got {bits}")),
+    }
+}
+
+/// Barill's parameters, validated: the library accepts any `β` (NaN means "exact"), but a
+/// Python user passing NaN or a negative `β` has made a mistake.
+pub fn fast_params(beta: f64, order: u8) -> Result<FastParams, String> {
+    if !(beta.is_finite() && beta > 0.0) {
+        return Err(format!("beta must be a positive finite number, got {beta}"));
+    }
+    if order > 2 {
+        return Err(format!("order must be 0, 1 or 2, got {order}"));
+    }
+    Ok(FastParams::barill(beta, order))
+}
+
+/// Why an evaluator cannot answer a query kind.
+#[derive(Clone, Copy, Debug)]
+pub struct Unsupported {
+    /// What was asked (`"gradient"`, `"parts"`).
+    pub what: &'static str,
+    /// The evaluator's description.
+    pub method: &'static str,
+}
+
+impl std::fmt::Display for Unsupported {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} is not available with the {} method",
+            self.what, self.method
+        )
+    }
+}
+
+/// One built evaluator.
+#[derive(Debug)]
+pub enum Evaluator {
+    /// Exact Antipodal method (boxed: it is several times larger than the other variants).
+    Exact(Box<WindingNumber>),
+    /// Direct sum over the triangles of the mesh.
+    Direct(Arc<Mesh>),
+    /// Barnes–Hut over a triangle soup.
+    FastSoup(FastWindingNumber),
+    /// Barnes–Hut over an oriented point cloud.
+    FastCloud(PointCloudWindingNumber),
+}
+
+impl Evaluator {
+    /// Builds the evaluator of `method` for a mesh.
+    pub fn for_mesh(
+        mesh: &Arc<Mesh>,
+        method: Method,
+        options: Options,
+        params: FastParams,
+    ) -> Result<Self, String> {
+        Ok(match method {
+            Method::Exact => Evaluator::Exact(Box::new(
+                WindingNumber::with_options(mesh, options).map_err(|e| e.to_string())?,
+            )),
+            Method::Direct => Evaluator::Direct(mesh.clone()),
+            Method::Fast => Evaluator::FastSoup(FastWindingNumber::with_params(mesh, params)),
+        })
+    }
+
+    /// What `Unsupported` calls this evaluator.
+    fn description(&self) -> &'static str {
+        match self {
+            Evaluator::Exact(_) => "exact",
+            Evaluator::Direct(_) => "direct",
+            Evaluator::FastSoup(_) => "fast",
+            Evaluator::FastCloud(_) => "fast point-cloud",
+        }
+    }
+
+    /// Winding numbers at `points` (parallel on the current rayon pool).
+    pub fn eval_batch(&self, points: &[[f64; 3]]) -> Vec<f64> {
+        match self {
+            Evaluator::Exact(wn) => wn.eval_batch(points),
+            Evaluator::Direct(mesh) => winding_number_direct_batch(mesh, points),
+            Evaluator::FastSoup(f) => f.eval_batch(points),
+            Evaluator::FastCloud(f) => f.eval_batch(points),
+        }
+    }
+
+    /// Gradients `∇w` at `points` (exact and direct methods).
+    pub fn gradient_batch(&self, points: &[[f64; 3]]) -> Result<Vec<[f64; 3]>, Unsupported> {
+        match self {
+            Evaluator::Exact(wn) => Ok(wn.gradient_batch(points)),
+            Evaluator::Direct(mesh) => Ok(points
+                .par_iter()
+                .map(|&q| winding_number_gradient_direct(mesh, q))
+                .collect()),
+            _ => Err(Unsupported {
+                what: "gradient",
+                method: self.description(),
+            }),
+        }
+    }
+
+    /// The integer crossing count χ and the fractional boundary part `w − χ` (exact method).
+    pub fn parts_batch(&self, points: &[[f64; 3]]) -> Result<(Vec<i64>, Vec<f64>), Unsupported> {
+        match self {
+            Evaluator::Exact(wn) => Ok(points
+                .par_iter()
+                .map(|&q| {
+                    let (chi, boundary_sum) = wn.parts(q);
+                    (chi, boundary_sum * INV_4PI)
+                })
+                .unzip()),
+            _ => Err(Unsupported {
+                what: "parts",
+                method: self.description(),
+            }),
+        }
+    }
+
+    /// The exact evaluator, when this is one (grids with ray reuse need it).
+    pub fn exact(&self) -> Option<&WindingNumber> {
+        match self {
+            Evaluator::Exact(wn) => Some(wn.as_ref()),
+            _ => None,
+        }
+    }
+
+    /// Number of boundary edges (exact method).
+    pub fn boundary_edge_count(&self) -> Option<usize> {
+        self.exact().map(WindingNumber::boundary_edge_count)
+    }
+}

@@ -1,0 +1,39 @@
+//! Python bindings of `gwn` (module `gwn._gwn`, re-exported by the `gwn` package).
+//!
+//! Every function is a thin call of the library: arrays are validated and converted in
+//! [`arrays`], evaluation runs with the GIL released in a rayon pool of the requested size
+//! ([`threads`]), and library errors become `ValueError`/`OSError` with the library's message
+//! ([`errors`]). No formula lives here.
+
+mod arrays;
+mod curve;
+mod errors;
+mod evaluator;
+mod loaders;
+mod oneshot;
+mod products;
+mod threads;
+mod winding_number;
+
+use pyo3::prelude::*;
+
+#[pymodule]
+fn _gwn(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<winding_number::PyWindingNumber>()?;
+    m.add_function(wrap_pyfunction!(oneshot::winding_number, m)?)?;
+    m.add_function(wrap_pyfunction!(oneshot::fast_winding_number, m)?)?;
+    m.add_function(wrap_pyfunction!(products::voxelize, m)?)?;
+    m.add_function(wrap_pyfunction!(products::sdf, m)?)?;
+    m.add_function(wrap_pyfunction!(products::signed_distance, m)?)?;
+    m.add_function(wrap_pyfunction!(products::slice, m)?)?;
+    m.add_function(wrap_pyfunction!(products::classify, m)?)?;
+    m.add_function(wrap_pyfunction!(products::filter_tets, m)?)?;
+    m.add_function(wrap_pyfunction!(curve::gauwn, m)?)?;
+    m.add_function(wrap_pyfunction!(loaders::load, m)?)?;
+    m.add_function(wrap_pyfunction!(loaders::load_point_cloud, m)?)?;
+    m.add_function(wrap_pyfunction!(loaders::load_points, m)?)?;
+    m.add_function(wrap_pyfunction!(loaders::load_tets, m)?)?;
+    m.add_function(wrap_pyfunction!(loaders::load_polygon, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

@@ -1,0 +1,318 @@
+//! Grids and products: `voxelize`, `sdf`, `signed_distance`, `slice`, `classify`, `filter_tets`.
+//! Each is a thin call of the library function the CLI uses, so values are the CLI's, bit for bit.
+
+use gwn::BoundingBox;
+use gwn::Mesh;
+use gwn::eval::antipodal::{Options, WindingNumber};
+use gwn::grid::GridSpec;
+use gwn::products::classify::classify_faces;
+use gwn::products::png::Slice;
+use gwn::products::sdf::SignedDistance;
+use numpy::PyArray1;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyBytes;
+
+use crate::arrays::{array_nd, array1, indices_vec, with_points};
+use crate::errors::value_error;
+use crate::oneshot::mesh_from;
+use crate::threads;
+
+/// Largest grid a call may allocate (the CLI's limit): 2^31 samples, 16 GiB of float64.
+const MAX_GRID_SAMPLES: usize = 1 << 31;
+/// Largest slice side in pixels (the CLI's limit).
+const MAX_SLICE_RES: usize = 1 << 15;
+
+/// The grid of `voxelize` and `sdf`: explicit `bounds` or the mesh's box grown by `margin`,
+/// explicit `dims` (W, H, D) or `res` cells along the longest side.
+fn grid_spec(
+    mesh: &Mesh,
+    res: usize,
+    dims: Option<[usize; 3]>,
+    bounds: Option<[f64; 6]>,
+    margin: f64,
+) -> PyResult<GridSpec> {
+    let bounds = match bounds {
+        Some(b) => BoundingBox {
+            min: [b[0], b[1], b[2]],
+            max: [b[3], b[4], b[5]],
+        },
+        None => {
+            if !(margin.is_finite() && margin >= 0.0) {
+                return Err(PyValueError::new_err(format!(
+                    "margin must be a non-negative number, got {margin}"
+                )));
+            }
+            mesh.bounding_box()
+                .ok_or_else(|| PyValueError::new_err("the mesh has no triangles"))?
+                .enlarged(margin)
+        }
+    };
+    let spec = match dims {
+        Some(d) => GridSpec::new(bounds, d),
+        None => GridSpec::with_resolution(bounds, res),
+    }
+    .map_err(|e| PyValueError::new_err(format!("bad grid: {e}")))?;
+    if spec.len() > MAX_GRID_SAMPLES {
+        return Err(PyValueError::new_err(format!(
+            "a grid of {:?} cells is too large (limit 2^31)",
+            spec.dims
+        )));
+    }
+    Ok(spec)
+}
+
+/// A grid's values (D, H, W), origin (3,) and spacing (3,).
+type GridArrays<'py> = (
+    Bound<'py, PyAny>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+);
+
+/// `(values (D, H, W), origin (3,), spacing (3,))` of a grid.
+fn grid_result<'py>(
+    py: Python<'py>,
+    spec: &GridSpec,
+    values: Vec<f64>,
+) -> PyResult<GridArrays<'py>> {
+    let origin = spec.point(0, 0, 0).to_vec();
+    let spacing = spec.spacing().to_vec();
+    Ok((
+        array_nd(py, values, &spec.shape())?,
+        array1(py, origin),
+        array1(py, spacing),
+    ))
+}
+
+/// Exact winding numbers on a voxel grid (ray reuse: one ray per grid column).
+///
+/// Returns ``(W, origin, spacing)``: ``W`` float64 of shape (D, H, W) indexed ``[z, y, x]``
+/// (x fastest, as ``gwn voxelize`` writes it), samples at cell centres
+/// ``origin + (i, j, k) * spacing`` for ``W[k, j, i]``. The grid covers ``bounds``
+/// ``(x0, y0, z0, x1, y1, z1)`` or the mesh's bounding box grown by ``margin`` times its largest
+/// extent, with ``dims`` (W, H, D) cells or ``res`` cells along the longest side.
+#[pyfunction]
+#[pyo3(signature = (V, F, res = 64, *, dims = None, bounds = None, margin = 0.05, threads = None))]
+#[allow(non_snake_case, clippy::too_many_arguments)]
+pub fn voxelize<'py>(
+    py: Python<'py>,
+    V: &Bound<'py, PyAny>,
+    F: &Bound<'py, PyAny>,
+    res: usize,
+    dims: Option<[usize; 3]>,
+    bounds: Option<[f64; 6]>,
+    margin: f64,
+    threads: Option<usize>,
+) -> PyResult<GridArrays<'py>> {
+    let mesh = mesh_from(V, F, "V", "F")?;
+    let spec = grid_spec(&mesh, res, dims, bounds, margin)?;
+    let values = threads::run(py, threads, || {
+        WindingNumber::new(&mesh).map(|wn| gwn::grid::evaluate(&wn, &spec))
+    })?
+    .map_err(value_error)?;
+    grid_result(py, &spec, values)
+}
+
+/// Signed distance on a voxel grid: distance to the closest point of the triangles, negative
+/// where the exact winding number is above 1/2 (correct on open and dirty meshes).
+///
+/// Same grid arguments and return value as :func:`voxelize` (``gwn sdf``'s values).
+#[pyfunction]
+#[pyo3(signature = (V, F, res = 64, *, dims = None, bounds = None, margin = 0.05, threads = None))]
+#[allow(non_snake_case, clippy::too_many_arguments)]
+pub fn sdf<'py>(
+    py: Python<'py>,
+    V: &Bound<'py, PyAny>,
+    F: &Bound<'py, PyAny>,
+    res: usize,
+    dims: Option<[usize; 3]>,
+    bounds: Option<[f64; 6]>,
+    margin: f64,
+    threads: Option<usize>,
+) -> PyResult<GridArrays<'py>> {
+    let mesh = mesh_from(V, F, "V", "F")?;
+    let spec = grid_spec(&mesh, res, dims, bounds, margin)?;
+    let values = threads::run(py, threads, || {
+        SignedDistance::new(&mesh).map(|s| s.eval_grid(&spec))
+    })?
+    .map_err(value_error)?;
+    grid_result(py, &spec, values)
+}
+
+/// Signed distance at the rows of ``Q`` (k, 3): float64 (k,), negative where the exact winding
+/// number is above 1/2; ``inf`` for a mesh without triangles.
+#[pyfunction]
+#[pyo3(signature = (V, F, Q, threads = None))]
+#[allow(non_snake_case)]
+pub fn signed_distance<'py>(
+    py: Python<'py>,
+    V: &Bound<'py, PyAny>,
+    F: &Bound<'py, PyAny>,
+    Q: &Bound<'py, PyAny>,
+    threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let mesh = mesh_from(V, F, "V", "F")?;
+    let values = with_points(Q, "Q", |q| {
+        threads::run(py, threads, || {
+            SignedDistance::new(&mesh).map(|s| s.eval_batch(q))
+        })
+    })?
+    .map_err(value_error)?;
+    Ok(array1(py, values))
+}
+
+fn axis_index(axis: &str) -> PyResult<usize> {
+    match axis {
+        "x" => Ok(0),
+        "y" => Ok(1),
+        "z" => Ok(2),
+        _ => Err(PyValueError::new_err(format!(
+            "axis must be \"x\", \"y\" or \"z\", got {axis:?}"
+        ))),
+    }
+}
+
+/// A slice of the exact winding number on an axis-aligned plane, as ``gwn slice`` renders it.
+///
+/// The plane is normal to ``axis`` at ``at`` (fraction of the mesh's bounding box along the axis,
+/// 0 = min, 1 = max) or at the absolute coordinate ``at_coord``; it covers the box grown by
+/// ``margin``, with ``res`` pixels along its longer side. Returns ``(image, png)``: ``image``
+/// float64 (height, width), row 0 at the top (x-slice: y right, z up; y-slice: x right, z up;
+/// z-slice: x right, y up), and ``png`` the bytes of the coloured picture with its colour bar
+/// (and the mesh's cross-section in black when ``outline``).
+#[pyfunction]
+#[pyo3(signature = (V, F, axis = "z", at = 0.5, *, at_coord = None, res = 1024, margin = 0.1, outline = false, threads = None))]
+#[allow(non_snake_case, clippy::too_many_arguments)]
+pub fn slice<'py>(
+    py: Python<'py>,
+    V: &Bound<'py, PyAny>,
+    F: &Bound<'py, PyAny>,
+    axis: &str,
+    at: f64,
+    at_coord: Option<f64>,
+    res: usize,
+    margin: f64,
+    outline: bool,
+    threads: Option<usize>,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyBytes>)> {
+    let axis = axis_index(axis)?;
+    if res == 0 || res > MAX_SLICE_RES {
+        return Err(PyValueError::new_err(format!(
+            "res must be between 1 and {MAX_SLICE_RES}, got {res}"
+        )));
+    }
+    if !(margin.is_finite() && margin >= 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "margin must be a non-negative number, got {margin}"
+        )));
+    }
+    let mesh = mesh_from(V, F, "V", "F")?;
+    let bbox = mesh
+        .bounding_box()
+        .ok_or_else(|| PyValueError::new_err("the mesh has no triangles"))?;
+    let coord = match at_coord {
+        Some(c) if c.is_finite() => c,
+        Some(c) => {
+            return Err(PyValueError::new_err(format!(
+                "at_coord must be finite, got {c}"
+            )));
+        }
+        None if at.is_finite() => bbox.min[axis] + at * (bbox.max[axis] - bbox.min[axis]),
+        None => {
+            return Err(PyValueError::new_err(format!(
+                "at must be finite, got {at}"
+            )));
+        }
+    };
+    let slice = Slice::new(&bbox.enlarged(margin), axis, coord, res);
+    let (values, png) = threads::run(py, threads, || {
+        let wn = WindingNumber::with_options(
+            &mesh,
+            Options {
+                ray: slice.ray(),
+                ..Options::default()
+            },
+        )?;
+        let values = slice.evaluate(&wn);
+        let mut png = Vec::new();
+        // Writing into a Vec cannot fail for I/O reasons; an encoder error is still reported.
+        let written = slice
+            .render(&values, outline.then_some(&mesh))
+            .write_png(&mut png);
+        Ok::<_, Box<dyn std::error::Error + Send + Sync>>((values, written.map(|()| png)))
+    })?
+    .map_err(value_error)?;
+    let png = png.map_err(value_error)?;
+    Ok((
+        array_nd(py, values, &[slice.height, slice.width])?,
+        PyBytes::new(py, &png),
+    ))
+}
+
+/// Classifies each face of mesh A by the exact winding number of mesh B at its centroid
+/// (the building block of mesh booleans; ``gwn classify``). Returns float64 (faces of A,);
+/// ``w > 0.5`` means inside B.
+#[pyfunction]
+#[pyo3(signature = (VA, FA, VB, FB, threads = None))]
+#[allow(non_snake_case)]
+pub fn classify<'py>(
+    py: Python<'py>,
+    VA: &Bound<'py, PyAny>,
+    FA: &Bound<'py, PyAny>,
+    VB: &Bound<'py, PyAny>,
+    FB: &Bound<'py, PyAny>,
+    threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let a = mesh_from(VA, FA, "VA", "FA")?;
+    let b = mesh_from(VB, FB, "VB", "FB")?;
+    let values = threads::run(py, threads, || {
+        WindingNumber::new(&b).map(|wn| classify_faces(&a, &wn))
+    })?
+    .map_err(value_error)?;
+    Ok(array1(py, values))
+}
+
+/// Marks the tets whose centroid has exact winding number above ``threshold`` with respect to
+/// the surface ``(V, F)`` (the front end of a tet mesher; ``gwn filter-tets``).
+///
+/// ``points`` (p, 3) float, ``tets`` (t, 4) int corner indices; returns a bool array (t,)
+/// (``tets[mask]`` keeps the inside tets).
+#[pyfunction]
+#[pyo3(signature = (V, F, points, tets, threshold = 0.5, threads = None))]
+#[allow(non_snake_case)]
+pub fn filter_tets<'py>(
+    py: Python<'py>,
+    V: &Bound<'py, PyAny>,
+    F: &Bound<'py, PyAny>,
+    points: &Bound<'py, PyAny>,
+    tets: &Bound<'py, PyAny>,
+    threshold: f64,
+    threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray1<bool>>> {
+    let mesh = mesh_from(V, F, "V", "F")?;
+    if !threshold.is_finite() {
+        return Err(PyValueError::new_err(format!(
+            "threshold must be finite, got {threshold}"
+        )));
+    }
+    let tet_indices = indices_vec::<4>(tets, "tets")?;
+    let keep = with_points::<3, _>(points, "points", |tet_points| {
+        let n = tet_points.len();
+        if let Some((i, t)) = tet_indices
+            .iter()
+            .enumerate()
+            .find(|(_, t)| t.iter().any(|&c| c as usize >= n))
+        {
+            return Err(PyValueError::new_err(format!(
+                "tets[{i}] = {t:?} references a point beyond the {n} points"
+            )));
+        }
+        threads::run(py, threads, || {
+            WindingNumber::new(&mesh).map(|wn| {
+                gwn::products::tets::filter_tets(tet_points, &tet_indices, &wn, threshold)
+            })
+        })?
+        .map_err(value_error)
+    })?;
+    Ok(PyArray1::from_vec(py, keep))
+}

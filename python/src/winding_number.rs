@@ -1,0 +1,287 @@
+//! `gwn.WindingNumber`: build once, query many times from any number of Python threads.
+
+use std::sync::Arc;
+
+use gwn::Mesh;
+use gwn::eval::antipodal::Options;
+use gwn::eval::fast::{PointCloud, PointCloudWindingNumber};
+use numpy::PyArray1;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+
+use crate::arrays::{array1, array2, indices_vec, points_vec, values_vec, with_points};
+use crate::errors::{mesh_error, value_error};
+use crate::evaluator::{Evaluator, Method, fast_params, parse_precision, parse_ray};
+use crate::threads;
+
+/// `WindingNumber.parts`' result: crossing counts and fractional parts.
+type Parts<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<f64>>);
+
+/// What the evaluator was built from, kept for pickling (rebuilt from these on unpickle).
+#[derive(Debug)]
+enum Source {
+    Mesh(Arc<Mesh>),
+    Cloud {
+        positions: Vec<[f64; 3]>,
+        /// As given (the library normalises them; normalising twice could change the last bit).
+        normals: Vec<[f64; 3]>,
+        /// As used: given or estimated, so that the rebuilt object skips the estimation and
+        /// gives bit-identical values.
+        areas: Vec<f64>,
+    },
+}
+
+/// Winding-number evaluator of one mesh or oriented point cloud, built once.
+///
+/// ``WindingNumber(V, F, method="exact", beta=2.0, order=2, precision=60, ray="+z")``
+///
+/// ``method``: ``"exact"`` (Antipodal method, the default), ``"direct"`` (solid-angle sum over
+/// all triangles) or ``"fast"`` (Barnes-Hut with accuracy ``beta`` and expansion ``order``).
+/// ``precision`` (30 or 60 bits) and ``ray`` (``"+z"``, ``"-x"``, ...) are options of the exact
+/// method. Oriented point clouds: :meth:`WindingNumber.from_point_cloud`.
+///
+/// Calls release the GIL; one object can be queried from several Python threads at once.
+/// Objects pickle by their arrays and are rebuilt on unpickling.
+#[pyclass(module = "gwn", name = "WindingNumber", frozen)]
+pub struct PyWindingNumber {
+    evaluator: Evaluator,
+    source: Source,
+    method: Method,
+    beta: f64,
+    order: u8,
+    precision: u32,
+    ray: String,
+}
+
+fn build_err(e: String) -> PyErr {
+    PyValueError::new_err(e)
+}
+
+impl PyWindingNumber {
+    /// Builds the evaluator of a mesh given as arrays.
+    #[allow(clippy::too_many_arguments)]
+    fn from_mesh_arrays(
+        py: Python<'_>,
+        v: &Bound<'_, PyAny>,
+        f: &Bound<'_, PyAny>,
+        method: &str,
+        beta: f64,
+        order: u8,
+        precision: u32,
+        ray: &str,
+    ) -> PyResult<Self> {
+        let method = Method::parse(method).map_err(build_err)?;
+        let options = Options {
+            precision: parse_precision(precision).map_err(build_err)?,
+            ray: parse_ray(ray).map_err(build_err)?,
+        };
+        let params = fast_params(beta, order).map_err(build_err)?;
+        let mesh =
+            Arc::new(Mesh::new(points_vec(v, "V")?, indices_vec(f, "F")?).map_err(mesh_error)?);
+        let evaluator = py
+            .allow_threads(|| Evaluator::for_mesh(&mesh, method, options, params))
+            .map_err(build_err)?;
+        Ok(PyWindingNumber {
+            evaluator,
+            source: Source::Mesh(mesh),
+            method,
+            beta,
+            order,
+            precision,
+            ray: ray.to_string(),
+        })
+    }
+
+    /// The exact evaluator and mesh, for products that need both.
+    pub fn evaluator(&self) -> &Evaluator {
+        &self.evaluator
+    }
+}
+
+#[pymethods]
+impl PyWindingNumber {
+    #[new]
+    #[pyo3(signature = (V, F, method = "exact", beta = 2.0, order = 2, precision = 60, ray = "+z"))]
+    #[allow(non_snake_case, clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        V: &Bound<'_, PyAny>,
+        F: &Bound<'_, PyAny>,
+        method: &str,
+        beta: f64,
+        order: u8,
+        precision: u32,
+        ray: &str,
+    ) -> PyResult<Self> {
+        Self::from_mesh_arrays(py, V, F, method, beta, order, precision, ray)
+    }
+
+    /// Barnes-Hut evaluator of an oriented point cloud: positions ``P`` (n, 3), normals ``N``
+    /// (n, 3; their length is ignored) and areas ``A`` (n,), estimated from the 20 nearest
+    /// neighbours when ``None``. ``beta`` defaults to 2.3 (Barill et al. for points).
+    #[staticmethod]
+    #[pyo3(signature = (P, N, A = None, beta = 2.3, order = 2))]
+    #[allow(non_snake_case)]
+    fn from_point_cloud(
+        py: Python<'_>,
+        P: &Bound<'_, PyAny>,
+        N: &Bound<'_, PyAny>,
+        A: Option<&Bound<'_, PyAny>>,
+        beta: f64,
+        order: u8,
+    ) -> PyResult<Self> {
+        let params = fast_params(beta, order).map_err(build_err)?;
+        let positions = points_vec::<3>(P, "P")?;
+        let normals = points_vec::<3>(N, "N")?;
+        let areas = A.map(|a| values_vec(a, "A", positions.len())).transpose()?;
+        let cloud =
+            PointCloud::new(positions.clone(), normals.clone(), areas).map_err(value_error)?;
+        let fast = py.allow_threads(|| PointCloudWindingNumber::with_params(&cloud, params));
+        let areas = fast.areas().to_vec();
+        let evaluator = Evaluator::FastCloud(fast);
+        Ok(PyWindingNumber {
+            evaluator,
+            source: Source::Cloud {
+                positions,
+                normals,
+                areas,
+            },
+            method: Method::Fast,
+            beta,
+            order,
+            precision: 60,
+            ray: "+z".to_string(),
+        })
+    }
+
+    /// Winding numbers at the rows of ``Q`` (n, 3): float64 array (n,).
+    #[pyo3(signature = (Q, threads = None))]
+    #[allow(non_snake_case)]
+    fn __call__<'py>(
+        &self,
+        py: Python<'py>,
+        Q: &Bound<'py, PyAny>,
+        threads: Option<usize>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let values = with_points(Q, "Q", |q| {
+            threads::run(py, threads, || self.evaluator.eval_batch(q))
+        })?;
+        Ok(array1(py, values))
+    }
+
+    /// Gradients of the winding number at the rows of ``Q`` (n, 3): float64 array (n, 3).
+    /// Exact and direct methods only (``ValueError`` for ``"fast"``).
+    #[pyo3(signature = (Q, threads = None))]
+    #[allow(non_snake_case)]
+    fn gradient<'py>(
+        &self,
+        py: Python<'py>,
+        Q: &Bound<'py, PyAny>,
+        threads: Option<usize>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let grads = with_points(Q, "Q", |q| {
+            threads::run(py, threads, || self.evaluator.gradient_batch(q))
+        })?
+        .map_err(value_error)?;
+        array2(py, grads)
+    }
+
+    /// Integer and fractional parts of the winding number at the rows of ``Q`` (exact method):
+    /// ``(chi, fraction)`` with ``chi`` int64 (n,) the signed crossing count of the ray and
+    /// ``fraction`` float64 (n,) the boundary term, so that ``chi + fraction == wn(Q)`` bit for
+    /// bit. For a closed mesh ``fraction`` is 0 and ``chi`` is the exact winding number.
+    #[pyo3(signature = (Q, threads = None))]
+    #[allow(non_snake_case)]
+    fn parts<'py>(
+        &self,
+        py: Python<'py>,
+        Q: &Bound<'py, PyAny>,
+        threads: Option<usize>,
+    ) -> PyResult<Parts<'py>> {
+        let (chi, fraction) = with_points(Q, "Q", |q| {
+            threads::run(py, threads, || self.evaluator.parts_batch(q))
+        })?
+        .map_err(value_error)?;
+        Ok((PyArray1::from_vec(py, chi), array1(py, fraction)))
+    }
+
+    /// ``"exact"``, ``"direct"`` or ``"fast"``.
+    #[getter]
+    fn method(&self) -> &'static str {
+        self.method.name()
+    }
+
+    /// Number of triangles (0 for a point cloud).
+    #[getter]
+    fn face_count(&self) -> usize {
+        match &self.source {
+            Source::Mesh(m) => m.triangles().len(),
+            Source::Cloud { .. } => 0,
+        }
+    }
+
+    /// Number of boundary edges of the exact method's signed boundary (``None`` for the other
+    /// methods).
+    #[getter]
+    fn boundary_edge_count(&self) -> Option<usize> {
+        self.evaluator.boundary_edge_count()
+    }
+
+    fn __repr__(&self) -> String {
+        match &self.source {
+            Source::Mesh(m) => format!(
+                "gwn.WindingNumber(method={:?}, vertices={}, faces={})",
+                self.method.name(),
+                m.positions().len(),
+                m.triangles().len()
+            ),
+            Source::Cloud { positions, .. } => format!(
+                "gwn.WindingNumber(method=\"fast\", points={})",
+                positions.len()
+            ),
+        }
+    }
+
+    /// Pickles by the source arrays and the options; unpickling rebuilds the evaluator
+    /// (see docs/python.md for why rebuilding was chosen over serializing the built index).
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        match &self.source {
+            Source::Mesh(m) => {
+                let cls = py.get_type::<PyWindingNumber>().into_any();
+                let args = (
+                    array2(py, m.positions().to_vec())?,
+                    array2(py, m.triangles().to_vec())?,
+                    self.method.name(),
+                    self.beta,
+                    self.order,
+                    self.precision,
+                    self.ray.as_str(),
+                )
+                    .into_pyobject(py)?;
+                Ok((cls, args))
+            }
+            Source::Cloud {
+                positions,
+                normals,
+                areas,
+            } => {
+                let rebuild = py
+                    .get_type::<PyWindingNumber>()
+                    .getattr("from_point_cloud")?;
+                let args = (
+                    array2(py, positions.clone())?,
+                    array2(py, normals.clone())?,
+                    array1(py, areas.clone()),
+                    self.beta,
+                    self.order,
+                )
+                    .into_pyobject(py)?;
+                Ok((rebuild, args))
+            }
+        }
+    }
+}

@@ -1,0 +1,125 @@
+"""Bit-for-bit agreement with the `gwn` command-line tool (same library calls, same values)."""
+
+import subprocess
+
+import numpy as np
+import pytest
+
+import gwn
+from conftest import LION_HEAD, random_points
+
+
+def run(cli, *args):
+    subprocess.run([str(cli), *map(str, args)], check=True, capture_output=True)
+
+
+@pytest.fixture(scope="module")
+def queries(tmp_path_factory, lion):
+    v, _ = lion
+    lo, hi = v.min(axis=0), v.max(axis=0)
+    q = lo + (hi - lo) * random_points(2000, lo=-0.1, hi=1.1, seed=30)
+    path = tmp_path_factory.mktemp("q") / "q.npy"
+    np.save(path, q)
+    return q, path
+
+
+@pytest.mark.parametrize(
+    "method, cli_args, kwargs",
+    [
+        ("exact", [], {}),
+        ("exact", ["--precision", "30", "--ray", "-x"], {"precision": 30, "ray": "-x"}),
+        ("direct", [], {}),
+        ("fast", ["--beta", "2.5", "--order", "1"], {"beta": 2.5, "order": 1}),
+    ],
+)
+def test_eval(cli, tmp_path, lion, queries, method, cli_args, kwargs):
+    q, qpath = queries
+    out = tmp_path / "w.npy"
+    run(cli, "eval", LION_HEAD, "--points", qpath, "--out", out, "--method", method, *cli_args)
+    wn = gwn.WindingNumber(*lion, method=method, **kwargs)
+    np.testing.assert_array_equal(wn(q), np.load(out))
+
+
+def test_one_shot_calls_equal_cli(cli, tmp_path, lion, queries):
+    q, qpath = queries
+    run(cli, "eval", LION_HEAD, "--points", qpath, "--out", tmp_path / "e.npy")
+    run(cli, "eval", LION_HEAD, "--points", qpath, "--out", tmp_path / "f.npy", "--method", "fast")
+    np.testing.assert_array_equal(gwn.winding_number(*lion, q), np.load(tmp_path / "e.npy"))
+    np.testing.assert_array_equal(gwn.fast_winding_number(*lion, q), np.load(tmp_path / "f.npy"))
+
+
+@pytest.mark.parametrize("method", ["exact", "direct"])
+def test_gradient(cli, tmp_path, lion, queries, method):
+    q, qpath = queries
+    out = tmp_path / "g.npy"
+    run(cli, "eval", LION_HEAD, "--points", qpath, "--out", tmp_path / "w.npy", "--method", method,
+        "--gradient", "--gradient-out", out)
+    np.testing.assert_array_equal(gwn.WindingNumber(*lion, method=method).gradient(q), np.load(out))
+
+
+def test_point_cloud(cli, tmp_path):
+    rng = np.random.default_rng(31)
+    p = rng.normal(size=(800, 3))
+    n = p + rng.normal(scale=0.1, size=p.shape)
+    cloud = tmp_path / "cloud.xyz"
+    cloud.write_text("".join(" ".join(repr(float(c)) for c in row) + "\n" for row in np.hstack([p, n])))
+    q = random_points(300, lo=-2, hi=2, seed=32)
+    np.save(tmp_path / "q.npy", q)
+    run(cli, "eval", cloud, "--points", tmp_path / "q.npy", "--out", tmp_path / "w.npy")
+    np.testing.assert_array_equal(gwn.fast_winding_number(p, n, q), np.load(tmp_path / "w.npy"))
+    np.testing.assert_array_equal(
+        gwn.WindingNumber.from_point_cloud(p, n, beta=2.0)(q), np.load(tmp_path / "w.npy")
+    )
+
+
+def test_voxelize_and_sdf(cli, tmp_path, lion):
+    run(cli, "voxelize", LION_HEAD, "--res", 20, "--dtype", "f64", "--out", tmp_path / "w.npy")
+    w, origin, spacing = gwn.voxelize(*lion, 20)
+    np.testing.assert_array_equal(w, np.load(tmp_path / "w.npy"))
+    run(cli, "sdf", LION_HEAD, "--dims", 7, 9, 11, "--margin", 0.2, "--dtype", "f64",
+        "--out", tmp_path / "s.npy")
+    d, _, _ = gwn.sdf(*lion, dims=(7, 9, 11), margin=0.2)
+    np.testing.assert_array_equal(d, np.load(tmp_path / "s.npy"))
+
+
+def test_slice_png_bytes(cli, tmp_path, lion):
+    out = tmp_path / "s.png"
+    run(cli, "slice", LION_HEAD, "--axis", "x", "--at", 0.4, "--res", 96, "--outline", "--out", out)
+    img, png = gwn.slice(*lion, axis="x", at=0.4, res=96, outline=True)
+    assert png == out.read_bytes()
+    assert np.isfinite(img).all()
+
+
+def test_classify(cli, tmp_path, lion):
+    v, f = lion
+    shifted = tmp_path / "b.off"
+    vb = v * 0.9 + v.mean(axis=0) * 0.1
+    shifted.write_text(
+        "OFF\n%d %d 0\n" % (len(vb), len(f))
+        + "".join("%r %r %r\n" % tuple(map(float, p)) for p in vb)
+        + "".join("3 %d %d %d\n" % tuple(t) for t in f)
+    )
+    run(cli, "classify", LION_HEAD, shifted, "--out", tmp_path / "c.npy")
+    np.testing.assert_array_equal(gwn.classify(v, f, vb, f), np.load(tmp_path / "c.npy"))
+
+
+def test_filter_tets(cli, tmp_path, lion):
+    v, f = lion
+    lo, hi = v.min(axis=0), v.max(axis=0)
+    points = lo + (hi - lo) * random_points(400, lo=0, hi=1, seed=33)
+    tets = np.random.default_rng(34).integers(0, len(points), size=(300, 4))
+    path = tmp_path / "t.mesh"
+    path.write_text(
+        "MeshVersionFormatted 1\nDimension 3\nVertices\n%d\n" % len(points)
+        + "".join("%r %r %r 0\n" % tuple(map(float, p)) for p in points)
+        + "Tetrahedra\n%d\n" % len(tets)
+        + "".join("%d %d %d %d 0\n" % tuple(t + 1) for t in tets)
+        + "End\n"
+    )
+    run(cli, "filter-tets", LION_HEAD, path, "--out", tmp_path / "kept.mesh")
+    kept_points, kept_tets, _ = gwn.load_tets(tmp_path / "kept.mesh")
+    mask = gwn.filter_tets(v, f, points, tets)
+    assert mask.dtype == np.bool_
+    np.testing.assert_array_equal(kept_points[kept_tets], points[tets[mask]])
+    p2, t2, _ = gwn.load_tets(path)
+    np.testing.assert_array_equal(gwn.filter_tets(v, f, p2, t2), mask)

@@ -1,0 +1,72 @@
+"""Threads (GIL released, one object shared) and pickling (rebuilt from arrays)."""
+
+import pickle
+import threading
+
+import numpy as np
+import pytest
+
+import gwn
+from conftest import CUBE_V, OPEN_BOX_F, random_points
+
+
+def test_threads_argument_does_not_change_values(lion):
+    v, f = lion
+    q = random_points(3000, lo=v.min(), hi=v.max(), seed=20)
+    wn = gwn.WindingNumber(v, f)
+    reference = wn(q)
+    for threads in (1, 2, 3):
+        np.testing.assert_array_equal(wn(q, threads=threads), reference)
+
+
+def test_two_python_threads_on_one_object(lion):
+    v, f = lion
+    wn = gwn.WindingNumber(v, f)
+    batches = [random_points(4000, lo=v.min(), hi=v.max(), seed=s) for s in range(8)]
+    expected = [wn(b) for b in batches]
+    results = {}
+    errors = []
+
+    def work(k):
+        try:
+            for i in range(k, len(batches), 2):
+                results[i] = (wn(batches[i], threads=1), wn.gradient(batches[i][:100], threads=1))
+        except Exception as e:  # reported by the main thread
+            errors.append(e)
+
+    threads = [threading.Thread(target=work, args=(k,)) for k in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not errors
+    for i, b in enumerate(batches):
+        np.testing.assert_array_equal(results[i][0], expected[i])
+        np.testing.assert_array_equal(results[i][1], wn.gradient(b[:100]))
+
+
+@pytest.mark.parametrize("method", ["exact", "direct", "fast"])
+def test_pickle_round_trip_is_bit_identical(method):
+    wn = gwn.WindingNumber(CUBE_V, OPEN_BOX_F, method=method, beta=3.0, order=1)
+    q = random_points(500, seed=21)
+    back = pickle.loads(pickle.dumps(wn))
+    assert back.method == method
+    np.testing.assert_array_equal(back(q), wn(q))
+
+
+def test_pickle_keeps_exact_options():
+    wn = gwn.WindingNumber(CUBE_V, OPEN_BOX_F, precision=30, ray="-x")
+    back = pickle.loads(pickle.dumps(wn))
+    q = np.array([[0.5, 0.5, 0.0]])  # on the bottom face: the value depends on the ray frame
+    np.testing.assert_array_equal(back(q), wn(q))
+    assert back.__reduce__()[1][5:] == (30, "-x")
+
+
+def test_pickle_point_cloud_keeps_estimated_areas():
+    rng = np.random.default_rng(22)
+    p = rng.normal(size=(500, 3))
+    p /= np.linalg.norm(p, axis=1, keepdims=True)
+    wn = gwn.WindingNumber.from_point_cloud(p, p)
+    back = pickle.loads(pickle.dumps(wn))
+    q = random_points(200, lo=-1.5, hi=1.5, seed=23)
+    np.testing.assert_array_equal(back(q), wn(q))
