@@ -16,7 +16,7 @@ use crate::voxelize::GridArgs;
 /// pseudo-normal signs fail.
 #[derive(ClapArgs, Debug)]
 pub struct Args {
-    /// Mesh file (OBJ, STL, OFF, PLY).
+    /// Mesh file (OBJ, STL, OFF, PLY, glTF/GLB).
     pub mesh: PathBuf,
     #[command(flatten)]
     pub grid: GridArgs,

@@ -44,7 +44,7 @@ impl Axis {
 /// (x right, y up).
 #[derive(ClapArgs, Debug)]
 pub struct Args {
-    /// Mesh file (OBJ, STL, OFF, PLY).
+    /// Mesh file (OBJ, STL, OFF, PLY, glTF/GLB).
     pub mesh: PathBuf,
     /// Normal axis of the slice plane.
     #[arg(long, value_enum, default_value_t = Axis::Z)]

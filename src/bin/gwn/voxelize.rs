@@ -113,7 +113,7 @@ fn io_err(p: &Path, e: std::io::Error) -> CliError {
 /// equal per-point evaluation exactly.
 #[derive(ClapArgs, Debug)]
 pub struct Args {
-    /// Mesh file (OBJ, STL, OFF, PLY).
+    /// Mesh file (OBJ, STL, OFF, PLY, glTF/GLB).
     pub mesh: PathBuf,
     #[command(flatten)]
     pub grid: GridArgs,
