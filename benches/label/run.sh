@@ -23,7 +23,7 @@ target="${CARGO_TARGET_DIR:-$repo/target}"
 case "$target" in /*) ;; *) target="$repo/$target" ;; esac
 args=("$@")
 has_path=0
-for a in "$@"; do case "$a" in --*) ;; *) has_path=1 ;; esac; done
+for a in "$@"; do if [ -e "$a" ]; then has_path=1; fi; done
 if [ "$has_path" = 0 ]; then args=("$repo/../shared/meshes" "${args[@]}"); fi
 cd "$repo"
 export LABEL_BENCH_COMMAND="benches/label/run.sh${*:+ $*}"
