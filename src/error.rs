@@ -157,7 +157,7 @@ impl fmt::Display for LoadErrorKind {
         match self {
             LoadErrorKind::Io(e) => write!(f, "cannot read: {e}"),
             LoadErrorKind::UnknownFormat => {
-                f.write_str("unknown format (expected .obj, .stl, .off or .ply)")
+                f.write_str("unknown format (expected .obj, .stl, .off, .ply, .gltf or .glb)")
             }
             LoadErrorKind::Truncated(s) => write!(f, "truncated: {s}"),
             LoadErrorKind::Syntax(s) => f.write_str(s),

@@ -13,7 +13,7 @@ fn fuzz_corpus_never_panics() {
             let data = std::fs::read(&path).unwrap();
             check_load_mesh(&data);
             // Every format on the same bytes, too.
-            for sel in 0..6u8 {
+            for sel in 0..7u8 {
                 let mut d = data.clone();
                 if let Some(first) = d.first_mut() {
                     *first = sel;

@@ -2,19 +2,20 @@
 // stable test replays the corpus through exactly the code the fuzzer runs.
 
 /// Feeds `data` to a loader: the first byte selects the format (OBJ, STL, OFF, PLY, detect by
-/// content, or query points), the rest is the file. Must never panic; a successful load must
+/// content, query points, or glTF), the rest is the file. Must never panic; a successful load must
 /// give a valid, non-empty mesh whose statistics compute.
 pub fn check_load_mesh(data: &[u8]) {
     use gwn::io::{Format, LoadOptions, load_mesh_from_bytes_with, load_points_from_bytes};
     let Some((&selector, body)) = data.split_first() else {
         return;
     };
-    let hint = match selector % 6 {
+    let hint = match selector % 7 {
         0 => Some(Format::Obj),
         1 => Some(Format::Stl),
         2 => Some(Format::Off),
         3 => Some(Format::Ply),
         4 => None,
+        6 => Some(Format::Gltf),
         _ => {
             if let Ok(p) = load_points_from_bytes(body, "fuzz.txt") {
                 assert!(!p.is_empty());

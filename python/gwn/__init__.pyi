@@ -168,7 +168,7 @@ def gauwn(
     """Gaussian-smoothed winding number of a polygon at the rows of Q (k, 2) (and its gradient)."""
 
 def load(path: _Path, weld: Optional[bool] = None) -> Tuple[_F64, _I64]:
-    """Reads a mesh (OBJ, STL, OFF, PLY) as (V float64 (n, 3), F int64 (m, 3))."""
+    """Reads a mesh (OBJ, STL, OFF, PLY, glTF/GLB) as (V float64 (n, 3), F int64 (m, 3))."""
 
 def load_point_cloud(path: _Path) -> Tuple[_F64, _F64, Optional[_F64]]:
     """Reads an oriented point cloud as (P, N, A or None)."""
@@ -181,3 +181,23 @@ def load_tets(path: _Path) -> Tuple[_F64, _I64, _I64]:
 
 def load_polygon(path: _Path) -> list[_F64]:
     """Reads a 2D polygon (text or SVG) as a list of float64 (n_i, 2) loops."""
+
+def common_root(paths: Sequence[_Path]) -> str:
+    """The deepest folder holding every path (absolute): the default root of a dataset."""
+
+def label_dataset(
+    paths: Sequence[_Path],
+    out_dir: _Path,
+    *,
+    root: Optional[_Path] = None,
+    uniform: int = 50_000,
+    near: int = 50_000,
+    sigmas: Sequence[float] = (0.005, 0.05),
+    padding: float = 0.05,
+    seed: int = 0,
+    time_limit: Optional[float] = None,
+    weld: Optional[bool] = None,
+    threads: Optional[int] = None,
+) -> list[dict]:
+    """Labels meshes (w, occupancy, sdf at seeded sample points), one .npz per mesh and
+    manifest.jsonl in out_dir, like `gwn label`; returns the manifest rows in input order."""

@@ -9,6 +9,7 @@ mod arrays;
 mod curve;
 mod errors;
 mod evaluator;
+mod label;
 mod loaders;
 mod oneshot;
 mod products;
@@ -29,6 +30,9 @@ fn _gwn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(products::classify, m)?)?;
     m.add_function(wrap_pyfunction!(products::filter_tets, m)?)?;
     m.add_function(wrap_pyfunction!(curve::gauwn, m)?)?;
+    m.add_function(wrap_pyfunction!(label::label_dataset, m)?)?;
+    m.add_function(wrap_pyfunction!(label::label_file, m)?)?;
+    m.add_function(wrap_pyfunction!(label::common_root, m)?)?;
     m.add_function(wrap_pyfunction!(loaders::load, m)?)?;
     m.add_function(wrap_pyfunction!(loaders::load_point_cloud, m)?)?;
     m.add_function(wrap_pyfunction!(loaders::load_points, m)?)?;

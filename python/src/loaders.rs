@@ -17,7 +17,7 @@ fn widen<const N: usize>(rows: Vec<[u32; N]>) -> Vec<[i64; N]> {
 
 /// Reads a triangle mesh (OBJ, STL ascii/binary, OFF, PLY ascii/binary; format by extension,
 /// else by content) as ``(V, F)``: float64 (n, 3) and int64 (m, 3). Polygons are
-/// fan-triangulated. ``weld``: merge bit-identical vertices (default: on for STL only).
+/// fan-triangulated. ``weld``: merge bit-identical vertices (default: on for STL and glTF/GLB only).
 /// ``OSError`` when the file cannot be read, ``ValueError`` when it is not a valid mesh.
 #[pyfunction]
 #[pyo3(signature = (path, weld = None))]

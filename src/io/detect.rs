@@ -5,7 +5,7 @@ use std::path::Path;
 
 use super::Format;
 
-/// The format an extension names (`.obj`, `.stl`, `.off`, `.ply`, any case).
+/// The format an extension names (`.obj`, `.stl`, `.off`, `.ply`, `.gltf`, `.glb`, any case).
 pub fn format_from_extension(path: &Path) -> Option<Format> {
     let ext = path.extension()?.to_str()?.to_ascii_lowercase();
     match ext.as_str() {
@@ -13,6 +13,7 @@ pub fn format_from_extension(path: &Path) -> Option<Format> {
         "stl" => Some(Format::Stl),
         "off" => Some(Format::Off),
         "ply" => Some(Format::Ply),
+        "gltf" | "glb" => Some(Format::Gltf),
         _ => None,
     }
 }
@@ -27,15 +28,22 @@ pub(crate) fn is_off_keyword(tok: &[u8]) -> bool {
             .all(|b| matches!(b, b'C' | b'N' | b'S' | b'T' | b'4'))
 }
 
-/// Guesses the format from the bytes, in this order: `ply` magic line; an OFF keyword as the first
+/// Guesses the format from the bytes, in this order: `glTF` magic (GLB); a JSON object whose first
+/// 64 KiB mention `"asset"` (glTF JSON); `ply` magic line; an OFF keyword as the first
 /// token after `#` comment lines; a binary STL whose size is exactly `84 + 50·n` for the count `n`
 /// in its header; a file starting with `solid` (ascii STL); a line starting with `v ` or `f `
 /// within the first 64 KiB (OBJ).
 pub fn format_from_content(bytes: &[u8]) -> Option<Format> {
+    if bytes.starts_with(b"glTF") {
+        return Some(Format::Gltf);
+    }
+    let head = &bytes[..bytes.len().min(1 << 16)];
+    if head.trim_ascii_start().starts_with(b"{") && head.windows(7).any(|w| w == b"\"asset\"") {
+        return Some(Format::Gltf);
+    }
     if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n") {
         return Some(Format::Ply);
     }
-    let head = &bytes[..bytes.len().min(1 << 16)];
     for (_, line) in super::text_lines(head) {
         let t = line.trim_ascii_start();
         if t.is_empty() || t.starts_with(b"#") {
@@ -76,6 +84,14 @@ mod tests {
         );
         assert_eq!(format_from_extension(Path::new("x.Obj")), Some(Format::Obj));
         assert_eq!(format_from_extension(Path::new("x")), None);
+        assert_eq!(
+            format_from_extension(Path::new("s.GLB")),
+            Some(Format::Gltf)
+        );
+        assert_eq!(
+            format_from_extension(Path::new("s.gltf")),
+            Some(Format::Gltf)
+        );
         assert_eq!(format_from_extension(Path::new("x.txt")), None);
     }
 
@@ -94,5 +110,11 @@ mod tests {
         bin[80] = 1;
         assert_eq!(format_from_content(&bin), Some(Format::Stl));
         assert_eq!(format_from_content(b"hello"), None);
+        assert_eq!(format_from_content(b"glTF\x02\0\0\0"), Some(Format::Gltf));
+        assert_eq!(
+            format_from_content(b" {\"asset\": {\"version\": \"2.0\"}}"),
+            Some(Format::Gltf)
+        );
+        assert_eq!(format_from_content(b"{\"a\": 1}"), None);
     }
 }

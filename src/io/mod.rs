@@ -1,4 +1,4 @@
-//! Reading meshes (OBJ, STL, OFF, PLY) and query points (text, `.npy`), writing results.
+//! Reading meshes (OBJ, STL, OFF, PLY, glTF/GLB) and query points (text, `.npy`), writing results.
 //!
 //! Every loader works on an in-memory byte slice ([`load_mesh_from_bytes`]), so fuzzing and
 //! tests need no files, and every error is a [`LoadError`] naming the file and a location (line
@@ -19,6 +19,7 @@
 
 pub mod cloud;
 pub mod detect;
+mod gltf_scene;
 mod obj;
 mod off;
 mod ply;
@@ -45,15 +46,25 @@ pub enum Format {
     Off,
     /// Stanford PLY, ascii or binary (either endianness).
     Ply,
+    /// glTF 2.0: `.glb` (binary) or `.gltf` (JSON); all mesh instances of the scene, transformed.
+    Gltf,
 }
 
 impl Format {
     /// All formats, in a fixed order.
-    pub const ALL: [Format; 4] = [Format::Obj, Format::Stl, Format::Off, Format::Ply];
+    pub const ALL: [Format; 5] = [
+        Format::Obj,
+        Format::Stl,
+        Format::Off,
+        Format::Ply,
+        Format::Gltf,
+    ];
 
-    /// True for formats that are welded by default (STL).
+    /// True for formats that are welded by default: STL, which stores every triangle's corners
+    /// separately, and glTF, whose exporters split vertices wherever a normal or texture
+    /// coordinate changes (every such seam would otherwise be a boundary edge).
     pub fn welds_by_default(self) -> bool {
-        self == Format::Stl
+        matches!(self, Format::Stl | Format::Gltf)
     }
 }
 
@@ -64,6 +75,7 @@ impl fmt::Display for Format {
             Format::Stl => "STL",
             Format::Off => "OFF",
             Format::Ply => "PLY",
+            Format::Gltf => "glTF",
         })
     }
 }
@@ -71,8 +83,8 @@ impl fmt::Display for Format {
 /// Options for [`load_mesh_with`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct LoadOptions {
-    /// Merge bit-identical positions after loading. `None`: the format's default (on for STL, off
-    /// for OBJ, OFF and PLY).
+    /// Merge bit-identical positions after loading. `None`: the format's default (on for STL and
+    /// glTF, off for OBJ, OFF and PLY).
     pub weld: Option<bool>,
 }
 
@@ -136,7 +148,8 @@ pub(crate) fn index_error(face: usize, index: u64, vertex_count: usize) -> Fail 
 }
 
 /// Loads a mesh, choosing the format by extension (case-insensitive) or, failing that, by
-/// content; STL is welded, other formats are not.
+/// content; STL and glTF are welded, other formats are not. External glTF buffers are read
+/// relative to the file's directory.
 pub fn load_mesh(path: impl AsRef<Path>) -> Result<LoadedMesh, LoadError> {
     load_mesh_with(path, &LoadOptions::default())
 }
@@ -148,7 +161,14 @@ pub fn load_mesh_with(
 ) -> Result<LoadedMesh, LoadError> {
     let path = path.as_ref();
     let bytes = read_input(path)?;
-    load_mesh_from_bytes_with(&bytes, path, format_from_extension(path), options)
+    let base_dir = path.parent().unwrap_or(Path::new("."));
+    load_mesh_from_bytes_in(
+        &bytes,
+        path,
+        format_from_extension(path),
+        options,
+        Some(base_dir),
+    )
 }
 
 /// The most bytes read from a file that is not a regular file (a pipe, a device): such a file has
@@ -194,12 +214,24 @@ pub fn load_mesh_from_bytes(
     load_mesh_from_bytes_with(bytes, name_for_errors, format_hint, &LoadOptions::default())
 }
 
-/// [`load_mesh_from_bytes`] with explicit options.
+/// [`load_mesh_from_bytes`] with explicit options. A glTF file whose buffers are external files
+/// is an error here (use [`load_mesh_with`]).
 pub fn load_mesh_from_bytes_with(
     bytes: &[u8],
     name_for_errors: impl AsRef<Path>,
     format_hint: Option<Format>,
     options: &LoadOptions,
+) -> Result<LoadedMesh, LoadError> {
+    load_mesh_from_bytes_in(bytes, name_for_errors, format_hint, options, None)
+}
+
+/// The loader; `base_dir` resolves external glTF buffers.
+fn load_mesh_from_bytes_in(
+    bytes: &[u8],
+    name_for_errors: impl AsRef<Path>,
+    format_hint: Option<Format>,
+    options: &LoadOptions,
+    base_dir: Option<&Path>,
 ) -> Result<LoadedMesh, LoadError> {
     let name = name_for_errors.as_ref();
     let err = |(location, kind): Fail| LoadError::new(name, location, kind);
@@ -214,6 +246,7 @@ pub fn load_mesh_from_bytes_with(
         Format::Stl => stl::parse(bytes),
         Format::Off => off::parse(bytes),
         Format::Ply => ply::parse(bytes),
+        Format::Gltf => gltf_scene::parse(bytes, base_dir),
     }
     .map_err(err)?;
     if raw.triangles.is_empty() {

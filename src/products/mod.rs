@@ -1,11 +1,14 @@
 //! What users run on whole fields: slice images ([`png`], [`colormap`]), voxel-grid files
 //! ([`npy`], [`vti`]), signed distance ([`sdf`]), inside/outside filtering of tetrahedral meshes
-//! ([`tets`]) and per-face classification for booleans ([`classify`]). The grids themselves are
+//! ([`tets`]), per-face classification for booleans ([`classify`]) and dataset labelling
+//! ([`label`], [`npz`]). The grids themselves are
 //! in [`crate::grid`]. See `docs/products.md`.
 
 pub mod classify;
 pub mod colormap;
+pub mod label;
 pub mod npy;
+pub mod npz;
 pub mod png;
 pub mod sdf;
 pub mod tets;

@@ -1,5 +1,5 @@
-//! NumPy `.npy` (format 1.0) writers for n-dimensional arrays in C order: `float64`, `float32`
-//! and `uint8`.
+//! NumPy `.npy` (format 1.0) writers for n-dimensional arrays in C order: `float64`, `float32`,
+//! `uint32`, `uint8` and `bool`.
 
 use std::io::{self, Write};
 use std::path::Path;
@@ -23,6 +23,20 @@ impl NpyElement for f32 {
     const DESCR: &'static str = "<f4";
     fn put(self, out: &mut Vec<u8>) {
         out.extend_from_slice(&self.to_le_bytes());
+    }
+}
+
+impl NpyElement for u32 {
+    const DESCR: &'static str = "<u4";
+    fn put(self, out: &mut Vec<u8>) {
+        out.extend_from_slice(&self.to_le_bytes());
+    }
+}
+
+impl NpyElement for bool {
+    const DESCR: &'static str = "|b1";
+    fn put(self, out: &mut Vec<u8>) {
+        out.push(u8::from(self));
     }
 }
 

@@ -126,6 +126,13 @@ impl<E: Evaluator> SignedDistance<E> {
         signed(self.unsigned(q), self.wn.eval(q))
     }
 
+    /// `(signed distance, winding number)` at `q`: both labels from one call, the sign taken from
+    /// that same `w`.
+    pub fn eval_with_winding(&self, q: [f64; 3]) -> (f64, f64) {
+        let w = self.wn.eval(q);
+        (signed(self.unsigned(q), w), w)
+    }
+
     /// Signed distances at many points, in parallel.
     pub fn eval_batch(&self, points: &[[f64; 3]]) -> Vec<f64> {
         points.par_iter().map(|&q| self.eval(q)).collect()

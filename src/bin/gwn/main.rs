@@ -13,6 +13,7 @@ mod eval;
 mod filter_tets;
 mod r#gen;
 mod info;
+mod label;
 mod method;
 mod sdf;
 mod slice;
@@ -51,6 +52,8 @@ enum Command {
     Gen(r#gen::Args),
     /// Print format, size and topology of a mesh (boundary, non-manifold edges, components…).
     Info(info::Args),
+    /// Label a dataset: sample points per mesh, write w / occupancy / SDF as .npz and a manifest.
+    Label(label::Args),
     /// Signed distance on a voxel grid, signed by the winding number (inside where w > 1/2).
     Sdf(sdf::Args),
     /// Write a PNG slice of the winding-number field (the default job when no subcommand is given).
@@ -86,6 +89,7 @@ fn run(cli: Cli) -> Result<(), common::CliError> {
         Some(Command::FilterTets(a)) => filter_tets::run(a),
         Some(Command::Gen(a)) => r#gen::run(a),
         Some(Command::Info(a)) => info::run(a),
+        Some(Command::Label(a)) => label::run(a),
         Some(Command::Sdf(a)) => sdf::run(a),
         Some(Command::Slice(a)) => slice::run(a),
         Some(Command::Voxelize(a)) => voxelize::run(a),

@@ -17,7 +17,7 @@ use crate::voxelize::GridArgs;
 /// stays correct on open and dirty meshes where pseudo-normal signs fail.
 #[derive(ClapArgs, Debug)]
 pub struct Args {
-    /// Mesh file (OBJ, STL, OFF, PLY) or oriented point cloud (.xyz, .csv, .pts, .ply).
+    /// Mesh file (OBJ, STL, OFF, PLY, glTF/GLB) or oriented point cloud (.xyz, .csv, .pts, .ply).
     pub mesh: PathBuf,
     #[command(flatten)]
     pub grid: GridArgs,

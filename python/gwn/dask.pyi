@@ -1,0 +1,22 @@
+from os import PathLike
+from typing import Any, Optional, Sequence, Union
+
+_Path = Union[str, PathLike]
+
+def label_dataset(
+    paths: Sequence[_Path],
+    out_dir: _Path,
+    client: Optional[Any] = None,
+    *,
+    root: Optional[_Path] = None,
+    uniform: int = 50_000,
+    near: int = 50_000,
+    sigmas: Sequence[float] = (0.005, 0.05),
+    padding: float = 0.05,
+    seed: int = 0,
+    time_limit: Optional[float] = None,
+    weld: Optional[bool] = None,
+    threads_per_task: int = 1,
+) -> list[dict]:
+    """gwn.label_dataset with one Dask task per mesh on `client` (default: the current client);
+    byte-identical outputs."""

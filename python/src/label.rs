@@ -1,0 +1,117 @@
+//! Dataset labelling: `label_dataset` (the whole job, rayon over meshes) and `label_file` (one
+//! mesh, the unit of a Dask task). Both call `gwn::products::label`, so the `.npz` files are the
+//! CLI's, byte for byte, and rows come back as the manifest's JSON lines.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use gwn::io::LoadOptions;
+use gwn::products::label::{self, JobOptions, SamplingOptions};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+use crate::errors::value_error;
+use crate::threads;
+
+#[allow(clippy::too_many_arguments)]
+fn job_options(
+    uniform: usize,
+    near: usize,
+    sigmas: Vec<f64>,
+    padding: f64,
+    seed: u64,
+    time_limit: Option<f64>,
+    weld: Option<bool>,
+) -> PyResult<JobOptions> {
+    let time_limit = match time_limit {
+        Some(s) if s.is_finite() && s > 0.0 && s < 1e9 => Some(Duration::from_secs_f64(s)),
+        Some(s) => {
+            return Err(PyValueError::new_err(format!(
+                "time_limit must be a positive number of seconds, got {s}"
+            )));
+        }
+        None => None,
+    };
+    let sampling = SamplingOptions {
+        uniform,
+        near,
+        sigmas,
+        padding,
+        seed,
+    };
+    sampling.validate().map_err(value_error)?;
+    Ok(JobOptions {
+        sampling,
+        time_limit,
+        load: LoadOptions { weld },
+    })
+}
+
+/// Labels every mesh of ``paths`` into ``out_dir`` (see ``gwn label --help``): per mesh,
+/// ``uniform`` points in the bounding box padded by ``padding`` × diagonal and ``near`` points
+/// near the surface (Gaussian offsets of ``sigmas`` × diagonal), labelled with the exact winding
+/// number ``w``, ``occupancy`` (w > 1/2) and ``sdf``; one ``.npz`` per mesh at
+/// ``out_dir/<path below root>.npz`` and ``out_dir/manifest.jsonl``. Meshes whose output exists
+/// are skipped (resumable); broken files, panics and ``time_limit`` overruns are rows, not
+/// exceptions. Returns the manifest rows as JSON strings, in input order.
+#[pyfunction]
+#[pyo3(signature = (paths, out_dir, *, root = None, uniform = 50_000, near = 50_000,
+    sigmas = vec![0.005, 0.05], padding = 0.05, seed = 0, time_limit = None, weld = None,
+    threads = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn label_dataset(
+    py: Python<'_>,
+    paths: Vec<PathBuf>,
+    out_dir: PathBuf,
+    root: Option<PathBuf>,
+    uniform: usize,
+    near: usize,
+    sigmas: Vec<f64>,
+    padding: f64,
+    seed: u64,
+    time_limit: Option<f64>,
+    weld: Option<bool>,
+    threads: Option<usize>,
+) -> PyResult<Vec<String>> {
+    let opts = job_options(uniform, near, sigmas, padding, seed, time_limit, weld)?;
+    let rows = threads::run(py, threads, move || {
+        label::label_dataset(&paths, &out_dir, root.as_deref(), &opts, |_| {})
+    })?
+    .map_err(value_error)?;
+    Ok(rows.iter().map(|r| r.to_json()).collect())
+}
+
+/// Labels one mesh into ``out_dir`` (skipped when its output exists) and returns its manifest
+/// row as a JSON string. ``root`` must be the same for every mesh of a dataset (see
+/// ``common_root``): it fixes the output path and the mesh's seed.
+#[pyfunction]
+#[pyo3(signature = (path, out_dir, root, *, uniform = 50_000, near = 50_000,
+    sigmas = vec![0.005, 0.05], padding = 0.05, seed = 0, time_limit = None, weld = None,
+    threads = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn label_file(
+    py: Python<'_>,
+    path: PathBuf,
+    out_dir: PathBuf,
+    root: PathBuf,
+    uniform: usize,
+    near: usize,
+    sigmas: Vec<f64>,
+    padding: f64,
+    seed: u64,
+    time_limit: Option<f64>,
+    weld: Option<bool>,
+    threads: Option<usize>,
+) -> PyResult<String> {
+    let opts = job_options(uniform, near, sigmas, padding, seed, time_limit, weld)?;
+    let root = std::path::absolute(&root).unwrap_or(root);
+    threads::run(py, threads, move || {
+        label::label_file(&path, &root, &out_dir, &opts).to_json()
+    })
+}
+
+/// The deepest folder holding every path (absolute): the default ``root`` of a dataset.
+#[pyfunction]
+pub fn common_root(paths: Vec<PathBuf>) -> PathBuf {
+    label::common_root(&paths)
+}
