@@ -459,7 +459,7 @@ fn assemble(mode: Mode, order: &[u32], what: &str) -> Result<Vec<[u32; 3]>, Fail
     let n = order.len();
     Ok(match mode {
         Mode::Triangles => {
-            if n % 3 != 0 {
+            if !n.is_multiple_of(3) {
                 return Err(syntax(format!(
                     "{what}: {n} indices are not a whole number of triangles"
                 )));
