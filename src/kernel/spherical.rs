@@ -46,10 +46,45 @@ pub fn signed_double_atan2(s: i32, mag: f64, den: f64) -> f64 {
 /// (e.g. 1/8) at a convex corner. Never NaN for finite input.
 #[inline]
 pub fn triangle_solid_angle(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
+    if let Some(w) = solid_angle_moderate(a, b, c, 0.0) {
+        return w;
+    }
     match solid_angle_parts(a, b, c) {
         Some((sign, det, den)) => signed_double_atan2(sign, det.abs(), den),
         None => 0.0,
     }
+}
+
+/// The common case in the textbook form (no normalization, as fast as before the magnitude
+/// fixes): when every `|r|²` is a normal `f64` far from over- and underflow, and
+/// `√(det² + den²) ≥ condition·|a||b||c|`. `None` sends the triangle to the careful path
+/// ([`solid_angle_parts`], double-double).
+#[inline]
+fn solid_angle_moderate(a: [f64; 3], b: [f64; 3], c: [f64; 3], condition: f64) -> Option<f64> {
+    let (la2, lb2, lc2) = (dot(a, a), dot(b, b), dot(c, c));
+    let (lo, hi) = (la2.min(lb2).min(lc2), la2.max(lb2).max(lc2));
+    if !(lo > 1e-180 && hi < 1e180) {
+        return None;
+    }
+    let det = dot(a, cross(b, c));
+    if det == 0.0 {
+        return Some(0.0);
+    }
+    let (la, lb, lc) = (la2.sqrt(), lb2.sqrt(), lc2.sqrt());
+    let labc = la * lb * lc;
+    let den = labc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
+    if det.abs() <= 1e-12 * labc {
+        // See the zero-area test of `solid_angle_parts`.
+        let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+        if cross(e1, e2) == [0.0; 3] {
+            return Some(0.0);
+        }
+    }
+    if det * det + den * den < (condition * labc) * (condition * labc) {
+        return None;
+    }
+    Some(2.0 * det.atan2(den))
 }
 
 /// `(sign, â·(b̂×ĉ), 1 + â·b̂ + b̂·ĉ + ĉ·â)`, or `None` when the triangle subtends nothing
@@ -63,9 +98,15 @@ fn solid_angle_parts(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> Option<(i32, f64,
         .iter()
         .flatten()
         .fold(0.0_f64, |m, x| m.max(x.abs()));
-    let s = power_of_two_scale(m);
-    let scaled = |v: [f64; 3]| v.map(|x| x * s[0] * s[1]);
-    let raw = dot(scaled(a), cross(scaled(b), scaled(c)));
+    // Products of three components stay in range below 2^300: no scaling needed (the common case).
+    let (a, b, c) = if (MODERATE_LO..=MODERATE_HI).contains(&m) {
+        (a, b, c)
+    } else {
+        let s = power_of_two_scale(m);
+        let scaled = |v: [f64; 3]| v.map(|x| x * s[0] * s[1]);
+        (scaled(a), scaled(b), scaled(c))
+    };
+    let raw = dot(a, cross(b, c));
     let sign = if raw != 0.0 {
         if raw > 0.0 { 1 } else { -1 }
     } else {
@@ -74,9 +115,9 @@ fn solid_angle_parts(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> Option<(i32, f64,
     if sign == 0 {
         return None;
     }
-    let (a, b, c) = (unit(a), unit(b), unit(c));
-    let det = dot(a, cross(b, c));
-    let den = 1.0 + dot(a, b) + dot(b, c) + dot(c, a);
+    let (ua, ub, uc) = (unit(a), unit(b), unit(c));
+    let det = dot(ua, cross(ub, uc));
+    let den = 1.0 + dot(ua, ub) + dot(ub, uc) + dot(uc, ua);
     if det.abs() <= 1e-12 {
         // A zero-area triangle subtends no solid angle. Without this test, a collinear triangle
         // seen from a point close to its line gives det ≈ ±tiny against den ≤ 0 or den ≈ 0,
@@ -133,13 +174,18 @@ pub const SOLID_ANGLE_CONDITION: f64 = 1.0 / 64.0;
 /// triangles ([`SOLID_ANGLE_CONDITION`]) are evaluated in double-double.
 #[inline]
 pub fn triangle_solid_angle_at(p: [[f64; 3]; 3], q: [f64; 3]) -> f64 {
+    // The rounded offsets are the leading parts of the exact ones: the fast path needs no more.
+    let f = p.map(|v| [v[0] - q[0], v[1] - q[1], v[2] - q[2]]);
+    if let Some(w) = solid_angle_moderate(f[0], f[1], f[2], SOLID_ANGLE_CONDITION) {
+        return w;
+    }
     let r: [[DoubleDouble; 3]; 3] =
         p.map(|v| std::array::from_fn(|k| DoubleDouble::diff(v[k], q[k])));
     let f = r.map(|v| v.map(|c| c.hi));
     let Some((sign, det, den)) = solid_angle_parts(f[0], f[1], f[2]) else {
         return 0.0;
     };
-    if det.hypot(den) >= SOLID_ANGLE_CONDITION {
+    if det * det + den * den >= SOLID_ANGLE_CONDITION * SOLID_ANGLE_CONDITION {
         return signed_double_atan2(sign, det.abs(), den);
     }
     let [a, b, c] = r.map(unit_dd);
@@ -153,13 +199,21 @@ pub fn triangle_solid_angle_at(p: [[f64; 3]; 3], q: [f64; 3]) -> f64 {
     signed_double_atan2(sign, det.value().abs(), den.value())
 }
 
-/// `v/|v|`, scaled by a power of two first so that neither `|v|²` overflows nor underflows.
+/// `v/|v|`, scaled by a power of two first when needed so that `|v|²` neither overflows nor
+/// underflows.
 #[inline]
 fn unit(v: [f64; 3]) -> [f64; 3] {
-    let s = power_of_two_scale(v[0].abs().max(v[1].abs()).max(v[2].abs()));
-    let v = v.map(|c| c * s[0] * s[1]);
-    normalized(v)
+    let m = v[0].abs().max(v[1].abs()).max(v[2].abs());
+    if (MODERATE_LO..=MODERATE_HI).contains(&m) {
+        return normalized(v);
+    }
+    let s = power_of_two_scale(m);
+    normalized(v.map(|c| c * s[0] * s[1]))
 }
+
+/// Magnitudes between which products of three offset components stay normal `f64`s.
+const MODERATE_LO: f64 = 1e-90;
+const MODERATE_HI: f64 = 1e90;
 
 /// [`unit`] in double-double.
 fn unit_dd(v: [DoubleDouble; 3]) -> [DoubleDouble; 3] {
