@@ -9,9 +9,11 @@
 pub mod boundary;
 mod point_cloud;
 pub mod stats;
+mod tet_mesh;
 
 pub use boundary::{BoundaryEdge, boundary_edges};
 pub use point_cloud::{PointCloud, PointCloudError};
+pub use tet_mesh::TetMesh;
 
 use crate::error::MeshError;
 
