@@ -104,12 +104,14 @@ impl From<BuildError> for WindingNumberError {
 /// NaN for a non-finite query; an invalid mesh is an error.
 ///
 /// ```
-/// // The unit cube without its top face: w = 5/6 at the centre.
+/// // The unit cube without its top face: w = 5/6 at the centre; below it, the missing face is
+/// // seen from outside, w = −Ω/4π with Ω = 4·atan(1/(8·√4.5)) the face's solid angle.
 /// let p = [[0.,0.,0.],[1.,0.,0.],[1.,1.,0.],[0.,1.,0.],[0.,0.,1.],[1.,0.,1.],[1.,1.,1.],[0.,1.,1.]];
 /// let t: [[usize; 3]; 10] =
 ///     [[0,2,1],[0,3,2],[0,1,5],[0,5,4],[1,2,6],[1,6,5],[2,3,7],[2,7,6],[3,0,4],[3,4,7]];
 /// let w = gwn::winding_number(&p, &t, &[[0.5, 0.5, 0.5], [0.5, 0.5, -1.0]])?;
-/// assert!((w[0] - 5.0 / 6.0).abs() < 1e-14 && w[1].abs() < 1e-14);
+/// let below = -(1.0_f64 / (8.0 * 4.5_f64.sqrt())).atan() / std::f64::consts::PI;
+/// assert!((w[0] - 5.0 / 6.0).abs() < 1e-14 && (w[1] - below).abs() < 1e-14);
 /// assert!(gwn::winding_number(&p, &[[0usize, 1, 8]], &[[0.0; 3]]).is_err());
 /// # Ok::<(), gwn::WindingNumberError>(())
 /// ```

@@ -9,11 +9,13 @@
 pub mod boundary;
 mod point_cloud;
 pub mod stats;
+mod tet_mesh;
 
 pub use boundary::{
     BoundaryEdge, boundary_edges, boundary_welded_by, geometric_boundary_edges, signed_boundary,
 };
 pub use point_cloud::{PointCloud, PointCloudError};
+pub use tet_mesh::TetMesh;
 
 use crate::error::MeshError;
 
