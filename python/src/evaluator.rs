@@ -12,9 +12,8 @@ use gwn::kernel::quantize::Precision;
 use rayon::prelude::*;
 
 /// `1/4π` exactly as `WindingNumber::eval` multiplies the boundary sum with, so that
-/// `chi + fraction` is bit-identical to the value (the library keeps its copy private; issue 13
-/// gives the constant one public home).
-const INV_4PI: f64 = 1.0 / (4.0 * std::f64::consts::PI);
+/// `chi + fraction` is bit-identical to the value.
+use gwn::kernel::spherical::INV_4PI;
 
 /// The evaluation method a user asked for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

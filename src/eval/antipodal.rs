@@ -34,7 +34,7 @@ use crate::kernel::quantize::{Grid, GridRangeError, Precision, Snap};
 use crate::kernel::spherical::{EdgeSigns, antipodal_edge_area, segment_gradient};
 use crate::mesh::{boundary_edges, boundary_welded_by};
 
-const INV_4PI: f64 = 1.0 / (4.0 * std::f64::consts::PI);
+use crate::kernel::spherical::INV_4PI;
 
 /// Options of the exact evaluator.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -17,7 +17,7 @@ use crate::Mesh;
 use crate::kernel::compensated::NeumaierSum;
 use crate::kernel::spherical::{segment_gradient, triangle_solid_angle_at};
 
-const INV_4PI: f64 = 1.0 / (4.0 * std::f64::consts::PI);
+use crate::kernel::spherical::INV_4PI;
 
 /// Winding number of `mesh` at `q` by the direct sum. `O(F)`.
 pub fn winding_number_direct(mesh: &Mesh, q: [f64; 3]) -> f64 {

@@ -1,9 +1,12 @@
 //! The exact kernel. Nothing outside this module computes a predicate or chooses an `atan2`
 //! branch.
 //!
-//! - [`quantize`]: the fixed-point grid (power-of-two cell size) and the query clamp;
+//! - [`quantize`]: the fixed-point grid (power-of-two cell size, exact power-of-two rescaling),
+//!   exact snapping with residuals, and the query clamp;
+//! - [`frame`]: the ray frames (the six axis directions as proper rotations);
 //! - [`predicates`]: the symbolically perturbed orientation sign shared by the ray–triangle test
-//!   and the atan2 branch, and the perturbed depth test (filter + exact fallback);
+//!   and the atan2 branch, and the perturbed depth test (filter + exact fallback), also at
+//!   queries off the lattice;
 //! - [`spherical`]: the solid-angle and spherical-triangle formulas;
 //! - [`angle_sum`]: sums of many `atan2` terms as one complex product with turn counting;
 //! - [`boundary`]: the SIMD loop over the boundary edges of the Antipodal formula;

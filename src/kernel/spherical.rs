@@ -9,6 +9,9 @@
 //!   predicate and the symbolic limits of the degenerate configurations written out.
 
 use super::double_double::{DoubleDouble, dot3};
+
+/// `1/(4π)`: a solid angle (or a sum of spherical areas) as a winding number.
+pub const INV_4PI: f64 = 1.0 / (4.0 * std::f64::consts::PI);
 use super::quantize::decompose;
 
 /// `2·atan2(s·mag, den)` where the sign `s ∈ {−1, 0, 1}` of the numerator was decided exactly.
@@ -466,32 +469,6 @@ mod tests {
         assert_eq!(signed_double_atan2(-1, 0.0, -1.0), -2.0 * PI);
         assert_eq!(signed_double_atan2(-1, 0.0, 1.0), 0.0);
         assert_eq!(signed_double_atan2(0, 1.0, -1.0), 0.0);
-    }
-
-    #[test]
-    fn simd_atan2_matches_std() {
-        // The boundary loop (kernel::boundary) relies on wide's f64x4::atan2.
-        let mut x: u64 = 12345;
-        let mut next = || {
-            x = x
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((x >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        };
-        let mut worst = 0.0f64;
-        for _ in 0..50000 {
-            let y: [f64; 4] = std::array::from_fn(|_| next() * 10f64.powi((next() * 12.0) as i32));
-            let d: [f64; 4] = std::array::from_fn(|_| next() * 10f64.powi((next() * 12.0) as i32));
-            let got = wide::f64x4::from(y).atan2(wide::f64x4::from(d)).to_array();
-            for l in 0..4 {
-                let want = y[l].atan2(d[l]);
-                let ulps =
-                    (got[l] - want).abs() / (f64::EPSILON * want.abs().max(f64::MIN_POSITIVE));
-                worst = worst.max(ulps);
-                assert!(ulps <= 4.0, "{} {}: {} vs {want}", y[l], d[l], got[l]);
-            }
-        }
-        eprintln!("wide f64x4::atan2: worst {worst:.2} ulp vs std over 200000 samples");
     }
 
     #[test]

@@ -14,7 +14,7 @@ use crate::BoundingBox;
 use crate::kernel::compensated::NeumaierSum;
 use crate::mesh::PointCloud;
 
-const INV_4PI: f64 = 1.0 / (4.0 * std::f64::consts::PI);
+use crate::kernel::spherical::INV_4PI;
 
 /// Largest number of points in a leaf. Barill et al. found clouds fastest with tiny cells.
 pub const POINT_LEAF_SIZE: usize = 4;

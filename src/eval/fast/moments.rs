@@ -26,7 +26,7 @@ use wide::f32x4;
 
 use crate::kernel::spherical::{cross, dot};
 
-const INV_4PI: f64 = 1.0 / (4.0 * std::f64::consts::PI);
+use crate::kernel::spherical::INV_4PI;
 
 /// Index pairs `(i, j)` of the six independent entries of a symmetric 3×3 matrix, in the order
 /// `M2` stores them: the diagonal first, then `xy, xz, yz`.

@@ -12,7 +12,7 @@ use crate::kernel::angle_sum::AngleSum;
 use crate::kernel::spherical::{segment_gradient, triangle_solid_angle};
 use crate::{BoundingBox, Mesh};
 
-const INV_4PI: f64 = 1.0 / (4.0 * std::f64::consts::PI);
+use crate::kernel::spherical::INV_4PI;
 
 /// Largest number of triangles in a leaf (summed exactly when the leaf is near the query).
 pub const TRIANGLE_LEAF_SIZE: usize = 4;
