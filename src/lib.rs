@@ -35,6 +35,7 @@ pub mod grid;
 pub mod io;
 pub mod kernel;
 pub mod mesh;
+pub mod patch;
 pub mod products;
 #[cfg(any(feature = "testing", feature = "cli"))]
 pub mod testing;
