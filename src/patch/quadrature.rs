@@ -81,28 +81,36 @@ pub struct Integral {
     pub evaluations: usize,
 }
 
-/// One 15-point Kronrod and embedded 7-point Gauss value on `[a, b]`.
+/// One 15-point Kronrod and embedded 7-point Gauss value on `[a, b]`, and the Kronrod value
+/// of `|f|` (the scale of the rounding in the sums).
 #[inline]
-pub fn gk15(f: &mut impl FnMut(f64) -> f64, a: f64, b: f64) -> (f64, f64) {
+pub fn gk15(f: &mut impl FnMut(f64) -> f64, a: f64, b: f64) -> (f64, f64, f64) {
     let c = 0.5 * (a + b);
     let h = 0.5 * (b - a);
     let fc = f(c);
     let mut k = WGK[7] * fc;
     let mut g = WG[3] * fc;
+    let mut kabs = WGK[7] * fc.abs();
     for i in 0..7 {
         let x = h * XGK[i];
-        let s = f(c - x) + f(c + x);
-        k += WGK[i] * s;
+        let (fl, fr) = (f(c - x), f(c + x));
+        k += WGK[i] * (fl + fr);
+        kabs += WGK[i] * (fl.abs() + fr.abs());
         if i % 2 == 1 {
-            g += WG[i / 2] * s;
+            g += WG[i / 2] * (fl + fr);
         }
     }
-    (k * h, g * h)
+    (k * h, g * h, kabs * h.abs())
 }
 
+/// `|K15 − G7|` below this multiple of `ε·∫|f|` is rounding, not truncation: splitting further
+/// cannot reduce it (without this floor a tolerance below rounding bisects to the depth limit
+/// everywhere).
+const ROUNDING_FLOOR: f64 = 50.0 * f64::EPSILON;
+
 /// `∫_a^b f` to absolute tolerance `tol` by adaptive bisection: an interval is accepted when
-/// `|K15 − G7| ≤ tol · length / (b − a)` (so the accepted errors sum to at most `tol`), or at
-/// the depth limit.
+/// `|K15 − G7| ≤ tol · length / (b − a)` (so the accepted errors sum to at most `tol`), when the
+/// difference is at the rounding level of the interval, or at the depth limit.
 pub fn integrate(mut f: impl FnMut(f64) -> f64, a: f64, b: f64, tol: f64) -> Integral {
     let total = b - a;
     let mut value = NeumaierSum::new();
@@ -110,10 +118,10 @@ pub fn integrate(mut f: impl FnMut(f64) -> f64, a: f64, b: f64, tol: f64) -> Int
     let mut evaluations = 0;
     let mut stack = vec![(a, b, 0u32)];
     while let Some((lo, hi, depth)) = stack.pop() {
-        let (k, g) = gk15(&mut f, lo, hi);
+        let (k, g, kabs) = gk15(&mut f, lo, hi);
         evaluations += 15;
         let err = (k - g).abs();
-        let allowed = tol * ((hi - lo) / total);
+        let allowed = (tol * ((hi - lo) / total)).max(ROUNDING_FLOOR * kabs);
         if err <= allowed || depth >= MAX_DEPTH || !err.is_finite() {
             value.add(k);
             error += err;
@@ -140,10 +148,10 @@ mod tests {
         let sg: f64 = 2.0 * WG[..3].iter().sum::<f64>() + WG[3];
         assert!((sk - 2.0).abs() < 1e-15 && (sg - 2.0).abs() < 1e-15);
         // K15 is exact to degree 22, G7 to degree 13.
-        let (k, g) = gk15(&mut |x: f64| x.powi(22), 0.0, 1.0);
+        let (k, g, _) = gk15(&mut |x: f64| x.powi(22), 0.0, 1.0);
         assert!((k - 1.0 / 23.0).abs() < 1e-15);
         assert!((g - 1.0 / 23.0).abs() > 1e-8);
-        let (k, g) = gk15(&mut |x: f64| x.powi(13), -1.0, 2.0);
+        let (k, g, _) = gk15(&mut |x: f64| x.powi(13), -1.0, 2.0);
         let exact = (2f64.powi(14) - 1.0) / 14.0;
         assert!((k - exact).abs() < 1e-11 && (g - exact).abs() < 1e-11);
     }
