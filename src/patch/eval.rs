@@ -85,6 +85,8 @@ pub struct PatchWindingNumber {
     set: PatchSet,
     links: Vec<[EdgeLink; 4]>,
     edges: Vec<[Vec<usize>; 4]>,
+    /// World bounding box of each patch's control points.
+    boxes: Vec<([f64; 3], [f64; 3])>,
     options: Options,
 }
 
@@ -117,10 +119,26 @@ impl PatchWindingNumber {
                 std::array::from_fn(|e| edge_indices(m, n, e))
             })
             .collect();
+        let boxes = set
+            .patches()
+            .iter()
+            .map(|p| {
+                let mut lo = [f64::INFINITY; 3];
+                let mut hi = [f64::NEG_INFINITY; 3];
+                for x in p.points() {
+                    for a in 0..3 {
+                        lo[a] = lo[a].min(x[a]);
+                        hi[a] = hi[a].max(x[a]);
+                    }
+                }
+                (lo, hi)
+            })
+            .collect();
         PatchWindingNumber {
             set: set.clone(),
             links,
             edges,
+            boxes,
             options,
         }
     }
@@ -163,30 +181,34 @@ impl PatchWindingNumber {
             tol: self.options.tolerance * 4.0 * PI * 0.1,
             out: Evaluation::default(),
         };
-        let nets: Vec<Net> = self
-            .set
-            .patches()
-            .iter()
+        let ray = self.options.ray;
+        let frame_point = |p: usize, k: usize| -> [f64; 3] {
+            let pt = self.set.patches()[p].points()[k];
+            ray.to_frame([pt[0] - q[0], pt[1] - q[1], pt[2] - q[2]])
+        };
+        let forms: Vec<Option<Form>> = (0..self.set.patches().len())
             .map(|p| {
-                let (m, n) = p.degree();
-                let h = p
-                    .points()
-                    .iter()
-                    .zip(p.weights())
-                    .map(|(pt, &w)| {
-                        let d = self
-                            .options
-                            .ray
-                            .to_frame([pt[0] - q[0], pt[1] - q[1], pt[2] - q[2]]);
-                        [w * d[0], w * d[1], w * d[2], w]
-                    })
-                    .collect();
-                Net { m, n, h }
+                let z = self.frame_z_range(p, q);
+                classify_points(
+                    (0..self.set.patches()[p].points().len()).map(|k| frame_point(p, k)),
+                    Some(z),
+                )
             })
             .collect();
-        let forms: Vec<Option<Form>> = nets.iter().map(classify).collect();
-        let edge_ctrl = |p: usize, e: usize| -> Vec<Homogeneous> {
-            self.edges[p][e].iter().map(|&k| nets[p].h[k]).collect()
+        let mut buf = [[0.0f64; 4]; super::model::MAX_DEGREE + 1];
+        let fill = |p: usize, e: usize, buf: &mut [Homogeneous]| -> usize {
+            let idx = &self.edges[p][e];
+            let weights = self.set.patches()[p].weights();
+            for (slot, &k) in buf.iter_mut().zip(idx) {
+                let d = frame_point(p, k);
+                let w = weights[k];
+                *slot = [w * d[0], w * d[1], w * d[2], w];
+            }
+            idx.len()
+        };
+        let mut edge_ctrl = |p: usize, e: usize| -> Vec<Homogeneous> {
+            let len = fill(p, e, &mut buf);
+            buf[..len].to_vec()
         };
         for (p, form) in forms.iter().enumerate() {
             let Some(form) = *form else { continue };
@@ -204,10 +226,18 @@ impl PatchWindingNumber {
             }
         }
         let mut leaf_edges = Vec::new();
-        for (p, net) in nets.into_iter().enumerate() {
+        for (p, patch) in self.set.patches().iter().enumerate() {
             if forms[p].is_none() {
                 acc.out.mixed_patches += 1;
-                self.subdivide(net, &mut leaf_edges, &mut acc);
+                let (m, n) = patch.degree();
+                let h = (0..patch.points().len())
+                    .map(|k| {
+                        let d = frame_point(p, k);
+                        let w = patch.weights()[k];
+                        [w * d[0], w * d[1], w * d[2], w]
+                    })
+                    .collect();
+                self.subdivide(Net { m, n, h }, &mut leaf_edges, &mut acc);
             }
         }
         acc.leaf_edges(leaf_edges);
@@ -215,6 +245,20 @@ impl PatchWindingNumber {
         out.value = acc.sum.value() / (4.0 * PI);
         out.error_estimate /= 4.0 * PI;
         out
+    }
+
+    /// `(min, max, scale)` of the frame `z` of patch `p`'s control points relative to `q`, from
+    /// its world box: `fl(x − q)` is monotone in `x`, so these are the extremes of the per-point
+    /// values, exactly. `scale` bounds every frame coordinate's magnitude.
+    fn frame_z_range(&self, p: usize, q: [f64; 3]) -> (f64, f64, f64) {
+        let (lo, hi) = self.boxes[p];
+        let [_, _, (axis, negated)] = self.options.ray.map();
+        let (a, b) = (lo[axis] - q[axis], hi[axis] - q[axis]);
+        let mut scale = 0.0f64;
+        for k in 0..3 {
+            scale = scale.max((lo[k] - q[k]).abs()).max((hi[k] - q[k]).abs());
+        }
+        if negated { (-b, -a, scale) } else { (a, b, scale) }
     }
 
     /// Halves a mixed net until its pieces are classified; records their edges.
@@ -366,46 +410,52 @@ impl LeafEdge {
     }
 }
 
-/// The plane normals tried, in order: the four axis directions and four diagonals of the `xy`
-/// plane (they contain the ray's line, so they certify either form), then the same tilted
-/// towards `−z` (certify [`Form::Down`]) and towards `+z` ([`Form::Up`]).
-fn candidate_normals() -> impl Iterator<Item = ([f64; 3], Option<Form>)> {
-    const H: [[f64; 2]; 8] = [
-        [1.0, 0.0],
-        [-1.0, 0.0],
-        [0.0, 1.0],
-        [0.0, -1.0],
-        [1.0, 1.0],
-        [-1.0, 1.0],
-        [-1.0, -1.0],
-        [1.0, -1.0],
-    ];
-    let flat = H.into_iter().map(|h| ([h[0], h[1], 0.0], None));
-    let down = H.into_iter().map(|h| ([h[0], h[1], -1.0], Some(Form::Down)));
-    let up = H.into_iter().map(|h| ([h[0], h[1], 1.0], Some(Form::Up)));
-    flat.chain(down).chain(up)
-}
+/// The eight axis and diagonal directions of the `xy` plane.
+const DIRECTIONS: [[f64; 2]; 8] = [
+    [1.0, 0.0],
+    [1.0, 1.0],
+    [0.0, 1.0],
+    [-1.0, 1.0],
+    [-1.0, 0.0],
+    [-1.0, -1.0],
+    [0.0, -1.0],
+    [1.0, -1.0],
+];
 
-/// The form a net's piece can use, or `None` if it must be subdivided.
+/// The form a leaf net can use, or `None` if it must be subdivided.
 fn classify(net: &Net) -> Option<Form> {
-    let pts: Vec<[f64; 3]> = net
-        .h
-        .iter()
-        .map(|h| {
+    classify_points(
+        net.h.iter().map(|h| {
             if h[3] == 1.0 {
                 [h[0], h[1], h[2]]
             } else {
                 [h[0] / h[3], h[1] / h[3], h[2] / h[3]]
             }
-        })
-        .collect();
-    let mut scale = 0.0f64;
-    let (mut z0, mut z1) = (f64::INFINITY, f64::NEG_INFINITY);
-    for p in &pts {
-        scale = scale.max(p[0].abs()).max(p[1].abs()).max(p[2].abs());
-        z0 = z0.min(p[2]);
-        z1 = z1.max(p[2]);
-    }
+        }),
+        None,
+    )
+}
+
+/// The form a piece with (Euclidean, frame, query-relative) control points `pts` can use, or
+/// `None` if it must be subdivided. `z` is `(min z, max z, coordinate scale)` when known.
+///
+/// First the exact height tests; then separating planes through the query with margin `μ`,
+/// tried in the direction of the control points' mean: the flat plane whose normal is the
+/// direction `h` (of [`DIRECTIONS`]) closest to the mean's azimuth, its two neighbours, and the
+/// best one tilted towards `−z` (certifies [`Form::Down`]) and `+z` ([`Form::Up`]).
+fn classify_points(
+    pts: impl Iterator<Item = [f64; 3]> + Clone,
+    z: Option<(f64, f64, f64)>,
+) -> Option<Form> {
+    let (z0, z1, scale) = z.unwrap_or_else(|| {
+        let mut r = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
+        for p in pts.clone() {
+            r.0 = r.0.min(p[2]);
+            r.1 = r.1.max(p[2]);
+            r.2 = r.2.max(p[0].abs()).max(p[1].abs()).max(p[2].abs());
+        }
+        r
+    });
     let slack = Z_SLACK * scale;
     if z0 > slack {
         return Some(Form::Up);
@@ -413,16 +463,43 @@ fn classify(net: &Net) -> Option<Form> {
     if z1 < -slack {
         return Some(Form::Down);
     }
+    let (mut mx, mut my) = (0.0, 0.0);
+    for p in pts.clone() {
+        let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+        if r > 0.0 {
+            mx += p[0] / r;
+            my += p[1] / r;
+        }
+    }
+    let best = (0..8)
+        .max_by(|&a, &b| {
+            let score = |i: usize| {
+                let h = DIRECTIONS[i];
+                (h[0] * mx + h[1] * my) / (h[0].abs() + h[1].abs()).sqrt()
+            };
+            score(a).total_cmp(&score(b))
+        })
+        .unwrap_or(0);
     let m2 = MARGIN * MARGIN;
-    for (n, form) in candidate_normals() {
+    let separates = |n: [f64; 3]| {
         let nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
-        let separated = pts.iter().all(|p| {
+        pts.clone().all(|p| {
             let d = n[0] * p[0] + n[1] * p[1] + n[2] * p[2];
             d > 0.0 && d * d >= m2 * nn * (p[0] * p[0] + p[1] * p[1] + p[2] * p[2])
-        });
-        if separated {
-            return Some(form.unwrap_or(Form::Down));
+        })
+    };
+    for i in [best, (best + 1) % 8, (best + 7) % 8] {
+        let h = DIRECTIONS[i];
+        if separates([h[0], h[1], 0.0]) {
+            return Some(Form::Down);
         }
+    }
+    let h = DIRECTIONS[best];
+    if separates([h[0], h[1], -1.0]) {
+        return Some(Form::Down);
+    }
+    if separates([h[0], h[1], 1.0]) {
+        return Some(Form::Up);
     }
     None
 }

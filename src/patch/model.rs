@@ -232,6 +232,49 @@ impl Patch {
     pub fn eval(&self, s: f64, t: f64) -> [f64; 3] {
         self.eval_with_partials(s, t).0
     }
+
+    /// The two halves of the patch split at parameter `tau ∈ (0, 1)` of `s` (`along_s`) or `t`
+    /// (de Casteljau on the homogeneous net). The halves share the split curve's control points
+    /// bit for bit, so their common edge cancels exactly in the boundary.
+    pub fn split(&self, along_s: bool, tau: f64) -> (Patch, Patch) {
+        let (m, n) = self.degree;
+        let h: Vec<[f64; 4]> = self
+            .points
+            .iter()
+            .zip(&self.weights)
+            .map(|(p, &w)| [w * p[0], w * p[1], w * p[2], w])
+            .collect();
+        // Lines along the split direction: columns for s, rows for t.
+        let (lines, len) = if along_s { (n + 1, m + 1) } else { (m + 1, n + 1) };
+        let at = |line: usize, k: usize| if along_s { k * (n + 1) + line } else { line * (n + 1) + k };
+        let mut a = h.clone();
+        let mut b = h.clone();
+        for line in 0..lines {
+            let mut work: Vec<[f64; 4]> = (0..len).map(|k| h[at(line, k)]).collect();
+            let d = len - 1;
+            a[at(line, 0)] = work[0];
+            b[at(line, d)] = work[d];
+            for level in 1..=d {
+                for i in 0..=(d - level) {
+                    for c in 0..4 {
+                        work[i][c] = (1.0 - tau) * work[i][c] + tau * work[i + 1][c];
+                    }
+                }
+                a[at(line, level)] = work[0];
+                b[at(line, d - level)] = work[d - level];
+            }
+        }
+        let back = |h: Vec<[f64; 4]>| {
+            let points = h.iter().map(|q| [q[0] / q[3], q[1] / q[3], q[2] / q[3]]).collect();
+            let weights = h.iter().map(|q| q[3]).collect();
+            Patch {
+                degree: (m, n),
+                points,
+                weights,
+            }
+        };
+        (back(a), back(b))
+    }
 }
 
 /// The Bernstein basis `B_i^d(x)`, `i = 0..=d`, and its derivative.

@@ -74,10 +74,12 @@ impl From<Ray> for RayAxis {
 ///   gwn eval mesh.off --points q.txt --gradient --gradient-out g.npy
 ///   gwn eval soup.stl --points q.csv --method fast --beta 2 --order 2
 ///   gwn eval cloud.xyz --points q.csv
+///   gwn eval teapot.bpt --points q.npy --ray -x       # Bézier patches (.bpt / rational .rbpt)
 #[derive(ClapArgs, Debug)]
 #[command(verbatim_doc_comment)]
 pub struct Args {
-    /// Mesh file (.obj, .stl, .off, .ply) or oriented point cloud (.xyz, .csv, .pts, .ply).
+    /// Mesh file (.obj, .stl, .off, .ply), oriented point cloud (.xyz, .csv, .pts, .ply), or
+    /// Bézier patch set (.bpt, rational .rbpt).
     pub mesh: PathBuf,
     /// Query points file (.csv/.txt/.xyz text or .npy).
     #[arg(long)]
@@ -112,6 +114,10 @@ pub struct Args {
     /// Do not weld bit-identical vertices of STL files.
     #[arg(long)]
     pub no_weld: bool,
+    /// Patch sets: target absolute error of w (boundary quadrature of the exact method, surface
+    /// quadrature of the direct method).
+    #[arg(long, default_value_t = 1e-10)]
+    pub tolerance: f64,
 }
 
 fn parse_precision(s: &str) -> Result<u32, String> {
@@ -124,6 +130,9 @@ fn parse_precision(s: &str) -> Result<u32, String> {
 
 /// Runs `gwn eval`.
 pub fn run(args: Args) -> Result<(), CliError> {
+    if gwn::patch::is_patch_path(&args.mesh) {
+        return run_patches(&args);
+    }
     if is_point_cloud(&args.mesh) {
         return run_cloud(&args);
     }
@@ -219,6 +228,42 @@ fn run_cloud(args: &Args) -> Result<(), CliError> {
     let params = FastParams::barill(args.beta, args.order);
     let wn = PointCloudWindingNumber::with_params(&cloud, params);
     let values = wn.eval_batch(&points);
+    write_outputs(args, &values, None)
+}
+
+/// Bézier patch sets: the boundary method (`exact`) or the surface quadrature (`direct`).
+fn run_patches(args: &Args) -> Result<(), CliError> {
+    if args.gradient {
+        return Err(CliError::msg("--gradient is not available for patch sets"));
+    }
+    if !(args.tolerance.is_finite() && args.tolerance > 0.0) {
+        return Err(CliError(format!(
+            "--tolerance must be a positive number, not {}",
+            args.tolerance
+        )));
+    }
+    let set = gwn::patch::load_patches(&args.mesh)?;
+    let points = gwn::io::points::load_points(&args.points)?;
+    let values = match args.method {
+        Method::Exact => gwn::patch::PatchWindingNumber::with_options(
+            &set,
+            gwn::patch::Options {
+                ray: args.ray.into(),
+                tolerance: args.tolerance,
+            },
+        )
+        .eval_batch(&points),
+        Method::Direct => gwn::patch::surface_quadrature::winding_number_surface_quadrature_batch(
+            &set,
+            &points,
+            args.tolerance,
+        ),
+        Method::Fast => {
+            return Err(CliError::msg(
+                "--method fast is not available for patch sets (use exact or direct)",
+            ));
+        }
+    };
     write_outputs(args, &values, None)
 }
 
