@@ -28,7 +28,10 @@ fn env(name: &str, default: usize) -> usize {
 fn time_per_query(points: &[[f64; 3]], f: impl Fn([f64; 3]) -> f64) -> (f64, Vec<f64>) {
     let t = Instant::now();
     let values: Vec<f64> = points.iter().map(|&p| f(p)).collect();
-    (t.elapsed().as_secs_f64() * 1e3 / points.len() as f64, values)
+    (
+        t.elapsed().as_secs_f64() * 1e3 / points.len() as f64,
+        values,
+    )
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -129,7 +132,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let sub: Vec<[f64; 3]> = points.iter().step_by(stride).copied().collect();
     let sub_ref: Vec<f64> = reference.iter().step_by(stride).copied().collect();
     let sub_good: Vec<bool> = ref_err.iter().step_by(stride).map(|&e| e < 1e-9).collect();
-    for tol in [1e-6, 1e-8] {
+    for tol in [1e-4, 1e-5] {
         let (ms, w) = time_per_query(&sub, |q| winding_number_surface_quadrature(&set, q, tol).0);
         let worst = (0..sub.len())
             .filter(|&i| sub_good[i])

@@ -145,12 +145,17 @@ fn rational_sphere_is_one_inside_and_zero_outside() {
 #[test]
 fn hemisphere_cap_on_its_axis_is_the_closed_form() {
     let set = PatchSet::new(sphere().patches()[4..].to_vec()).unwrap();
-    for h in [-3.0, -1.0, -0.5, -1e-3, 1e-9, 0.25, 0.5, 0.999, 1.001, 2.0, 10.0] {
+    for h in [
+        -3.0, -1.0, -0.5, -1e-3, 1e-9, 0.25, 0.5, 0.999, 1.001, 2.0, 10.0,
+    ] {
         let disk = 0.5 * (1.0 - f64::abs(h) / (1.0 + h * h).sqrt());
         let expected = if h > 0.0 && h < 1.0 { 1.0 } else { 0.0 } - f64::signum(h) * disk;
         for ray in RayAxis::ALL {
             let w = with(&set, ray, 1e-13).eval([0.0, 0.0, h]);
-            assert!((w - expected).abs() < 1e-11, "h = {h}, {ray:?}: {w} vs {expected}");
+            assert!(
+                (w - expected).abs() < 1e-11,
+                "h = {h}, {ray:?}: {w} vs {expected}"
+            );
         }
     }
 }

@@ -53,7 +53,11 @@ pub fn link_edges(set: &PatchSet) -> Vec<[EdgeLink; 4]> {
                 continue;
             }
             let rev = edge_key(p, e, true);
-            let (key, forward) = if fwd <= rev { (fwd, true) } else { (rev, false) };
+            let (key, forward) = if fwd <= rev {
+                (fwd, true)
+            } else {
+                (rev, false)
+            };
             groups.entry(key).or_default().push((pi, e, forward));
         }
     }

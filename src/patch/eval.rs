@@ -24,7 +24,9 @@ use std::f64::consts::PI;
 use rayon::prelude::*;
 
 use super::boundary::{EdgeLink, edge_counts, edge_indices, link_edges};
-use super::curve::{Form, Homogeneous, azimuth_change, eval_with_derivative, integrand, split_half};
+use super::curve::{
+    Form, Homogeneous, azimuth_change, eval_with_derivative, integrand, split_half,
+};
 use super::model::PatchSet;
 use super::quadrature::{Integral, integrate};
 use crate::kernel::compensated::NeumaierSum;
@@ -258,7 +260,11 @@ impl PatchWindingNumber {
         for k in 0..3 {
             scale = scale.max((lo[k] - q[k]).abs()).max((hi[k] - q[k]).abs());
         }
-        if negated { (-b, -a, scale) } else { (a, b, scale) }
+        if negated {
+            (-b, -a, scale)
+        } else {
+            (a, b, scale)
+        }
     }
 
     /// Halves a mixed net until its pieces are classified; records their edges.
@@ -400,7 +406,11 @@ impl LeafEdge {
         };
         let fwd = bits(&mut ctrl.iter());
         let rev = bits(&mut ctrl.iter().rev());
-        let (key, forward) = if fwd <= rev { (fwd, true) } else { (rev, false) };
+        let (key, forward) = if fwd <= rev {
+            (fwd, true)
+        } else {
+            (rev, false)
+        };
         LeafEdge {
             key,
             forward,

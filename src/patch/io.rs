@@ -101,7 +101,11 @@ pub fn parse_patches(text: &str, format: PatchFormat) -> Result<PatchSet, PatchE
         let mut points = Vec::with_capacity(size);
         let mut weights = Vec::with_capacity(size);
         for _ in 0..size {
-            let what = if per_point == 3 { "`x y z`" } else { "`x y z w`" };
+            let what = if per_point == 3 {
+                "`x y z`"
+            } else {
+                "`x y z w`"
+            };
             let (pl, row) = next(what)?;
             let v = numbers::<f64>(row, per_point, pl, what)?;
             points.push([v[0], v[1], v[2]]);
@@ -175,8 +179,14 @@ mod tests {
         assert!(matches!(e, Err(PatchError::Parse { line: 7, .. })), "{e:?}");
         let e = parse_patches("1\n1 1\n0 0 0\n1 0\n", PatchFormat::Bpt);
         assert!(matches!(e, Err(PatchError::Parse { line: 4, .. })), "{e:?}");
-        let e = parse_patches("1\n1 1\n0 0 0 1\n1 0 0 1\n0 1 0 -1\n1 1 0 1\n", PatchFormat::Rbpt);
-        assert!(matches!(e, Err(PatchError::BadWeight { point: 2, .. })), "{e:?}");
+        let e = parse_patches(
+            "1\n1 1\n0 0 0 1\n1 0 0 1\n0 1 0 -1\n1 1 0 1\n",
+            PatchFormat::Rbpt,
+        );
+        assert!(
+            matches!(e, Err(PatchError::BadWeight { point: 2, .. })),
+            "{e:?}"
+        );
         let e = parse_patches("99999999999\n", PatchFormat::Bpt);
         assert!(matches!(e, Err(PatchError::Parse { line: 2, .. })), "{e:?}");
         let e = parse_patches("1\n1000 1000\n", PatchFormat::Bpt);

@@ -245,8 +245,18 @@ impl Patch {
             .map(|(p, &w)| [w * p[0], w * p[1], w * p[2], w])
             .collect();
         // Lines along the split direction: columns for s, rows for t.
-        let (lines, len) = if along_s { (n + 1, m + 1) } else { (m + 1, n + 1) };
-        let at = |line: usize, k: usize| if along_s { k * (n + 1) + line } else { line * (n + 1) + k };
+        let (lines, len) = if along_s {
+            (n + 1, m + 1)
+        } else {
+            (m + 1, n + 1)
+        };
+        let at = |line: usize, k: usize| {
+            if along_s {
+                k * (n + 1) + line
+            } else {
+                line * (n + 1) + k
+            }
+        };
         let mut a = h.clone();
         let mut b = h.clone();
         for line in 0..lines {
@@ -265,7 +275,10 @@ impl Patch {
             }
         }
         let back = |h: Vec<[f64; 4]>| {
-            let points = h.iter().map(|q| [q[0] / q[3], q[1] / q[3], q[2] / q[3]]).collect();
+            let points = h
+                .iter()
+                .map(|q| [q[0] / q[3], q[1] / q[3], q[2] / q[3]])
+                .collect();
             let weights = h.iter().map(|q| q[3]).collect();
             Patch {
                 degree: (m, n),

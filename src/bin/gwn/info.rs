@@ -51,7 +51,12 @@ fn patch_report(path: &std::path::Path, set: &gwn::patch::PatchSet) -> String {
         ("file", path.display().to_string()),
         (
             "format",
-            if set.is_rational() { "rational Bézier patches" } else { "Bézier patches" }.into(),
+            if set.is_rational() {
+                "rational Bézier patches"
+            } else {
+                "Bézier patches"
+            }
+            .into(),
         ),
         ("patches", set.patches().len().to_string()),
         (
