@@ -137,7 +137,10 @@ fn teapot_near_the_gap_and_tube_ends() {
     for &q in points.iter().take(2) {
         let (reference, _) = winding_number_surface_quadrature(&set, q, 1e-5);
         let w = evaluators[0].eval(q);
-        assert!((w - reference).abs() < 1e-8, "q = {q:?}: {w} vs {reference}");
+        assert!(
+            (w - reference).abs() < 1e-8,
+            "q = {q:?}: {w} vs {reference}"
+        );
     }
 }
 
