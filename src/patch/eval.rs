@@ -15,9 +15,9 @@
 //! `Up` and a `Down` piece contributes `±2∫dφ`, a closed form ([`azimuth_change`]) certified by
 //! exact sign tests. What remains are integrals of smooth integrands over the surface boundary
 //! and over the edges next to mixed patches, done by adaptive Gauss–Kronrod. Paper Eq. 15's
-//! `χ(x0)` is the sum of the `2∫dφ` terms over the up/down interface divided by `4π` minus the
-//! rotation the `Up` pieces' boundary integrals absorb: it is never formed as an integer, so it
-//! cannot disagree with the integral. See `docs/patches.md` for the argument and the error model.
+//! crossing count `χ(x0)` is carried by the `α↑ − α↓ = 2dφ` difference on the `Up` pieces; it is
+//! never formed as an integer, so it cannot disagree with the integral. See `docs/patches.md` for
+//! the argument and the error model.
 
 use std::f64::consts::PI;
 
