@@ -38,6 +38,7 @@ pub mod io;
 pub mod kernel;
 pub mod mesh;
 mod one_shot;
+pub mod patch;
 #[cfg(feature = "products")]
 pub mod products;
 #[cfg(any(feature = "testing", feature = "cli"))]

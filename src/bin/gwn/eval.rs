@@ -63,10 +63,12 @@ impl From<Ray> for RayAxis {
 ///   gwn eval mesh.off --points q.txt --gradient --gradient-out g.npy
 ///   gwn eval soup.stl --points q.csv --method fast --beta 2 --order 2
 ///   gwn eval cloud.xyz --points q.csv
+///   gwn eval teapot.bpt --points q.npy --ray -x       # Bézier patches (.bpt / rational .rbpt)
 #[derive(ClapArgs, Debug)]
 #[command(verbatim_doc_comment)]
 pub struct Args {
-    /// Mesh file (.obj, .stl, .off, .ply) or oriented point cloud (.xyz, .csv, .pts, .ply).
+    /// Mesh file (.obj, .stl, .off, .ply), oriented point cloud (.xyz, .csv, .pts, .ply), or
+    /// Bézier patch set (.bpt, rational .rbpt).
     pub mesh: PathBuf,
     /// Query points file (.csv/.txt/.xyz text or .npy).
     #[arg(long)]
@@ -92,6 +94,10 @@ pub struct Args {
     pub gradient_out: Option<PathBuf>,
     #[command(flatten)]
     pub weld: crate::common::WeldArgs,
+    /// Patch sets: target absolute error of w (boundary quadrature of the exact method, surface
+    /// quadrature of the direct method).
+    #[arg(long, default_value_t = 1e-10)]
+    pub tolerance: f64,
 }
 
 fn parse_precision(s: &str) -> Result<u32, String> {
@@ -104,6 +110,9 @@ fn parse_precision(s: &str) -> Result<u32, String> {
 
 /// Runs `gwn eval`.
 pub fn run(args: Args) -> Result<(), CliError> {
+    if gwn::patch::is_patch_path(&args.mesh) {
+        return run_patches(&args);
+    }
     if let Some(beta) = args.method.beta {
         check_beta(beta)?;
     }
@@ -150,6 +159,52 @@ pub fn run(args: Args) -> Result<(), CliError> {
         None
     };
     write_outputs(&args, &values, grads.as_deref())
+}
+
+/// Bézier patch sets: the boundary method (`exact`) or the surface quadrature (`direct`).
+fn run_patches(args: &Args) -> Result<(), CliError> {
+    if args.gradient {
+        return Err(CliError::msg("--gradient is not available for patch sets"));
+    }
+    if !(args.tolerance.is_finite() && args.tolerance > 0.0) {
+        return Err(CliError(format!(
+            "--tolerance must be a positive number, not {}",
+            args.tolerance
+        )));
+    }
+    if args.method.beta.is_some() || args.method.order.is_some() || args.precision.is_some() {
+        return Err(CliError::msg(
+            "--beta, --order and --precision do not apply to patch sets",
+        ));
+    }
+    let set = gwn::patch::load_patches(&args.mesh)?;
+    let points = gwn::io::points::load_points(&args.points)?;
+    let values = match args.method.method.unwrap_or(Method::Exact) {
+        Method::Exact => gwn::patch::PatchWindingNumber::with_options(
+            &set,
+            gwn::patch::Options {
+                ray: args.ray.unwrap_or(Ray::PosZ).into(),
+                tolerance: args.tolerance,
+            },
+        )
+        .eval_batch(&points),
+        Method::Direct => {
+            if args.ray.is_some() {
+                return Err(CliError::msg("--ray applies to --method exact only"));
+            }
+            gwn::patch::surface_quadrature::winding_number_surface_quadrature_batch(
+                &set,
+                &points,
+                args.tolerance,
+            )
+        }
+        Method::Fast => {
+            return Err(CliError::msg(
+                "--method fast is not available for patch sets (use exact or direct)",
+            ));
+        }
+    };
+    write_outputs(args, &values, None)
 }
 
 fn write_outputs(args: &Args, values: &[f64], grads: Option<&[[f64; 3]]>) -> Result<(), CliError> {

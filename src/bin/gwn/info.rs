@@ -11,7 +11,8 @@ use crate::common::CliError;
 /// Arguments of `gwn info`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Mesh file (.obj, .stl, .off, .ply; detected by content if the extension is unknown).
+    /// Mesh file (.obj, .stl, .off, .ply; detected by content if the extension is unknown), or
+    /// Bézier patch set (.bpt, rational .rbpt).
     pub mesh: PathBuf,
     #[command(flatten)]
     pub weld: crate::common::WeldArgs,
@@ -19,6 +20,11 @@ pub struct Args {
 
 /// Loads the mesh and prints its statistics.
 pub fn run(args: Args) -> Result<(), CliError> {
+    if gwn::patch::is_patch_path(&args.mesh) {
+        let set = gwn::patch::load_patches(&args.mesh)?;
+        crate::common::write_stdout(format_args!("{}", patch_report(&args.mesh, &set)))?;
+        return Ok(());
+    }
     let loaded = load_mesh_with(&args.mesh, &args.weld.load_options())?;
     crate::common::print_load_warnings(&args.mesh, &loaded.warnings);
     let s = MeshStats::compute(&loaded.mesh);
@@ -26,6 +32,49 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .write_all(report(&args.mesh, &loaded, &s).as_bytes())
         .map_err(crate::common::stdout_error)?;
     Ok(())
+}
+
+/// The text block `gwn info` prints for a Bézier patch set.
+fn patch_report(path: &std::path::Path, set: &gwn::patch::PatchSet) -> String {
+    let wn = gwn::patch::PatchWindingNumber::new(set);
+    let (boundary, shared, degenerate) = wn.edge_counts();
+    let mut degrees: Vec<(usize, usize)> = set.patches().iter().map(|p| p.degree()).collect();
+    degrees.sort_unstable();
+    degrees.dedup();
+    let (lo, hi) = set.bounding_box();
+    let rows: Vec<(&str, String)> = vec![
+        ("file", path.display().to_string()),
+        (
+            "format",
+            if set.is_rational() {
+                "rational Bézier patches"
+            } else {
+                "Bézier patches"
+            }
+            .into(),
+        ),
+        ("patches", set.patches().len().to_string()),
+        (
+            "degrees",
+            degrees
+                .iter()
+                .map(|(m, n)| format!("{m}x{n}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+        ),
+        ("boundary edges", boundary.to_string()),
+        ("shared edge pairs", shared.to_string()),
+        ("collapsed edges", degenerate.to_string()),
+        ("closed", yes(boundary == 0).to_string()),
+        ("bbox min", format!("{lo:?}")),
+        ("bbox max", format!("{hi:?}")),
+    ];
+    let width = rows.iter().map(|(k, _)| k.len()).max().unwrap_or(0);
+    let mut out = String::new();
+    for (k, v) in rows {
+        out.push_str(&format!("{k:<width$}  {v}\n"));
+    }
+    out
 }
 
 fn yes(b: bool) -> &'static str {

@@ -57,11 +57,16 @@ pub enum Input {
     Mesh(Mesh),
     /// An oriented point cloud.
     Cloud(PointCloud),
+    /// A set of (rational) Bézier patches (`.bpt`, `.rbpt`).
+    Patches(gwn::patch::PatchSet),
 }
 
 impl Input {
     /// Loads `path` as a point cloud when it is one ([`is_point_cloud`]), as a mesh otherwise.
     pub fn load(path: &Path, weld: WeldArgs) -> Result<Input, CliError> {
+        if gwn::patch::is_patch_path(path) {
+            return Ok(Input::Patches(gwn::patch::load_patches(path)?));
+        }
         if is_point_cloud(path) {
             let (cloud, warnings) = gwn::io::cloud::load_point_cloud_with_warnings(path)?;
             crate::common::print_load_warnings(path, &warnings);
@@ -76,6 +81,10 @@ impl Input {
         match self {
             Input::Mesh(m) => m.bounding_box(),
             Input::Cloud(c) => BoundingBox::of_points(c.positions()),
+            Input::Patches(p) => {
+                let (min, max) = p.bounding_box();
+                Some(BoundingBox { min, max })
+            }
         }
     }
 
@@ -85,6 +94,10 @@ impl Input {
             Input::Mesh(m) => Ok(m),
             Input::Cloud(_) => Err(CliError::msg(format!(
                 "{}: is a point cloud, but {what} needs a triangle mesh",
+                path.display()
+            ))),
+            Input::Patches(_) => Err(CliError::msg(format!(
+                "{}: is a patch set, but {what} needs a triangle mesh",
                 path.display()
             ))),
         }
@@ -115,7 +128,7 @@ impl MethodArgs {
     /// The method for `input`: the one asked for, else exact for meshes and fast for clouds.
     pub fn method(&self, input: &Input) -> Method {
         self.method.unwrap_or(match input {
-            Input::Mesh(_) => Method::Exact,
+            Input::Mesh(_) | Input::Patches(_) => Method::Exact,
             Input::Cloud(_) => Method::Fast,
         })
     }
@@ -157,6 +170,23 @@ impl MethodArgs {
             }
             (Input::Cloud(cloud), Method::Fast) => {
                 Box::new(PointCloudWindingNumber::with_params(cloud, params))
+            }
+            (Input::Patches(set), Method::Exact) => {
+                Box::new(gwn::patch::PatchWindingNumber::with_options(
+                    set,
+                    gwn::patch::Options {
+                        ray: exact.ray,
+                        ..Default::default()
+                    },
+                ))
+            }
+            (Input::Patches(_), m) => {
+                return Err(CliError::msg(format!(
+                    "{}: {} does not apply to a patch set here (use --method exact; `gwn eval` \
+                     also has --method direct)",
+                    path.display(),
+                    m.flag()
+                )));
             }
             (Input::Cloud(_), m) => {
                 return Err(CliError::msg(format!(

@@ -45,6 +45,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let sdf = match &input {
         Input::Mesh(mesh) => SignedDistance::with_evaluator(mesh, wn),
         Input::Cloud(cloud) => SignedDistance::with_points(cloud.positions(), wn),
+        Input::Patches(_) => {
+            return Err(CliError::msg(format!(
+                "{}: sdf needs a triangle mesh or a point cloud (tessellate the patches)",
+                args.mesh.display()
+            )));
+        }
     };
     let cols = spec.column_count(gwn::grid::column_axis(sdf.winding_number()));
     let pb = progress((cols + spec.len()) as u64, "sdf");

@@ -1,0 +1,28 @@
+//! Winding numbers of curved surfaces: sets of tensor-product polynomial and rational Bézier
+//! patches (antipodal paper, Section 4.4 and Alg. 2), see `docs/patches.md`.
+//!
+//! - [`model`]: patches and patch sets;
+//! - [`io`]: the `.bpt` reader (Utah teapot format) and the rational `.rbpt` format;
+//! - [`boundary`]: the signed boundary (patch edges that no neighbour cancels exactly);
+//! - [`curve`]: rational Bézier curves and the two potentials of the solid-angle form;
+//! - [`quadrature`]: adaptive Gauss–Kronrod 7/15;
+//! - [`eval`]: the evaluator [`PatchWindingNumber`];
+//! - [`tessellate`]: triangle meshes of patch sets (reference values, products);
+//! - [`surface_quadrature`]: the direct surface integral (the benchmark's baseline).
+
+// Homogeneous points are `[f64; 4]` updated component by component in de Casteljau loops;
+// index loops over `0..4` read more plainly than zipped iterators there.
+#![allow(clippy::needless_range_loop)]
+
+pub mod boundary;
+pub mod curve;
+pub mod eval;
+pub mod io;
+pub mod model;
+pub mod quadrature;
+pub mod surface_quadrature;
+pub mod tessellate;
+
+pub use eval::{Evaluation, Options, PatchWindingNumber};
+pub use io::{is_patch_path, load_patches};
+pub use model::{Patch, PatchError, PatchSet};
