@@ -18,6 +18,7 @@ pub mod gauwn;
 pub mod io;
 pub mod open;
 pub mod polygon;
+pub mod tangled;
 
 pub use bvh::CurveBvh;
 pub use bvn::BvnMethod;
