@@ -294,7 +294,7 @@ impl Default for UntangleParams {
             decay: 0.95,
             max_outer: 80,
             inner_iters: 30,
-            patience: 20,
+            patience: 8,
             unsmoothed: false,
         }
     }
@@ -735,13 +735,17 @@ impl OffsetParams {
 pub enum OffsetStop {
     /// The mean displacement reached `|D|`.
     Reached,
-    /// A step did not increase the mean displacement (e.g. an inward offset larger than the
-    /// shape's inradius).
+    /// A step did not increase the mean displacement, or the last 20 steps together increased
+    /// it by less than 1% of `|D|` (e.g. an inward offset larger than the shape's inradius: the
+    /// curve collapses towards a point).
     Stalled,
     /// `max_steps` steps were performed.
     MaxSteps,
     /// The energy or its gradient became non-finite; the last good curve is returned.
     NonFinite,
+    /// The next step would make a curve without self-intersections intersect itself (e.g. an
+    /// inward offset through the shape's centre); the last curve before it is returned.
+    SelfIntersecting,
 }
 
 /// The outcome of [`offset`].
@@ -798,6 +802,9 @@ impl OffsetProblem<'_> {
 
 impl_argmin_problem!(OffsetProblem);
 
+/// Offset steps over which the mean displacement must grow by 1% of |D| (else: stalled).
+const STALL_WINDOW: usize = 20;
+
 fn mean_disp(a: &[Point], b: &[Point]) -> (f64, Vec<f64>) {
     let d: Vec<f64> = a
         .iter()
@@ -822,8 +829,10 @@ pub fn offset(poly: &Polygon, params: &OffsetParams) -> Result<OffsetReport, Par
     let input = unit.points().to_vec();
     let o = -params.step * params.distance.signum();
     let mut current = unit.clone();
+    let simple = !unit.has_self_intersections();
     let mut steps = 0;
     let mut mean = 0.0;
+    let mut history: Vec<f64> = Vec::new();
     let mut stop = if target > 0.0 {
         OffsetStop::MaxSteps
     } else {
@@ -859,6 +868,14 @@ pub fn offset(poly: &Polygon, params: &OffsetParams) -> Result<OffsetReport, Par
             break;
         }
         let next = unflatten(&x);
+        if simple
+            && current
+                .with_points(next.clone())
+                .map_or(true, |p| p.has_self_intersections())
+        {
+            stop = OffsetStop::SelfIntersecting;
+            break;
+        }
         let (m, _) = mean_disp(&next, &input);
         if m >= target {
             // Scale the last step back so that the mean displacement is |D|.
@@ -879,8 +896,12 @@ pub fn offset(poly: &Polygon, params: &OffsetParams) -> Result<OffsetReport, Par
             stop = OffsetStop::Reached;
             break;
         }
-        if m <= mean {
-            // The flow has stalled; stop rather than loop.
+        history.push(m);
+        let window = STALL_WINDOW.min(history.len() - 1);
+        let slow = history.len() > STALL_WINDOW
+            && m - history[history.len() - 1 - window] < 0.01 * target;
+        if m <= mean || slow {
+            // The flow has stalled (e.g. the curve collapses to a point); stop rather than loop.
             if let Ok(p) = current.with_points(next) {
                 current = p;
             }

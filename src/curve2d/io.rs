@@ -286,7 +286,11 @@ pub fn parse_svg(text: &str, name: &str) -> Result<Curves, CurveIoError> {
         // Skip the viewBox → viewport map: coordinates stay in the root's user units.
         for child in root.children() {
             match child {
-                usvg::Node::Group(g) => collect_group(g, Affine::IDENTITY, &mut loops),
+                usvg::Node::Group(g) => {
+                    for c in g.children() {
+                        collect_node(c, Affine::IDENTITY, &mut loops);
+                    }
+                }
                 other => collect_node(other, Affine::IDENTITY, &mut loops),
             }
         }

@@ -33,7 +33,7 @@ enum CurveCmd {
         points: PathBuf,
         /// Kernel standard deviation σ (absolute units); without it, the plain (unsmoothed)
         /// generalized winding number.
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         sigma: Option<f64>,
         /// Also output ∇W_σ (needs --sigma): columns w, dw/dx, dw/dy.
         #[arg(long, requires = "sigma")]
@@ -51,7 +51,7 @@ enum CurveCmd {
         /// Input curves (.svg, or text: one loop per block of `x y` lines, `open` blocks).
         input: PathBuf,
         /// Kernel standard deviation σ (absolute units; default 1% of the size).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         sigma: Option<f64>,
         /// Pixels along the longer side.
         #[arg(long, default_value_t = 512)]
@@ -77,16 +77,16 @@ enum CurveCmd {
         /// Input polygon (closed loops).
         input: PathBuf,
         /// Initial σ relative to the size.
-        #[arg(long, default_value_t = 0.01)]
+        #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
         sigma0: f64,
         /// Test-point distance ε relative to the size.
-        #[arg(long, default_value_t = 0.004)]
+        #[arg(long, default_value_t = 0.004, allow_negative_numbers = true)]
         eps: f64,
         /// Regularisation weight λ (>= 0).
-        #[arg(long, default_value_t = 1.0)]
+        #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
         lambda: f64,
         /// σ factor per step, in (0, 1].
-        #[arg(long, default_value_t = 0.95)]
+        #[arg(long, default_value_t = 0.95, allow_negative_numbers = true)]
         decay: f64,
         /// Maximum σ steps.
         #[arg(long, default_value_t = 80)]
@@ -95,7 +95,7 @@ enum CurveCmd {
         #[arg(long, default_value_t = 30)]
         inner_iters: u64,
         /// Stop after this many σ steps without a better iterate.
-        #[arg(long, default_value_t = 20)]
+        #[arg(long, default_value_t = 8)]
         patience: usize,
         /// Exit with status 3 when the result still has intersections or misplaced test points.
         #[arg(long)]
@@ -112,13 +112,13 @@ enum CurveCmd {
         #[arg(long, allow_hyphen_values = true)]
         distance: f64,
         /// σ (absolute; default min(|D|/5, 2% of the size)).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         sigma: Option<f64>,
         /// GauWN change requested per step, in (0, 0.5].
-        #[arg(long, default_value_t = 0.1)]
+        #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]
         step: f64,
         /// Weight of the displacement term (units of 1/σ²).
-        #[arg(long, default_value_t = 0.1)]
+        #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]
         lambda: f64,
         /// Maximum flow steps.
         #[arg(long, default_value_t = 2000)]
@@ -552,6 +552,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 OffsetStop::Stalled => "TARGET NOT REACHED, the flow stalled".to_string(),
                 OffsetStop::MaxSteps => "TARGET NOT REACHED, --max-steps reached".to_string(),
                 OffsetStop::NonFinite => "TARGET NOT REACHED, non-finite energy".to_string(),
+                OffsetStop::SelfIntersecting => {
+                    "TARGET NOT REACHED, the next step would self-intersect".to_string()
+                }
             };
             println!(
                 "{}: offset {distance}: mean displacement {:.4e} ({verdict}) in {} steps, σ {:.3e}",
