@@ -34,10 +34,7 @@ fn main() {
         return;
     }
     let max_n: usize = arg.and_then(|s| s.parse().ok()).unwrap_or(usize::MAX);
-    println!(
-        "threads: {} (rayon)\n",
-        rayon::current_num_threads()
-    );
+    println!("threads: {} (rayon)\n", rayon::current_num_threads());
     println!(
         "| curve | vertices | crossings before | GauWN after | GauWN time (s) | GauWN σ steps (best at) | stop | no smoothing after | no smoothing time (s) |"
     );

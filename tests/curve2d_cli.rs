@@ -79,24 +79,28 @@ fn field_npy_equals_eval_at_the_same_points() {
     let dir = temp_dir("field");
     let input = dir.join("shape.txt");
     // A closed square and an open arc-like polyline.
-    std::fs::write(
-        &input,
-        "0 0\n1 0\n1 1\n0 1\n\nopen\n1.5 0\n2 0.5\n1.5 1\n",
-    )
-    .unwrap();
+    std::fs::write(&input, "0 0\n1 0\n1 1\n0 1\n\nopen\n1.5 0\n2 0.5\n1.5 1\n").unwrap();
     let npy = dir.join("w.npy");
     let png = dir.join("w.png");
     for extra in [vec!["--sigma", "0.05"], vec!["--plain"]] {
         let mut args = vec!["curve", "field", input.to_str().unwrap(), "--res", "40"];
         args.extend(&extra);
-        args.extend(["--npy", npy.to_str().unwrap(), "--out", png.to_str().unwrap()]);
+        args.extend([
+            "--npy",
+            npy.to_str().unwrap(),
+            "--out",
+            png.to_str().unwrap(),
+        ]);
         let o = gwn(&args, MINUTE);
         let (out, err) = text(&o);
         assert!(o.status.success(), "{err}");
         let grid_line = out.lines().find(|l| l.starts_with("grid origin")).unwrap();
         let f: Vec<&str> = grid_line.split_whitespace().collect();
-        let (ox, oy, h): (f64, f64, f64) =
-            (f[2].parse().unwrap(), f[3].parse().unwrap(), f[5].parse().unwrap());
+        let (ox, oy, h): (f64, f64, f64) = (
+            f[2].parse().unwrap(),
+            f[3].parse().unwrap(),
+            f[5].parse().unwrap(),
+        );
         let (ny, nx): (usize, usize) = (f[7].parse().unwrap(), f[8].parse().unwrap());
         let (shape, values) = read_npy_f64(&npy);
         assert_eq!(shape, vec![ny, nx]);
@@ -141,11 +145,26 @@ fn eval_gradient_columns_match_finite_differences() {
     let h = 1e-6;
     std::fs::write(
         &q,
-        format!("0.9 0.1\n{} 0.1\n{} 0.1\n0.9 {}\n0.9 {}\n", 0.9 + h, 0.9 - h, 0.1 + h, 0.1 - h),
+        format!(
+            "0.9 0.1\n{} 0.1\n{} 0.1\n0.9 {}\n0.9 {}\n",
+            0.9 + h,
+            0.9 - h,
+            0.1 + h,
+            0.1 - h
+        ),
     )
     .unwrap();
     let o = gwn(
-        &["curve", "eval", input.to_str().unwrap(), "--points", q.to_str().unwrap(), "--sigma", "0.1", "--gradient"],
+        &[
+            "curve",
+            "eval",
+            input.to_str().unwrap(),
+            "--points",
+            q.to_str().unwrap(),
+            "--sigma",
+            "0.1",
+            "--gradient",
+        ],
         MINUTE,
     );
     let (out, err) = text(&o);
@@ -155,9 +174,16 @@ fn eval_gradient_columns_match_finite_differences() {
         .map(|l| l.split_whitespace().map(|v| v.parse().unwrap()).collect())
         .collect();
     assert_eq!(rows[0].len(), 3);
-    let fd = [(rows[1][0] - rows[2][0]) / (2.0 * h), (rows[3][0] - rows[4][0]) / (2.0 * h)];
+    let fd = [
+        (rows[1][0] - rows[2][0]) / (2.0 * h),
+        (rows[3][0] - rows[4][0]) / (2.0 * h),
+    ];
     for c in 0..2 {
-        assert!((fd[c] - rows[0][1 + c]).abs() < 1e-6, "{fd:?} vs {:?}", rows[0]);
+        assert!(
+            (fd[c] - rows[0][1 + c]).abs() < 1e-6,
+            "{fd:?} vs {:?}",
+            rows[0]
+        );
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -170,37 +196,144 @@ fn bad_parameters_are_one_line_errors() {
     let out = dir.join("o.svg");
     let (i, o) = (input.to_str().unwrap(), out.to_str().unwrap());
     let cases: Vec<(Vec<&str>, &str)> = vec![
-        (vec!["curve", "untangle", i, "--out", o, "--sigma0", "nan"], "--sigma0"),
-        (vec!["curve", "untangle", i, "--out", o, "--lambda", "nan"], "--lambda"),
-        (vec!["curve", "untangle", i, "--out", o, "--lambda", "-1"], "--lambda"),
-        (vec!["curve", "untangle", i, "--out", o, "--eps", "0"], "--eps"),
-        (vec!["curve", "untangle", i, "--out", o, "--sigma0", "inf"], "--sigma0"),
-        (vec!["curve", "untangle", i, "--out", o, "--decay", "1.5"], "--decay"),
-        (vec!["curve", "untangle", i, "--out", o, "--max-iters", "0"], "--max-iters"),
-        (vec!["curve", "untangle", i, "--out", o, "--patience", "0"], "--patience"),
-        (vec!["curve", "offset", i, "--out", o, "--distance", "nan"], "--distance"),
-        (vec!["curve", "offset", i, "--out", o, "--distance", "0.1", "--sigma", "nan"], "--sigma"),
-        (vec!["curve", "offset", i, "--out", o, "--distance", "0.1", "--sigma", "0"], "--sigma"),
-        (vec!["curve", "offset", i, "--out", o, "--distance", "0.1", "--step", "0"], "--step"),
-        (vec!["curve", "offset", i, "--out", o, "--distance", "0.1", "--lambda", "-2"], "--lambda"),
-        (vec!["curve", "offset", i, "--out", o, "--distance", "0.1", "--max-steps", "0"], "--max-steps"),
-        (vec!["curve", "field", i, "--out", o, "--sigma", "-1"], "--sigma"),
+        (
+            vec!["curve", "untangle", i, "--out", o, "--sigma0", "nan"],
+            "--sigma0",
+        ),
+        (
+            vec!["curve", "untangle", i, "--out", o, "--lambda", "nan"],
+            "--lambda",
+        ),
+        (
+            vec!["curve", "untangle", i, "--out", o, "--lambda", "-1"],
+            "--lambda",
+        ),
+        (
+            vec!["curve", "untangle", i, "--out", o, "--eps", "0"],
+            "--eps",
+        ),
+        (
+            vec!["curve", "untangle", i, "--out", o, "--sigma0", "inf"],
+            "--sigma0",
+        ),
+        (
+            vec!["curve", "untangle", i, "--out", o, "--decay", "1.5"],
+            "--decay",
+        ),
+        (
+            vec!["curve", "untangle", i, "--out", o, "--max-iters", "0"],
+            "--max-iters",
+        ),
+        (
+            vec!["curve", "untangle", i, "--out", o, "--patience", "0"],
+            "--patience",
+        ),
+        (
+            vec!["curve", "offset", i, "--out", o, "--distance", "nan"],
+            "--distance",
+        ),
+        (
+            vec![
+                "curve",
+                "offset",
+                i,
+                "--out",
+                o,
+                "--distance",
+                "0.1",
+                "--sigma",
+                "nan",
+            ],
+            "--sigma",
+        ),
+        (
+            vec![
+                "curve",
+                "offset",
+                i,
+                "--out",
+                o,
+                "--distance",
+                "0.1",
+                "--sigma",
+                "0",
+            ],
+            "--sigma",
+        ),
+        (
+            vec![
+                "curve",
+                "offset",
+                i,
+                "--out",
+                o,
+                "--distance",
+                "0.1",
+                "--step",
+                "0",
+            ],
+            "--step",
+        ),
+        (
+            vec![
+                "curve",
+                "offset",
+                i,
+                "--out",
+                o,
+                "--distance",
+                "0.1",
+                "--lambda",
+                "-2",
+            ],
+            "--lambda",
+        ),
+        (
+            vec![
+                "curve",
+                "offset",
+                i,
+                "--out",
+                o,
+                "--distance",
+                "0.1",
+                "--max-steps",
+                "0",
+            ],
+            "--max-steps",
+        ),
+        (
+            vec!["curve", "field", i, "--out", o, "--sigma", "-1"],
+            "--sigma",
+        ),
         (vec!["curve", "field", i, "--out", o, "--res", "0"], "--res"),
-        (vec!["curve", "eval", i, "--points", i, "--sigma", "nan"], "--sigma"),
+        (
+            vec!["curve", "eval", i, "--points", i, "--sigma", "nan"],
+            "--sigma",
+        ),
     ];
     for (args, flag) in cases {
         let r = gwn(&args, MINUTE);
         let (_, err) = text(&r);
         assert!(!r.status.success(), "{args:?} succeeded");
         assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
-        assert!(err.starts_with("gwn: ") && err.contains(flag), "{args:?}: {err}");
+        assert!(
+            err.starts_with("gwn: ") && err.contains(flag),
+            "{args:?}: {err}"
+        );
     }
     // An open polyline cannot be untangled or offset.
     let open = dir.join("open.txt");
     std::fs::write(&open, "open\n0 0\n1 0\n1 1\n").unwrap();
-    let r = gwn(&["curve", "untangle", open.to_str().unwrap(), "--out", o], MINUTE);
+    let r = gwn(
+        &["curve", "untangle", open.to_str().unwrap(), "--out", o],
+        MINUTE,
+    );
     let (_, err) = text(&r);
-    assert!(!r.status.success() && err.contains("open polyline"), "{err}");
+    assert!(
+        !r.status.success() && err.contains("open polyline"),
+        "{err}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -224,7 +357,11 @@ fn tiny_and_huge_extents_finish_with_the_scaled_result() {
         let rep = offset(&p, &OffsetParams::new(0.1 * s)).unwrap();
         assert!(t.elapsed() < MINUTE);
         assert_eq!(rep.stop, OffsetStop::Reached, "scale {s}");
-        assert!(((rep.mean_displacement / s) - 0.1).abs() < 1e-6, "scale {s}: {}", rep.mean_displacement);
+        assert!(
+            ((rep.mean_displacement / s) - 0.1).abs() < 1e-6,
+            "scale {s}: {}",
+            rep.mean_displacement
+        );
         // Same flow as at unit size, up to the power-of-two scaling (exact) and s's rounding.
         for (a, b) in rep.polygon.points().iter().zip(reference.polygon.points()) {
             assert!((a[0] / s - b[0]).abs() < 1e-9 && (a[1] / s - b[1]).abs() < 1e-9);
@@ -236,14 +373,30 @@ fn tiny_and_huge_extents_finish_with_the_scaled_result() {
     std::fs::write(&input, circle_text(1e-20, 40)).unwrap();
     let o = dir.join("o.txt");
     let r = gwn(
-        &["curve", "offset", input.to_str().unwrap(), "--distance", "1e-21", "--out", o.to_str().unwrap(), "--strict"],
+        &[
+            "curve",
+            "offset",
+            input.to_str().unwrap(),
+            "--distance",
+            "1e-21",
+            "--out",
+            o.to_str().unwrap(),
+            "--strict",
+        ],
         MINUTE,
     );
     let (out, err) = text(&r);
     assert!(r.status.success(), "{out}{err}");
     assert!(out.contains("(reached)"), "{out}");
     let r = gwn(
-        &["curve", "untangle", input.to_str().unwrap(), "--out", o.to_str().unwrap(), "--strict"],
+        &[
+            "curve",
+            "untangle",
+            input.to_str().unwrap(),
+            "--out",
+            o.to_str().unwrap(),
+            "--strict",
+        ],
         MINUTE,
     );
     assert!(r.status.success(), "{:?}", text(&r));
@@ -257,7 +410,15 @@ fn strict_fails_when_the_target_is_not_reached() {
     std::fs::write(&input, circle_text(1.0, 40)).unwrap();
     let o = dir.join("o.svg");
     // Inwards by more than the radius: the flow stalls.
-    let args = ["curve", "offset", input.to_str().unwrap(), "--distance", "-3", "--out", o.to_str().unwrap()];
+    let args = [
+        "curve",
+        "offset",
+        input.to_str().unwrap(),
+        "--distance",
+        "-3",
+        "--out",
+        o.to_str().unwrap(),
+    ];
     let r = gwn(&args, MINUTE);
     let (out, _) = text(&r);
     assert!(r.status.success());
@@ -269,13 +430,31 @@ fn strict_fails_when_the_target_is_not_reached() {
     // A figure-eight with large lobes cannot be untangled locally in 2 σ steps.
     let fig = dir.join("fig.txt");
     let p = figure_eight(60);
-    let s: String = p.points().iter().map(|v| format!("{} {}\n", v[0], v[1])).collect();
+    let s: String = p
+        .points()
+        .iter()
+        .map(|v| format!("{} {}\n", v[0], v[1]))
+        .collect();
     std::fs::write(&fig, s).unwrap();
-    let args = ["curve", "untangle", fig.to_str().unwrap(), "--max-iters", "2", "--inner-iters", "10", "--out", o.to_str().unwrap(), "--strict"];
+    let args = [
+        "curve",
+        "untangle",
+        fig.to_str().unwrap(),
+        "--max-iters",
+        "2",
+        "--inner-iters",
+        "10",
+        "--out",
+        o.to_str().unwrap(),
+        "--strict",
+    ];
     let r = gwn(&args, MINUTE);
     let (out, err) = text(&r);
     assert_eq!(r.status.code(), Some(3), "{out}{err}");
-    assert!(out.contains("TARGET NOT REACHED") && out.contains("1 → 1"), "{out}");
+    assert!(
+        out.contains("TARGET NOT REACHED") && out.contains("1 → 1"),
+        "{out}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

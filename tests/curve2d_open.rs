@@ -24,7 +24,10 @@ fn owens_t_matches_identities_and_quadrature() {
     for h in [0.0, 0.1, 0.7, 1.5, 3.0, 6.0, 12.0] {
         // T(h, 1) = ½Φ(h)Φ(−h); T(h, ∞) = ½Φ(−h); T(0, a) = atan(a)/2π.
         let t1 = owens_t(h, 1.0);
-        assert!((t1 - 0.5 * norm_cdf(h) * norm_cdf(-h)).abs() < 1e-16, "{h}: {t1}");
+        assert!(
+            (t1 - 0.5 * norm_cdf(h) * norm_cdf(-h)).abs() < 1e-16,
+            "{h}: {t1}"
+        );
         let tinf = owens_t(h, f64::INFINITY);
         assert!((tinf - 0.5 * norm_cdf(-h)).abs() < 1e-16);
         assert!((owens_t(h, 1e17) - 0.5 * norm_cdf(-h)).abs() < 1e-16);
@@ -107,7 +110,15 @@ fn plain_angles_sum_to_the_exact_winding_number() {
     }
     // Axis-aligned cases, where exact zeros are common.
     let sq = Polygon::new(vec![vec![[0., 0.], [1., 0.], [1., 1.], [0., 1.]]]).unwrap();
-    for q in [[0., 0.], [1., 0.], [0.5, 0.], [0., 0.5], [1., 1.], [2., 0.], [0., 2.]] {
+    for q in [
+        [0., 0.],
+        [1., 0.],
+        [0.5, 0.],
+        [0., 0.5],
+        [1., 1.],
+        [2., 0.],
+        [0., 2.],
+    ] {
         let s: f64 = sq
             .edges()
             .map(|(i, j)| segment_angle(sq.points()[i], sq.points()[j], q))
@@ -157,7 +168,10 @@ fn open_square_and_long_segment_closed_forms() {
             let s = segment_smoothed(sigma, [-l, 0.0], [l, 0.0], [0.3, y]);
             let expect = norm_cdf(y / sigma) - 0.5;
             let expect = if y == 0.0 { 0.0 } else { expect };
-            assert!((s - expect).abs() < 1e-8, "σ {sigma} y {y}: {s} vs {expect}");
+            assert!(
+                (s - expect).abs() < 1e-8,
+                "σ {sigma} y {y}: {s} vs {expect}"
+            );
         }
     }
 }

@@ -163,7 +163,10 @@ fn unreadable_svg_is_one_line_error() {
     for (text, what) in [
         ("<svg", "not a readable SVG"),
         (&svg("") as &str, "no visible shape"),
-        (&svg("<text x='0' y='0'>hi</text>") as &str, "no visible shape"),
+        (
+            &svg("<text x='0' y='0'>hi</text>") as &str,
+            "no visible shape",
+        ),
     ] {
         let e = parse_svg(text, "bad.svg").unwrap_err().to_string();
         assert!(e.starts_with("bad.svg: ") && e.contains(what), "{e}");

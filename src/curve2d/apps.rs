@@ -307,9 +307,27 @@ impl UntangleParams {
         positive("eps", self.eps, false)?;
         positive("lambda", self.lambda, true)?;
         positive("decay", self.decay, false)?;
-        in_range("decay", self.decay, f64::MIN_POSITIVE, 1.0, "a number in (0, 1]")?;
-        in_range("sigma0", self.sigma0, 0.0, 10.0, "at most 10 (relative to the size)")?;
-        in_range("eps", self.eps, 0.0, 1.0, "at most 1 (relative to the size)")?;
+        in_range(
+            "decay",
+            self.decay,
+            f64::MIN_POSITIVE,
+            1.0,
+            "a number in (0, 1]",
+        )?;
+        in_range(
+            "sigma0",
+            self.sigma0,
+            0.0,
+            10.0,
+            "at most 10 (relative to the size)",
+        )?;
+        in_range(
+            "eps",
+            self.eps,
+            0.0,
+            1.0,
+            "at most 1 (relative to the size)",
+        )?;
         in_range("max-iters", self.max_outer, 1, MAX_ITERATIONS, "1..=100000")?;
         in_range(
             "inner-iters",
@@ -637,7 +655,8 @@ pub fn untangle_with_progress(
             crossings: r.0,
             best_crossings: best.1.0.min(r.0),
         });
-        if (r.0, r.1) < (best.1.0, best.1.1) || ((r.0, r.1) == (best.1.0, best.1.1) && r.2 < best.1.2)
+        if (r.0, r.1) < (best.1.0, best.1.1)
+            || ((r.0, r.1) == (best.1.0, best.1.1) && r.2 < best.1.2)
         {
             let improved = (r.0, r.1) < (best.1.0, best.1.1);
             best = (current.clone(), r, outer);
@@ -898,8 +917,8 @@ pub fn offset(poly: &Polygon, params: &OffsetParams) -> Result<OffsetReport, Par
         }
         history.push(m);
         let window = STALL_WINDOW.min(history.len() - 1);
-        let slow = history.len() > STALL_WINDOW
-            && m - history[history.len() - 1 - window] < 0.01 * target;
+        let slow =
+            history.len() > STALL_WINDOW && m - history[history.len() - 1 - window] < 0.01 * target;
         if m <= mean || slow {
             // The flow has stalled (e.g. the curve collapses to a point); stop rather than loop.
             if let Ok(p) = current.with_points(next) {

@@ -507,7 +507,10 @@ pub fn parse_points_text(text: &str, name: &str) -> Result<Vec<Point>, CurveIoEr
             return Err(err(
                 name,
                 i + 1,
-                format!("expected two numbers `x y`, found {} field(s)", fields.len()),
+                format!(
+                    "expected two numbers `x y`, found {} field(s)",
+                    fields.len()
+                ),
             ));
         }
         let mut p = [0.0; 2];
@@ -526,10 +529,9 @@ pub fn parse_points_text(text: &str, name: &str) -> Result<Vec<Point>, CurveIoEr
 fn parse_points_npy(bytes: &[u8], name: &str) -> Result<Vec<Point>, CurveIoError> {
     let bad = |m: &str| err(name, 0, format!("NPY: {m}"));
     let (hlen, start) = match bytes.get(6) {
-        Some(1) if bytes.len() >= 10 => (
-            u16::from_le_bytes([bytes[8], bytes[9]]) as usize,
-            10usize,
-        ),
+        Some(1) if bytes.len() >= 10 => {
+            (u16::from_le_bytes([bytes[8], bytes[9]]) as usize, 10usize)
+        }
         Some(2) | Some(3) if bytes.len() >= 12 => (
             u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize,
             12usize,

@@ -154,7 +154,10 @@ pub fn benchmark_set() -> Vec<TangledCurve> {
         );
     }
     for (n, amp, seed) in [(100, 1.3, 5), (300, 1.2, 6), (1000, 1.0, 7), (1500, 0.9, 8)] {
-        push(format!("noisy circle ±{amp} n={n}"), noisy_circle(n, amp, seed));
+        push(
+            format!("noisy circle ±{amp} n={n}"),
+            noisy_circle(n, amp, seed),
+        );
     }
     v
 }

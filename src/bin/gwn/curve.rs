@@ -8,8 +8,8 @@ use gwn::curve2d::apps::{
 };
 use gwn::curve2d::io::{Drawing, SvgLayer, read_drawing, read_points, svg_string, text_string};
 use gwn::curve2d::{BvnMethod, Curves, CurvesField, GauWn, Point, Polygon};
-use gwn::products::png::Slice;
 use gwn::products::npy;
+use gwn::products::png::Slice;
 use rayon::prelude::*;
 use std::io::Write;
 use std::path::{Path, PathBuf};
