@@ -14,14 +14,29 @@ use gwn::curve2d::apps::{UntangleParams, UntangleReport, untangle};
 use gwn::curve2d::tangled::benchmark_set;
 use std::time::Instant;
 
-fn run(p: &gwn::curve2d::Polygon, unsmoothed: bool) -> (UntangleReport, f64) {
+/// CPU seconds (user + system, all threads) of this process so far, from `/proc/self/stat`
+/// (Linux; 0 elsewhere). Reported next to wall time because the shared machine's load makes
+/// wall time vary several-fold.
+fn cpu_seconds() -> f64 {
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
+        return 0.0;
+    };
+    // Fields after the command name (which ends with ')'): utime and stime are fields 14 and 15.
+    let rest = stat.rsplit(')').next().unwrap_or("");
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
+    (ticks(11) + ticks(12)) / 100.0
+}
+
+/// The report, wall seconds and CPU seconds of one run.
+fn run(p: &gwn::curve2d::Polygon, unsmoothed: bool) -> (UntangleReport, f64, f64) {
     let params = UntangleParams {
         unsmoothed,
         ..UntangleParams::default()
     };
-    let t = Instant::now();
+    let (t, c) = (Instant::now(), cpu_seconds());
     let rep = untangle(p, &params).expect("default parameters are valid");
-    (rep, t.elapsed().as_secs_f64())
+    (rep, t.elapsed().as_secs_f64(), cpu_seconds() - c)
 }
 
 fn main() {
@@ -36,7 +51,7 @@ fn main() {
     let max_n: usize = arg.and_then(|s| s.parse().ok()).unwrap_or(usize::MAX);
     println!("threads: {} (rayon)\n", rayon::current_num_threads());
     println!(
-        "| curve | vertices | crossings before | GauWN after | GauWN time (s) | GauWN σ steps (best at) | stop | no smoothing after | no smoothing time (s) |"
+        "| curve | vertices | crossings before | GauWN after | GauWN wall / CPU (s) | GauWN σ steps (best at) | stop | no smoothing after | no smoothing wall / CPU (s) |"
     );
     println!("| --- | ---: | ---: | ---: | ---: | ---: | --- | ---: | ---: |");
     let mut worse = 0;
@@ -45,13 +60,13 @@ fn main() {
         if n > max_n {
             continue;
         }
-        let (g, tg) = run(&c.polygon, false);
-        let (b, tb) = run(&c.polygon, true);
+        let (g, tg, cg) = run(&c.polygon, false);
+        let (b, tb, cb) = run(&c.polygon, true);
         if g.crossings_after > g.crossings_before || b.crossings_after > b.crossings_before {
             worse += 1;
         }
         println!(
-            "| {} | {n} | {} | {} | {tg:.2} | {} ({}) | {:?} | {} | {tb:.2} |",
+            "| {} | {n} | {} | {} | {tg:.1} / {cg:.1} | {} ({}) | {:?} | {} | {tb:.1} / {cb:.1} |",
             c.name,
             g.crossings_before,
             g.crossings_after,
