@@ -439,7 +439,7 @@ mod apps {
             count_crossings(&poly) > 0,
             "test polygon must start tangled"
         );
-        let rep = untangle(&poly, &UntangleParams::default());
+        let rep = untangle(&poly, &UntangleParams::default()).unwrap();
         eprintln!(
             "untangle: {} outer iterations, final sigma {:e}, max displacement {:.4}, converged {}",
             rep.outer_iterations, rep.final_sigma, rep.max_displacement, rep.converged
@@ -458,7 +458,7 @@ mod apps {
             }
         }
         // Same result (mirrored) for the reversed input.
-        let rev = untangle(&poly.reversed(), &UntangleParams::default());
+        let rev = untangle(&poly.reversed(), &UntangleParams::default()).unwrap();
         assert_eq!(count_crossings(&rev.polygon), 0);
     }
 
@@ -503,7 +503,7 @@ mod apps {
     fn offsetting_a_circle_grows_its_radius() {
         for (d, n) in [(0.1, 200), (-0.1, 200)] {
             let poly = circle(1.0, n, [0.0, 0.0]);
-            let rep = offset(&poly, &OffsetParams::new(d));
+            let rep = offset(&poly, &OffsetParams::new(d)).unwrap();
             let radii: Vec<f64> = rep
                 .polygon
                 .points()

@@ -75,6 +75,11 @@ fn gauss_legendre() -> &'static [Vec<(f64, f64)>; 3] {
     RULES.get_or_init(|| [gl_rule(6), gl_rule(12), gl_rule(20)])
 }
 
+/// The 20-point Gauss–Legendre rule on [−1, 1] as (positive node, weight) pairs.
+pub(crate) fn gauss_legendre_20() -> &'static [(f64, f64)] {
+    &gauss_legendre()[2]
+}
+
 fn gl_rule(n: usize) -> Vec<(f64, f64)> {
     let mut out = Vec::with_capacity(n / 2);
     for i in 1..=n / 2 {

@@ -16,9 +16,12 @@ pub mod bvh;
 pub mod bvn;
 pub mod gauwn;
 pub mod io;
+pub mod open;
 pub mod polygon;
+pub mod tangled;
 
 pub use bvh::CurveBvh;
 pub use bvn::BvnMethod;
 pub use gauwn::GauWn;
+pub use open::{Curves, CurvesField};
 pub use polygon::{Point, Polygon, PolygonError};
