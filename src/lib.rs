@@ -23,7 +23,7 @@
 //! ```
 
 // `deny`, not `forbid`: the one exception is the runtime-checked AVX2 dispatch of the boundary
-// loop (`kernel::boundary`), justified by a benchmark and tested bit-identical to the portable loop.
+// loop (`kernel::boundary_sum`), justified by a benchmark and tested bit-identical to the portable loop.
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 

@@ -97,9 +97,12 @@ def voxelize(
     dims: Optional[Tuple[int, int, int]] = None,
     bounds: Optional[Tuple[float, float, float, float, float, float]] = None,
     margin: float = 0.05,
+    method: Literal["exact", "direct", "fast"] = "exact",
+    beta: float = 2.0,
+    order: int = 2,
     threads: Optional[int] = None,
 ) -> _Grid:
-    """Exact winding numbers on a voxel grid: (values (D, H, W) indexed [z, y, x], origin, spacing)."""
+    """Winding numbers (exact by default) on a voxel grid: (values (D, H, W) indexed [z, y, x], origin, spacing)."""
 
 def sdf(
     V: _Floats,
@@ -128,14 +131,25 @@ def slice(
     res: int = 1024,
     margin: float = 0.1,
     outline: bool = False,
+    method: Literal["exact", "direct", "fast"] = "exact",
+    beta: float = 2.0,
+    order: int = 2,
     threads: Optional[int] = None,
 ) -> Tuple[_F64, bytes]:
     """Winding numbers on an axis-aligned plane: (image (height, width), PNG bytes)."""
 
 def classify(
-    VA: _Floats, FA: _Indices, VB: _Floats, FB: _Indices, threads: Optional[int] = None
+    VA: _Floats,
+    FA: _Indices,
+    VB: _Floats,
+    FB: _Indices,
+    *,
+    method: Literal["exact", "direct", "fast"] = "exact",
+    beta: float = 2.0,
+    order: int = 2,
+    threads: Optional[int] = None,
 ) -> _F64:
-    """Exact winding number of mesh B at each face centroid of mesh A."""
+    """Winding number (exact by default) of mesh B at each face centroid of mesh A."""
 
 def filter_tets(
     V: _Floats,
@@ -143,9 +157,13 @@ def filter_tets(
     points: _Floats,
     tets: _Indices,
     threshold: float = 0.5,
+    *,
+    method: Literal["exact", "direct", "fast"] = "exact",
+    beta: float = 2.0,
+    order: int = 2,
     threads: Optional[int] = None,
 ) -> npt.NDArray[np.bool_]:
-    """Mask of the tets whose centroid has exact winding number above threshold."""
+    """Mask of the tets whose centroid has winding number (exact by default) above threshold."""
 
 @overload
 def gauwn(

@@ -3,7 +3,10 @@
 
 use gwn::BoundingBox;
 use gwn::Mesh;
+use gwn::eval::Evaluator;
 use gwn::eval::antipodal::{Options, WindingNumber};
+use gwn::eval::direct::DirectWindingNumber;
+use gwn::eval::fast::FastWindingNumber;
 use gwn::grid::GridSpec;
 use gwn::products::classify::classify_faces;
 use gwn::products::png::Slice;
@@ -15,8 +18,39 @@ use pyo3::types::PyBytes;
 
 use crate::arrays::{array_nd, array1, indices_vec, with_points};
 use crate::errors::value_error;
+use crate::evaluator::{Method, fast_params};
 use crate::oneshot::mesh_from;
 use crate::threads;
+
+/// The evaluator a product uses: any of the library's, through its `Evaluator` trait (the CLI's
+/// `--method/--beta/--order`). `beta`/`order` only apply to `"fast"`; `exact` are the exact
+/// method's options.
+type AnyEvaluator<'m> = Box<dyn Evaluator + 'm>;
+
+/// Checks the method arguments up front (so that errors come before any work).
+fn method_of(
+    method: &str,
+    beta: f64,
+    order: u8,
+) -> PyResult<(Method, gwn::eval::fast::FastParams)> {
+    let m = Method::parse(method).map_err(PyValueError::new_err)?;
+    let params = fast_params(beta, order).map_err(PyValueError::new_err)?;
+    Ok((m, params))
+}
+
+/// Builds the chosen evaluator for `mesh`.
+fn evaluator_for<'m>(
+    mesh: &'m Mesh,
+    method: Method,
+    params: gwn::eval::fast::FastParams,
+    exact: Options,
+) -> Result<AnyEvaluator<'m>, Box<dyn std::error::Error + Send + Sync>> {
+    Ok(match method {
+        Method::Exact => Box::new(WindingNumber::with_options(mesh, exact)?),
+        Method::Direct => Box::new(DirectWindingNumber::new(mesh)),
+        Method::Fast => Box::new(FastWindingNumber::with_params(mesh, params)),
+    })
+}
 
 /// Largest grid a call may allocate (the CLI's limit): 2^31 samples, 16 GiB of float64.
 const MAX_GRID_SAMPLES: usize = 1 << 31;
@@ -84,7 +118,8 @@ fn grid_result<'py>(
     ))
 }
 
-/// Exact winding numbers on a voxel grid (ray reuse: one ray per grid column).
+/// Winding numbers on a voxel grid (``method`` exact by default, with ray reuse: one ray per
+/// grid column; ``"direct"`` or ``"fast"`` with ``beta``/``order`` as in ``gwn voxelize``).
 ///
 /// Returns ``(W, origin, spacing)``: ``W`` float64 of shape (D, H, W) indexed ``[z, y, x]``
 /// (x fastest, as ``gwn voxelize`` writes it), samples at cell centres
@@ -92,7 +127,7 @@ fn grid_result<'py>(
 /// ``(x0, y0, z0, x1, y1, z1)`` or the mesh's bounding box grown by ``margin`` times its largest
 /// extent, with ``dims`` (W, H, D) cells or ``res`` cells along the longest side.
 #[pyfunction]
-#[pyo3(signature = (V, F, res = 64, *, dims = None, bounds = None, margin = 0.05, threads = None))]
+#[pyo3(signature = (V, F, res = 64, *, dims = None, bounds = None, margin = 0.05, method = "exact", beta = 2.0, order = 2, threads = None))]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub fn voxelize<'py>(
     py: Python<'py>,
@@ -102,12 +137,17 @@ pub fn voxelize<'py>(
     dims: Option<[usize; 3]>,
     bounds: Option<[f64; 6]>,
     margin: f64,
+    method: &str,
+    beta: f64,
+    order: u8,
     threads: Option<usize>,
 ) -> PyResult<GridArrays<'py>> {
+    let (method, params) = method_of(method, beta, order)?;
     let mesh = mesh_from(V, F, "V", "F")?;
     let spec = grid_spec(&mesh, res, dims, bounds, margin)?;
     let values = threads::run(py, threads, || {
-        WindingNumber::new(&mesh).map(|wn| gwn::grid::evaluate(&wn, &spec))
+        evaluator_for(&mesh, method, params, Options::default())
+            .map(|wn| gwn::grid::evaluate(&wn, &spec))
     })?
     .map_err(value_error)?;
     grid_result(py, &spec, values)
@@ -181,7 +221,7 @@ fn axis_index(axis: &str) -> PyResult<usize> {
 /// z-slice: x right, y up), and ``png`` the bytes of the coloured picture with its colour bar
 /// (and the mesh's cross-section in black when ``outline``).
 #[pyfunction]
-#[pyo3(signature = (V, F, axis = "z", at = 0.5, *, at_coord = None, res = 1024, margin = 0.1, outline = false, threads = None))]
+#[pyo3(signature = (V, F, axis = "z", at = 0.5, *, at_coord = None, res = 1024, margin = 0.1, outline = false, method = "exact", beta = 2.0, order = 2, threads = None))]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub fn slice<'py>(
     py: Python<'py>,
@@ -193,8 +233,12 @@ pub fn slice<'py>(
     res: usize,
     margin: f64,
     outline: bool,
+    method: &str,
+    beta: f64,
+    order: u8,
     threads: Option<usize>,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyBytes>)> {
+    let (method, params) = method_of(method, beta, order)?;
     let axis = axis_index(axis)?;
     if res == 0 || res > MAX_SLICE_RES {
         return Err(PyValueError::new_err(format!(
@@ -226,8 +270,10 @@ pub fn slice<'py>(
     };
     let slice = Slice::new(&bbox.enlarged(margin), axis, coord, res);
     let (values, png) = threads::run(py, threads, || {
-        let wn = WindingNumber::with_options(
+        let wn = evaluator_for(
             &mesh,
+            method,
+            params,
             Options {
                 ray: slice.ray(),
                 ..Options::default()
@@ -253,20 +299,24 @@ pub fn slice<'py>(
 /// (the building block of mesh booleans; ``gwn classify``). Returns float64 (faces of A,);
 /// ``w > 0.5`` means inside B.
 #[pyfunction]
-#[pyo3(signature = (VA, FA, VB, FB, threads = None))]
-#[allow(non_snake_case)]
+#[pyo3(signature = (VA, FA, VB, FB, *, method = "exact", beta = 2.0, order = 2, threads = None))]
+#[allow(non_snake_case, clippy::too_many_arguments)]
 pub fn classify<'py>(
     py: Python<'py>,
     VA: &Bound<'py, PyAny>,
     FA: &Bound<'py, PyAny>,
     VB: &Bound<'py, PyAny>,
     FB: &Bound<'py, PyAny>,
+    method: &str,
+    beta: f64,
+    order: u8,
     threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let (method, params) = method_of(method, beta, order)?;
     let a = mesh_from(VA, FA, "VA", "FA")?;
     let b = mesh_from(VB, FB, "VB", "FB")?;
     let values = threads::run(py, threads, || {
-        WindingNumber::new(&b).map(|wn| classify_faces(&a, &wn))
+        evaluator_for(&b, method, params, Options::default()).map(|wn| classify_faces(&a, &wn))
     })?
     .map_err(value_error)?;
     Ok(array1(py, values))
@@ -278,8 +328,8 @@ pub fn classify<'py>(
 /// ``points`` (p, 3) float, ``tets`` (t, 4) int corner indices; returns a bool array (t,)
 /// (``tets[mask]`` keeps the inside tets).
 #[pyfunction]
-#[pyo3(signature = (V, F, points, tets, threshold = 0.5, threads = None))]
-#[allow(non_snake_case)]
+#[pyo3(signature = (V, F, points, tets, threshold = 0.5, *, method = "exact", beta = 2.0, order = 2, threads = None))]
+#[allow(non_snake_case, clippy::too_many_arguments)]
 pub fn filter_tets<'py>(
     py: Python<'py>,
     V: &Bound<'py, PyAny>,
@@ -287,8 +337,12 @@ pub fn filter_tets<'py>(
     points: &Bound<'py, PyAny>,
     tets: &Bound<'py, PyAny>,
     threshold: f64,
+    method: &str,
+    beta: f64,
+    order: u8,
     threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray1<bool>>> {
+    let (method, params) = method_of(method, beta, order)?;
     let mesh = mesh_from(V, F, "V", "F")?;
     if !threshold.is_finite() {
         return Err(PyValueError::new_err(format!(
@@ -308,7 +362,7 @@ pub fn filter_tets<'py>(
             )));
         }
         threads::run(py, threads, || {
-            WindingNumber::new(&mesh).map(|wn| {
+            evaluator_for(&mesh, method, params, Options::default()).map(|wn| {
                 gwn::products::tets::filter_tets(tet_points, &tet_indices, &wn, threshold)
             })
         })?

@@ -123,3 +123,37 @@ def test_filter_tets(cli, tmp_path, lion):
     np.testing.assert_array_equal(kept_points[kept_tets], points[tets[mask]])
     p2, t2, _ = gwn.load_tets(path)
     np.testing.assert_array_equal(gwn.filter_tets(v, f, p2, t2), mask)
+
+
+@pytest.mark.parametrize(
+    "method,cli_args,kwargs",
+    [
+        ("direct", ["--method", "direct"], {"method": "direct"}),
+        ("fast", ["--method", "fast", "--beta", "2.5", "--order", "1"],
+         {"method": "fast", "beta": 2.5, "order": 1}),
+    ],
+)
+def test_products_take_any_method(cli, tmp_path, lion, method, cli_args, kwargs):
+    """Grids and products use any evaluator (the library's Evaluator trait), like the CLI."""
+    v, f = lion
+    run(cli, "voxelize", LION_HEAD, "--res", 10, "--dtype", "f64", "--out", tmp_path / "w.npy",
+        *cli_args)
+    w, _, _ = gwn.voxelize(v, f, 10, **kwargs)
+    np.testing.assert_array_equal(w, np.load(tmp_path / "w.npy"))
+    exact, _, _ = gwn.voxelize(v, f, 10)
+    tol = 1e-9 if method == "direct" else 0.05
+    assert np.abs(w - exact).max() < tol
+    out = tmp_path / "s.png"
+    run(cli, "slice", LION_HEAD, "--axis", "y", "--res", 48, "--out", out, *cli_args)
+    _, png = gwn.slice(v, f, axis="y", res=48, **kwargs)
+    assert png == out.read_bytes()
+    run(cli, "classify", LION_HEAD, LION_HEAD, "--out", tmp_path / "c.npy", *cli_args)
+    np.testing.assert_array_equal(gwn.classify(v, f, v, f, **kwargs), np.load(tmp_path / "c.npy"))
+
+
+def test_products_reject_bad_methods(lion):
+    v, f = lion
+    with pytest.raises(ValueError, match="method"):
+        gwn.voxelize(v, f, 4, method="approximate")
+    with pytest.raises(ValueError, match="beta"):
+        gwn.classify(v, f, v, f, method="fast", beta=float("nan"))

@@ -24,11 +24,12 @@ use rayon::prelude::*;
 
 use crate::Mesh;
 use crate::bvh::RayBvh;
-use crate::kernel::boundary::BoundaryEdges;
+use crate::kernel::boundary_sum::BoundaryEdges;
 use crate::kernel::compensated::NeumaierSum;
 use crate::kernel::frame::RayAxis;
 use crate::kernel::predicates::{
-    W64, W128, Width, perturbed_plane_side, projected_containment, ray_crossing, ray_crossing_at,
+    W64, W128, Width, far_query_numerator_sign, perturbed_plane_side, projected_containment,
+    ray_crossing, ray_crossing_at,
 };
 use crate::kernel::quantize::{Grid, GridRangeError, Precision, Snap};
 use crate::kernel::spherical::{EdgeSigns, antipodal_edge_area, segment_gradient};
@@ -116,8 +117,8 @@ pub struct WindingNumber {
 
 #[derive(Clone, Debug)]
 enum Dispatch {
-    Narrow(Core<W64>),
-    Wide(Core<W128>),
+    Narrow(FrameEvaluator<W64>),
+    Wide(FrameEvaluator<W128>),
 }
 
 impl WindingNumber {
@@ -130,8 +131,8 @@ impl WindingNumber {
     pub fn with_options(mesh: &Mesh, options: Options) -> Result<Self, BuildError> {
         let start = Instant::now();
         let core = match options.precision {
-            Precision::Bits30 => Dispatch::Narrow(Core::build(mesh, options)?),
-            Precision::Bits60 => Dispatch::Wide(Core::build(mesh, options)?),
+            Precision::Bits30 => Dispatch::Narrow(FrameEvaluator::build(mesh, options)?),
+            Precision::Bits60 => Dispatch::Wide(FrameEvaluator::build(mesh, options)?),
         };
         let boundary = match &core {
             Dispatch::Narrow(c) => c.boundary.len(),
@@ -231,7 +232,7 @@ impl WindingNumber {
 
 /// Everything in the ray frame: integer vertices, boundary edges as structure of arrays, BVH.
 #[derive(Clone, Debug)]
-struct Core<W: Width> {
+struct FrameEvaluator<W: Width> {
     grid: Grid,
     ray: RayAxis,
     /// Grid origin in frame coordinates.
@@ -246,7 +247,7 @@ struct Core<W: Width> {
     _width: PhantomData<W>,
 }
 
-impl<W: Width> Core<W> {
+impl<W: Width> FrameEvaluator<W> {
     fn build(mesh: &Mesh, options: Options) -> Result<Self, BuildError> {
         let ray = options.ray;
         let Some(bbox) = mesh.bounding_box() else {
@@ -295,7 +296,7 @@ impl<W: Width> Core<W> {
             .into_iter()
             .map(|f| tris[f as usize].map(|i| verts[i as usize]))
             .collect();
-        Ok(Core {
+        Ok(FrameEvaluator {
             origin: ray.to_frame(grid.origin()),
             cell: grid.cell(),
             grid,
@@ -309,7 +310,7 @@ impl<W: Width> Core<W> {
     }
 
     fn empty(grid: Grid, ray: RayAxis) -> Self {
-        Core {
+        FrameEvaluator {
             origin: ray.to_frame(grid.origin()),
             cell: grid.cell(),
             grid,
@@ -519,15 +520,8 @@ impl<W: Width> Core<W> {
             let (a, b, weight) = self.boundary.edge(i);
             let ra = self.rel_f64(a, qf);
             let rb = self.rel_f64(b, qf);
-            let n = -(ra[0] * rb[1] - ra[1] * rb[0]);
             let signs = EdgeSigns {
-                numerator: if n > 0.0 {
-                    1
-                } else if n < 0.0 {
-                    -1
-                } else {
-                    0
-                },
+                numerator: far_query_numerator_sign(ra, rb),
                 query_inside_segment: false,
             };
             sum += weight * antipodal_edge_area(ra, rb, signs);

@@ -9,12 +9,12 @@
 //!   queries off the lattice;
 //! - [`spherical`]: the solid-angle and spherical-triangle formulas;
 //! - [`angle_sum`]: sums of many `atan2` terms as one complex product with turn counting;
-//! - [`boundary`]: the SIMD loop over the boundary edges of the Antipodal formula;
+//! - [`boundary_sum`]: the SIMD loop over the boundary edges of the Antipodal formula;
 //! - [`compensated`]: Neumaier summation;
 //! - [`double_double`]: the extended precision of ill-conditioned near-edge terms.
 
 pub mod angle_sum;
-pub mod boundary;
+pub mod boundary_sum;
 pub mod compensated;
 pub mod double_double;
 pub mod frame;

@@ -115,6 +115,56 @@ pub fn exact_dot3_sign(d: [i64; 3], n: [i128; 3]) -> i32 {
     }
 }
 
+/// The `f64` filter of [`perturbed_orient2d`], as the boundary loop (`kernel::boundary_sum`, both its
+/// portable and its AVX2 form) evaluates it four edges at a time; the loop uses these constants and
+/// this formula, so "one predicate decides both parts" stays visible here.
+///
+/// Inputs are the offsets `a − q`, `b − q` formed in `f64` from grid integers of magnitude
+/// `≤ limit = 2^(bits−1)`: each conversion errs by `≤ u·limit` and the subtraction by
+/// `≤ u·|offset|` (`u = 2^-53`), and `d = ax·by − ay·bx` adds `3u·(|ax·by| + |ay·bx|)`. The bound
+/// takes twice that: `CONVERSION·limit·(|ax| + |ay| + |bx| + |by|) + RELATIVE·(|p1| + |p2|)`.
+/// When `|d|` clears it, `sign(d)` is the exact sign (the ε terms are infinitesimal); otherwise
+/// `None`: the exact integer predicate decides.
+#[inline]
+pub fn orient2d_filtered(ra: [f64; 2], rb: [f64; 2], limit: f64) -> Option<i32> {
+    let p1 = ra[0] * rb[1];
+    let p2 = ra[1] * rb[0];
+    let d = p1 - p2;
+    let bound = ORIENT2D_FILTER_CONVERSION
+        * limit
+        * (ra[0].abs() + ra[1].abs() + rb[0].abs() + rb[1].abs())
+        + ORIENT2D_FILTER_RELATIVE * (p1.abs() + p2.abs());
+    if d > bound {
+        Some(1)
+    } else if d < -bound {
+        Some(-1)
+    } else {
+        None
+    }
+}
+
+/// Conversion term of [`orient2d_filtered`]'s bound, per unit of `limit`: `2·2u`.
+pub const ORIENT2D_FILTER_CONVERSION: f64 = 2.0 * 2.0 * (f64::EPSILON * 0.5);
+
+/// Rounding term of [`orient2d_filtered`]'s bound, relative to `|p1| + |p2|`: `2·4u`.
+pub const ORIENT2D_FILTER_RELATIVE: f64 = 2.0 * 4.0 * (f64::EPSILON * 0.5);
+
+/// The atan2 numerator's sign `−sign((a−q)×(b−q))_z` for a query whose ray cannot meet the mesh
+/// (outside the padded box across the ray): `q` is farther than the mesh's extent from every
+/// edge, so the edge's projected line is not near `q` and the boundary term has no branch cut
+/// nearby; the `f64` sign is the one the formula needs (a rounding-signed zero contributes 0).
+#[inline]
+pub fn far_query_numerator_sign(ra: [f64; 3], rb: [f64; 3]) -> i32 {
+    let n = -(ra[0] * rb[1] - ra[1] * rb[0]);
+    if n > 0.0 {
+        1
+    } else if n < 0.0 {
+        -1
+    } else {
+        0
+    }
+}
+
 /// Result of the perturbed 2D orientation: the sign, and whether the unperturbed determinant was
 /// exactly zero (the query's projection is on the line through the edge's projection).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -6,15 +6,15 @@
 //! are all legal input, because the winding number is defined for every one of them and the
 //! users of this crate feed exactly such meshes.
 
-pub mod boundary;
 mod point_cloud;
+pub mod signed_boundary;
 pub mod stats;
 mod tet_mesh;
 
-pub use boundary::{
+pub use point_cloud::{PointCloud, PointCloudError};
+pub use signed_boundary::{
     BoundaryEdge, boundary_edges, boundary_welded_by, geometric_boundary_edges, signed_boundary,
 };
-pub use point_cloud::{PointCloud, PointCloudError};
 pub use tet_mesh::TetMesh;
 
 use crate::error::MeshError;

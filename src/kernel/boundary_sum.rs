@@ -20,7 +20,8 @@ use super::angle_sum::AngleSum;
 use super::compensated::NeumaierSum;
 use super::double_double::DoubleDouble;
 use super::predicates::{
-    Width, perturbed_orient2d, perturbed_orient2d_at, query_inside_segment, query_inside_segment_at,
+    ORIENT2D_FILTER_CONVERSION, ORIENT2D_FILTER_RELATIVE, Width, perturbed_orient2d,
+    perturbed_orient2d_at, query_inside_segment, query_inside_segment_at,
 };
 use super::spherical::{EdgeSigns, antipodal_edge_area, antipodal_edge_area_accurate};
 use crate::bvh::RayBvh;
@@ -312,8 +313,10 @@ impl BoundaryEdges {
     /// d = ax·by − ay·bx: Σ |other factor|·(offset error) + 3u(|p1| + |p2|). We use twice that:
     /// `bound = conv·(|ax| + |ay| + |bx| + |by|) + rel·(|p1| + |p2|)`.
     fn filter_constants(&self) -> (f64, f64) {
-        let u = f64::EPSILON * 0.5;
-        (2.0 * 2.0 * u * self.limit, 2.0 * 4.0 * u)
+        (
+            ORIENT2D_FILTER_CONVERSION * self.limit,
+            ORIENT2D_FILTER_RELATIVE,
+        )
     }
 
     /// The chained edges' terms for the query `q` (grid units, `f64`) multiplied into an
@@ -578,6 +581,7 @@ mod tests {
 
     #[test]
     fn avx2_loop_is_bit_identical_to_the_portable_loop() {
+        use crate::kernel::predicates::orient2d_filtered;
         #[cfg(target_arch = "x86_64")]
         {
             if !std::arch::is_x86_feature_detected!("avx2") {
@@ -633,6 +637,21 @@ mod tests {
                         "case {case} q {q:?}: {s1} vs {s2}"
                     );
                     assert_eq!(u1, u2, "undecided edges differ");
+                    // The loop's filter is `predicates::orient2d_filtered`, lane by lane.
+                    let mut undecided: Vec<u32> = u1.clone();
+                    undecided.sort_unstable();
+                    undecided.dedup();
+                    let by_scalar: Vec<u32> = (0..edges.len() as u32)
+                        .filter(|&e| {
+                            let (a, b, _) = edges.edge(e as usize);
+                            let off = |p: [i64; 3]| [p[0] as f64 - q[0], p[1] as f64 - q[1]];
+                            orient2d_filtered(off(a), off(b), edges.limit).is_none()
+                        })
+                        .collect();
+                    assert_eq!(
+                        undecided, by_scalar,
+                        "case {case}: loop filter ≠ orient2d_filtered"
+                    );
                 }
             }
         }
