@@ -19,8 +19,7 @@ const PAD: f32 = 1.0 / (1 << 20) as f32;
 /// probability that a *random* ray meets it; for rays along `+z` that probability is the box's
 /// projected xy area, which is what a box flattened along z measures. A small non-zero scale
 /// keeps z as a tie-breaker (it lets the `hi_z` test cull the part of a column below the
-/// query). Measured on ten shared meshes (1 thread, random-order grid queries): 1.0 → 0.1
-/// gains 3–10 % on closed meshes; 0.02 is no better.
+/// query). The value was chosen by measurement (docs/benchmarks.md, "Design measurements").
 const Z_SCALE: f32 = 0.1;
 
 /// An inner node holding the boxes of up to four children, reduced to what an axis-aligned ray

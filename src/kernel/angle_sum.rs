@@ -76,8 +76,8 @@ impl AngleSum {
     /// Brings the accumulators back to modulus in [1, 4) (the arguments are unchanged).
     ///
     /// Multiplies by the power of two `2^-E`, `E` the exponent of `max(|re|, |im|)`, built from
-    /// the exponent bits: exact, and a few integer operations instead of a division (whose
-    /// latency was 10 % of the boundary loop). `2^-E` is a normal number for every finite
+    /// the exponent bits: exact, and a few integer operations instead of a division, whose latency
+    /// was measurable in the boundary loop (docs/benchmarks.md, "Design measurements"). `2^-E` is a normal number for every finite
     /// non-zero `E` (its biased exponent `2046 − (E + 1023)` lies in `1..=2045`).
     #[inline]
     pub fn rescale(&mut self) {

@@ -1,11 +1,11 @@
 //! The boundary term of the Antipodal formula for one query: `Σ_k w_k·Area(A_k, B_k, x1)` over all
-//! signed boundary edges — the hot loop (≈ 90 % of the time in the paper).
+//! signed boundary edges — the hot loop of open meshes.
 //!
 //! Four edges at a time (`wide::f64x4`, or AVX2 intrinsics chosen at run time): offsets from the
 //! query, the `f64` orientation `d` with a rigorous error bound, lengths and the cancellation-free
 //! denominator. Instead of one `atan2` per edge, the terms `den + i·num` go into one [`AngleSum`]
-//! (a complex product with turn counting; one `atan2` at the end). (Profiling showed `atan2` at
-//! 53 % of the time before this change.)
+//! (a complex product with turn counting; one `atan2` at the end): `atan2` dominated the loop
+//! before (docs/benchmarks.md, "Design measurements").
 //!
 //! Lanes whose `|d|` does not clear the bound (the query is within ~1e-15·extent of the edge's
 //! line through the ray, or a degenerate configuration) and edges of weight above

@@ -75,7 +75,7 @@ impl Width for W128 {
     #[inline]
     fn orient3d_sign(d: [i64; 3], e1: [i64; 3], e2: [i64; 3]) -> i32 {
         // Filter in f64 straight from the differences (no i128 products, no i128 → f64
-        // conversion, which was ~4 % of a closed-mesh query). Each difference (< 2^61) is
+        // conversion, which was measurable: docs/benchmarks.md, "Design measurements"). Each difference (< 2^61) is
         // rounded once on conversion, relative error ≤ u = 2^-53 — the error model of
         // Shewchuk's orient3d, whose first-stage bound (7 + 56u)·u·permanent therefore holds;
         // we test 8u·permanent. Exact otherwise: i128 cross product, BigInt dot product.

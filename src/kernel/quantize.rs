@@ -408,7 +408,7 @@ const FAR: f64 = (1_u64 << 30) as f64;
 const TRUNC_EXACT: f64 = (1_u64 << 62) as f64;
 
 /// `v.round()` (ties away from zero) as an integer, for `|v| < 2^62`. Without SSE4.1, `round` is
-/// a libm call that was ~5 % of a closed-mesh query; truncation and an exact remainder are not:
+/// a libm call, visible in closed-mesh queries (docs/benchmarks.md, "Design measurements"); truncation and an exact remainder are not:
 /// `v − trunc(v)` is exact because both lie in the same binade (or `trunc(v) = 0`).
 #[inline]
 fn round_half_away(v: f64) -> i64 {
