@@ -43,6 +43,7 @@ pub mod patch;
 pub mod products;
 #[cfg(any(feature = "testing", feature = "cli"))]
 pub mod testing;
+pub mod vec3;
 
 pub use mesh::{BoundingBox, Mesh};
 pub use one_shot::{Position, TriangleIndices, WindingNumberError, winding_number};

@@ -11,6 +11,7 @@
 //! principal value), so the direct sum returns the local solid-angle fraction: 1/2 on a face of
 //! a closed mesh, 1/8 at the corner of a cube, 1/4 on its edges. Never NaN for finite input.
 
+use crate::vec3::sub;
 use rayon::prelude::*;
 
 use crate::Mesh;
@@ -55,11 +56,6 @@ pub fn winding_number_gradient_direct(mesh: &Mesh, q: [f64; 3]) -> [f64; 3] {
         }
     }
     g.map(|s| s.value() * INV_4PI)
-}
-
-#[inline]
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 /// The direct sum as an [`Evaluator`](crate::eval::Evaluator): owns a copy of the mesh (the sum

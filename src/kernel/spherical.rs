@@ -13,6 +13,7 @@ use super::double_double::{DoubleDouble, dot3};
 /// `1/(4π)`: a solid angle (or a sum of spherical areas) as a winding number.
 pub const INV_4PI: f64 = 1.0 / (4.0 * std::f64::consts::PI);
 use super::quantize::decompose;
+use crate::vec3::{cross, dot, norm};
 
 /// `2·atan2(s·mag, den)` where the sign `s ∈ {−1, 0, 1}` of the numerator was decided exactly.
 ///
@@ -393,25 +394,6 @@ fn limit_direction(r: [f64; 3]) -> [f64; 3] {
     } else {
         normalized(r)
     }
-}
-
-#[inline]
-pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-#[inline]
-pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-#[inline]
-pub(crate) fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
 }
 
 #[inline]

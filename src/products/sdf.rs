@@ -22,6 +22,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+use crate::vec3::{cross, dot, sub};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
@@ -321,23 +322,6 @@ fn build_tree(tris: &[[[f64; 3]; 3]]) -> (Vec<Node>, Vec<u32>) {
         }
     }
     (nodes, prims)
-}
-
-#[inline]
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-#[inline]
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-#[inline]
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 /// Closest point on segment `ab` to `p`: `(squared distance, point, parameter t ∈ [0, 1])`.

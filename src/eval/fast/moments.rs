@@ -22,9 +22,10 @@
 // The tensor code indexes like the formulas it transcribes (`M1[i][j] += δᵢ Nⱼ`).
 #![allow(clippy::needless_range_loop)]
 
+use crate::vec3::sub;
 use wide::f32x4;
 
-use crate::kernel::spherical::{cross, dot};
+use crate::vec3::{cross, dot};
 
 use crate::kernel::spherical::INV_4PI;
 
@@ -477,11 +478,6 @@ impl<T: Lanes> FarField<T> {
         let inv_d7 = inv_d5 * inv_d2;
         w3 * inv_d3 + w5 * inv_d5 + w7 * inv_d7
     }
-}
-
-#[inline]
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 #[inline]

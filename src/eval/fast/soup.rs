@@ -10,6 +10,8 @@ use wide::{CmpGt, CmpLt, f64x4};
 
 use crate::kernel::angle_sum::AngleSum;
 use crate::kernel::spherical::{segment_gradient, triangle_solid_angle};
+pub(crate) use crate::vec3::dist2;
+use crate::vec3::sub;
 use crate::{BoundingBox, Mesh};
 
 use crate::kernel::spherical::INV_4PI;
@@ -277,17 +279,6 @@ fn push_solid_angles(angles: &mut AngleSum, t: &[f64x4; 9], q: [f64; 3]) -> u32 
 #[inline]
 fn centroid(t: &[[f64; 3]; 3]) -> [f64; 3] {
     [0, 1, 2].map(|k| (t[0][k] + t[1][k] + t[2][k]) / 3.0)
-}
-
-#[inline]
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-#[inline]
-pub(crate) fn dist2(a: [f64; 3], b: [f64; 3]) -> f64 {
-    let d = sub(a, b);
-    d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
 }
 
 #[cfg(test)]
