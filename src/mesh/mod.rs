@@ -262,3 +262,16 @@ impl Mesh {
         )
     }
 }
+
+/// Writes `mesh` as OBJ (`v x y z`, then 1-based `f i j k`), coordinates in Rust's shortest
+/// round-trip form, so reading the file back gives the same `f64`s. The one OBJ writer of the
+/// crate (face classification's `--mesh-out`, the testing kit's corpus files).
+pub fn write_obj(mut w: impl std::io::Write, mesh: &Mesh) -> std::io::Result<()> {
+    for p in mesh.positions() {
+        writeln!(w, "v {:?} {:?} {:?}", p[0], p[1], p[2])?;
+    }
+    for t in mesh.triangles() {
+        writeln!(w, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)?;
+    }
+    w.flush()
+}

@@ -81,13 +81,4 @@ pub fn submesh(mesh: &Mesh, keep: &[bool]) -> Mesh {
     Mesh::new(pos, tris).unwrap_or_default()
 }
 
-/// Writes a mesh as Wavefront OBJ (`v` and 1-based `f` lines, round-trippable coordinates).
-pub fn write_obj(mut w: impl std::io::Write, mesh: &Mesh) -> std::io::Result<()> {
-    for p in mesh.positions() {
-        writeln!(w, "v {:?} {:?} {:?}", p[0], p[1], p[2])?;
-    }
-    for t in mesh.triangles() {
-        writeln!(w, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)?;
-    }
-    w.flush()
-}
+pub use crate::mesh::write_obj;

@@ -7,16 +7,7 @@ use std::io::{self, Write};
 use super::oracle::{Certified, Decision};
 use crate::Mesh;
 
-/// Wavefront OBJ: `v x y z` lines, then `f i j k` (1-based).
-pub fn write_obj(mut w: impl Write, mesh: &Mesh) -> io::Result<()> {
-    for p in mesh.positions() {
-        writeln!(w, "v {} {} {}", p[0], p[1], p[2])?;
-    }
-    for t in mesh.triangles() {
-        writeln!(w, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)?;
-    }
-    Ok(())
-}
+pub use crate::mesh::write_obj;
 
 /// OFF: header, vertices, then `3 i j k` faces (0-based).
 pub fn write_off(mut w: impl Write, mesh: &Mesh) -> io::Result<()> {
