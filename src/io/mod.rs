@@ -25,6 +25,7 @@ mod off;
 mod ply;
 pub mod points;
 mod stl;
+pub mod tets;
 
 use std::fmt;
 use std::path::Path;
