@@ -27,6 +27,7 @@
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod base;
 pub mod bvh;
 #[cfg(feature = "curve2d")]
 pub mod curve2d;
@@ -43,9 +44,9 @@ pub mod patch;
 pub mod products;
 #[cfg(any(feature = "testing", feature = "cli"))]
 pub mod testing;
-pub mod vec3;
 
-pub use mesh::{BoundingBox, Mesh};
+pub use base::bounding_box::BoundingBox;
+pub use mesh::Mesh;
 pub use one_shot::{Position, TriangleIndices, WindingNumberError, winding_number};
 
 /// The README's library example, compiled and run as a doctest.

@@ -174,7 +174,7 @@ impl CurveBvh {
             stack.push(node.left);
             stack.push(node.right);
         }
-        (sum.total(), bound)
+        (sum.value(), bound)
     }
 
     fn grad_far(&self, node: &Node, sigma: f64, q: Point) -> bool {

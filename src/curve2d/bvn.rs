@@ -331,7 +331,7 @@ mod reference_tests {
                 }
             }
         }
-        sum.total()
+        sum.value()
     }
 
     #[test]

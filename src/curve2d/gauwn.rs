@@ -82,7 +82,7 @@ impl GauWn {
         for (i, j) in poly.edges() {
             sum.add(self.segment_value(p[i], p[j], q));
         }
-        sum.total()
+        sum.value()
     }
 
     /// `(∂c/∂p₀, ∂c/∂p₁)` for the edge `p₀ → p₁` (zero for a zero-length edge).
@@ -164,28 +164,8 @@ impl GauWn {
     }
 }
 
-/// Neumaier's compensated summation.
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct Neumaier {
-    s: f64,
-    c: f64,
-}
-
-impl Neumaier {
-    pub(crate) fn add(&mut self, x: f64) {
-        let t = self.s + x;
-        if self.s.abs() >= x.abs() {
-            self.c += (self.s - t) + x;
-        } else {
-            self.c += (x - t) + self.s;
-        }
-        self.s = t;
-    }
-
-    pub(crate) fn total(&self) -> f64 {
-        self.s + self.c
-    }
-}
+/// Neumaier's compensated summation: the crate's one implementation (`crate::base`).
+pub(crate) use crate::base::compensated::NeumaierSum as Neumaier;
 
 #[cfg(test)]
 mod tests {

@@ -11,7 +11,7 @@
 //! principal value), so the direct sum returns the local solid-angle fraction: 1/2 on a face of
 //! a closed mesh, 1/8 at the corner of a cube, 1/4 on its edges. Never NaN for finite input.
 
-use crate::vec3::sub;
+use crate::base::vec3::sub;
 use rayon::prelude::*;
 
 use crate::Mesh;

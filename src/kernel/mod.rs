@@ -10,12 +10,12 @@
 //! - [`spherical`]: the solid-angle and spherical-triangle formulas;
 //! - [`angle_sum`]: sums of many `atan2` terms as one complex product with turn counting;
 //! - [`boundary_sum`]: the SIMD loop over the boundary edges of the Antipodal formula;
-//! - [`compensated`]: Neumaier summation;
+//! - [`compensated`]: Neumaier summation (re-exported from the ground floor, `crate::base`);
 //! - [`double_double`]: the extended precision of ill-conditioned near-edge terms.
 
 pub mod angle_sum;
+pub use crate::base::compensated;
 pub mod boundary_sum;
-pub mod compensated;
 pub mod double_double;
 pub mod frame;
 pub mod predicates;

@@ -13,7 +13,7 @@ use super::double_double::{DoubleDouble, dot3};
 /// `1/(4π)`: a solid angle (or a sum of spherical areas) as a winding number.
 pub const INV_4PI: f64 = 1.0 / (4.0 * std::f64::consts::PI);
 use super::quantize::decompose;
-use crate::vec3::{cross, dot, norm};
+use crate::base::vec3::{cross, dot, norm};
 
 /// `2·atan2(s·mag, den)` where the sign `s ∈ {−1, 0, 1}` of the numerator was decided exactly.
 ///

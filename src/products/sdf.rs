@@ -22,7 +22,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-use crate::vec3::{cross, dot, sub};
+use crate::base::vec3::{cross, dot, sub};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 

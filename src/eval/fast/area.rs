@@ -180,10 +180,10 @@ fn tangent_basis(n: [f64; 3]) -> ([f64; 3], [f64; 3]) {
     } else {
         [0.0, 0.0, 1.0]
     };
-    let u = crate::vec3::cross(n, a);
+    let u = crate::base::vec3::cross(n, a);
     let l = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
     let u = u.map(|x| x / l);
-    let v = crate::vec3::cross(n, u);
+    let v = crate::base::vec3::cross(n, u);
     (u, v)
 }
 

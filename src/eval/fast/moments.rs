@@ -22,10 +22,10 @@
 // The tensor code indexes like the formulas it transcribes (`M1[i][j] += δᵢ Nⱼ`).
 #![allow(clippy::needless_range_loop)]
 
-use crate::vec3::sub;
+use crate::base::vec3::sub;
 use wide::f32x4;
 
-use crate::vec3::{cross, dot};
+use crate::base::vec3::{cross, dot};
 
 use crate::kernel::spherical::INV_4PI;
 

@@ -8,10 +8,10 @@ use super::moments::Moments;
 use super::tree::Tree;
 use wide::{CmpGt, CmpLt, f64x4};
 
+pub(crate) use crate::base::vec3::dist2;
+use crate::base::vec3::sub;
 use crate::kernel::angle_sum::AngleSum;
 use crate::kernel::spherical::{segment_gradient, triangle_solid_angle};
-pub(crate) use crate::vec3::dist2;
-use crate::vec3::sub;
 use crate::{BoundingBox, Mesh};
 
 use crate::kernel::spherical::INV_4PI;
