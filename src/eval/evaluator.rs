@@ -99,53 +99,37 @@ pub trait Evaluator: Send + Sync {
     }
 }
 
-impl<E: Evaluator + ?Sized> Evaluator for &E {
-    fn eval(&self, q: [f64; 3]) -> f64 {
-        (**self).eval(q)
-    }
-    fn name(&self) -> &'static str {
-        (**self).name()
-    }
-    fn eval_batch(&self, points: &[[f64; 3]]) -> Vec<f64> {
-        (**self).eval_batch(points)
-    }
-    fn column_axis(&self) -> Option<usize> {
-        (**self).column_axis()
-    }
-    fn eval_column(&self, q: [f64; 3], axis: usize, ts: &[f64]) -> Vec<f64> {
-        (**self).eval_column(q, axis, ts)
-    }
-    fn try_gradient(&self, q: [f64; 3]) -> Result<[f64; 3], NoGradient> {
-        (**self).try_gradient(q)
-    }
-    fn try_gradient_batch(&self, points: &[[f64; 3]]) -> Result<Vec<[f64; 3]>, NoGradient> {
-        (**self).try_gradient_batch(points)
-    }
+/// References and boxes of an evaluator are evaluators (every method forwarded, so overrides such
+/// as the exact evaluator's ray-reuse column are kept).
+macro_rules! forward_evaluator {
+    ($($ty:ty),*) => {$(
+        impl<E: Evaluator + ?Sized> Evaluator for $ty {
+            fn eval(&self, q: [f64; 3]) -> f64 {
+                (**self).eval(q)
+            }
+            fn name(&self) -> &'static str {
+                (**self).name()
+            }
+            fn eval_batch(&self, points: &[[f64; 3]]) -> Vec<f64> {
+                (**self).eval_batch(points)
+            }
+            fn column_axis(&self) -> Option<usize> {
+                (**self).column_axis()
+            }
+            fn eval_column(&self, q: [f64; 3], axis: usize, ts: &[f64]) -> Vec<f64> {
+                (**self).eval_column(q, axis, ts)
+            }
+            fn try_gradient(&self, q: [f64; 3]) -> Result<[f64; 3], NoGradient> {
+                (**self).try_gradient(q)
+            }
+            fn try_gradient_batch(&self, points: &[[f64; 3]]) -> Result<Vec<[f64; 3]>, NoGradient> {
+                (**self).try_gradient_batch(points)
+            }
+        }
+    )*};
 }
 
-impl<E: Evaluator + ?Sized> Evaluator for Box<E> {
-    fn eval(&self, q: [f64; 3]) -> f64 {
-        (**self).eval(q)
-    }
-    fn name(&self) -> &'static str {
-        (**self).name()
-    }
-    fn eval_batch(&self, points: &[[f64; 3]]) -> Vec<f64> {
-        (**self).eval_batch(points)
-    }
-    fn column_axis(&self) -> Option<usize> {
-        (**self).column_axis()
-    }
-    fn eval_column(&self, q: [f64; 3], axis: usize, ts: &[f64]) -> Vec<f64> {
-        (**self).eval_column(q, axis, ts)
-    }
-    fn try_gradient(&self, q: [f64; 3]) -> Result<[f64; 3], NoGradient> {
-        (**self).try_gradient(q)
-    }
-    fn try_gradient_batch(&self, points: &[[f64; 3]]) -> Result<Vec<[f64; 3]>, NoGradient> {
-        (**self).try_gradient_batch(points)
-    }
-}
+forward_evaluator!(&E, Box<E>);
 
 impl Evaluator for WindingNumber {
     fn eval(&self, q: [f64; 3]) -> f64 {

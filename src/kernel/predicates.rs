@@ -189,6 +189,13 @@ pub fn perturbed_orient2d<W: Width>(q: [i64; 2], a: [i64; 2], b: [i64; 2]) -> Or
             degenerate: false,
         };
     }
+    orient2d_perturbation(a, b)
+}
+
+/// The sign of `det(a − q_ε, b − q_ε)` when its real part is zero: the first non-zero of the ε1
+/// and ε2 coefficients `a_y − b_y`, `b_x − a_x` (they do not depend on `q`).
+#[inline]
+fn orient2d_perturbation(a: [i64; 2], b: [i64; 2]) -> Orient2d {
     let s1 = (a[1] - b[1]).signum() as i32;
     let sign = if s1 != 0 {
         s1
@@ -315,16 +322,7 @@ pub fn perturbed_orient2d_at<W: Width>(
             degenerate: false,
         };
     }
-    let s1 = (a[1] - b[1]).signum() as i32;
-    let sign = if s1 != 0 {
-        s1
-    } else {
-        (b[0] - a[0]).signum() as i32
-    };
-    Orient2d {
-        sign,
-        degenerate: true,
-    }
+    orient2d_perturbation(a, b)
 }
 
 /// Relative bound of the residual predicates' `f64` filters: `8u`, twice the `4u` that covers
