@@ -1,7 +1,7 @@
 //! Curved surfaces: closed forms, oracles and ray independence for the patch evaluator
 //! (`docs/patches.md`).
 
-use std::f64::consts::FRAC_1_SQRT_2;
+mod common;
 
 use gwn::Mesh;
 use gwn::eval::antipodal::WindingNumber;
@@ -86,33 +86,7 @@ fn planar_patches_equal_the_triangle_evaluator() {
 
 /// The unit sphere as 8 rational biquadratic patches (quarter circles × half meridians), outward.
 fn sphere() -> PatchSet {
-    let w = FRAC_1_SQRT_2;
-    // Meridian from the south pole to the equator and on to the north pole: (r, z), weight.
-    let south = [(0.0, -1.0, 1.0), (1.0, -1.0, w), (1.0, 0.0, 1.0)];
-    let north = [(1.0, 0.0, 1.0), (1.0, 1.0, w), (0.0, 1.0, 1.0)];
-    // Counter-clockwise quarter circles in xy.
-    let quarters = [
-        [(1.0, 0.0), (1.0, 1.0), (0.0, 1.0)],
-        [(0.0, 1.0), (-1.0, 1.0), (-1.0, 0.0)],
-        [(-1.0, 0.0), (-1.0, -1.0), (0.0, -1.0)],
-        [(0.0, -1.0), (1.0, -1.0), (1.0, 0.0)],
-    ];
-    let cw = [1.0, w, 1.0];
-    let mut patches = Vec::new();
-    for profile in [south, north] {
-        for quarter in quarters {
-            let mut pts = Vec::new();
-            let mut ws = Vec::new();
-            for &(r, z, wp) in &profile {
-                for (j, &(x, y)) in quarter.iter().enumerate() {
-                    pts.push([r * x, r * y, z]);
-                    ws.push(wp * cw[j]);
-                }
-            }
-            patches.push(Patch::rational(2, 2, pts, ws).unwrap());
-        }
-    }
-    PatchSet::new(patches).unwrap()
+    PatchSet::new(common::rational_sphere_patches()).unwrap()
 }
 
 #[test]

@@ -1,41 +1,17 @@
 //! Property tests of the patch evaluator: closed patch sets split and perturbed at random stay
 //! integer-valued off the surface, for every ray; random open patches agree with tessellations.
 
-use std::f64::consts::FRAC_1_SQRT_2;
-
 use gwn::eval::antipodal::WindingNumber;
 use gwn::kernel::frame::RayAxis;
 use gwn::patch::tessellate::tessellate;
 use gwn::patch::{Options, Patch, PatchSet, PatchWindingNumber};
+mod common;
+
 use proptest::prelude::*;
 
-/// The unit sphere as 8 rational biquadratic patches, outward.
+/// The unit sphere as 8 rational biquadratic patches, outward (shared with `tests/patches.rs`).
 fn sphere() -> Vec<Patch> {
-    let w = FRAC_1_SQRT_2;
-    let south = [(0.0, -1.0, 1.0), (1.0, -1.0, w), (1.0, 0.0, 1.0)];
-    let north = [(1.0, 0.0, 1.0), (1.0, 1.0, w), (0.0, 1.0, 1.0)];
-    let quarters = [
-        [(1.0, 0.0), (1.0, 1.0), (0.0, 1.0)],
-        [(0.0, 1.0), (-1.0, 1.0), (-1.0, 0.0)],
-        [(-1.0, 0.0), (-1.0, -1.0), (0.0, -1.0)],
-        [(0.0, -1.0), (1.0, -1.0), (1.0, 0.0)],
-    ];
-    let cw = [1.0, w, 1.0];
-    let mut patches = Vec::new();
-    for profile in [south, north] {
-        for quarter in quarters {
-            let mut pts = Vec::new();
-            let mut ws = Vec::new();
-            for &(r, z, wp) in &profile {
-                for (j, &(x, y)) in quarter.iter().enumerate() {
-                    pts.push([r * x, r * y, z]);
-                    ws.push(wp * cw[j]);
-                }
-            }
-            patches.push(Patch::rational(2, 2, pts, ws).unwrap());
-        }
-    }
-    patches
+    common::rational_sphere_patches()
 }
 
 /// The unit cube's six faces as planar bicubic patches, outward.

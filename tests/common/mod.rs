@@ -48,3 +48,33 @@ impl Rng {
 }
 
 pub use gwn::testing::direct_at_perturbed;
+
+/// The unit sphere as 8 rational biquadratic patches (quarter circles × half meridians),
+/// outward.
+pub fn rational_sphere_patches() -> Vec<gwn::patch::Patch> {
+    let w = std::f64::consts::FRAC_1_SQRT_2;
+    let south = [(0.0, -1.0, 1.0), (1.0, -1.0, w), (1.0, 0.0, 1.0)];
+    let north = [(1.0, 0.0, 1.0), (1.0, 1.0, w), (0.0, 1.0, 1.0)];
+    let quarters = [
+        [(1.0, 0.0), (1.0, 1.0), (0.0, 1.0)],
+        [(0.0, 1.0), (-1.0, 1.0), (-1.0, 0.0)],
+        [(-1.0, 0.0), (-1.0, -1.0), (0.0, -1.0)],
+        [(0.0, -1.0), (1.0, -1.0), (1.0, 0.0)],
+    ];
+    let cw = [1.0, w, 1.0];
+    let mut patches = Vec::new();
+    for profile in [south, north] {
+        for quarter in quarters {
+            let mut pts = Vec::new();
+            let mut ws = Vec::new();
+            for &(r, z, wp) in &profile {
+                for (j, &(x, y)) in quarter.iter().enumerate() {
+                    pts.push([r * x, r * y, z]);
+                    ws.push(wp * cw[j]);
+                }
+            }
+            patches.push(gwn::patch::Patch::rational(2, 2, pts, ws).unwrap());
+        }
+    }
+    patches
+}

@@ -23,7 +23,7 @@ use crate::common::{CliError, check_beta, checked_threads, load_mesh_for_cli, ou
 #[derive(ClapArgs, Debug)]
 #[command(verbatim_doc_comment)]
 pub struct Args {
-    /// Mesh files or folders (every .obj/.stl/.off/.ply inside, sorted).
+    /// Mesh files or folders (every .obj/.stl/.off/.ply/.gltf/.glb inside, sorted).
     #[arg(required = true)]
     pub paths: Vec<PathBuf>,
     /// Grid resolution per axis (1 to 256: the grid has N³ points).
@@ -83,7 +83,8 @@ pub fn run(mut args: Args) -> Result<(), CliError> {
                 .filter_map(|e| e.ok().map(|e| e.path()))
                 .filter(|p| {
                     p.extension().and_then(|e| e.to_str()).is_some_and(|e| {
-                        ["obj", "stl", "off", "ply"].contains(&e.to_ascii_lowercase().as_str())
+                        ["obj", "stl", "off", "ply", "gltf", "glb"]
+                            .contains(&e.to_ascii_lowercase().as_str())
                     })
                 })
                 .collect();

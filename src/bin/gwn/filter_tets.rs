@@ -14,7 +14,8 @@ use crate::method::{Input, MethodArgs};
 /// Unreferenced points are dropped from the output.
 #[derive(ClapArgs, Debug)]
 pub struct Args {
-    /// Surface mesh (OBJ, STL, OFF, PLY) or oriented point cloud (.xyz, .csv, .pts, .ply).
+    /// Surface mesh (OBJ, STL, OFF, PLY, glTF/GLB), patch set (.bpt, .rbpt) or oriented point cloud
+    /// (.xyz, .csv, .pts, .ply).
     pub mesh: PathBuf,
     #[command(flatten)]
     pub method: MethodArgs,

@@ -45,7 +45,8 @@ impl Axis {
 /// (x right, y up).
 #[derive(ClapArgs, Debug)]
 pub struct Args {
-    /// Mesh file (OBJ, STL, OFF, PLY, glTF/GLB) or oriented point cloud (.xyz, .csv, .pts, .ply).
+    /// Mesh file (OBJ, STL, OFF, PLY, glTF/GLB), patch set (.bpt, .rbpt) or oriented point cloud
+    /// (.xyz, .csv, .pts, .ply).
     pub mesh: PathBuf,
     #[command(flatten)]
     pub method: MethodArgs,

@@ -200,7 +200,8 @@ mod tests {
 /// (ray reuse); values equal per-point evaluation exactly. Point clouds use the fast method.
 #[derive(ClapArgs, Debug)]
 pub struct Args {
-    /// Mesh file (OBJ, STL, OFF, PLY, glTF/GLB) or oriented point cloud (.xyz, .csv, .pts, .ply).
+    /// Mesh file (OBJ, STL, OFF, PLY, glTF/GLB), patch set (.bpt, .rbpt) or oriented point cloud
+    /// (.xyz, .csv, .pts, .ply).
     pub mesh: PathBuf,
     #[command(flatten)]
     pub grid: GridArgs,
