@@ -9,12 +9,15 @@
 //!   queries off the lattice;
 //! - [`spherical`]: the solid-angle and spherical-triangle formulas;
 //! - [`angle_sum`]: sums of many `atan2` terms as one complex product with turn counting;
-//! - [`boundary_sum`]: the SIMD loop over the boundary edges of the Antipodal formula;
+//! - [`boundary_sum`]: the SIMD loop over the boundary edges of the Antipodal formula, and the
+//!   certified hierarchy over them;
+//! - [`boundary_multipole`]: the far-field expansion of a boundary cluster and its error bound;
 //! - [`compensated`]: Neumaier summation (re-exported from the ground floor, `crate::base`);
 //! - [`double_double`]: the extended precision of ill-conditioned near-edge terms.
 
 pub mod angle_sum;
 pub use crate::base::compensated;
+pub mod boundary_multipole;
 pub mod boundary_sum;
 pub mod double_double;
 pub mod frame;
