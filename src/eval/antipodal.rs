@@ -25,6 +25,7 @@ use rayon::prelude::*;
 use crate::Mesh;
 use crate::bvh::RayBvh;
 use crate::kernel::boundary_sum::BoundaryEdges;
+use crate::kernel::boundary_tree::BoundaryTree;
 use crate::kernel::compensated::NeumaierSum;
 use crate::kernel::frame::RayAxis;
 use crate::kernel::predicates::{
@@ -38,7 +39,7 @@ use crate::mesh::{boundary_edges, boundary_welded_by};
 use crate::kernel::spherical::INV_4PI;
 
 /// Options of the exact evaluator.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Options {
     /// Grid width (default 60 bits with `i128` predicates).
     pub precision: Precision,
@@ -46,6 +47,27 @@ pub struct Options {
     pub ray: RayAxis,
     /// How boundary edges are matched (default: by position).
     pub boundary: BoundaryBy,
+    /// Absolute tolerance on `w` for the far boundary (docs/boundary.md): boundary clusters far
+    /// from the query may be replaced by a multipole expansion whose certified error bound, summed
+    /// over the query, stays `≤ tolerance` ([`WindingNumber::eval_with_bound`] returns it). The
+    /// integer part is never approximated. `0` is the flat exact loop. Default
+    /// [`DEFAULT_TOLERANCE`].
+    pub tolerance: f64,
+}
+
+/// The default [`Options::tolerance`]: the documented error of the exact evaluator stays
+/// `≤ 1e-10` (docs/robustness.md); a node is expanded only where that is cheaper than its loop.
+pub const DEFAULT_TOLERANCE: f64 = 1e-10;
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            precision: Precision::default(),
+            ray: RayAxis::default(),
+            boundary: BoundaryBy::default(),
+            tolerance: DEFAULT_TOLERANCE,
+        }
+    }
 }
 
 /// Which boundary the Antipodal sum runs over. Both give the same `w` (up to rounding off the
@@ -153,6 +175,30 @@ impl WindingNumber {
         chi as f64 + area * INV_4PI
     }
 
+    /// Winding number at `q` and a certified bound on its difference from the flat exact loop
+    /// (tolerance 0): `0` unless far boundary clusters were expanded ([`Options::tolerance`]),
+    /// and never above the tolerance. `(NaN, 0)` if `q` is not finite.
+    ///
+    /// ```
+    /// use gwn::{Mesh, eval::antipodal::{Options, WindingNumber}};
+    /// let p = [[0.,0.,0.],[1.,0.,0.],[0.,1.,0.]];
+    /// let w = WindingNumber::with_options(&Mesh::from_slices(&p, &[[0, 1, 2]])?,
+    ///     Options { tolerance: 1e-6, ..Default::default() })?;
+    /// let (value, bound) = w.eval_with_bound([0.2, 0.2, 0.5]);
+    /// assert!(bound <= 1e-6 && (value - w.eval([0.2, 0.2, 0.5])).abs() <= bound);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn eval_with_bound(&self, q: [f64; 3]) -> (f64, f64) {
+        if q.iter().any(|c| !c.is_finite()) {
+            return (f64::NAN, 0.0);
+        }
+        let (chi, area, bound) = match &self.core {
+            Dispatch::Narrow(c) => c.parts_with_bound(q),
+            Dispatch::Wide(c) => c.parts_with_bound(q),
+        };
+        (chi as f64 + area * INV_4PI, bound)
+    }
+
     /// Winding numbers at many points, in parallel.
     pub fn eval_batch(&self, points: &[[f64; 3]]) -> Vec<f64> {
         points.par_iter().map(|&q| self.eval(q)).collect()
@@ -243,6 +289,8 @@ struct FrameEvaluator<W: Width> {
     /// Triangle corners in grid coordinates (frame), in BVH leaf order.
     tri_pts: Vec<[[i64; 3]; 3]>,
     boundary: BoundaryEdges,
+    /// The certified hierarchy over `boundary` (tolerance > 0 and some node can pay).
+    tree: Option<BoundaryTree>,
     bvh: RayBvh,
     _width: PhantomData<W>,
 }
@@ -276,6 +324,7 @@ impl<W: Width> FrameEvaluator<W> {
             boundary.iter().map(|e| f64::from(e.weight)).collect(),
             grid.precision().bits(),
         );
+        let tree = BoundaryTree::build(&boundary, options.tolerance);
         let to_unit = 1.0 / (1_i64 << (grid.precision().bits() - 1)) as f64;
         let boxes: Vec<([f32; 3], [f32; 3])> = tris
             .iter()
@@ -304,6 +353,7 @@ impl<W: Width> FrameEvaluator<W> {
             to_unit,
             tri_pts,
             boundary,
+            tree,
             bvh,
             _width: PhantomData,
         })
@@ -318,6 +368,7 @@ impl<W: Width> FrameEvaluator<W> {
             to_unit: 1.0,
             tri_pts: Vec::new(),
             boundary: BoundaryEdges::default(),
+            tree: None,
             bvh: RayBvh::default(),
             _width: PhantomData,
         }
@@ -346,15 +397,22 @@ impl<W: Width> FrameEvaluator<W> {
 
     /// The parts at a world query (finite).
     fn parts(&self, q: [f64; 3]) -> (i64, f64) {
+        let (chi, area, _) = self.parts_with_bound(q);
+        (chi, area)
+    }
+
+    /// The parts and the bound of the expanded boundary (on `w`) at a world query (finite).
+    fn parts_with_bound(&self, q: [f64; 3]) -> (i64, f64, f64) {
         self.parts_in_grid_space(self.grid.pull_in_far(self.grid.to_grid_space(q)))
     }
 
-    /// The parts at a grid-space query already pulled in ([`Grid::pull_in_far`]).
-    fn parts_in_grid_space(&self, q: [f64; 3]) -> (i64, f64) {
+    /// The parts at a grid-space query already pulled in ([`Grid::pull_in_far`]), and the bound.
+    fn parts_in_grid_space(&self, q: [f64; 3]) -> (i64, f64, f64) {
         let qf = self.ray.to_frame(q);
         let (snap, residual) = self.snap_frame(q);
         let (Snap::In(x), Snap::In(y)) = (snap[0], snap[1]) else {
-            return (0, self.far_boundary_sum(qf));
+            let (area, bound) = self.far_boundary_sum(qf);
+            return (0, area, bound);
         };
         let limit = self.grid.limit();
         let (z, z_exact) = match snap[2] {
@@ -375,8 +433,8 @@ impl<W: Width> FrameEvaluator<W> {
         } else {
             self.signed_crossings_at(qi, r)
         };
-        let area = self.boundary_sum(qi, r, z_exact, qf[2]);
-        (chi, area)
+        let (area, bound) = self.boundary_sum(qi, r, z_exact, qf[2]);
+        (chi, area, bound)
     }
 
     fn column(&self, q: [f64; 3], ts: &[f64]) -> Vec<f64> {
@@ -397,7 +455,7 @@ impl<W: Width> FrameEvaluator<W> {
                 .iter()
                 .map(|&t| {
                     if t.is_finite() {
-                        let (chi, area) = self.parts_in_grid_space(at(t));
+                        let (chi, area, _) = self.parts_in_grid_space(at(t));
                         chi as f64 + area * INV_4PI
                     } else {
                         f64::NAN
@@ -420,7 +478,7 @@ impl<W: Width> FrameEvaluator<W> {
                     Snap::In(z) if residual[2] == 0.0 => (z, true, qf[2]),
                     Snap::In(z) => {
                         if t.is_finite() {
-                            let (chi, area) = self.parts_in_grid_space(p);
+                            let (chi, area, _) = self.parts_in_grid_space(p);
                             *out = chi as f64 + area * INV_4PI;
                         }
                         (z, false, f64::NAN)
@@ -473,7 +531,7 @@ impl<W: Width> FrameEvaluator<W> {
             } else {
                 0
             };
-            out[k] = c as f64 + self.boundary_sum([x, y, z], [0.0; 3], exact, qz) * INV_4PI;
+            out[k] = c as f64 + self.boundary_sum([x, y, z], [0.0; 3], exact, qz).0 * INV_4PI;
         }
         out
     }
@@ -500,33 +558,68 @@ impl<W: Width> FrameEvaluator<W> {
     }
 
     /// `Σ k·Area(A, B, x1)` with exact branch signs at the query `qi + r` (lattice point and
-    /// residual). `z_exact` is false when the query's frame z lies outside the grid (then `qz`
-    /// is used in floating point for the magnitudes). Queries near a boundary edge, or whose
-    /// residual matters for a sign, take the double-double path.
-    fn boundary_sum(&self, qi: [i64; 3], r: [f64; 3], z_exact: bool, qz: f64) -> f64 {
+    /// residual), and the bound (on `w`) of its expanded far part. `z_exact` is false when the
+    /// query's frame z lies outside the grid (then `qz` is used in floating point for the
+    /// magnitudes). Queries near a boundary edge, or whose residual matters for a sign, take the
+    /// double-double path, never the hierarchy.
+    fn boundary_sum(&self, qi: [i64; 3], r: [f64; 3], z_exact: bool, qz: f64) -> (f64, f64) {
         let qz_units = (qz - self.origin[2]) / self.cell;
         if self.boundary.needs_accurate_sum::<W>(qi, r, z_exact) {
-            self.boundary
-                .area_sum_accurate::<W>(qi, r, z_exact, qz_units)
-        } else {
-            self.boundary.area_sum::<W>(qi, z_exact, qz_units)
+            let area = self
+                .boundary
+                .area_sum_accurate::<W>(qi, r, z_exact, qz_units);
+            return (area, 0.0);
+        }
+        match &self.tree {
+            Some(tree) => {
+                let sum = tree.area_sum::<W>(&self.boundary, qi, z_exact, qz_units);
+                (sum.area, sum.bound)
+            }
+            None => (
+                self.boundary.area_sum::<W>(qi, z_exact, qz_units),
+                0.0,
+            ),
         }
     }
 
-    /// Boundary sum for a query whose ray cannot approach the mesh: plain floating point.
-    fn far_boundary_sum(&self, qf: [f64; 3]) -> f64 {
-        let mut sum = 0.0;
-        for i in 0..self.boundary.len() {
-            let (a, b, weight) = self.boundary.edge(i);
+    /// Boundary sum for a query whose ray cannot approach the mesh: plain floating point (and
+    /// the hierarchy, whose every node the ray misses).
+    fn far_boundary_sum(&self, qf: [f64; 3]) -> (f64, f64) {
+        let term = |a: [i64; 3], b: [i64; 3]| {
             let ra = self.rel_f64(a, qf);
             let rb = self.rel_f64(b, qf);
             let signs = EdgeSigns {
                 numerator: far_query_numerator_sign(ra, rb),
                 query_inside_segment: false,
             };
-            sum += weight * antipodal_edge_area(ra, rb, signs);
+            antipodal_edge_area(ra, rb, signs)
+        };
+        let Some(tree) = &self.tree else {
+            let mut sum = 0.0;
+            for i in 0..self.boundary.len() {
+                let (a, b, weight) = self.boundary.edge(i);
+                sum += weight * term(a, b);
+            }
+            return (sum, 0.0);
+        };
+        let limit = self.boundary.limit();
+        let q = std::array::from_fn(|k| (qf[k] - self.origin[k]) / self.cell / limit);
+        let mut exact_sum = 0.0;
+        let mut exact = |range: std::ops::Range<usize>| {
+            for j in range {
+                if let Some(e) = self.boundary.slot_edge(j) {
+                    let (a, b, _) = self.boundary.edge(e);
+                    exact_sum += term(a, b);
+                }
+            }
+        };
+        let sum = tree.traverse(q, |_, _| true, &mut exact, term);
+        let mut area = sum.area + exact_sum;
+        for e in self.boundary.heavy_edges() {
+            let (a, b, weight) = self.boundary.edge(e);
+            area += weight * term(a, b);
         }
-        sum
+        (area, sum.bound)
     }
 
     #[inline]

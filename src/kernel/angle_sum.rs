@@ -91,6 +91,18 @@ impl AngleSum {
         self.im *= scale;
     }
 
+    /// Adds every angle of `other` (lane by lane: the product of the two accumulators, with the
+    /// same turn counting as [`AngleSum::push`], plus `other`'s turns).
+    #[inline]
+    pub fn absorb(&mut self, other: &AngleSum) {
+        let mut o = *other;
+        o.rescale();
+        self.rescale();
+        self.push(o.re, o.im);
+        self.turns_up += o.turns_up;
+        self.turns_down += o.turns_down;
+    }
+
     /// `Σ atan2(y_i, x_i)` over every lane of every push.
     ///
     /// The four lanes are multiplied together (with the same turn counting) so that one `atan2`

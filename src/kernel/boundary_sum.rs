@@ -190,6 +190,21 @@ impl BoundaryEdges {
         if self.a.is_empty() {
             return 0.0;
         }
+        let (angles, scalar) = self.range_area_sum::<W>(qi, z_exact, qz_units, 0..self.slots);
+        2.0 * angles.total() + scalar + self.heavy_area_sum::<W>(qi, z_exact, qz_units)
+    }
+
+    /// The chained edges of the slots `range` (a multiple of 4 at the start; see
+    /// [`BoundaryEdges::padded_slots`]): their `atan2` terms as one product (so that one `atan2`
+    /// can serve many ranges, [`AngleSum::absorb`]) and the sum of the terms recomputed exactly.
+    pub(crate) fn range_area_sum<W: Width>(
+        &self,
+        qi: [i64; 3],
+        z_exact: bool,
+        qz_units: f64,
+        range: std::ops::Range<usize>,
+    ) -> (AngleSum, f64) {
+        debug_assert!(range.start % 4 == 0 && range.end <= self.padded_slots());
         let q = [
             qi[0] as f64,
             qi[1] as f64,
@@ -200,23 +215,49 @@ impl BoundaryEdges {
             scalar += self.exact_edge_area::<W>(e as usize, qi, z_exact, qz_units);
         };
         #[cfg(target_arch = "x86_64")]
-        let angles = if std::arch::is_x86_feature_detected!("avx2") {
+        let range_angles = if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: `chain_angles_avx2` only needs the AVX2 instructions it is compiled
             // with, and the CPU was just checked to have them.
             #[allow(unsafe_code)]
             unsafe {
-                self.chain_angles_avx2(q, &mut undecided)
+                self.chain_angles_avx2(q, range, &mut undecided)
             }
         } else {
-            self.chain_angles(q, &mut undecided)
+            self.chain_angles(q, range, &mut undecided)
         };
         #[cfg(not(target_arch = "x86_64"))]
-        let angles = self.chain_angles(q, &mut undecided);
+        let range_angles = self.chain_angles(q, range, &mut undecided);
+        (range_angles, scalar)
+    }
+
+    /// The edges too heavy to chain (each one exact term times its weight).
+    pub(crate) fn heavy_area_sum<W: Width>(&self, qi: [i64; 3], z_exact: bool, qz_units: f64) -> f64 {
+        let mut sum = 0.0;
         for &e in &self.heavy {
             let e = e as usize;
-            scalar += self.weight[e] * self.exact_edge_area::<W>(e, qi, z_exact, qz_units);
+            sum += self.weight[e] * self.exact_edge_area::<W>(e, qi, z_exact, qz_units);
         }
-        2.0 * angles.total() + scalar
+        sum
+    }
+
+    /// Edges of weight above [`MAX_CHAINED_WEIGHT`] (not in any slot).
+    pub(crate) fn heavy_edges(&self) -> impl Iterator<Item = usize> + '_ {
+        self.heavy.iter().map(|&e| e as usize)
+    }
+
+    /// Slots rounded up to a multiple of 4: the end of the last range a loop may visit.
+    pub(crate) fn padded_slots(&self) -> usize {
+        self.slots.div_ceil(4) * 4
+    }
+
+    /// The edge of slot `j` (vertex `j` → vertex `j + 1`), or `None` for a break or padding.
+    pub(crate) fn slot_edge(&self, j: usize) -> Option<usize> {
+        (self.link[j] != 0.0).then(|| self.edge_of[j] as usize)
+    }
+
+    /// `2^(bits−1)`: grid coordinates divided by it are normalized to `[−1, 1]`.
+    pub(crate) fn limit(&self) -> f64 {
+        self.limit
     }
 
     /// Whether the query `qi + r` (lattice point, residual in cells; `r[2] = 0` when `z_exact` is
@@ -321,7 +362,12 @@ impl BoundaryEdges {
 
     /// The chained edges' terms for the query `q` (grid units, `f64`) multiplied into an
     /// [`AngleSum`]; `undecided(e)` is called for each edge the filter cannot sign.
-    fn chain_angles(&self, q: [f64; 3], undecided: &mut impl FnMut(u32)) -> AngleSum {
+    fn chain_angles(
+        &self,
+        q: [f64; 3],
+        slots: std::ops::Range<usize>,
+        undecided: &mut impl FnMut(u32),
+    ) -> AngleSum {
         let [qx, qy, qz] = q.map(f64x4::splat);
         let (conv, rel) = self.filter_constants();
         let (conv, rel) = (f64x4::splat(conv), f64x4::splat(rel));
@@ -340,8 +386,8 @@ impl BoundaryEdges {
             [x, y, s, p]
         };
         let mut angles = AngleSum::new();
-        let mut cur = vertices(0);
-        for j in (0..self.slots).step_by(4) {
+        let mut cur = vertices(slots.start);
+        for j in slots.step_by(4) {
             // Edge slots j..j+4 run from these vertices to the next four, i.e. to lanes
             // shifted by one (the data is padded past the last slot).
             let next = vertices(j + 4);
@@ -381,7 +427,12 @@ impl BoundaryEdges {
     /// `area_sum` calls it, after checking that the CPU has AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn chain_angles_avx2(&self, q: [f64; 3], undecided: &mut impl FnMut(u32)) -> AngleSum {
+    fn chain_angles_avx2(
+        &self,
+        q: [f64; 3],
+        slots: std::ops::Range<usize>,
+        undecided: &mut impl FnMut(u32),
+    ) -> AngleSum {
         use std::arch::x86_64::*;
         let load = |v: &[f64], j: usize| -> __m256d { bytemuck::cast(lanes4(v, j)) };
         let (qx, qy, qz) = (
@@ -423,8 +474,8 @@ impl BoundaryEdges {
         let (mut up_turns, mut down_turns) = (_mm256_setzero_si256(), _mm256_setzero_si256());
         let exponent = _mm256_set1_epi64x(0x7ff0_0000_0000_0000);
         let twice_bias = _mm256_set1_epi64x(2046 << 52);
-        let mut cur = vertices!(0);
-        for j in (0..self.slots).step_by(4) {
+        let mut cur = vertices!(slots.start);
+        for j in slots.step_by(4) {
             let next = vertices!(j + 4);
             let [ax, ay, sa, pa] = cur;
             let (bx, by, sb, pb) = (
@@ -511,24 +562,35 @@ impl BoundaryEdges {
         z_exact: bool,
         qz_units: f64,
     ) -> f64 {
-        let a = self.a[i];
-        let b = self.b[i];
-        let o = perturbed_orient2d::<W>([qi[0], qi[1]], [a[0], a[1]], [b[0], b[1]]);
-        let dz = |p: [i64; 3]| {
-            if z_exact {
-                (p[2] - qi[2]) as f64
-            } else {
-                p[2] as f64 - qz_units
-            }
-        };
-        let ra = [(a[0] - qi[0]) as f64, (a[1] - qi[1]) as f64, dz(a)];
-        let rb = [(b[0] - qi[0]) as f64, (b[1] - qi[1]) as f64, dz(b)];
-        let signs = EdgeSigns {
-            numerator: -o.sign,
-            query_inside_segment: o.degenerate && z_exact && query_inside_segment(qi, a, b),
-        };
-        antipodal_edge_area(ra, rb, signs)
+        segment_area::<W>(self.a[i], self.b[i], qi, z_exact, qz_units)
     }
+}
+
+/// The term `Area(A, B, x1)` of any segment `a → b` (grid coordinates, frame) at the lattice
+/// query `qi` through the exact predicate and the limit formulas: the same sign as every other
+/// term (the hierarchy's spoke segments use it, see [`super::boundary_tree`]).
+pub(crate) fn segment_area<W: Width>(
+    a: [i64; 3],
+    b: [i64; 3],
+    qi: [i64; 3],
+    z_exact: bool,
+    qz_units: f64,
+) -> f64 {
+    let o = perturbed_orient2d::<W>([qi[0], qi[1]], [a[0], a[1]], [b[0], b[1]]);
+    let dz = |p: [i64; 3]| {
+        if z_exact {
+            (p[2] - qi[2]) as f64
+        } else {
+            p[2] as f64 - qz_units
+        }
+    };
+    let ra = [(a[0] - qi[0]) as f64, (a[1] - qi[1]) as f64, dz(a)];
+    let rb = [(b[0] - qi[0]) as f64, (b[1] - qi[1]) as f64, dz(b)];
+    let signs = EdgeSigns {
+        numerator: -o.sign,
+        query_inside_segment: o.degenerate && z_exact && query_inside_segment(qi, a, b),
+    };
+    antipodal_edge_area(ra, rb, signs)
 }
 
 /// Decomposes the edges (edge `i` repeated `weight[i]` times, heavy edges left out) into chains: sequences of edges,

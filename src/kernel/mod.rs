@@ -9,8 +9,8 @@
 //!   queries off the lattice;
 //! - [`spherical`]: the solid-angle and spherical-triangle formulas;
 //! - [`angle_sum`]: sums of many `atan2` terms as one complex product with turn counting;
-//! - [`boundary_sum`]: the SIMD loop over the boundary edges of the Antipodal formula, and the
-//!   certified hierarchy over them;
+//! - [`boundary_sum`]: the SIMD loop over the boundary edges of the Antipodal formula;
+//! - [`boundary_tree`]: the certified hierarchy over the boundary chains (far nodes expanded);
 //! - [`boundary_multipole`]: the far-field expansion of a boundary cluster and its error bound;
 //! - [`compensated`]: Neumaier summation (re-exported from the ground floor, `crate::base`);
 //! - [`double_double`]: the extended precision of ill-conditioned near-edge terms.
@@ -19,6 +19,7 @@ pub mod angle_sum;
 pub use crate::base::compensated;
 pub mod boundary_multipole;
 pub mod boundary_sum;
+pub mod boundary_tree;
 pub mod double_double;
 pub mod frame;
 pub mod predicates;

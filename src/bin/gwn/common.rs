@@ -88,6 +88,39 @@ impl WeldArgs {
     }
 }
 
+/// `--tolerance` of the exact method's far boundary, shared by the products (`gwn eval` has its
+/// own, which also serves patch sets).
+#[derive(clap::Args, Debug, Clone, Copy)]
+pub struct ToleranceArgs {
+    /// Exact method: absolute tolerance on w for far boundary clusters, replaced by a multipole
+    /// expansion with a certified error bound (docs/boundary.md); 0 = the flat exact loop. The
+    /// integer part is always exact.
+    #[arg(long, default_value_t = gwn::eval::antipodal::DEFAULT_TOLERANCE)]
+    pub tolerance: f64,
+}
+
+impl ToleranceArgs {
+    /// The exact method's options for these flags and `weld`.
+    pub fn exact_options(&self, weld: WeldArgs) -> Result<gwn::eval::antipodal::Options, CliError> {
+        check_boundary_tolerance(self.tolerance)?;
+        Ok(gwn::eval::antipodal::Options {
+            tolerance: self.tolerance,
+            ..weld.exact_options()
+        })
+    }
+}
+
+/// A boundary tolerance must be a finite number `≥ 0`.
+pub fn check_boundary_tolerance(tolerance: f64) -> Result<(), CliError> {
+    if tolerance.is_finite() && tolerance >= 0.0 {
+        Ok(())
+    } else {
+        Err(CliError(format!(
+            "--tolerance must be a finite number >= 0, not {tolerance}"
+        )))
+    }
+}
+
 /// Loads a mesh for a subcommand, welded as `weld` says; errors name the file.
 pub fn load_mesh_for_cli(path: &std::path::Path, weld: WeldArgs) -> Result<gwn::Mesh, CliError> {
     let opts = weld.load_options();

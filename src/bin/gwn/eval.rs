@@ -94,8 +94,10 @@ pub struct Args {
     pub gradient_out: Option<PathBuf>,
     #[command(flatten)]
     pub weld: crate::common::WeldArgs,
-    /// Patch sets: target absolute error of w (boundary quadrature of the exact method, surface
-    /// quadrature of the direct method).
+    /// Target absolute error of w. Meshes, exact method: far boundary clusters are replaced by a
+    /// multipole expansion with a certified bound (docs/boundary.md; 0 = the flat exact loop, the
+    /// integer part is always exact). Patch sets: boundary quadrature of the exact method, surface
+    /// quadrature of the direct method.
     #[arg(long, default_value_t = 1e-10)]
     pub tolerance: f64,
 }
@@ -121,6 +123,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             "--gradient-out needs --gradient (no gradient is computed without it)",
         ));
     }
+    crate::common::check_boundary_tolerance(args.tolerance)?;
     let input = Input::load(&args.mesh, args.weld)?;
     let method = args.method.method(&input);
     if method != Method::Exact {
@@ -142,6 +145,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             Precision::Bits60
         },
         ray: args.ray.unwrap_or(Ray::PosZ).into(),
+        tolerance: args.tolerance,
         ..args.weld.exact_options()
     };
     let wn = args.method.build(&input, &args.mesh, options)?;

@@ -29,6 +29,8 @@ pub struct Args {
     pub threshold: f64,
     #[command(flatten)]
     pub weld: crate::common::WeldArgs,
+    #[command(flatten)]
+    pub boundary: crate::common::ToleranceArgs,
 }
 
 /// Runs `gwn filter-tets`.
@@ -38,7 +40,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let tets = load_tets(&args.tets)?;
     let wn = args
         .method
-        .build(&input, &args.mesh, args.weld.exact_options())?;
+        .build(&input, &args.mesh, args.boundary.exact_options(args.weld)?)?;
     let keep = filter_tets(&tets.points, &tets.tets, &wn, args.threshold);
     let kept = tets.select(&keep);
     // `save_tets` errors already start with the file they concern.

@@ -28,6 +28,8 @@ pub struct Args {
     pub out: PathBuf,
     #[command(flatten)]
     pub weld: crate::common::WeldArgs,
+    #[command(flatten)]
+    pub boundary: crate::common::ToleranceArgs,
 }
 
 /// Peak bytes per cell of `gwn sdf`: the winding numbers (with the per-column results they are
@@ -41,7 +43,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let spec = args.grid.spec(&input, &args.mesh, SDF_BYTES_PER_CELL)?;
     let wn = args
         .method
-        .build(&input, &args.mesh, args.weld.exact_options())?;
+        .build(&input, &args.mesh, args.boundary.exact_options(args.weld)?)?;
     let sdf = match &input {
         Input::Mesh(mesh) => SignedDistance::with_evaluator(mesh, wn),
         Input::Cloud(cloud) => SignedDistance::with_points(cloud.positions(), wn),

@@ -73,6 +73,8 @@ pub struct Args {
     pub out: PathBuf,
     #[command(flatten)]
     pub weld: crate::common::WeldArgs,
+    #[command(flatten)]
+    pub boundary: crate::common::ToleranceArgs,
 }
 
 /// Runs `gwn slice`.
@@ -96,6 +98,9 @@ pub fn run_default() -> Result<(), CliError> {
         outline: true,
         out: PathBuf::from("slice.png"),
         weld: Default::default(),
+        boundary: crate::common::ToleranceArgs {
+            tolerance: gwn::eval::antipodal::DEFAULT_TOLERANCE,
+        },
     };
     eprintln!(
         "gwn: no subcommand given; rendering the bundled lion head (an open mesh with holes) \
@@ -137,7 +142,7 @@ fn render(input: &Input, args: &Args) -> Result<(), CliError> {
     // A ray in the plane: one ray serves a whole image column or row.
     let exact = Options {
         ray: slice.ray(),
-        ..args.weld.exact_options()
+        ..args.boundary.exact_options(args.weld)?
     };
     let wn = args.method.build(input, &args.mesh, exact)?;
     let pb = progress(

@@ -218,6 +218,8 @@ pub struct Args {
     pub occupancy_out: Option<PathBuf>,
     #[command(flatten)]
     pub weld: crate::common::WeldArgs,
+    #[command(flatten)]
+    pub boundary: crate::common::ToleranceArgs,
 }
 
 /// Runs `gwn voxelize`.
@@ -237,7 +239,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .spec(&input, &args.mesh, VOXELIZE_BYTES_PER_CELL)?;
     let wn = args
         .method
-        .build(&input, &args.mesh, args.weld.exact_options())?;
+        .build(&input, &args.mesh, args.boundary.exact_options(args.weld)?)?;
     let pb = progress(
         spec.column_count(gwn::grid::column_axis(&wn)) as u64,
         "voxelize",
