@@ -25,12 +25,21 @@ fn run(w: &WindingNumber, points: &[[f64; 3]], reps: usize) -> (f64, Vec<(f64, f
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let env = |k: &str, d: usize| std::env::var(k).ok().and_then(|s| s.parse().ok()).unwrap_or(d);
+    let env = |k: &str, d: usize| {
+        std::env::var(k)
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(d)
+    };
     let (reps, min_b) = (env("REPS", 3), env("MIN_B", 300));
     let tolerances = [1e-10, 1e-6, 1e-3];
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mut files: Vec<std::path::PathBuf> = Vec::new();
-    for a in if args.is_empty() { vec!["../shared/meshes".to_string()] } else { args } {
+    for a in if args.is_empty() {
+        vec!["../shared/meshes".to_string()]
+    } else {
+        args
+    } {
         let p = std::path::PathBuf::from(a);
         if p.is_dir() {
             files.extend(std::fs::read_dir(&p)?.filter_map(|e| e.ok().map(|e| e.path())));
@@ -39,25 +48,47 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     files.sort();
-    println!("| mesh | B | grid | flat q/s | τ | q/s | speed-up | max diff | max bound | expanded |");
+    println!(
+        "| mesh | B | grid | flat q/s | τ | q/s | speed-up | max diff | max bound | expanded |"
+    );
     println!("|---|---|---|---|---|---|---|---|---|---|");
     let mut violations = 0;
     for path in files {
-        let Ok(loaded) = gwn::io::load_mesh(&path) else { continue };
+        let Ok(loaded) = gwn::io::load_mesh(&path) else {
+            continue;
+        };
         let mesh = loaded.mesh;
-        let Some(bbox) = mesh.bounding_box() else { continue };
-        let flat = WindingNumber::with_options(&mesh, Options { tolerance: 0.0, ..Default::default() })?;
+        let Some(bbox) = mesh.bounding_box() else {
+            continue;
+        };
+        let flat = WindingNumber::with_options(
+            &mesh,
+            Options {
+                tolerance: 0.0,
+                ..Default::default()
+            },
+        )?;
         let b = flat.boundary_edge_count();
         if b < min_b {
             continue;
         }
-        let name = path.file_name().unwrap_or_default().to_string_lossy().to_string();
+        let name = path
+            .file_name()
+            .unwrap_or_default()
+            .to_string_lossy()
+            .to_string();
         for (label, grow) in [("near", 0.1), ("far", 3.0)] {
             let points = GridSpec::new(bbox.enlarged(grow), [32; 3])?.points();
             let (q0, v0) = run(&flat, &points, reps);
             for &tol in &tolerances {
                 let t = std::time::Instant::now();
-                let w = WindingNumber::with_options(&mesh, Options { tolerance: tol, ..Default::default() })?;
+                let w = WindingNumber::with_options(
+                    &mesh,
+                    Options {
+                        tolerance: tol,
+                        ..Default::default()
+                    },
+                )?;
                 let build = t.elapsed().as_secs_f64();
                 let (q, v) = run(&w, &points, reps);
                 let mut diff: f64 = 0.0;

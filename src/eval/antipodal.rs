@@ -575,10 +575,7 @@ impl<W: Width> FrameEvaluator<W> {
                 let sum = tree.area_sum::<W>(&self.boundary, qi, z_exact, qz_units);
                 (sum.area, sum.bound)
             }
-            None => (
-                self.boundary.area_sum::<W>(qi, z_exact, qz_units),
-                0.0,
-            ),
+            None => (self.boundary.area_sum::<W>(qi, z_exact, qz_units), 0.0),
         }
     }
 
@@ -613,8 +610,10 @@ impl<W: Width> FrameEvaluator<W> {
                 }
             }
         };
-        let sum = tree.traverse(q, |_, _| true, &mut exact, term);
-        let mut area = sum.area + exact_sum;
+        let mut spokes = 0.0;
+        let mut spoke = |p: [i64; 3], v: [i64; 3], m: i32| spokes -= f64::from(m) * term(p, v);
+        let sum = tree.traverse(q, |_, _| true, &mut exact, &mut spoke);
+        let mut area = sum.area + exact_sum + spokes;
         for e in self.boundary.heavy_edges() {
             let (a, b, weight) = self.boundary.edge(e);
             area += weight * term(a, b);

@@ -33,11 +33,11 @@ pub const fn coefficients_up_to(k: usize) -> usize {
     (k + 1) * (k + 2) * (k + 3) / 6
 }
 
-/// Rounding allowance of one evaluation, relative to `Σ|N_α·b_α|`: a model bound, not a proof.
-/// The recurrence of Eq. 5 loses `O(K)` ulps per coefficient relative to its terms, the moments
-/// `O(K)` ulps per shift; at `K ≤ 10` and a handful of shifts that is below `2^-45`, and we allow
-/// `2^-40` (the flat loop itself errs by `~1e-15` relative, docs/robustness.md).
-pub const EVALUATION_ROUNDING: f64 = 1.0 / (1u64 << 40) as f64;
+/// Rounding allowance of one evaluation, relative to the magnitude of everything summed (moments
+/// and coefficients in absolute values, [`Expansion::evaluate`]): a model bound, not a proof.
+/// Each quantity is a sum of at most `COEFFICIENTS` products formed through a handful of shifts,
+/// so its error is below `(COEFFICIENTS + 64)·2^-53 < 2^-44` of that magnitude; we allow `2^-42`.
+pub const EVALUATION_ROUNDING: f64 = 1.0 / (1u64 << 42) as f64;
 
 /// `√2`: the gradient bound `|∇(|u|^l P_l(û·ê))| ≤ √2·l·|u|^(l−1)` (radial part `l·P_l`, the
 /// tangential part `√(1−x²)·P_l'(x) ≤ l` by Bernstein's inequality; Eq. 8).
@@ -124,7 +124,7 @@ fn table() -> &'static Table {
 /// `b_α(s) = ∂^α(1/|s|)/α!` for `|α| ≤ order`, into `b[..coefficients_up_to(order)]`
 /// (`b[COEFFICIENTS] = 0` is the padding slot). Eq. 5:
 /// `n|s|²·b_α + (2n−1)·Σ_k s_k·b_{α−e_k} + (n−1)·Σ_k b_{α−2e_k} = 0`.
-#[inline]
+#[cfg(test)]
 fn taylor_coefficients(s: [f64; 3], order: usize, b: &mut [f64; COEFFICIENTS + 1]) {
     let t = table();
     let r2 = s[0] * s[0] + s[1] * s[1] + s[2] * s[2];
@@ -141,9 +141,10 @@ fn taylor_coefficients(s: [f64; 3], order: usize, b: &mut [f64; COEFFICIENTS + 1
     }
 }
 
-/// The truncated expansion at `q`: `(Ω_K(q), Σ|N_α·b_α|)` for the cluster with moments `m`
-/// about `centre` (Eq. 4; the second value feeds [`EVALUATION_ROUNDING`]).
-pub fn evaluate(m: &Moments, centre: [f64; 3], q: [f64; 3], order: usize) -> (f64, f64) {
+/// The truncated expansion at `q` straight from Eq. 4 and the recurrence: `(Ω_K(q), Σ|N_α·b_α|)`
+/// for the cluster with moments `m` about `centre`. The reference for [`Expansion::evaluate`].
+#[cfg(test)]
+fn evaluate(m: &Moments, centre: [f64; 3], q: [f64; 3], order: usize) -> (f64, f64) {
     let mut b = [0.0; COEFFICIENTS + 1];
     let s = [centre[0] - q[0], centre[1] - q[1], centre[2] - q[2]];
     taylor_coefficients(s, order, &mut b);
@@ -174,9 +175,16 @@ pub fn truncation_bound(area: f64, radius: f64, distance: f64, order: usize) -> 
 /// Adds the moments of the fan triangle `(p, a, b)` about `p` (coordinates relative to `p`:
 /// `ra = a − p`, `rb = b − p`) to `m`. Eq. 6: with `m⃗ = ra × rb` (twice the vector area),
 /// `∫_T n_k u^β dA = m⃗_k/(|β|+2)·∫_0^1 v(μ)^β dμ`, `v(μ) = (1−μ)·ra + μ·rb`, a polynomial of
-/// degree `≤ MAX_ORDER − 1` in `μ`, integrated exactly by five Gauss–Legendre points. Returns the
-/// triangle's area.
-pub fn add_fan_triangle(m: &mut Moments, ra: [f64; 3], rb: [f64; 3]) -> f64 {
+/// degree `≤ MAX_ORDER − 1` in `μ`, integrated exactly by five Gauss–Legendre points. `sign`
+/// (±1) orients the triangle; `magnitude` accumulates the same sums in absolute values (the scale
+/// of the rounding errors, [`EVALUATION_ROUNDING`]). Returns the triangle's area.
+pub fn add_fan_triangle(
+    m: &mut Moments,
+    magnitude: &mut Moments,
+    ra: [f64; 3],
+    rb: [f64; 3],
+    sign: f64,
+) -> f64 {
     // Gauss–Legendre on [0, 1], exact to degree 9 = MAX_ORDER − 1.
     const NODES: [f64; 5] = [
         0.046_910_077_030_668_004,
@@ -201,28 +209,34 @@ pub fn add_fan_triangle(m: &mut Moments, ra: [f64; 3], rb: [f64; 3]) -> f64 {
     ];
     let below = coefficients_up_to(MAX_ORDER - 1);
     let mut line = [0.0; COEFFICIENTS + 1];
+    let mut line_abs = [0.0; COEFFICIENTS + 1];
     let mut power = [0.0; COEFFICIENTS + 1];
     for (&mu, &w) in NODES.iter().zip(&WEIGHTS) {
         let v: [f64; 3] = std::array::from_fn(|k| (1.0 - mu) * ra[k] + mu * rb[k]);
         power[0] = 1.0;
         line[0] += w;
+        line_abs[0] += w;
         for i in 1..below {
             let k = t.axis[i] as usize;
             power[i] = power[t.minus1[i][k] as usize] * v[k];
             line[i] += w * power[i];
+            line_abs[i] += w * power[i].abs();
         }
     }
     // N_α = Σ_k α_k ∫ n_k u^(α−e_k) dA, and |α − e_k| + 2 = |α| + 1.
     for i in 1..COEFFICIENTS {
         let a = t.alpha[i];
         let n = f64::from(a[0] + a[1] + a[2]);
-        let mut sum = 0.0;
+        let (mut sum, mut sum_abs) = (0.0, 0.0);
         for k in 0..3 {
             if a[k] > 0 {
-                sum += f64::from(a[k]) * normal[k] * line[t.minus1[i][k] as usize];
+                let j = t.minus1[i][k] as usize;
+                sum += f64::from(a[k]) * normal[k] * line[j];
+                sum_abs += f64::from(a[k]) * normal[k].abs() * line_abs[j];
             }
         }
-        m[i] += sum / (n + 1.0);
+        m[i] += sign * sum / (n + 1.0);
+        magnitude[i] += sum_abs / (n + 1.0);
     }
     0.5 * (normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]).sqrt()
 }
@@ -258,6 +272,150 @@ pub fn shifted(m: &Moments, delta: [f64; 3]) -> Moments {
         cur = next;
     }
     cur
+}
+
+/// The expansion of one cluster ready to evaluate: Eq. 4 regrouped by degree (Eq. 5b). Each
+/// `b_α(s)·|s|^(2n+1)` is a homogeneous polynomial of degree `n = |α|` in `s`, so
+/// `Ω_K(q) = (1/r)·Σ_{1≤|β|≤K} P_β·σ^β`, `σ = s/r²`, `s = c − q`, with
+/// `P_β = −Σ_{|α|=|β|} N_α·[σ^β](b_α·r^(2n+1))` computed once per cluster: a query costs one
+/// multiply-add per coefficient instead of the recurrence.
+#[derive(Clone, Debug)]
+pub struct Expansion {
+    coefficients: Moments,
+    /// `Σ_{|β|=n} Σ_α |N_α·[σ^β](…)|` per degree `n`, from the moments' magnitudes: the scale of
+    /// the rounding errors of the coefficients and of the sum.
+    magnitude_by_degree: [f64; MAX_ORDER + 1],
+}
+
+/// The polynomials `B_α(s) = b_α(s)·|s|^(2n+1)`: `B_α` has its coefficients over the degree-`n`
+/// monomials at `offsets[n]..` in the degree-ordered table. From Eq. 5 multiplied by
+/// `|s|^(2n−1)`: `n·B_α = −(2n−1)·Σ_k s_k·B_{α−e_k} − (n−1)·|s|²·Σ_k B_{α−2e_k}`.
+fn polynomials() -> &'static Vec<Vec<f64>> {
+    static POLY: OnceLock<Vec<Vec<f64>>> = OnceLock::new();
+    POLY.get_or_init(|| {
+        let t = table();
+        let index = |a: [u8; 3]| t.alpha.iter().position(|&b| b == a).unwrap_or(COEFFICIENTS);
+        // Polynomials as dense vectors over all multi-indices (only one degree is non-zero).
+        let mut poly: Vec<Vec<f64>> = Vec::with_capacity(COEFFICIENTS);
+        for i in 0..COEFFICIENTS {
+            let a = t.alpha[i];
+            let mut p = vec![0.0; COEFFICIENTS];
+            if a == [0; 3] {
+                p[0] = 1.0;
+                poly.push(p);
+                continue;
+            }
+            let (w1, w2) = t.weights[i];
+            for k in 0..3 {
+                let j = t.minus1[i][k];
+                if j != ZERO {
+                    // −(2n−1)/n · s_k · B_{α−e_k}
+                    for (m, &c) in poly[j as usize].iter().enumerate() {
+                        if c != 0.0 {
+                            let mut e = t.alpha[m];
+                            e[k] += 1;
+                            p[index(e)] += w1 * c;
+                        }
+                    }
+                }
+                let j = t.minus2[i][k];
+                if j != ZERO {
+                    // −(n−1)/n · (s_x² + s_y² + s_z²) · B_{α−2e_k}
+                    for (m, &c) in poly[j as usize].iter().enumerate() {
+                        if c != 0.0 {
+                            for l in 0..3 {
+                                let mut e = t.alpha[m];
+                                e[l] += 2;
+                                p[index(e)] += w2 * c;
+                            }
+                        }
+                    }
+                }
+            }
+            poly.push(p);
+        }
+        poly
+    })
+}
+
+impl Expansion {
+    /// From moments about the centre and their magnitudes (see [`add_fan_triangle`]).
+    pub fn new(moments: &Moments, magnitude: &Moments) -> Self {
+        let t = table();
+        let poly = polynomials();
+        let mut coefficients = [0.0; COEFFICIENTS];
+        let mut magnitude_by_degree = [0.0; MAX_ORDER + 1];
+        for i in 1..COEFFICIENTS {
+            let a = t.alpha[i];
+            let n = usize::from(a[0] + a[1] + a[2]);
+            let (lo, hi) = (coefficients_up_to(n - 1), coefficients_up_to(n));
+            for j in lo..hi {
+                let c = poly[i][j];
+                coefficients[j] -= moments[i] * c;
+                magnitude_by_degree[n] += (magnitude[i] + moments[i].abs()) * c.abs();
+            }
+        }
+        Expansion {
+            coefficients,
+            magnitude_by_degree,
+        }
+    }
+
+    /// `(Ω_K(q), rounding allowance)` about `centre` (Eq. 5b). The allowance is
+    /// [`EVALUATION_ROUNDING`] times the sum's magnitude bound `(1/r)·Σ_n M_n·r^−n` (`|σ^β| ≤ r^−n`).
+    #[inline]
+    pub fn evaluate(&self, centre: [f64; 3], q: [f64; 3], order: usize) -> (f64, f64) {
+        let s = [centre[0] - q[0], centre[1] - q[1], centre[2] - q[2]];
+        let r2 = s[0] * s[0] + s[1] * s[1] + s[2] * s[2];
+        let inv_r2 = 1.0 / r2;
+        let inv_r = inv_r2.sqrt();
+        let sigma = s.map(|c| c * inv_r2);
+        let mut px = [1.0; MAX_ORDER + 1];
+        let mut py = [1.0; MAX_ORDER + 1];
+        let mut pz = [1.0; MAX_ORDER + 1];
+        for j in 1..=order {
+            px[j] = px[j - 1] * sigma[0];
+            py[j] = py[j - 1] * sigma[1];
+            pz[j] = pz[j - 1] * sigma[2];
+        }
+        // diagonal[m][j] = σ_y^(m−j)·σ_z^j: the yz monomials of degree m in the table's order.
+        let mut diagonal = [[0.0; MAX_ORDER + 1]; MAX_ORDER + 1];
+        for m in 0..=order {
+            for j in 0..=m {
+                diagonal[m][j] = py[m - j] * pz[j];
+            }
+        }
+        let c = &self.coefficients;
+        let (mut sum, mut scale, mut inv_rn) = (0.0, 0.0, 1.0);
+        let mut i = 1;
+        for n in 1..=order {
+            // Within a degree the table runs over σ_x^a, a descending, then the yz monomials of
+            // degree n − a: one dot product per a (four accumulators, no serial chain).
+            let mut degree_sum = 0.0;
+            for a in (0..=n).rev() {
+                let m = n - a;
+                let block = &c[i..i + m + 1];
+                let d = &diagonal[m][..m + 1];
+                let mut acc = [0.0; 4];
+                let mut chunks = block.chunks_exact(4).zip(d.chunks_exact(4));
+                for (cb, db) in &mut chunks {
+                    for l in 0..4 {
+                        acc[l] += cb[l] * db[l];
+                    }
+                }
+                let tail = (m + 1) / 4 * 4;
+                for l in tail..=m {
+                    acc[0] += block[l] * d[l];
+                }
+                degree_sum += px[a] * ((acc[0] + acc[1]) + (acc[2] + acc[3]));
+                i += m + 1;
+            }
+            sum += degree_sum;
+            inv_rn *= inv_r;
+            scale += self.magnitude_by_degree[n] * inv_rn;
+        }
+        (sum * inv_r, EVALUATION_ROUNDING * scale * inv_r)
+    }
 }
 
 /// The smallest order whose [`truncation_bound`] is at most `budget`, if any is `≤ MAX_ORDER`.
@@ -348,7 +506,10 @@ mod tests {
                 } else {
                     g2
                 };
-                assert!(g2 <= 2.0 * (l * l) as f64 * (1.0 + 1e-12), "l = {l}, x = {x}");
+                assert!(
+                    g2 <= 2.0 * (l * l) as f64 * (1.0 + 1e-12),
+                    "l = {l}, x = {x}"
+                );
             }
         }
     }
@@ -367,14 +528,17 @@ mod tests {
             let pts = fan(&mut state, 6);
             let p = pts[0];
             let mut m = [0.0; COEFFICIENTS];
+            let mut mag = [0.0; COEFFICIENTS];
             let mut area = 0.0;
             for w in pts[1..].windows(2) {
                 let ra = std::array::from_fn(|k| w[0][k] - p[k]);
                 let rb = std::array::from_fn(|k| w[1][k] - p[k]);
-                area += add_fan_triangle(&mut m, ra, rb);
+                area += add_fan_triangle(&mut m, &mut mag, ra, rb, 1.0);
             }
             // Move the moments from the apex to the origin: δ = p − 0.
             let m = shifted(&m, p);
+            let mag = shifted(&mag, p.map(f64::abs));
+            let expansion = Expansion::new(&m, &mag);
             let radius = pts
                 .iter()
                 .map(|v| v.iter().map(|c| c * c).sum::<f64>().sqrt())
@@ -390,10 +554,13 @@ mod tests {
                     .map(|w| triangle_solid_angle(rel(p), rel(w[0]), rel(w[1])))
                     .sum();
                 for order in 1..=MAX_ORDER {
-                    let (value, magnitude) = evaluate(&m, [0.0; 3], q, order);
-                    let bound = truncation_bound(area, radius, d, order)
-                        + EVALUATION_ROUNDING * magnitude
-                        + 1e-15;
+                    let (value, rounding) = expansion.evaluate([0.0; 3], q, order);
+                    let (reference, _) = evaluate(&m, [0.0; 3], q, order);
+                    assert!(
+                        (value - reference).abs() <= 1e-13 * (1.0 + reference.abs()),
+                        "K = {order}: {value} vs recurrence {reference}"
+                    );
+                    let bound = truncation_bound(area, radius, d, order) + rounding + 1e-15;
                     let err = (value - exact).abs();
                     assert!(
                         err <= bound,
@@ -413,11 +580,14 @@ mod tests {
         let mut state = 5;
         let pts = fan(&mut state, 4);
         let mut m = [0.0; COEFFICIENTS];
+        let mut mag = [0.0; COEFFICIENTS];
         for w in pts[1..].windows(2) {
             add_fan_triangle(
                 &mut m,
+                &mut mag,
                 std::array::from_fn(|k| w[0][k] - pts[0][k]),
                 std::array::from_fn(|k| w[1][k] - pts[0][k]),
+                1.0,
             );
         }
         let once = shifted(&m, [0.3, -0.2, 0.5]);

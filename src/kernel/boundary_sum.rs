@@ -231,7 +231,12 @@ impl BoundaryEdges {
     }
 
     /// The edges too heavy to chain (each one exact term times its weight).
-    pub(crate) fn heavy_area_sum<W: Width>(&self, qi: [i64; 3], z_exact: bool, qz_units: f64) -> f64 {
+    pub(crate) fn heavy_area_sum<W: Width>(
+        &self,
+        qi: [i64; 3],
+        z_exact: bool,
+        qz_units: f64,
+    ) -> f64 {
         let mut sum = 0.0;
         for &e in &self.heavy {
             let e = e as usize;
@@ -689,10 +694,14 @@ mod tests {
                         [rng.coord(big), rng.coord(big), rng.coord(big)].map(|c| c as f64)
                     };
                     let (mut u1, mut u2) = (Vec::new(), Vec::new());
-                    let s1 = edges.chain_angles(q, &mut |e| u1.push(e)).total();
+                    let s1 = edges
+                        .chain_angles(q, 0..edges.slots, &mut |e| u1.push(e))
+                        .total();
                     #[allow(unsafe_code)]
                     // SAFETY: AVX2 was detected above.
-                    let s2 = unsafe { edges.chain_angles_avx2(q, &mut |e| u2.push(e)) }.total();
+                    let s2 =
+                        unsafe { edges.chain_angles_avx2(q, 0..edges.slots, &mut |e| u2.push(e)) }
+                            .total();
                     assert_eq!(
                         s1.to_bits(),
                         s2.to_bits(),

@@ -16,12 +16,13 @@
 
 use super::angle_sum::AngleSum;
 use super::boundary_multipole::{
-    COEFFICIENTS, EVALUATION_ROUNDING, MAX_ORDER, Moments, add_fan_triangle, coefficients_up_to,
-    evaluate, shifted, truncation_bound,
+    COEFFICIENTS, Expansion, MAX_ORDER, Moments, add_fan_triangle, coefficients_up_to, shifted,
+    truncation_bound,
 };
 use super::boundary_sum::{BoundaryEdges, segment_area};
-use super::predicates::Width;
+use super::predicates::{Width, orient2d_filtered};
 use super::spherical::INV_4PI;
+use wide::f64x4;
 
 /// Slots per leaf (a multiple of the SIMD loop's 4).
 const LEAF_SLOTS: usize = 32;
@@ -73,9 +74,15 @@ struct Node {
 #[derive(Clone, Debug)]
 pub struct BoundaryTree {
     nodes: Vec<Node>,
-    moments: Vec<Moments>,
+    expansions: Vec<Expansion>,
     ends: Vec<([i64; 3], i32)>,
     tolerance: f64,
+}
+
+/// Moments of the nodes while building (children before parents): values and magnitudes.
+struct Building {
+    moments: Vec<Moments>,
+    magnitudes: Vec<Moments>,
 }
 
 /// What the hierarchy did for one query: the boundary sum, its certified error bound on `w`, and
@@ -88,6 +95,8 @@ pub struct TreeSum {
     pub bound: f64,
     /// Nodes replaced by their expansion.
     pub expanded: u32,
+    /// Nodes visited.
+    pub visited: u32,
 }
 
 impl BoundaryTree {
@@ -106,12 +115,35 @@ impl BoundaryTree {
         }
         let mut tree = BoundaryTree {
             nodes: Vec::new(),
-            moments: Vec::new(),
+            expansions: Vec::new(),
             ends: Vec::new(),
             tolerance,
         };
         let per_edge = 4.0 * std::f64::consts::PI * tolerance / total as f64;
-        tree.build_node(edges, 0, edges.padded_slots(), per_edge);
+        let mut building = Building {
+            moments: Vec::new(),
+            magnitudes: Vec::new(),
+        };
+        tree.build_node(edges, 0, edges.padded_slots(), per_edge, &mut building);
+        tree.expansions = building
+            .moments
+            .iter()
+            .zip(&building.magnitudes)
+            .map(|(m, a)| Expansion::new(m, a))
+            .collect();
+        if std::env::var("GWN_TREE_DEBUG").is_ok() {
+            for (i, n) in tree.nodes.iter().enumerate() {
+                eprintln!(
+                    "node {i} edges {} radius {:.4} area {:.2e} ends {} reach {:.4} sub {:.4}",
+                    n.edges,
+                    n.radius,
+                    n.area,
+                    n.ends.1 - n.ends.0,
+                    n.reach.iter().copied().fold(f64::INFINITY, f64::min),
+                    n.subtree_reach
+                );
+            }
+        }
         (tree.nodes[0].subtree_reach.is_finite()).then_some(tree)
     }
 
@@ -120,8 +152,25 @@ impl BoundaryTree {
         self.tolerance
     }
 
+    /// Nodes, and the smallest distance (normalized units) at which the root's subtree can
+    /// expand anything.
+    pub fn stats(&self) -> (usize, f64, f64) {
+        (
+            self.nodes.len(),
+            self.nodes[0].subtree_reach,
+            self.nodes[0].radius,
+        )
+    }
+
     /// Builds the node of slots `j0..j1` and its subtree; returns its index.
-    fn build_node(&mut self, edges: &BoundaryEdges, j0: usize, j1: usize, per_edge: f64) -> u32 {
+    fn build_node(
+        &mut self,
+        edges: &BoundaryEdges,
+        j0: usize,
+        j1: usize,
+        per_edge: f64,
+        building: &mut Building,
+    ) -> u32 {
         let index = self.nodes.len();
         let limit = edges.limit();
         let norm = |p: [i64; 3]| p.map(|c| c as f64 / limit);
@@ -148,8 +197,10 @@ impl BoundaryTree {
         let radius = endpoints()
             .map(|p| {
                 let v = norm(p);
-                ((v[0] - centre[0]).powi(2) + (v[1] - centre[1]).powi(2) + (v[2] - centre[2]).powi(2))
-                    .sqrt()
+                ((v[0] - centre[0]).powi(2)
+                    + (v[1] - centre[1]).powi(2)
+                    + (v[2] - centre[2]).powi(2))
+                .sqrt()
             })
             .fold(0.0, f64::max);
         // Rounding of the distances above: a relative 2^-50 is far more than their error.
@@ -189,33 +240,37 @@ impl BoundaryTree {
             reach: [f64::INFINITY; MAX_ORDER],
             subtree_reach: f64::INFINITY,
         });
-        self.moments.push([0.0; COEFFICIENTS]);
+        building.moments.push([0.0; COEFFICIENTS]);
+        building.magnitudes.push([0.0; COEFFICIENTS]);
         // Moments about the apex, then shifted to the centre.
-        let (about_apex, area) = if j1 - j0 <= LEAF_SLOTS {
-            let mut m = [0.0; COEFFICIENTS];
+        let mut m = [0.0; COEFFICIENTS];
+        let mut mag = [0.0; COEFFICIENTS];
+        let area = if j1 - j0 <= LEAF_SLOTS {
             let mut area = 0.0;
             for &e in &slot_edges {
                 let (a, b, _) = edges.edge(e);
-                area += add_fan_triangle(&mut m, rel(a, apex, limit), rel(b, apex, limit));
+                let (ra, rb) = (rel(a, apex, limit), rel(b, apex, limit));
+                area += add_fan_triangle(&mut m, &mut mag, ra, rb, 1.0);
             }
-            (m, area)
+            area
         } else {
             let mid = j0 + ((j1 - j0) / 2).div_ceil(LEAF_SLOTS) * LEAF_SLOTS;
-            let left = self.build_node(edges, j0, mid, per_edge);
-            let right = self.build_node(edges, mid, j1, per_edge);
+            let left = self.build_node(edges, j0, mid, per_edge, building);
+            let right = self.build_node(edges, mid, j1, per_edge, building);
             self.nodes[index].children = Some((left, right));
             let apex_c = norm(apex);
-            let mut m = [0.0; COEFFICIENTS];
             let mut area = 0.0;
             for child in [left, right] {
                 let c = &self.nodes[child as usize];
                 if c.edges == 0 {
                     continue;
                 }
-                let delta = std::array::from_fn(|k| c.centre[k] - apex_c[k]);
-                let moved = shifted(&self.moments[child as usize], delta);
+                let delta: [f64; 3] = std::array::from_fn(|k| c.centre[k] - apex_c[k]);
+                let moved = shifted(&building.moments[child as usize], delta);
+                let moved_mag = shifted(&building.magnitudes[child as usize], delta.map(f64::abs));
                 for i in 0..COEFFICIENTS {
                     m[i] += moved[i];
+                    mag[i] += moved_mag[i];
                 }
                 area += c.area;
                 if c.apex != apex {
@@ -226,28 +281,26 @@ impl BoundaryTree {
                     let ends: Vec<([i64; 3], i32)> = self.ends[c0 as usize..c1 as usize].to_vec();
                     for (v, mv) in ends {
                         let (ra, rb) = (rel(child_apex, apex, limit), rel(v, apex, limit));
+                        let weight = -f64::from(mv);
                         for _ in 0..mv.unsigned_abs() {
-                            // −m_v: the triangle's orientation flipped when m_v > 0.
-                            area += if mv > 0 {
-                                add_fan_triangle(&mut m, rb, ra)
-                            } else {
-                                add_fan_triangle(&mut m, ra, rb)
-                            };
+                            area += add_fan_triangle(&mut m, &mut mag, ra, rb, weight.signum());
                         }
                     }
                 }
             }
-            (m, area)
+            area
         };
-        let delta = std::array::from_fn(|k| norm(apex)[k] - centre[k]);
-        self.moments[index] = shifted(&about_apex, delta);
+        let delta: [f64; 3] = std::array::from_fn(|k| norm(apex)[k] - centre[k]);
+        building.moments[index] = shifted(&m, delta);
+        building.magnitudes[index] = shifted(&mag, delta.map(f64::abs));
         let node = &mut self.nodes[index];
         node.area = area * (1.0 + 1e-12);
         // Orders that can pay: evaluation cheaper than the node's loop.
         let ends = (node.ends.1 - node.ends.0) as f64;
         let loop_cost = node.edges as f64 * EDGE_COST;
         for k in 1..=MAX_ORDER {
-            let cost = NODE_COST + coefficients_up_to(k) as f64 * COEFFICIENT_COST + ends * SPOKE_COST;
+            let cost =
+                NODE_COST + coefficients_up_to(k) as f64 * COEFFICIENT_COST + ends * SPOKE_COST;
             if cost < loop_cost && node.edges > 0 {
                 node.reach[k - 1] = reach(node.area, node.radius, k, node.budget);
             }
@@ -295,9 +348,16 @@ impl BoundaryTree {
             }
             scalar += s;
         };
-        let spoke = |p: [i64; 3], v: [i64; 3]| segment_area::<W>(p, v, qi, z_exact, qz_units);
-        let mut sum = self.traverse(q, misses, &mut run_exact, spoke);
-        sum.area += angles.map_or(0.0, |a| 2.0 * a.total()) + scalar;
+        let mut spokes = SpokeSum::new(qi, z_exact, qz_units, limit);
+        let mut spoke = |p: [i64; 3], v: [i64; 3], m: i32| spokes.subtract::<W>(p, v, m);
+        let mut sum = self.traverse(q, misses, &mut run_exact, &mut spoke);
+        let (spoke_angles, spoke_scalar) = spokes.finish();
+        if let Some(a) = &mut angles {
+            a.absorb(&spoke_angles);
+        } else if sum.expanded > 0 {
+            angles = Some(spoke_angles);
+        }
+        sum.area += angles.map_or(0.0, |a| 2.0 * a.total()) + scalar + spoke_scalar;
         sum.area += edges.heavy_area_sum::<W>(qi, z_exact, qz_units);
         sum
     }
@@ -309,11 +369,12 @@ impl BoundaryTree {
         q: [f64; 3],
         misses: impl Fn([i64; 3], [i64; 3]) -> bool,
         exact: &mut impl FnMut(std::ops::Range<usize>),
-        spoke: impl Fn([i64; 3], [i64; 3]) -> f64,
+        spoke: &mut impl FnMut([i64; 3], [i64; 3], i32),
     ) -> TreeSum {
         let mut out = TreeSum::default();
         let mut pending: Option<std::ops::Range<usize>> = None;
-        let mut flush = |range: std::ops::Range<usize>, pending: &mut Option<std::ops::Range<usize>>| {
+        let mut flush = |range: std::ops::Range<usize>,
+                         pending: &mut Option<std::ops::Range<usize>>| {
             match pending {
                 Some(p) if p.end == range.start => p.end = range.end,
                 _ => {
@@ -331,6 +392,7 @@ impl BoundaryTree {
             top -= 1;
             let i = stack[top];
             let n = &self.nodes[i as usize];
+            out.visited += 1;
             if n.edges == 0 {
                 continue;
             }
@@ -345,15 +407,14 @@ impl BoundaryTree {
             if r >= n.subtree_reach && misses(n.lo, n.hi) {
                 if let Some(k) = (1..=MAX_ORDER).find(|&k| r >= n.reach[k - 1]) {
                     let bound = truncation_bound(n.area, n.radius, r, k);
-                    let (omega, magnitude) = evaluate(&self.moments[i as usize], n.centre, q, k);
-                    let bound = bound + EVALUATION_ROUNDING * magnitude;
+                    let (omega, rounding) = self.expansions[i as usize].evaluate(n.centre, q, k);
+                    let bound = bound + rounding;
                     if bound <= n.budget {
                         let (e0, e1) = n.ends;
-                        let spokes: f64 = self.ends[e0 as usize..e1 as usize]
-                            .iter()
-                            .map(|&(v, m)| f64::from(m) * spoke(n.apex, v))
-                            .sum();
-                        out.area += omega - spokes;
+                        for &(v, m) in &self.ends[e0 as usize..e1 as usize] {
+                            spoke(n.apex, v, m);
+                        }
+                        out.area += omega;
                         out.bound += bound * INV_4PI;
                         out.expanded += 1;
                         continue;
@@ -374,7 +435,93 @@ impl BoundaryTree {
         }
         out
     }
+}
 
+/// The spoke terms `−Σ m_v·Area(p, v)` of the expanded nodes at one lattice query, as one angle
+/// product like the boundary loop's (no `atan2` per spoke). The ray misses the node's box, so the
+/// term has no branch near: the `f64` form of the loop applies whenever the filter signs the
+/// numerator, and the exact scalar term (the same perturbed predicate) otherwise.
+struct SpokeSum {
+    q: [i64; 3],
+    qz: f64,
+    z_exact: bool,
+    qz_units: f64,
+    limit: f64,
+    angles: AngleSum,
+    re: [f64; 4],
+    im: [f64; 4],
+    len: usize,
+    scalar: f64,
+}
+
+impl SpokeSum {
+    fn new(q: [i64; 3], z_exact: bool, qz_units: f64, limit: f64) -> Self {
+        SpokeSum {
+            q,
+            qz: if z_exact { q[2] as f64 } else { qz_units },
+            z_exact,
+            qz_units,
+            limit,
+            angles: AngleSum::new(),
+            re: [1.0; 4],
+            im: [0.0; 4],
+            len: 0,
+            scalar: 0.0,
+        }
+    }
+
+    /// Adds `−m·Area(p, v)`.
+    #[inline]
+    fn subtract<W: Width>(&mut self, p: [i64; 3], v: [i64; 3], m: i32) {
+        let offset = |a: [i64; 3]| {
+            [
+                (a[0] - self.q[0]) as f64,
+                (a[1] - self.q[1]) as f64,
+                a[2] as f64 - self.qz,
+            ]
+        };
+        let (a, b) = (offset(p), offset(v));
+        let Some(sign) = orient2d_filtered([a[0], a[1]], [b[0], b[1]], self.limit) else {
+            self.scalar -=
+                f64::from(m) * segment_area::<W>(p, v, self.q, self.z_exact, self.qz_units);
+            return;
+        };
+        // The boundary loop's factors: s = |r| + |r_z|, (|r| − r_z)·s = h² or s².
+        let factors = |r: [f64; 3]| {
+            let h = r[0] * r[0] + r[1] * r[1];
+            let s = (h + r[2] * r[2]).sqrt() + r[2].abs();
+            (s, if r[2] > 0.0 { h } else { s * s })
+        };
+        let ((sa, pa), (sb, pb)) = (factors(a), factors(b));
+        let d = a[0] * b[1] - a[1] * b[0];
+        let s2 = sa * sb;
+        let re = pa * pb + (a[0] * b[0] + a[1] * b[1]) * s2;
+        // The numerator −d carries the filtered sign; subtracting m terms conjugates them.
+        let im = -f64::from(sign) * d.abs() * s2 * -f64::from(m.signum());
+        for _ in 0..m.unsigned_abs() {
+            self.re[self.len] = re;
+            self.im[self.len] = im;
+            self.len += 1;
+            if self.len == 4 {
+                self.flush();
+            }
+        }
+    }
+
+    fn flush(&mut self) {
+        self.angles.push(f64x4::from(self.re), f64x4::from(self.im));
+        self.angles.rescale();
+        self.re = [1.0; 4];
+        self.im = [0.0; 4];
+        self.len = 0;
+    }
+
+    fn finish(mut self) -> (AngleSum, f64) {
+        if self.len > 0 {
+            self.flush();
+        }
+        (self.angles, self.scalar)
+    }
 }
 
 /// `b − a` in normalized coordinates (exact integer difference, one rounding).
@@ -405,4 +552,45 @@ fn reach(area: f64, radius: f64, order: usize, budget: f64) -> f64 {
         }
     }
     hi
+}
+
+#[cfg(test)]
+mod probe {
+    #[test]
+    #[ignore]
+    fn timing() {
+        use super::super::boundary_multipole::*;
+        use super::super::predicates::W128;
+        let mut m = [0.37; COEFFICIENTS];
+        m[0] = 0.0;
+        let e = Expansion::new(&m, &m);
+        for k in [1, 2, 4, 6, 8, 10] {
+            let t = std::time::Instant::now();
+            let mut s = 0.0;
+            for i in 0..200_000 {
+                s += e
+                    .evaluate([0.1, 0.2, 0.3], [1.0 + i as f64 * 1e-9, 0.5, 0.25], k)
+                    .0;
+            }
+            eprintln!(
+                "K {k}: {:.1} ns ({s:e})",
+                t.elapsed().as_secs_f64() / 200_000.0 * 1e9
+            );
+        }
+        let t = std::time::Instant::now();
+        let mut s = 0.0;
+        for i in 0..200_000i64 {
+            s += super::segment_area::<W128>(
+                [1 << 50, 3 << 48, 1 << 49],
+                [5 << 47, 1 << 50, 7 << 46],
+                [i << 20, 1 << 40, 1 << 30],
+                true,
+                0.0,
+            );
+        }
+        eprintln!(
+            "spoke: {:.1} ns ({s:e})",
+            t.elapsed().as_secs_f64() / 200_000.0 * 1e9
+        );
+    }
 }

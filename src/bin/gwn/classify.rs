@@ -55,7 +55,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let a_input = Input::load(&args.a, args.weld)?;
     let a = a_input.mesh(&args.a, "classify (its faces are classified)")?;
     let b = Input::load(&args.b, args.weld)?;
-    let wn = args.method.build(&b, &args.b, args.boundary.exact_options(args.weld)?)?;
+    let wn = args
+        .method
+        .build(&b, &args.b, args.boundary.exact_options(args.weld)?)?;
     let values = classify_faces(a, &wn);
     gwn::io::points::save_values(&args.out, &values)
         .map_err(|e| CliError::msg(format!("{}: cannot write: {e}", args.out.display())))?;
