@@ -23,9 +23,12 @@ class WindingNumber:
     """Winding-number evaluator of one mesh or oriented point cloud, built once.
 
     ``method``: "exact" (Antipodal method, default), "direct" (solid-angle sum) or "fast"
-    (Barnes-Hut with accuracy ``beta`` and expansion ``order``). ``precision`` (30 or 60 bits)
-    and ``ray`` are options of the exact method. Calls release the GIL; one object may be used
-    from several Python threads at once. Picklable (rebuilt from its arrays).
+    (Barnes-Hut with accuracy ``beta`` and expansion ``order``). ``precision`` (30 or 60 bits),
+    ``ray`` and ``tolerance`` are options of the exact method: ``tolerance`` (finite, >= 0) is
+    the absolute tolerance on w for far boundary clusters, replaced by a multipole expansion with
+    a certified error bound (``eval_with_bound``); the integer part is always exact, 0 is the
+    flat exact loop. Calls release the GIL; one object may be used from several Python threads
+    at once. Picklable (rebuilt from its arrays and options).
     """
 
     def __init__(
@@ -37,6 +40,7 @@ class WindingNumber:
         order: int = 2,
         precision: int = 60,
         ray: _Ray = "+z",
+        tolerance: float = 1e-10,
     ) -> None: ...
     @staticmethod
     def from_point_cloud(
@@ -49,9 +53,15 @@ class WindingNumber:
         """Gradients at the rows of ``Q``: float64 (n, 3). Exact and direct methods only."""
     def parts(self, Q: _Floats, threads: Optional[int] = None) -> Tuple[_I64, _F64]:
         """``(chi, fraction)`` with ``chi + fraction == self(Q)`` bit for bit. Exact method only."""
+    def eval_with_bound(self, Q: _Floats, threads: Optional[int] = None) -> Tuple[_F64, _F64]:
+        """``(w, bound)``, float64 (n,) each: ``w == self(Q)`` and a certified bound on
+        ``|w - w_flat|`` (the flat loop, tolerance 0), ``0 <= bound <= tolerance``. Exact only."""
     @property
     def method(self) -> _Method:
         """The evaluation method."""
+    @property
+    def tolerance(self) -> Optional[float]:
+        """The exact method's boundary tolerance (None for the other methods)."""
     @property
     def face_count(self) -> int:
         """Number of triangles (0 for a point cloud)."""
@@ -60,7 +70,12 @@ class WindingNumber:
         """Signed boundary edges of the exact method (None for the other methods)."""
 
 def winding_number(
-    V: _Floats, F: _Indices, O: _Floats, threads: Optional[int] = None
+    V: _Floats,
+    F: _Indices,
+    O: _Floats,
+    threads: Optional[int] = None,
+    *,
+    tolerance: float = 1e-10,
 ) -> _F64:
     """Exact winding numbers of mesh (V, F) at the rows of O; drop-in for igl.winding_number."""
 
@@ -100,6 +115,7 @@ def voxelize(
     method: Literal["exact", "direct", "fast"] = "exact",
     beta: float = 2.0,
     order: int = 2,
+    tolerance: float = 1e-10,
     threads: Optional[int] = None,
 ) -> _Grid:
     """Winding numbers (exact by default) on a voxel grid: (values (D, H, W) indexed [z, y, x], origin, spacing)."""
@@ -112,12 +128,18 @@ def sdf(
     dims: Optional[Tuple[int, int, int]] = None,
     bounds: Optional[Tuple[float, float, float, float, float, float]] = None,
     margin: float = 0.05,
+    tolerance: float = 1e-10,
     threads: Optional[int] = None,
 ) -> _Grid:
     """Signed distance on a voxel grid, negative where w > 1/2; same layout as voxelize."""
 
 def signed_distance(
-    V: _Floats, F: _Indices, Q: _Floats, threads: Optional[int] = None
+    V: _Floats,
+    F: _Indices,
+    Q: _Floats,
+    threads: Optional[int] = None,
+    *,
+    tolerance: float = 1e-10,
 ) -> _F64:
     """Signed distance at the rows of Q, negative where w > 1/2."""
 
@@ -134,6 +156,7 @@ def slice(
     method: Literal["exact", "direct", "fast"] = "exact",
     beta: float = 2.0,
     order: int = 2,
+    tolerance: float = 1e-10,
     threads: Optional[int] = None,
 ) -> Tuple[_F64, bytes]:
     """Winding numbers on an axis-aligned plane: (image (height, width), PNG bytes)."""
@@ -147,6 +170,7 @@ def classify(
     method: Literal["exact", "direct", "fast"] = "exact",
     beta: float = 2.0,
     order: int = 2,
+    tolerance: float = 1e-10,
     threads: Optional[int] = None,
 ) -> _F64:
     """Winding number (exact by default) of mesh B at each face centroid of mesh A."""
@@ -161,6 +185,7 @@ def filter_tets(
     method: Literal["exact", "direct", "fast"] = "exact",
     beta: float = 2.0,
     order: int = 2,
+    tolerance: float = 1e-10,
     threads: Optional[int] = None,
 ) -> npt.NDArray[np.bool_]:
     """Mask of the tets whose centroid has winding number (exact by default) above threshold."""

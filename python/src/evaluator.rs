@@ -4,7 +4,7 @@
 use std::sync::Arc;
 
 use gwn::Mesh;
-use gwn::eval::antipodal::{Options, WindingNumber};
+use gwn::eval::antipodal::{DEFAULT_TOLERANCE, Options, WindingNumber};
 use gwn::eval::direct::{winding_number_direct_batch, winding_number_gradient_direct};
 use gwn::eval::fast::{FastParams, FastWindingNumber, PointCloudWindingNumber};
 use gwn::kernel::frame::RayAxis;
@@ -83,10 +83,26 @@ pub fn fast_params(beta: f64, order: u8) -> Result<FastParams, String> {
     Ok(FastParams::barill(beta, order))
 }
 
+/// The Python default of `tolerance=`, written as a literal in the `#[pyo3(signature)]`s so that
+/// `help()` shows it; this pins it to the library's default.
+pub const PY_DEFAULT_TOLERANCE: f64 = 1e-10;
+const _: () = assert!(PY_DEFAULT_TOLERANCE == DEFAULT_TOLERANCE);
+
+/// The exact method's boundary tolerance, validated: a finite number `>= 0` (the CLI's rule).
+pub fn check_tolerance(tolerance: f64) -> Result<f64, String> {
+    if tolerance.is_finite() && tolerance >= 0.0 {
+        Ok(tolerance)
+    } else {
+        Err(format!(
+            "tolerance must be a finite number >= 0, got {tolerance}"
+        ))
+    }
+}
+
 /// Why an evaluator cannot answer a query kind.
 #[derive(Clone, Copy, Debug)]
 pub struct Unsupported {
-    /// What was asked (`"gradient"`, `"parts"`).
+    /// What was asked (`"gradient"`, `"parts"`, `"eval_with_bound"`).
     pub what: &'static str,
     /// The evaluator's description.
     pub method: &'static str,
@@ -179,6 +195,18 @@ impl Evaluator {
                 .unzip()),
             _ => Err(Unsupported {
                 what: "parts",
+                method: self.description(),
+            }),
+        }
+    }
+
+    /// Winding numbers and their certified bounds on `|w − w_flat|` (exact method;
+    /// [`WindingNumber::eval_with_bound`]), parallel on the current rayon pool.
+    pub fn bound_batch(&self, points: &[[f64; 3]]) -> Result<(Vec<f64>, Vec<f64>), Unsupported> {
+        match self {
+            Evaluator::Exact(wn) => Ok(points.par_iter().map(|&q| wn.eval_with_bound(q)).unzip()),
+            _ => Err(Unsupported {
+                what: "eval_with_bound",
                 method: self.description(),
             }),
         }

@@ -13,7 +13,7 @@ use pyo3::types::PyTuple;
 
 use crate::arrays::{array1, indices_vec, is_integer_array, points_vec, values_vec, with_points};
 use crate::errors::{mesh_error, value_error};
-use crate::evaluator::fast_params;
+use crate::evaluator::{check_tolerance, fast_params};
 use crate::threads;
 
 /// A validated mesh from `V`, `F` arrays.
@@ -30,10 +30,11 @@ pub fn mesh_from(
 ///
 /// Drop-in for ``igl.winding_number(V, F, O)``: ``V`` (n, 3) float, ``F`` (m, 3) int,
 /// ``O`` (k, 3) float; returns float64 (k,). Uses the exact Antipodal method (never off by an
-/// integer, also on the surface). The GIL is released; ``threads`` limits the worker threads
-/// (default: all cores).
+/// integer, also on the surface). ``tolerance`` (finite, ``>= 0``, default 1e-10) is the
+/// absolute tolerance on ``w`` for far boundary clusters (certified; ``0``: the flat exact loop).
+/// The GIL is released; ``threads`` limits the worker threads (default: all cores).
 #[pyfunction]
-#[pyo3(signature = (V, F, O, threads = None))]
+#[pyo3(signature = (V, F, O, threads = None, *, tolerance = 1e-10))]
 #[allow(non_snake_case)]
 pub fn winding_number<'py>(
     py: Python<'py>,
@@ -41,11 +42,16 @@ pub fn winding_number<'py>(
     F: &Bound<'py, PyAny>,
     O: &Bound<'py, PyAny>,
     threads: Option<usize>,
+    tolerance: f64,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let options = Options {
+        tolerance: check_tolerance(tolerance).map_err(PyValueError::new_err)?,
+        ..Options::default()
+    };
     let mesh = mesh_from(V, F, "V", "F")?;
     let values = with_points(O, "O", |q| {
         threads::run(py, threads, || {
-            WindingNumber::with_options(&mesh, Options::default()).map(|wn| wn.eval_batch(q))
+            WindingNumber::with_options(&mesh, options).map(|wn| wn.eval_batch(q))
         })
     })?
     .map_err(value_error)?;

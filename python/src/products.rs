@@ -18,7 +18,7 @@ use pyo3::types::PyBytes;
 
 use crate::arrays::{array_nd, array1, indices_vec, with_points};
 use crate::errors::value_error;
-use crate::evaluator::{Method, fast_params};
+use crate::evaluator::{Method, check_tolerance, fast_params};
 use crate::oneshot::mesh_from;
 use crate::threads;
 
@@ -36,6 +36,14 @@ fn method_of(
     let m = Method::parse(method).map_err(PyValueError::new_err)?;
     let params = fast_params(beta, order).map_err(PyValueError::new_err)?;
     Ok((m, params))
+}
+
+/// The exact method's options for `tolerance=` (the CLI's `--tolerance`), checked up front.
+fn exact_options(tolerance: f64) -> PyResult<Options> {
+    Ok(Options {
+        tolerance: check_tolerance(tolerance).map_err(PyValueError::new_err)?,
+        ..Options::default()
+    })
 }
 
 /// Builds the chosen evaluator for `mesh`.
@@ -125,9 +133,11 @@ fn grid_result<'py>(
 /// (x fastest, as ``gwn voxelize`` writes it), samples at cell centres
 /// ``origin + (i, j, k) * spacing`` for ``W[k, j, i]``. The grid covers ``bounds``
 /// ``(x0, y0, z0, x1, y1, z1)`` or the mesh's bounding box grown by ``margin`` times its largest
-/// extent, with ``dims`` (W, H, D) cells or ``res`` cells along the longest side.
+/// extent, with ``dims`` (W, H, D) cells or ``res`` cells along the longest side. ``tolerance``
+/// is the exact method's boundary tolerance (``gwn voxelize --tolerance``; see
+/// :class:`WindingNumber`).
 #[pyfunction]
-#[pyo3(signature = (V, F, res = 64, *, dims = None, bounds = None, margin = 0.05, method = "exact", beta = 2.0, order = 2, threads = None))]
+#[pyo3(signature = (V, F, res = 64, *, dims = None, bounds = None, margin = 0.05, method = "exact", beta = 2.0, order = 2, tolerance = 1e-10, threads = None))]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub fn voxelize<'py>(
     py: Python<'py>,
@@ -140,14 +150,15 @@ pub fn voxelize<'py>(
     method: &str,
     beta: f64,
     order: u8,
+    tolerance: f64,
     threads: Option<usize>,
 ) -> PyResult<GridArrays<'py>> {
     let (method, params) = method_of(method, beta, order)?;
+    let exact = exact_options(tolerance)?;
     let mesh = mesh_from(V, F, "V", "F")?;
     let spec = grid_spec(&mesh, res, dims, bounds, margin)?;
     let values = threads::run(py, threads, || {
-        evaluator_for(&mesh, method, params, Options::default())
-            .map(|wn| gwn::grid::evaluate(&wn, &spec))
+        evaluator_for(&mesh, method, params, exact).map(|wn| gwn::grid::evaluate(&wn, &spec))
     })?
     .map_err(value_error)?;
     grid_result(py, &spec, values)
@@ -156,9 +167,10 @@ pub fn voxelize<'py>(
 /// Signed distance on a voxel grid: distance to the closest point of the triangles, negative
 /// where the exact winding number is above 1/2 (correct on open and dirty meshes).
 ///
-/// Same grid arguments and return value as :func:`voxelize` (``gwn sdf``'s values).
+/// Same grid arguments and return value as :func:`voxelize` (``gwn sdf``'s values);
+/// ``tolerance`` is the exact sign's boundary tolerance (``gwn sdf --tolerance``).
 #[pyfunction]
-#[pyo3(signature = (V, F, res = 64, *, dims = None, bounds = None, margin = 0.05, threads = None))]
+#[pyo3(signature = (V, F, res = 64, *, dims = None, bounds = None, margin = 0.05, tolerance = 1e-10, threads = None))]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub fn sdf<'py>(
     py: Python<'py>,
@@ -168,21 +180,24 @@ pub fn sdf<'py>(
     dims: Option<[usize; 3]>,
     bounds: Option<[f64; 6]>,
     margin: f64,
+    tolerance: f64,
     threads: Option<usize>,
 ) -> PyResult<GridArrays<'py>> {
+    let exact = exact_options(tolerance)?;
     let mesh = mesh_from(V, F, "V", "F")?;
     let spec = grid_spec(&mesh, res, dims, bounds, margin)?;
     let values = threads::run(py, threads, || {
-        SignedDistance::new(&mesh).map(|s| s.eval_grid(&spec))
+        SignedDistance::with_options(&mesh, exact).map(|s| s.eval_grid(&spec))
     })?
     .map_err(value_error)?;
     grid_result(py, &spec, values)
 }
 
 /// Signed distance at the rows of ``Q`` (k, 3): float64 (k,), negative where the exact winding
-/// number is above 1/2; ``inf`` for a mesh without triangles.
+/// number is above 1/2; ``inf`` for a mesh without triangles. ``tolerance`` is the exact sign's
+/// boundary tolerance (see :class:`WindingNumber`).
 #[pyfunction]
-#[pyo3(signature = (V, F, Q, threads = None))]
+#[pyo3(signature = (V, F, Q, threads = None, *, tolerance = 1e-10))]
 #[allow(non_snake_case)]
 pub fn signed_distance<'py>(
     py: Python<'py>,
@@ -190,11 +205,13 @@ pub fn signed_distance<'py>(
     F: &Bound<'py, PyAny>,
     Q: &Bound<'py, PyAny>,
     threads: Option<usize>,
+    tolerance: f64,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let exact = exact_options(tolerance)?;
     let mesh = mesh_from(V, F, "V", "F")?;
     let values = with_points(Q, "Q", |q| {
         threads::run(py, threads, || {
-            SignedDistance::new(&mesh).map(|s| s.eval_batch(q))
+            SignedDistance::with_options(&mesh, exact).map(|s| s.eval_batch(q))
         })
     })?
     .map_err(value_error)?;
@@ -219,9 +236,10 @@ fn axis_index(axis: &str) -> PyResult<usize> {
 /// ``margin``, with ``res`` pixels along its longer side. Returns ``(image, png)``: ``image``
 /// float64 (height, width), row 0 at the top (x-slice: y right, z up; y-slice: x right, z up;
 /// z-slice: x right, y up), and ``png`` the bytes of the coloured picture with its colour bar
-/// (and the mesh's cross-section in black when ``outline``).
+/// (and the mesh's cross-section in black when ``outline``). ``tolerance`` is the exact method's
+/// boundary tolerance (``gwn slice --tolerance``).
 #[pyfunction]
-#[pyo3(signature = (V, F, axis = "z", at = 0.5, *, at_coord = None, res = 1024, margin = 0.1, outline = false, method = "exact", beta = 2.0, order = 2, threads = None))]
+#[pyo3(signature = (V, F, axis = "z", at = 0.5, *, at_coord = None, res = 1024, margin = 0.1, outline = false, method = "exact", beta = 2.0, order = 2, tolerance = 1e-10, threads = None))]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub fn slice<'py>(
     py: Python<'py>,
@@ -236,9 +254,11 @@ pub fn slice<'py>(
     method: &str,
     beta: f64,
     order: u8,
+    tolerance: f64,
     threads: Option<usize>,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyBytes>)> {
     let (method, params) = method_of(method, beta, order)?;
+    let exact = exact_options(tolerance)?;
     let axis = axis_index(axis)?;
     if res == 0 || res > MAX_SLICE_RES {
         return Err(PyValueError::new_err(format!(
@@ -276,7 +296,7 @@ pub fn slice<'py>(
             params,
             Options {
                 ray: slice.ray(),
-                ..Options::default()
+                ..exact
             },
         )?;
         let values = slice.evaluate(&wn);
@@ -297,9 +317,10 @@ pub fn slice<'py>(
 
 /// Classifies each face of mesh A by the exact winding number of mesh B at its centroid
 /// (the building block of mesh booleans; ``gwn classify``). Returns float64 (faces of A,);
-/// ``w > 0.5`` means inside B.
+/// ``w > 0.5`` means inside B. ``tolerance`` is the exact method's boundary tolerance
+/// (``gwn classify --tolerance``).
 #[pyfunction]
-#[pyo3(signature = (VA, FA, VB, FB, *, method = "exact", beta = 2.0, order = 2, threads = None))]
+#[pyo3(signature = (VA, FA, VB, FB, *, method = "exact", beta = 2.0, order = 2, tolerance = 1e-10, threads = None))]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub fn classify<'py>(
     py: Python<'py>,
@@ -310,13 +331,15 @@ pub fn classify<'py>(
     method: &str,
     beta: f64,
     order: u8,
+    tolerance: f64,
     threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let (method, params) = method_of(method, beta, order)?;
+    let exact = exact_options(tolerance)?;
     let a = mesh_from(VA, FA, "VA", "FA")?;
     let b = mesh_from(VB, FB, "VB", "FB")?;
     let values = threads::run(py, threads, || {
-        evaluator_for(&b, method, params, Options::default()).map(|wn| classify_faces(&a, &wn))
+        evaluator_for(&b, method, params, exact).map(|wn| classify_faces(&a, &wn))
     })?
     .map_err(value_error)?;
     Ok(array1(py, values))
@@ -326,9 +349,10 @@ pub fn classify<'py>(
 /// the surface ``(V, F)`` (the front end of a tet mesher; ``gwn filter-tets``).
 ///
 /// ``points`` (p, 3) float, ``tets`` (t, 4) int corner indices; returns a bool array (t,)
-/// (``tets[mask]`` keeps the inside tets).
+/// (``tets[mask]`` keeps the inside tets). ``tolerance`` is the exact method's boundary
+/// tolerance (``gwn filter-tets --tolerance``).
 #[pyfunction]
-#[pyo3(signature = (V, F, points, tets, threshold = 0.5, *, method = "exact", beta = 2.0, order = 2, threads = None))]
+#[pyo3(signature = (V, F, points, tets, threshold = 0.5, *, method = "exact", beta = 2.0, order = 2, tolerance = 1e-10, threads = None))]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub fn filter_tets<'py>(
     py: Python<'py>,
@@ -340,9 +364,11 @@ pub fn filter_tets<'py>(
     method: &str,
     beta: f64,
     order: u8,
+    tolerance: f64,
     threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray1<bool>>> {
     let (method, params) = method_of(method, beta, order)?;
+    let exact = exact_options(tolerance)?;
     let mesh = mesh_from(V, F, "V", "F")?;
     if !threshold.is_finite() {
         return Err(PyValueError::new_err(format!(
@@ -362,7 +388,7 @@ pub fn filter_tets<'py>(
             )));
         }
         threads::run(py, threads, || {
-            evaluator_for(&mesh, method, params, Options::default()).map(|wn| {
+            evaluator_for(&mesh, method, params, exact).map(|wn| {
                 gwn::products::tets::filter_tets(tet_points, &tet_indices, &wn, threshold)
             })
         })?

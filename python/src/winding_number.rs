@@ -12,11 +12,17 @@ use pyo3::types::PyTuple;
 
 use crate::arrays::{array1, array2, indices_vec, points_vec, values_vec, with_points};
 use crate::errors::{mesh_error, value_error};
-use crate::evaluator::{Evaluator, Method, fast_params, parse_precision, parse_ray};
+use crate::evaluator::{
+    Evaluator, Method, PY_DEFAULT_TOLERANCE, check_tolerance, fast_params, parse_precision,
+    parse_ray,
+};
 use crate::threads;
 
 /// `WindingNumber.parts`' result: crossing counts and fractional parts.
 type Parts<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<f64>>);
+
+/// `WindingNumber.eval_with_bound`'s result: values and their certified bounds.
+type Bounded<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
 
 /// What the evaluator was built from, kept for pickling (rebuilt from these on unpickle).
 #[derive(Debug)]
@@ -34,12 +40,17 @@ enum Source {
 
 /// Winding-number evaluator of one mesh or oriented point cloud, built once.
 ///
-/// ``WindingNumber(V, F, method="exact", beta=2.0, order=2, precision=60, ray="+z")``
+/// ``WindingNumber(V, F, method="exact", beta=2.0, order=2, precision=60, ray="+z",
+/// tolerance=1e-10)``
 ///
 /// ``method``: ``"exact"`` (Antipodal method, the default), ``"direct"`` (solid-angle sum over
 /// all triangles) or ``"fast"`` (Barnes-Hut with accuracy ``beta`` and expansion ``order``).
-/// ``precision`` (30 or 60 bits) and ``ray`` (``"+z"``, ``"-x"``, ...) are options of the exact
-/// method. Oriented point clouds: :meth:`WindingNumber.from_point_cloud`.
+/// ``precision`` (30 or 60 bits), ``ray`` (``"+z"``, ``"-x"``, ...) and ``tolerance`` are
+/// options of the exact method. ``tolerance`` (finite, ``>= 0``) is the absolute tolerance on
+/// ``w`` for the far boundary: far boundary clusters are replaced by a multipole expansion with a
+/// certified error bound (:meth:`WindingNumber.eval_with_bound`); the integer part is always
+/// exact, ``0`` is the flat exact loop. Oriented point clouds:
+/// :meth:`WindingNumber.from_point_cloud`.
 ///
 /// Calls release the GIL; one object can be queried from several Python threads at once.
 /// Objects pickle by their arrays and are rebuilt on unpickling.
@@ -52,6 +63,8 @@ pub struct PyWindingNumber {
     order: u8,
     precision: u32,
     ray: String,
+    /// The exact method's boundary tolerance as given (validated for every method).
+    tolerance: f64,
 }
 
 fn build_err(e: String) -> PyErr {
@@ -70,11 +83,13 @@ impl PyWindingNumber {
         order: u8,
         precision: u32,
         ray: &str,
+        tolerance: f64,
     ) -> PyResult<Self> {
         let method = Method::parse(method).map_err(build_err)?;
         let options = Options {
             precision: parse_precision(precision).map_err(build_err)?,
             ray: parse_ray(ray).map_err(build_err)?,
+            tolerance: check_tolerance(tolerance).map_err(build_err)?,
             ..Default::default()
         };
         let params = fast_params(beta, order).map_err(build_err)?;
@@ -91,6 +106,7 @@ impl PyWindingNumber {
             order,
             precision,
             ray: ray.to_string(),
+            tolerance,
         })
     }
 
@@ -103,7 +119,7 @@ impl PyWindingNumber {
 #[pymethods]
 impl PyWindingNumber {
     #[new]
-    #[pyo3(signature = (V, F, method = "exact", beta = 2.0, order = 2, precision = 60, ray = "+z"))]
+    #[pyo3(signature = (V, F, method = "exact", beta = 2.0, order = 2, precision = 60, ray = "+z", tolerance = 1e-10))]
     #[allow(non_snake_case, clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -114,8 +130,9 @@ impl PyWindingNumber {
         order: u8,
         precision: u32,
         ray: &str,
+        tolerance: f64,
     ) -> PyResult<Self> {
-        Self::from_mesh_arrays(py, V, F, method, beta, order, precision, ray)
+        Self::from_mesh_arrays(py, V, F, method, beta, order, precision, ray, tolerance)
     }
 
     /// Barnes-Hut evaluator of an oriented point cloud: positions ``P`` (n, 3), normals ``N``
@@ -153,6 +170,7 @@ impl PyWindingNumber {
             order,
             precision: 60,
             ray: "+z".to_string(),
+            tolerance: PY_DEFAULT_TOLERANCE,
         })
     }
 
@@ -207,6 +225,25 @@ impl PyWindingNumber {
         Ok((PyArray1::from_vec(py, chi), array1(py, fraction)))
     }
 
+    /// Winding numbers and certified error bounds at the rows of ``Q`` (n, 3) (exact method):
+    /// ``(w, bound)``, both float64 (n,), with ``|w - w_flat| <= bound <= tolerance`` where
+    /// ``w_flat`` is the flat exact loop (``tolerance=0``). ``bound`` is 0 where no far boundary
+    /// cluster was expanded; ``w`` equals ``self(Q)`` bit for bit.
+    #[pyo3(signature = (Q, threads = None))]
+    #[allow(non_snake_case)]
+    fn eval_with_bound<'py>(
+        &self,
+        py: Python<'py>,
+        Q: &Bound<'py, PyAny>,
+        threads: Option<usize>,
+    ) -> PyResult<Bounded<'py>> {
+        let (values, bounds) = with_points(Q, "Q", |q| {
+            threads::run(py, threads, || self.evaluator.bound_batch(q))
+        })?
+        .map_err(value_error)?;
+        Ok((array1(py, values), array1(py, bounds)))
+    }
+
     /// ``"exact"``, ``"direct"`` or ``"fast"``.
     #[getter]
     fn method(&self) -> &'static str {
@@ -220,6 +257,12 @@ impl PyWindingNumber {
             Source::Mesh(m) => m.triangles().len(),
             Source::Cloud { .. } => 0,
         }
+    }
+
+    /// The exact method's boundary tolerance (``None`` for the other methods).
+    #[getter]
+    fn tolerance(&self) -> Option<f64> {
+        (self.method == Method::Exact).then_some(self.tolerance)
     }
 
     /// Number of boundary edges of the exact method's signed boundary (``None`` for the other
@@ -261,6 +304,7 @@ impl PyWindingNumber {
                     self.order,
                     self.precision,
                     self.ray.as_str(),
+                    self.tolerance,
                 )
                     .into_pyobject(py)?;
                 Ok((cls, args))

@@ -28,6 +28,8 @@ def queries(tmp_path_factory, lion):
     [
         ("exact", [], {}),
         ("exact", ["--precision", "30", "--ray", "-x"], {"precision": 30, "ray": "-x"}),
+        ("exact", ["--tolerance", "1e-3"], {"tolerance": 1e-3}),
+        ("exact", ["--tolerance", "0"], {"tolerance": 0.0}),
         ("direct", [], {}),
         ("fast", ["--beta", "2.5", "--order", "1"], {"beta": 2.5, "order": 1}),
     ],
@@ -149,6 +151,18 @@ def test_products_take_any_method(cli, tmp_path, lion, method, cli_args, kwargs)
     assert png == out.read_bytes()
     run(cli, "classify", LION_HEAD, LION_HEAD, "--out", tmp_path / "c.npy", *cli_args)
     np.testing.assert_array_equal(gwn.classify(v, f, v, f, **kwargs), np.load(tmp_path / "c.npy"))
+
+
+def test_products_take_the_tolerance(cli, tmp_path, lion):
+    """tolerance= is the CLI's --tolerance on the products (exact method)."""
+    v, f = lion
+    run(cli, "voxelize", LION_HEAD, "--res", 10, "--margin", 2.0, "--dtype", "f64",
+        "--tolerance", "1e-3", "--out", tmp_path / "w.npy")
+    w, _, _ = gwn.voxelize(v, f, 10, margin=2.0, tolerance=1e-3)
+    np.testing.assert_array_equal(w, np.load(tmp_path / "w.npy"))
+    run(cli, "classify", LION_HEAD, LION_HEAD, "--tolerance", "0", "--out", tmp_path / "c.npy")
+    np.testing.assert_array_equal(gwn.classify(v, f, v, f, tolerance=0.0),
+                                  np.load(tmp_path / "c.npy"))
 
 
 def test_products_reject_bad_methods(lion):

@@ -48,6 +48,8 @@ pub type Moments = [f64; COEFFICIENTS];
 
 /// The degree-ordered multi-index tables shared by every routine of this file.
 struct Table {
+    /// Index of `α` at [`dense_index`]`(α)` (`ZERO` for `|α| > MAX_ORDER`).
+    dense: Vec<u16>,
     /// `α` per index.
     alpha: Vec<[u8; 3]>,
     /// Index of `α − e_k` (or `ZERO` when `α_k = 0`).
@@ -63,6 +65,13 @@ struct Table {
 /// The slot after the last coefficient: reads as 0 in the scratch arrays.
 const ZERO: u16 = COEFFICIENTS as u16;
 
+/// Side of the dense multi-index lookup.
+const DENSE: usize = MAX_ORDER + 1;
+
+fn dense_index(a: [u8; 3]) -> usize {
+    (usize::from(a[0]) * DENSE + usize::from(a[1])) * DENSE + usize::from(a[2])
+}
+
 fn table() -> &'static Table {
     static TABLE: OnceLock<Table> = OnceLock::new();
     TABLE.get_or_init(|| {
@@ -74,12 +83,11 @@ fn table() -> &'static Table {
                 }
             }
         }
-        let index = |a: [u8; 3]| -> u16 {
-            alpha
-                .iter()
-                .position(|&b| b == a)
-                .map_or(ZERO, |i| i as u16)
-        };
+        let mut dense = vec![ZERO; DENSE * DENSE * DENSE];
+        for (i, a) in alpha.iter().enumerate() {
+            dense[dense_index(*a)] = i as u16;
+        }
+        let index = |a: [u8; 3]| dense[dense_index(a)];
         let minus = |a: [u8; 3], k: usize, d: u8| -> u16 {
             if a[k] < d {
                 return ZERO;
@@ -112,6 +120,7 @@ fn table() -> &'static Table {
             .map(|a| (0..3).find(|&k| a[k] > 0).unwrap_or(0) as u8)
             .collect();
         Table {
+            dense,
             alpha,
             minus1,
             minus2,
@@ -176,15 +185,8 @@ pub fn truncation_bound(area: f64, radius: f64, distance: f64, order: usize) -> 
 /// `ra = a − p`, `rb = b − p`) to `m`. Eq. 6: with `m⃗ = ra × rb` (twice the vector area),
 /// `∫_T n_k u^β dA = m⃗_k/(|β|+2)·∫_0^1 v(μ)^β dμ`, `v(μ) = (1−μ)·ra + μ·rb`, a polynomial of
 /// degree `≤ MAX_ORDER − 1` in `μ`, integrated exactly by five Gauss–Legendre points. `sign`
-/// (±1) orients the triangle; `magnitude` accumulates the same sums in absolute values (the scale
-/// of the rounding errors, [`EVALUATION_ROUNDING`]). Returns the triangle's area.
-pub fn add_fan_triangle(
-    m: &mut Moments,
-    magnitude: &mut Moments,
-    ra: [f64; 3],
-    rb: [f64; 3],
-    sign: f64,
-) -> f64 {
+/// (±1) orients the triangle. Returns the triangle's area.
+pub fn add_fan_triangle(m: &mut Moments, ra: [f64; 3], rb: [f64; 3], sign: f64) -> f64 {
     // Gauss–Legendre on [0, 1], exact to degree 9 = MAX_ORDER − 1.
     const NODES: [f64; 5] = [
         0.046_910_077_030_668_004,
@@ -209,34 +211,28 @@ pub fn add_fan_triangle(
     ];
     let below = coefficients_up_to(MAX_ORDER - 1);
     let mut line = [0.0; COEFFICIENTS + 1];
-    let mut line_abs = [0.0; COEFFICIENTS + 1];
     let mut power = [0.0; COEFFICIENTS + 1];
     for (&mu, &w) in NODES.iter().zip(&WEIGHTS) {
         let v: [f64; 3] = std::array::from_fn(|k| (1.0 - mu) * ra[k] + mu * rb[k]);
         power[0] = 1.0;
         line[0] += w;
-        line_abs[0] += w;
         for i in 1..below {
             let k = t.axis[i] as usize;
             power[i] = power[t.minus1[i][k] as usize] * v[k];
             line[i] += w * power[i];
-            line_abs[i] += w * power[i].abs();
         }
     }
     // N_α = Σ_k α_k ∫ n_k u^(α−e_k) dA, and |α − e_k| + 2 = |α| + 1.
     for i in 1..COEFFICIENTS {
         let a = t.alpha[i];
         let n = f64::from(a[0] + a[1] + a[2]);
-        let (mut sum, mut sum_abs) = (0.0, 0.0);
+        let mut sum = 0.0;
         for k in 0..3 {
             if a[k] > 0 {
-                let j = t.minus1[i][k] as usize;
-                sum += f64::from(a[k]) * normal[k] * line[j];
-                sum_abs += f64::from(a[k]) * normal[k].abs() * line_abs[j];
+                sum += f64::from(a[k]) * normal[k] * line[t.minus1[i][k] as usize];
             }
         }
         m[i] += sign * sum / (n + 1.0);
-        magnitude[i] += sum_abs / (n + 1.0);
     }
     0.5 * (normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]).sqrt()
 }
@@ -282,8 +278,8 @@ pub fn shifted(m: &Moments, delta: [f64; 3]) -> Moments {
 #[derive(Clone, Debug)]
 pub struct Expansion {
     coefficients: Moments,
-    /// `Σ_{|β|=n} Σ_α |N_α·[σ^β](…)|` per degree `n`, from the moments' magnitudes: the scale of
-    /// the rounding errors of the coefficients and of the sum.
+    /// Per degree `n`, a bound on `Σ_{|β|=n} Σ_α |N_α·[σ^β](B_α)|` and on the same sums over the
+    /// moments' summands: the scale of the rounding errors of the coefficients and of the sum.
     magnitude_by_degree: [f64; MAX_ORDER + 1],
 }
 
@@ -294,7 +290,7 @@ fn polynomials() -> &'static Vec<Vec<f64>> {
     static POLY: OnceLock<Vec<Vec<f64>>> = OnceLock::new();
     POLY.get_or_init(|| {
         let t = table();
-        let index = |a: [u8; 3]| t.alpha.iter().position(|&b| b == a).unwrap_or(COEFFICIENTS);
+        let index = |a: [u8; 3]| usize::from(t.dense[dense_index(a)]);
         // Polynomials as dense vectors over all multi-indices (only one degree is non-zero).
         let mut poly: Vec<Vec<f64>> = Vec::with_capacity(COEFFICIENTS);
         for i in 0..COEFFICIENTS {
@@ -339,8 +335,12 @@ fn polynomials() -> &'static Vec<Vec<f64>> {
 }
 
 impl Expansion {
-    /// From moments about the centre and their magnitudes (see [`add_fan_triangle`]).
-    pub fn new(moments: &Moments, magnitude: &Moments) -> Self {
+    /// From moments about the centre of a surface of unsigned area `area` within `radius` of it.
+    ///
+    /// Magnitudes: `|∇u^α| ≤ n·|u|^(n−1)` (`|u^β| ≤ |u|^|β|`), so every moment, and every summand
+    /// that formed it (moments about other centres of the same ball, `|u| ≤ 2·radius`), is at
+    /// most `area·n·(2·radius)^(n−1)`.
+    pub fn new(moments: &Moments, area: f64, radius: f64) -> Self {
         let t = table();
         let poly = polynomials();
         let mut coefficients = [0.0; COEFFICIENTS];
@@ -349,10 +349,11 @@ impl Expansion {
             let a = t.alpha[i];
             let n = usize::from(a[0] + a[1] + a[2]);
             let (lo, hi) = (coefficients_up_to(n - 1), coefficients_up_to(n));
+            let bound = area * n as f64 * (2.0 * radius).powi(n as i32 - 1);
             for j in lo..hi {
                 let c = poly[i][j];
                 coefficients[j] -= moments[i] * c;
-                magnitude_by_degree[n] += (magnitude[i] + moments[i].abs()) * c.abs();
+                magnitude_by_degree[n] += bound.max(moments[i].abs()) * c.abs();
             }
         }
         Expansion {
@@ -528,21 +529,19 @@ mod tests {
             let pts = fan(&mut state, 6);
             let p = pts[0];
             let mut m = [0.0; COEFFICIENTS];
-            let mut mag = [0.0; COEFFICIENTS];
             let mut area = 0.0;
             for w in pts[1..].windows(2) {
                 let ra = std::array::from_fn(|k| w[0][k] - p[k]);
                 let rb = std::array::from_fn(|k| w[1][k] - p[k]);
-                area += add_fan_triangle(&mut m, &mut mag, ra, rb, 1.0);
+                area += add_fan_triangle(&mut m, ra, rb, 1.0);
             }
             // Move the moments from the apex to the origin: δ = p − 0.
             let m = shifted(&m, p);
-            let mag = shifted(&mag, p.map(f64::abs));
-            let expansion = Expansion::new(&m, &mag);
             let radius = pts
                 .iter()
                 .map(|v| v.iter().map(|c| c * c).sum::<f64>().sqrt())
                 .fold(0.0, f64::max);
+            let expansion = Expansion::new(&m, area, radius);
             let dir: [f64; 3] = std::array::from_fn(|_| lcg(&mut state));
             let norm = dir.iter().map(|c| c * c).sum::<f64>().sqrt();
             for dist in [1.3, 2.0, 4.0, 10.0, 100.0] {
@@ -580,11 +579,9 @@ mod tests {
         let mut state = 5;
         let pts = fan(&mut state, 4);
         let mut m = [0.0; COEFFICIENTS];
-        let mut mag = [0.0; COEFFICIENTS];
         for w in pts[1..].windows(2) {
             add_fan_triangle(
                 &mut m,
-                &mut mag,
                 std::array::from_fn(|k| w[0][k] - pts[0][k]),
                 std::array::from_fn(|k| w[1][k] - pts[0][k]),
                 1.0,

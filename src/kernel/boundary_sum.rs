@@ -95,7 +95,11 @@ impl BoundaryEdges {
     /// Packs edges `a[i] → b[i]` with positive integer weights `weight[i]` (grid coordinates, ray
     /// frame).
     pub fn new(a: Vec<[i64; 3]>, b: Vec<[i64; 3]>, weight: Vec<f64>, bits: u32) -> Self {
-        let chains = chain_edges(&a, &b, &weight);
+        let mut chains = chain_edges(&a, &b, &weight);
+        // Chains in Morton order of their first vertex: the hierarchy over slot ranges
+        // (`boundary_tree`) then groups nearby chains (a scan's many small holes) into compact
+        // nodes. The flat sum does not depend on the order (beyond rounding).
+        chains.sort_by_cached_key(|chain| morton_key(a[chain[0] as usize], bits));
         let mut xs = Vec::new();
         let mut ys = Vec::new();
         let mut zs = Vec::new();
@@ -596,6 +600,16 @@ pub(crate) fn segment_area<W: Width>(
         query_inside_segment: o.degenerate && z_exact && query_inside_segment(qi, a, b),
     };
     antipodal_edge_area(ra, rb, signs)
+}
+
+/// The Morton (Z-order) key of a grid point: the top 21 bits of each coordinate, interleaved.
+fn morton_key(p: [i64; 3], bits: u32) -> u64 {
+    let spread = |c: i64| -> u64 {
+        // Offset to non-negative, keep 21 bits, spread them three apart.
+        let v = ((c + (1_i64 << (bits - 1))) >> (bits.saturating_sub(21))) as u64 & 0x1f_ffff;
+        (0..21).fold(0, |acc, i| acc | (((v >> i) & 1) << (3 * i)))
+    };
+    spread(p[0]) | (spread(p[1]) << 1) | (spread(p[2]) << 2)
 }
 
 /// Decomposes the edges (edge `i` repeated `weight[i]` times, heavy edges left out) into chains: sequences of edges,

@@ -22,10 +22,11 @@ use super::boundary_multipole::{
 use super::boundary_sum::{BoundaryEdges, segment_area};
 use super::predicates::{Width, orient2d_filtered};
 use super::spherical::INV_4PI;
+use rayon::prelude::*;
 use wide::f64x4;
 
 /// Slots per leaf (a multiple of the SIMD loop's 4).
-const LEAF_SLOTS: usize = 32;
+const LEAF_SLOTS: usize = 64;
 
 /// More levels than any tree has (ranges halve down to [`LEAF_SLOTS`], slots fit in `u32`).
 const MAX_DEPTH: usize = 64;
@@ -79,10 +80,56 @@ pub struct BoundaryTree {
     tolerance: f64,
 }
 
-/// Moments of the nodes while building (children before parents): values and magnitudes.
+/// Moments of the nodes while building (in node order): values and magnitudes; and the leaves'.
 struct Building {
     moments: Vec<Moments>,
-    magnitudes: Vec<Moments>,
+    leaves: Vec<LeafMoments>,
+    /// Every node's open ends, its apex included (sorted by position).
+    full_ends: Vec<Vec<([i64; 3], i32)>>,
+}
+
+/// The fan moments of one leaf chunk about its apex (the first edge's start).
+struct LeafMoments {
+    moments: Box<Moments>,
+    area: f64,
+}
+
+fn leaf_moments(edges: &BoundaryEdges, range: std::ops::Range<usize>) -> LeafMoments {
+    let limit = edges.limit();
+    let mut m = Box::new([0.0; COEFFICIENTS]);
+    let mut area = 0.0;
+    let mut apex = None;
+    for e in range.filter_map(|j| edges.slot_edge(j)) {
+        let (a, b, _) = edges.edge(e);
+        let p = *apex.get_or_insert(a);
+        area += add_fan_triangle(&mut m, rel(a, p, limit), rel(b, p, limit), 1.0);
+    }
+    LeafMoments { moments: m, area }
+}
+
+/// Sums the multiplicities of equal positions in a sorted list and drops the zeros.
+fn merge_ends(sorted: Vec<([i64; 3], i32)>) -> Vec<([i64; 3], i32)> {
+    let mut merged: Vec<([i64; 3], i32)> = Vec::with_capacity(sorted.len());
+    for (v, m) in sorted {
+        match merged.last_mut() {
+            Some((w, n)) if *w == v => *n += m,
+            _ => merged.push((v, m)),
+        }
+    }
+    merged.retain(|&(_, m)| m != 0);
+    merged
+}
+
+/// The distance from which each order pays and meets the node's budget.
+fn set_reach(node: &mut Node) {
+    let ends = (node.ends.1 - node.ends.0) as f64;
+    let loop_cost = node.edges as f64 * EDGE_COST;
+    for k in 1..=MAX_ORDER {
+        let cost = NODE_COST + coefficients_up_to(k) as f64 * COEFFICIENT_COST + ends * SPOKE_COST;
+        if cost < loop_cost && node.edges > 0 {
+            node.reach[k - 1] = reach(node.area, node.radius, k, node.budget);
+        }
+    }
 }
 
 /// What the hierarchy did for one query: the boundary sum, its certified error bound on `w`, and
@@ -120,17 +167,51 @@ impl BoundaryTree {
             tolerance,
         };
         let per_edge = 4.0 * std::f64::consts::PI * tolerance / total as f64;
+        // The leaves are the LEAF_SLOTS-aligned chunks (every split is aligned): their fan moments,
+        // the bulk of the work, in parallel.
+        let slots = edges.padded_slots();
+        let t0 = std::time::Instant::now();
+        let leaves: Vec<LeafMoments> = (0..slots.div_ceil(LEAF_SLOTS))
+            .into_par_iter()
+            .map(|c| leaf_moments(edges, c * LEAF_SLOTS..((c + 1) * LEAF_SLOTS).min(slots)))
+            .collect();
         let mut building = Building {
             moments: Vec::new(),
-            magnitudes: Vec::new(),
+            leaves,
+            full_ends: Vec::new(),
         };
-        tree.build_node(edges, 0, edges.padded_slots(), per_edge, &mut building);
+        let t1 = t0.elapsed();
+        tree.build_node(edges, 0, slots, per_edge, &mut building);
+        let t2 = t0.elapsed();
         tree.expansions = building
             .moments
-            .iter()
-            .zip(&building.magnitudes)
-            .map(|(m, a)| Expansion::new(m, a))
+            .par_iter()
+            .zip(&tree.nodes)
+            .map(|(m, n)| Expansion::new(m, n.area, n.radius))
             .collect();
+        let t3 = t0.elapsed();
+        tree.nodes.par_iter_mut().for_each(set_reach);
+        if std::env::var("GWN_TREE_DEBUG").is_ok() {
+            eprintln!(
+                "leaves {t1:?} nodes {t2:?} expansions {t3:?} reach {:?} ({} nodes)",
+                t0.elapsed(),
+                tree.nodes.len()
+            );
+        }
+        // Pre-order: children come after their parent.
+        for i in (0..tree.nodes.len()).rev() {
+            let below = tree.nodes[i].children.map_or(f64::INFINITY, |(l, r)| {
+                tree.nodes[l as usize]
+                    .subtree_reach
+                    .min(tree.nodes[r as usize].subtree_reach)
+            });
+            let own = tree.nodes[i]
+                .reach
+                .iter()
+                .copied()
+                .fold(f64::INFINITY, f64::min);
+            tree.nodes[i].subtree_reach = own.min(below);
+        }
         if std::env::var("GWN_TREE_DEBUG").is_ok() {
             for (i, n) in tree.nodes.iter().enumerate() {
                 eprintln!(
@@ -205,25 +286,21 @@ impl BoundaryTree {
             .fold(0.0, f64::max);
         // Rounding of the distances above: a relative 2^-50 is far more than their error.
         let radius = radius * (1.0 + 1e-15) + 4.0 / limit;
-        // Open ends: m_v = (edges leaving v) − (edges arriving), merged by position.
-        let mut ends: Vec<([i64; 3], i32)> = Vec::new();
-        for &e in &slot_edges {
-            let (a, b, _) = edges.edge(e);
-            ends.push((a, 1));
-            ends.push((b, -1));
-        }
-        ends.sort_unstable();
-        let mut merged: Vec<([i64; 3], i32)> = Vec::new();
-        for (v, m) in ends {
-            match merged.last_mut() {
-                Some((w, n)) if *w == v => *n += m,
-                _ => merged.push((v, m)),
+        // Open ends: m_v = (edges leaving v) − (edges arriving), merged by position (sorted).
+        // Leaves sort their edges' ends; parents merge their children's lists.
+        let full_ends: Vec<([i64; 3], i32)> = if j1 - j0 <= LEAF_SLOTS {
+            let mut ends: Vec<([i64; 3], i32)> = Vec::with_capacity(2 * slot_edges.len());
+            for &e in &slot_edges {
+                let (a, b, _) = edges.edge(e);
+                ends.push((a, 1));
+                ends.push((b, -1));
             }
-        }
-        merged.retain(|&(v, m)| m != 0 && v != apex);
-        let e0 = self.ends.len() as u32;
-        self.ends.extend_from_slice(&merged);
-        let e1 = self.ends.len() as u32;
+            ends.sort_unstable();
+            merge_ends(ends)
+        } else {
+            Vec::new()
+        };
+        building.full_ends.push(full_ends);
         self.nodes.push(Node {
             j0: j0 as u32,
             j1: j1 as u32,
@@ -235,29 +312,27 @@ impl BoundaryTree {
             radius,
             area: 0.0,
             apex,
-            ends: (e0, e1),
+            ends: (0, 0),
             budget: per_edge * slot_edges.len() as f64,
             reach: [f64::INFINITY; MAX_ORDER],
             subtree_reach: f64::INFINITY,
         });
         building.moments.push([0.0; COEFFICIENTS]);
-        building.magnitudes.push([0.0; COEFFICIENTS]);
         // Moments about the apex, then shifted to the centre.
         let mut m = [0.0; COEFFICIENTS];
-        let mut mag = [0.0; COEFFICIENTS];
         let area = if j1 - j0 <= LEAF_SLOTS {
-            let mut area = 0.0;
-            for &e in &slot_edges {
-                let (a, b, _) = edges.edge(e);
-                let (ra, rb) = (rel(a, apex, limit), rel(b, apex, limit));
-                area += add_fan_triangle(&mut m, &mut mag, ra, rb, 1.0);
-            }
-            area
+            let leaf = &building.leaves[j0 / LEAF_SLOTS];
+            m = *leaf.moments;
+            leaf.area
         } else {
             let mid = j0 + ((j1 - j0) / 2).div_ceil(LEAF_SLOTS) * LEAF_SLOTS;
             let left = self.build_node(edges, j0, mid, per_edge, building);
             let right = self.build_node(edges, mid, j1, per_edge, building);
             self.nodes[index].children = Some((left, right));
+            let mut ends = building.full_ends[left as usize].clone();
+            ends.extend_from_slice(&building.full_ends[right as usize]);
+            ends.sort_unstable();
+            building.full_ends[index] = merge_ends(ends);
             let apex_c = norm(apex);
             let mut area = 0.0;
             for child in [left, right] {
@@ -267,23 +342,19 @@ impl BoundaryTree {
                 }
                 let delta: [f64; 3] = std::array::from_fn(|k| c.centre[k] - apex_c[k]);
                 let moved = shifted(&building.moments[child as usize], delta);
-                let moved_mag = shifted(&building.magnitudes[child as usize], delta.map(f64::abs));
                 for i in 0..COEFFICIENTS {
                     m[i] += moved[i];
-                    mag[i] += moved_mag[i];
                 }
                 area += c.area;
                 if c.apex != apex {
                     // S_child is the fan from the child's apex p_k; the node's fan from p adds,
                     // per open end v of the child, −m_v times the triangle (p, p_k, v) (Eq. 9).
-                    let (c0, c1) = c.ends;
                     let child_apex = c.apex;
-                    let ends: Vec<([i64; 3], i32)> = self.ends[c0 as usize..c1 as usize].to_vec();
-                    for (v, mv) in ends {
+                    for &(v, mv) in &building.full_ends[child as usize] {
                         let (ra, rb) = (rel(child_apex, apex, limit), rel(v, apex, limit));
                         let weight = -f64::from(mv);
                         for _ in 0..mv.unsigned_abs() {
-                            area += add_fan_triangle(&mut m, &mut mag, ra, rb, weight.signum());
+                            area += add_fan_triangle(&mut m, ra, rb, weight.signum());
                         }
                     }
                 }
@@ -292,26 +363,14 @@ impl BoundaryTree {
         };
         let delta: [f64; 3] = std::array::from_fn(|k| norm(apex)[k] - centre[k]);
         building.moments[index] = shifted(&m, delta);
-        building.magnitudes[index] = shifted(&mag, delta.map(f64::abs));
-        let node = &mut self.nodes[index];
-        node.area = area * (1.0 + 1e-12);
-        // Orders that can pay: evaluation cheaper than the node's loop.
-        let ends = (node.ends.1 - node.ends.0) as f64;
-        let loop_cost = node.edges as f64 * EDGE_COST;
-        for k in 1..=MAX_ORDER {
-            let cost =
-                NODE_COST + coefficients_up_to(k) as f64 * COEFFICIENT_COST + ends * SPOKE_COST;
-            if cost < loop_cost && node.edges > 0 {
-                node.reach[k - 1] = reach(node.area, node.radius, k, node.budget);
-            }
-        }
-        let own = node.reach.iter().copied().fold(f64::INFINITY, f64::min);
-        let below = node.children.map_or(f64::INFINITY, |(l, r)| {
-            self.nodes[l as usize]
-                .subtree_reach
-                .min(self.nodes[r as usize].subtree_reach)
-        });
-        self.nodes[index].subtree_reach = own.min(below);
+        self.nodes[index].area = area * (1.0 + 1e-12);
+        let e0 = self.ends.len() as u32;
+        self.ends.extend(
+            building.full_ends[index]
+                .iter()
+                .filter(|&&(v, _)| v != apex),
+        );
+        self.nodes[index].ends = (e0, self.ends.len() as u32);
         index as u32
     }
 
@@ -563,7 +622,7 @@ mod probe {
         use super::super::predicates::W128;
         let mut m = [0.37; COEFFICIENTS];
         m[0] = 0.0;
-        let e = Expansion::new(&m, &m);
+        let e = Expansion::new(&m, 1.0, 1.0);
         for k in [1, 2, 4, 6, 8, 10] {
             let t = std::time::Instant::now();
             let mut s = 0.0;
