@@ -289,8 +289,12 @@ struct FrameEvaluator<W: Width> {
     /// Triangle corners in grid coordinates (frame), in BVH leaf order.
     tri_pts: Vec<[[i64; 3]; 3]>,
     boundary: BoundaryEdges,
-    /// The certified hierarchy over `boundary` (tolerance > 0 and some node can pay).
-    tree: Option<BoundaryTree>,
+    /// Tolerance of the certified hierarchy over `boundary`.
+    tolerance: f64,
+    /// The hierarchy, built on first use (`None`: tolerance 0, or no node can ever pay). Lazy so
+    /// that the evaluator's precompute is the flat loop's: the tree costs up to as much again on
+    /// large boundaries (docs/benchmarks.md), paid by the first query instead.
+    tree: std::sync::OnceLock<Option<BoundaryTree>>,
     bvh: RayBvh,
     _width: PhantomData<W>,
 }
@@ -324,7 +328,6 @@ impl<W: Width> FrameEvaluator<W> {
             boundary.iter().map(|e| f64::from(e.weight)).collect(),
             grid.precision().bits(),
         );
-        let tree = BoundaryTree::build(&boundary, options.tolerance);
         let to_unit = 1.0 / (1_i64 << (grid.precision().bits() - 1)) as f64;
         let boxes: Vec<([f32; 3], [f32; 3])> = tris
             .iter()
@@ -353,7 +356,8 @@ impl<W: Width> FrameEvaluator<W> {
             to_unit,
             tri_pts,
             boundary,
-            tree,
+            tolerance: options.tolerance,
+            tree: std::sync::OnceLock::new(),
             bvh,
             _width: PhantomData,
         })
@@ -368,7 +372,8 @@ impl<W: Width> FrameEvaluator<W> {
             to_unit: 1.0,
             tri_pts: Vec::new(),
             boundary: BoundaryEdges::default(),
-            tree: None,
+            tolerance: 0.0,
+            tree: std::sync::OnceLock::new(),
             bvh: RayBvh::default(),
             _width: PhantomData,
         }
@@ -570,13 +575,20 @@ impl<W: Width> FrameEvaluator<W> {
                 .area_sum_accurate::<W>(qi, r, z_exact, qz_units);
             return (area, 0.0);
         }
-        match &self.tree {
+        match self.tree() {
             Some(tree) => {
                 let sum = tree.area_sum::<W>(&self.boundary, qi, z_exact, qz_units);
                 (sum.area, sum.bound)
             }
             None => (self.boundary.area_sum::<W>(qi, z_exact, qz_units), 0.0),
         }
+    }
+
+    /// The boundary hierarchy, built on first use.
+    fn tree(&self) -> Option<&BoundaryTree> {
+        self.tree
+            .get_or_init(|| BoundaryTree::build(&self.boundary, self.tolerance))
+            .as_ref()
     }
 
     /// Boundary sum for a query whose ray cannot approach the mesh: plain floating point (and
@@ -591,7 +603,9 @@ impl<W: Width> FrameEvaluator<W> {
             };
             antipodal_edge_area(ra, rb, signs)
         };
-        let Some(tree) = &self.tree else {
+        let limit = self.boundary.limit();
+        let q = std::array::from_fn(|k| (qf[k] - self.origin[k]) / self.cell / limit);
+        let Some(tree) = self.tree().filter(|t| t.reaches(q)) else {
             let mut sum = 0.0;
             for i in 0..self.boundary.len() {
                 let (a, b, weight) = self.boundary.edge(i);
@@ -599,8 +613,6 @@ impl<W: Width> FrameEvaluator<W> {
             }
             return (sum, 0.0);
         };
-        let limit = self.boundary.limit();
-        let q = std::array::from_fn(|k| (qf[k] - self.origin[k]) / self.cell / limit);
         let mut exact_sum = 0.0;
         let mut exact = |range: std::ops::Range<usize>| {
             for j in range {

@@ -379,39 +379,33 @@ impl Expansion {
             py[j] = py[j - 1] * sigma[1];
             pz[j] = pz[j - 1] * sigma[2];
         }
-        // diagonal[m][j] = σ_y^(m−j)·σ_z^j: the yz monomials of degree m in the table's order.
-        let mut diagonal = [[0.0; MAX_ORDER + 1]; MAX_ORDER + 1];
-        for m in 0..=order {
-            for j in 0..=m {
-                diagonal[m][j] = py[m - j] * pz[j];
+        // The monomials σ^β in the table's order (degree, then x descending, then y descending),
+        // then one long dot product with four accumulators.
+        let count = coefficients_up_to(order);
+        let mut monomials = [0.0; COEFFICIENTS];
+        let mut i = 0;
+        for n in 0..=order {
+            for a in (0..=n).rev() {
+                let x = px[a];
+                for b in (0..=n - a).rev() {
+                    monomials[i] = x * (py[b] * pz[n - a - b]);
+                    i += 1;
+                }
             }
         }
-        let c = &self.coefficients;
-        let (mut sum, mut scale, mut inv_rn) = (0.0, 0.0, 1.0);
-        let mut i = 1;
-        for n in 1..=order {
-            // Within a degree the table runs over σ_x^a, a descending, then the yz monomials of
-            // degree n − a: one dot product per a (four accumulators, no serial chain).
-            let mut degree_sum = 0.0;
-            for a in (0..=n).rev() {
-                let m = n - a;
-                let block = &c[i..i + m + 1];
-                let d = &diagonal[m][..m + 1];
-                let mut acc = [0.0; 4];
-                let mut chunks = block.chunks_exact(4).zip(d.chunks_exact(4));
-                for (cb, db) in &mut chunks {
-                    for l in 0..4 {
-                        acc[l] += cb[l] * db[l];
-                    }
-                }
-                let tail = (m + 1) / 4 * 4;
-                for l in tail..=m {
-                    acc[0] += block[l] * d[l];
-                }
-                degree_sum += px[a] * ((acc[0] + acc[1]) + (acc[2] + acc[3]));
-                i += m + 1;
+        let mut acc = [0.0; 4];
+        let (c, m) = (&self.coefficients[1..count], &monomials[1..count]);
+        for (cc, mm) in c.chunks_exact(4).zip(m.chunks_exact(4)) {
+            for l in 0..4 {
+                acc[l] += cc[l] * mm[l];
             }
-            sum += degree_sum;
+        }
+        for l in (c.len() / 4 * 4)..c.len() {
+            acc[0] += c[l] * m[l];
+        }
+        let sum = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+        let (mut scale, mut inv_rn) = (0.0, 1.0);
+        for n in 1..=order {
             inv_rn *= inv_r;
             scale += self.magnitude_by_degree[n] * inv_rn;
         }

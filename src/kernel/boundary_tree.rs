@@ -31,15 +31,17 @@ const LEAF_SLOTS: usize = 64;
 /// More levels than any tree has (ranges halve down to [`LEAF_SLOTS`], slots fit in `u32`).
 const MAX_DEPTH: usize = 64;
 
-/// Cost of one chained edge in the SIMD loop, in the units of the costs below (nanoseconds on the
-/// machine of docs/benchmarks.md, "Boundary hierarchy": only the ratios matter).
-const EDGE_COST: f64 = 2.0;
-/// Cost of one coefficient of [`evaluate`] (recurrence and product).
-const COEFFICIENT_COST: f64 = 1.6;
-/// Cost of one spoke term (exact predicate, `atan2`).
-const SPOKE_COST: f64 = 40.0;
-/// Fixed cost of expanding a node (distance, order choice, bound).
-const NODE_COST: f64 = 30.0;
+/// Cost of one chained edge in the SIMD loop, in nanoseconds as measured on the 2-core machine of
+/// docs/benchmarks.md ("Boundary hierarchy"; only the ratios matter).
+const EDGE_COST: f64 = 3.0;
+/// Cost of one coefficient of [`Expansion::evaluate`] (monomial and product): 2.2 ns with the
+/// coefficients in L1, about twice that in a traversal that touches many nodes (their 2.3 KB of
+/// coefficients come from L2/L3: measured as expansions that did not pay on the synthetic scans).
+const COEFFICIENT_COST: f64 = 4.5;
+/// Cost of one spoke term (filtered sign, one complex product).
+const SPOKE_COST: f64 = 15.0;
+/// Fixed cost of expanding a node (distance, order choice, bound, the evaluation's set-up).
+const NODE_COST: f64 = 100.0;
 
 /// One node: the slots `j0..j1`, their geometry and expansion.
 #[derive(Clone, Debug)]
@@ -170,7 +172,6 @@ impl BoundaryTree {
         // The leaves are the LEAF_SLOTS-aligned chunks (every split is aligned): their fan moments,
         // the bulk of the work, in parallel.
         let slots = edges.padded_slots();
-        let t0 = std::time::Instant::now();
         let leaves: Vec<LeafMoments> = (0..slots.div_ceil(LEAF_SLOTS))
             .into_par_iter()
             .map(|c| leaf_moments(edges, c * LEAF_SLOTS..((c + 1) * LEAF_SLOTS).min(slots)))
@@ -180,24 +181,14 @@ impl BoundaryTree {
             leaves,
             full_ends: Vec::new(),
         };
-        let t1 = t0.elapsed();
         tree.build_node(edges, 0, slots, per_edge, &mut building);
-        let t2 = t0.elapsed();
         tree.expansions = building
             .moments
             .par_iter()
             .zip(&tree.nodes)
             .map(|(m, n)| Expansion::new(m, n.area, n.radius))
             .collect();
-        let t3 = t0.elapsed();
         tree.nodes.par_iter_mut().for_each(set_reach);
-        if std::env::var("GWN_TREE_DEBUG").is_ok() {
-            eprintln!(
-                "leaves {t1:?} nodes {t2:?} expansions {t3:?} reach {:?} ({} nodes)",
-                t0.elapsed(),
-                tree.nodes.len()
-            );
-        }
         // Pre-order: children come after their parent.
         for i in (0..tree.nodes.len()).rev() {
             let below = tree.nodes[i].children.map_or(f64::INFINITY, |(l, r)| {
@@ -212,19 +203,6 @@ impl BoundaryTree {
                 .fold(f64::INFINITY, f64::min);
             tree.nodes[i].subtree_reach = own.min(below);
         }
-        if std::env::var("GWN_TREE_DEBUG").is_ok() {
-            for (i, n) in tree.nodes.iter().enumerate() {
-                eprintln!(
-                    "node {i} edges {} radius {:.4} area {:.2e} ends {} reach {:.4} sub {:.4}",
-                    n.edges,
-                    n.radius,
-                    n.area,
-                    n.ends.1 - n.ends.0,
-                    n.reach.iter().copied().fold(f64::INFINITY, f64::min),
-                    n.subtree_reach
-                );
-            }
-        }
         (tree.nodes[0].subtree_reach.is_finite()).then_some(tree)
     }
 
@@ -233,14 +211,17 @@ impl BoundaryTree {
         self.tolerance
     }
 
-    /// Nodes, and the smallest distance (normalized units) at which the root's subtree can
-    /// expand anything.
-    pub fn stats(&self) -> (usize, f64, f64) {
-        (
-            self.nodes.len(),
-            self.nodes[0].subtree_reach,
-            self.nodes[0].radius,
-        )
+    /// Number of nodes.
+    pub fn node_count(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Whether a query at `q` (normalized coordinates) can expand any node: otherwise the flat
+    /// loop is the same work without the traversal.
+    pub fn reaches(&self, q: [f64; 3]) -> bool {
+        let n = &self.nodes[0];
+        let d: [f64; 3] = std::array::from_fn(|k| q[k] - n.centre[k]);
+        (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() + n.radius >= n.subtree_reach
     }
 
     /// Builds the node of slots `j0..j1` and its subtree; returns its index.
@@ -611,45 +592,4 @@ fn reach(area: f64, radius: f64, order: usize, budget: f64) -> f64 {
         }
     }
     hi
-}
-
-#[cfg(test)]
-mod probe {
-    #[test]
-    #[ignore]
-    fn timing() {
-        use super::super::boundary_multipole::*;
-        use super::super::predicates::W128;
-        let mut m = [0.37; COEFFICIENTS];
-        m[0] = 0.0;
-        let e = Expansion::new(&m, 1.0, 1.0);
-        for k in [1, 2, 4, 6, 8, 10] {
-            let t = std::time::Instant::now();
-            let mut s = 0.0;
-            for i in 0..200_000 {
-                s += e
-                    .evaluate([0.1, 0.2, 0.3], [1.0 + i as f64 * 1e-9, 0.5, 0.25], k)
-                    .0;
-            }
-            eprintln!(
-                "K {k}: {:.1} ns ({s:e})",
-                t.elapsed().as_secs_f64() / 200_000.0 * 1e9
-            );
-        }
-        let t = std::time::Instant::now();
-        let mut s = 0.0;
-        for i in 0..200_000i64 {
-            s += super::segment_area::<W128>(
-                [1 << 50, 3 << 48, 1 << 49],
-                [5 << 47, 1 << 50, 7 << 46],
-                [i << 20, 1 << 40, 1 << 30],
-                true,
-                0.0,
-            );
-        }
-        eprintln!(
-            "spoke: {:.1} ns ({s:e})",
-            t.elapsed().as_secs_f64() / 200_000.0 * 1e9
-        );
-    }
 }
