@@ -208,7 +208,7 @@ impl BoundaryEdges {
         qz_units: f64,
         range: std::ops::Range<usize>,
     ) -> (AngleSum, f64) {
-        debug_assert!(range.start % 4 == 0 && range.end <= self.padded_slots());
+        debug_assert!(range.start.is_multiple_of(4) && range.end <= self.padded_slots());
         let q = [
             qi[0] as f64,
             qi[1] as f64,

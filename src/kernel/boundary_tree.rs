@@ -152,7 +152,7 @@ impl BoundaryTree {
     /// Builds the hierarchy for `edges` at tolerance `tolerance` (absolute, on `w`). `None` when
     /// no node could ever pay (too few edges, or a tolerance too small to expand anything).
     pub fn build(edges: &BoundaryEdges, tolerance: f64) -> Option<Self> {
-        if !(tolerance > 0.0) || !tolerance.is_finite() {
+        if tolerance.is_nan() || tolerance <= 0.0 || !tolerance.is_finite() {
             return None;
         }
         let total = (0..edges.padded_slots())
