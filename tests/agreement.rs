@@ -76,15 +76,9 @@ fn point_triangle_distance(q: [f64; 3], p: [[f64; 3]; 3]) -> f64 {
 
 #[test]
 fn exact_agrees_with_direct_and_with_other_rays_on_the_shared_corpus() {
-    let Some(dir) = common::shared_meshes() else {
+    let Some((dir, files)) = common::shared_mesh_files() else {
         return;
     };
-    let manifest = std::fs::read_to_string(dir.join("manifest.csv")).unwrap();
-    let files: Vec<&str> = manifest
-        .lines()
-        .skip(1)
-        .filter_map(|l| l.split(',').next())
-        .collect();
     assert!(files.len() > 90, "manifest has {} rows", files.len());
     let mut worst = (0.0f64, String::new());
     let mut worst_dir = (0.0f64, String::new());

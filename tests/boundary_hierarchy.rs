@@ -81,15 +81,9 @@ fn near_surface(mesh: &Mesh, rng: &mut common::Rng, n: usize) -> Vec<[f64; 3]> {
 
 #[test]
 fn error_never_exceeds_the_bound_on_the_shared_corpus() {
-    let Some(dir) = common::shared_meshes() else {
+    let Some((dir, files)) = common::shared_mesh_files() else {
         return;
     };
-    let manifest = std::fs::read_to_string(dir.join("manifest.csv")).unwrap();
-    let files: Vec<&str> = manifest
-        .lines()
-        .skip(1)
-        .filter_map(|l| l.split(',').next())
-        .collect();
     let mut expanded = [0usize; 2];
     let mut meshes = 0;
     for (fi, file) in files.iter().enumerate() {

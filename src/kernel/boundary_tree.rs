@@ -32,7 +32,7 @@ const LEAF_SLOTS: usize = 64;
 const MAX_DEPTH: usize = 64;
 
 /// Cost of one chained edge in the SIMD loop, in nanoseconds as measured on the 2-core machine of
-/// docs/benchmarks.md ("Boundary hierarchy"; only the ratios matter).
+/// docs/benchmarks.md ("Certified boundary hierarchy"; only the ratios matter).
 const EDGE_COST: f64 = 3.0;
 /// Cost of one coefficient of [`Expansion::evaluate`] (monomial and product): 2.2 ns with the
 /// coefficients in L1, about twice that in a traversal that touches many nodes (their 2.3 KB of

@@ -27,6 +27,20 @@ pub fn shared_meshes() -> Option<std::path::PathBuf> {
     }
 }
 
+/// The file names listed in the shared corpus's `manifest.csv` (first column), with the folder;
+/// `None` (and a printed reason) when the corpus is absent.
+pub fn shared_mesh_files() -> Option<(std::path::PathBuf, Vec<String>)> {
+    let dir = shared_meshes()?;
+    let manifest = std::fs::read_to_string(dir.join("manifest.csv")).unwrap();
+    let files = manifest
+        .lines()
+        .skip(1)
+        .filter_map(|l| l.split(',').next())
+        .map(str::to_owned)
+        .collect();
+    Some((dir, files))
+}
+
 /// Deterministic pseudo-random numbers (SplitMix64) so tests need no RNG dependency.
 pub struct Rng(pub u64);
 
