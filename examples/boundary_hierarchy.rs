@@ -1,7 +1,7 @@
 //! Issue 12, part 2: the certified boundary hierarchy against the flat exact loop. For every mesh
 //! of a folder (or the files given) with at least `MIN_B` (default 300) boundary edges, over the
-//! 32³ grid of `gwn bench` (the box grown by 10 %, "near") and over a "far" grid (the box grown 3×
-//! on every side): throughput flat (tolerance 0) and at each tolerance, side by side in one run
+//! 32³ grid of `gwn bench` (the box grown by 10 %, "+0.1") and over a far grid (the box grown by
+//! 3× its extent on every side, "+3"): throughput flat (tolerance 0) and at each tolerance, side by side in one run
 //! (best of `REPS`, default 3; 1 thread, and 2 threads at the default tolerance); the largest
 //! difference from the flat loop and the largest certified bound (the difference must not exceed
 //! it: the run fails otherwise); the share of queries that expanded a node; the build time flat
@@ -9,7 +9,11 @@
 //!
 //! ```text
 //! cargo run --release --example boundary_hierarchy -- ../shared/meshes
+//! TOLS=1e-10 GROW=0.1,0.5,1,2,3 cargo run --release --example boundary_hierarchy -- MESH
 //! ```
+//!
+//! `TOLS` and `GROW` (comma-separated) choose the tolerances and the grids (the box grown by that
+//! fraction of its largest extent on every side; default `0.1,3`).
 
 use gwn::eval::antipodal::{Options, WindingNumber};
 use gwn::grid::GridSpec;
@@ -50,7 +54,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .unwrap_or(d)
     };
     let (reps, min_b) = (env("REPS", 3), env("MIN_B", 300));
-    let tolerances = [1e-10, 1e-6, 1e-3];
+    let list = |k: &str, d: &str| -> Vec<f64> {
+        std::env::var(k)
+            .unwrap_or_else(|_| d.into())
+            .split(',')
+            .filter_map(|v| v.trim().parse().ok())
+            .collect()
+    };
+    let tolerances = list("TOLS", "1e-10,1e-6,1e-3");
+    let grows = list("GROW", "0.1,3");
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mut files: Vec<std::path::PathBuf> = Vec::new();
     for a in if args.is_empty() {
@@ -95,7 +107,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .unwrap_or_default()
             .to_string_lossy()
             .to_string();
-        for (label, grow) in [("near", 0.1), ("far", 3.0)] {
+        for &grow in &grows {
+            let label = format!("+{grow}");
             let points = GridSpec::new(bbox.enlarged(grow), [32; 3])?.points();
             let (q0, v0) = run(&flat, &points, reps);
             let q0_2 = run2(&flat, &points, reps);
