@@ -161,6 +161,26 @@ fn the_hierarchy_agrees_with_the_direct_sum() {
     assert!(used > 50, "only {used} queries used the hierarchy");
 }
 
+#[test]
+fn the_lazy_tree_is_built_safely_from_a_parallel_batch() {
+    // The hierarchy is built on first use, typically inside `eval_batch`'s rayon workers: many
+    // workers reach the `OnceLock` at once (a build that itself ran in parallel could deadlock
+    // there by stealing another query while waiting). Fresh evaluators, first call a big batch.
+    let mesh = bumpy_hemisphere(80, 40, 0.05, 0.05, 5);
+    let mut rng = common::Rng(9);
+    let points: Vec<[f64; 3]> = (0..20_000)
+        .map(|_| std::array::from_fn(|_| rng.range(-8.0, 8.0)))
+        .collect();
+    let flat = with_tolerance(&mesh, 0.0, RayAxis::PosZ).eval_batch(&points);
+    for _ in 0..4 {
+        let tree = with_tolerance(&mesh, 1e-6, RayAxis::PosZ);
+        let w = tree.eval_batch(&points);
+        for (a, b) in w.iter().zip(&flat) {
+            assert!((a - b).abs() <= 1e-6 + 1e-13);
+        }
+    }
+}
+
 /// A bumpy open hemisphere, `nu × nv` quads, a fraction of faces removed and another flipped.
 fn bumpy_hemisphere(nu: usize, nv: usize, removed: f64, flipped: f64, seed: u64) -> Mesh {
     let mut rng = common::Rng(seed);

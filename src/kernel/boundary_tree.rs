@@ -22,7 +22,6 @@ use super::boundary_multipole::{
 use super::boundary_sum::{BoundaryEdges, segment_area};
 use super::predicates::{Width, orient2d_filtered};
 use super::spherical::INV_4PI;
-use rayon::prelude::*;
 use wide::f64x4;
 
 /// Slots per leaf (a multiple of the SIMD loop's 4).
@@ -169,13 +168,37 @@ impl BoundaryTree {
             tolerance,
         };
         let per_edge = 4.0 * std::f64::consts::PI * tolerance / total as f64;
-        // The leaves are the LEAF_SLOTS-aligned chunks (every split is aligned): their fan moments,
-        // the bulk of the work, in parallel.
+        // The leaves are the LEAF_SLOTS-aligned chunks (every split is aligned): their fan moments
+        // are the bulk of the work, split over scoped OS threads. Not rayon: the evaluator builds
+        // the tree lazily inside a `OnceLock`, often from a rayon worker, and a worker waiting for
+        // a parallel build would steal another query's job, re-enter the `OnceLock` and deadlock;
+        // a scoped thread's join blocks without stealing.
         let slots = edges.padded_slots();
-        let leaves: Vec<LeafMoments> = (0..slots.div_ceil(LEAF_SLOTS))
-            .into_par_iter()
-            .map(|c| leaf_moments(edges, c * LEAF_SLOTS..((c + 1) * LEAF_SLOTS).min(slots)))
-            .collect();
+        let leaf_count = slots.div_ceil(LEAF_SLOTS);
+        let leaf =
+            |c: usize| leaf_moments(edges, c * LEAF_SLOTS..((c + 1) * LEAF_SLOTS).min(slots));
+        let threads = std::thread::available_parallelism()
+            .map_or(1, |n| n.get())
+            .min(8)
+            .min(leaf_count / 64)
+            .max(1);
+        let leaves: Vec<LeafMoments> = if threads == 1 {
+            (0..leaf_count).map(leaf).collect()
+        } else {
+            let per = leaf_count.div_ceil(threads);
+            std::thread::scope(|scope| {
+                let parts: Vec<_> = (0..threads)
+                    .map(|t| {
+                        let range = t * per..((t + 1) * per).min(leaf_count);
+                        scope.spawn(move || range.map(leaf).collect::<Vec<_>>())
+                    })
+                    .collect();
+                parts
+                    .into_iter()
+                    .flat_map(|h| h.join().expect("leaf moments do not panic"))
+                    .collect()
+            })
+        };
         let mut building = Building {
             moments: Vec::new(),
             leaves,
@@ -184,11 +207,11 @@ impl BoundaryTree {
         tree.build_node(edges, 0, slots, per_edge, &mut building);
         tree.expansions = building
             .moments
-            .par_iter()
+            .iter()
             .zip(&tree.nodes)
             .map(|(m, n)| Expansion::new(m, n.area, n.radius))
             .collect();
-        tree.nodes.par_iter_mut().for_each(set_reach);
+        tree.nodes.iter_mut().for_each(set_reach);
         // Pre-order: children come after their parent.
         for i in (0..tree.nodes.len()).rev() {
             let below = tree.nodes[i].children.map_or(f64::INFINITY, |(l, r)| {
