@@ -87,6 +87,20 @@ fn near_edge_pad(a: [i64; 3], b: [i64; 3]) -> i64 {
     (len >> 7).max(16)
 }
 
+/// Whether edge `a → b` is parallel to the ray (equal `x, y` in the frame; zero length included).
+///
+/// Its term is exactly zero for every query, so the loops leave it out: both ε coefficients of
+/// its perturbed orientation vanish (`a_y − b_y = b_x − a_x = 0`) and the unperturbed determinant
+/// is zero too (`a − q` and `b − q` have equal `x, y`), so [`perturbed_orient2d`] gives sign 0,
+/// for which [`antipodal_edge_area`] returns 0 (the query's projection, perturbed, never lies on
+/// the edge's projection, a point). The `f64` filter could never sign such an edge, so before
+/// this every one of them took the exact path on every query: CAD plates with vertical walls
+/// spent half their time there (docs/benchmarks.md).
+#[inline]
+pub(crate) fn is_parallel_to_ray(a: [i64; 3], b: [i64; 3]) -> bool {
+    a[0] == b[0] && a[1] == b[1]
+}
+
 /// Edges up to this weight are repeated in the chains; heavier ones (stacks of duplicated faces:
 /// one shared mesh has an edge of weight 466) take one exact scalar term times the weight.
 const MAX_CHAINED_WEIGHT: f64 = 4.0;
@@ -141,7 +155,10 @@ impl BoundaryEdges {
             edge_of.push(u32::MAX);
         }
         let heavy = (0..weight.len() as u32)
-            .filter(|&i| weight[i as usize] > MAX_CHAINED_WEIGHT)
+            .filter(|&i| {
+                weight[i as usize] > MAX_CHAINED_WEIGHT
+                    && !is_parallel_to_ray(a[i as usize], b[i as usize])
+            })
             .collect();
         let limit = (1_i64 << (bits - 1)) as f64;
         let to_unit = 1.0 / limit;
@@ -620,7 +637,9 @@ fn chain_edges(a: &[[i64; 3]], b: &[[i64; 3]], weight: &[f64]) -> Vec<Vec<u32>> 
     let mut out_edges: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
     let mut in_degree: HashMap<[i64; 3], usize> = HashMap::new();
     for i in 0..a.len() {
-        let copies = if weight[i] <= MAX_CHAINED_WEIGHT {
+        let copies = if is_parallel_to_ray(a[i], b[i]) {
+            0
+        } else if weight[i] <= MAX_CHAINED_WEIGHT {
             weight[i].max(0.0) as usize
         } else {
             0
@@ -659,6 +678,75 @@ fn chain_edges(a: &[[i64; 3]], b: &[[i64; 3]], weight: &[f64]) -> Vec<Vec<u32>> 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The reason [`is_parallel_to_ray`] edges may be left out of the loops: the exact path
+    /// gives them `0` for every query, on their line, at their ends and inside them included.
+    #[test]
+    fn edges_parallel_to_the_ray_add_exactly_zero() {
+        use crate::kernel::predicates::W128;
+        let mut checked = 0;
+        for x in -2..=2_i64 {
+            for [za, zb, qx, qz] in
+                (0..625).map(|k| [k % 5, k / 5 % 5, k / 25 % 5, k / 125].map(|v| v as i64 - 2))
+            {
+                let (a, b, q) = ([x, 1, za], [x, 1, zb], [qx, 1, qz]);
+                for z_exact in [true, false] {
+                    let area = segment_area::<W128>(a, b, q, z_exact, qz as f64 + 0.25);
+                    assert_eq!(area, 0.0, "a {a:?} b {b:?} q {q:?}");
+                    checked += 1;
+                }
+            }
+        }
+        assert_eq!(checked, 6250);
+    }
+
+    /// The chained sum equals the sum of exact per-edge terms on boundaries full of edges
+    /// parallel to the ray (left out of the chains) and heavy ones.
+    #[test]
+    fn chains_without_parallel_edges_match_the_per_edge_sum() {
+        use crate::kernel::predicates::W128;
+        let mut state = 11_u64;
+        let mut next = |m: u64| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 33) % m
+        };
+        let mut left_out = 0;
+        for _ in 0..200 {
+            let n = 2 + next(30) as usize;
+            let mut pts: Vec<[i64; 3]> = Vec::new();
+            for _ in 0..n {
+                let p = [next(9) as i64 - 4, next(9) as i64 - 4, next(9) as i64 - 4];
+                pts.push(p);
+                if next(2) == 0 {
+                    // A vertical step: the next vertex straight above or below.
+                    pts.push([p[0], p[1], next(9) as i64 - 4]);
+                }
+            }
+            let (a, b): (Vec<_>, Vec<_>) = pts.windows(2).map(|w| (w[0], w[1])).unzip();
+            let weight: Vec<f64> = (0..a.len())
+                .map(|_| [1.0, 2.0, 7.0][next(3) as usize])
+                .collect();
+            left_out += (0..a.len())
+                .filter(|&i| is_parallel_to_ray(a[i], b[i]))
+                .count();
+            let edges = BoundaryEdges::new(a.clone(), b.clone(), weight.clone(), 60);
+            for _ in 0..10 {
+                let q = [
+                    next(11) as i64 - 5,
+                    next(11) as i64 - 5,
+                    next(11) as i64 - 5,
+                ];
+                let want: f64 = (0..a.len())
+                    .map(|i| weight[i] * segment_area::<W128>(a[i], b[i], q, true, 0.0))
+                    .sum();
+                let got = edges.area_sum::<W128>(q, true, 0.0);
+                assert!((got - want).abs() < 1e-9, "q {q:?}: {got} vs {want}");
+            }
+        }
+        assert!(left_out > 500, "{left_out}");
+    }
 
     #[test]
     fn avx2_loop_is_bit_identical_to_the_portable_loop() {
@@ -730,7 +818,8 @@ mod tests {
                         .filter(|&e| {
                             let (a, b, _) = edges.edge(e as usize);
                             let off = |p: [i64; 3]| [p[0] as f64 - q[0], p[1] as f64 - q[1]];
-                            orient2d_filtered(off(a), off(b), edges.limit).is_none()
+                            !is_parallel_to_ray(a, b)
+                                && orient2d_filtered(off(a), off(b), edges.limit).is_none()
                         })
                         .collect();
                     assert_eq!(
@@ -769,7 +858,7 @@ mod tests {
                 }
             }
             for i in 0..n {
-                let want = if weight[i] <= MAX_CHAINED_WEIGHT {
+                let want = if weight[i] <= MAX_CHAINED_WEIGHT && !is_parallel_to_ray(a[i], b[i]) {
                     weight[i]
                 } else {
                     0.0
