@@ -7,25 +7,22 @@ use gwn::eval::antipodal::{Options, WindingNumber};
 use gwn::grid::{GridSpec, evaluate, evaluate_per_point};
 use gwn::kernel::frame::RayAxis;
 
-/// Grid vs per-point: values must agree to 1e-12 (so the crossing counts, which change `w` by
-/// whole numbers, are identical); returns how many samples were bit-identical.
+/// Grid vs per-point: every sample bit-identical (the column loop shares the `x, y` work of the
+/// boundary term and the ray of the crossings, but not a single rounding); returns the count.
 fn assert_grid_matches(wn: &WindingNumber, spec: &GridSpec, what: &str) -> usize {
     let grid = evaluate(wn, spec);
     let pts = spec.points();
     let reference = evaluate_per_point(wn, spec);
     assert_eq!(grid.len(), spec.len());
-    let mut identical = 0;
     for (i, (&g, &r)) in grid.iter().zip(&reference).enumerate() {
-        assert!(
-            (g - r).abs() <= 1e-12,
+        assert_eq!(
+            g.to_bits(),
+            r.to_bits(),
             "{what}: sample {i} at {:?}: grid {g} vs per-point {r}",
             pts[i]
         );
-        if g.to_bits() == r.to_bits() {
-            identical += 1;
-        }
     }
-    identical
+    grid.len()
 }
 
 /// The unit cube sampled at 0, 0.25, …, 1 on every axis: the cell centres of a 5³ grid over
@@ -143,6 +140,7 @@ fn grid_equals_per_point_on_shared_meshes() {
         meshes += 1;
     }
     eprintln!("{meshes} meshes, {samples} samples, {identical} bit-identical");
+    assert_eq!(identical, samples);
     assert!(meshes >= 50);
 }
 

@@ -24,6 +24,7 @@ use rayon::prelude::*;
 
 use crate::Mesh;
 use crate::bvh::RayBvh;
+use crate::kernel::boundary_column::ColumnQuery;
 use crate::kernel::boundary_sum::BoundaryEdges;
 use crate::kernel::boundary_tree::BoundaryTree;
 use crate::kernel::compensated::NeumaierSum;
@@ -454,8 +455,8 @@ impl<W: Width> FrameEvaluator<W> {
             self.grid.pull_in_far(self.grid.to_grid_space(p))
         };
         let (snap, residual) = self.snap_frame(self.grid.pull_in_far(self.grid.to_grid_space(q)));
-        let transverse_residual = residual[0] != 0.0 || residual[1] != 0.0;
-        let (Snap::In(x), Snap::In(y), false) = (snap[0], snap[1], transverse_residual) else {
+        let (Snap::In(x), Snap::In(y)) = (snap[0], snap[1]) else {
+            // Beyond the grid across the ray: far queries, one by one.
             return ts
                 .iter()
                 .map(|&t| {
@@ -468,75 +469,123 @@ impl<W: Width> FrameEvaluator<W> {
                 })
                 .collect();
         };
+        // Every point of the column has these lattice x, y and residuals (the pull-in and the
+        // snap act axis by axis).
+        let (rx, ry) = (residual[0], residual[1]);
+        let transverse_residual = rx != 0.0 || ry != 0.0;
         let limit = self.grid.limit();
-        // Frame z of every point (integer, or clamped with a flag), sorted ascending. Points off
-        // the lattice along the column (a z residual) are evaluated on their own.
-        let mut out = vec![f64::NAN; ts.len()];
-        let zs: Vec<(i64, bool, f64)> = ts
+        // Per finite point: lattice z (clamped when outside the grid along the ray), whether it
+        // is exact, the frame z, the residual along z, and whether it lies beyond the grid's top.
+        struct Point {
+            z: i64,
+            z_exact: bool,
+            qz: f64,
+            rz: f64,
+            high: bool,
+        }
+        let points: Vec<Option<Point>> = ts
             .iter()
-            .zip(out.iter_mut())
-            .map(|(&t, out)| {
-                let p = at(t);
-                let qf = self.ray.to_frame(p);
-                let (snap, residual) = self.snap_frame(p);
-                match snap[2] {
-                    Snap::In(z) if residual[2] == 0.0 => (z, true, qf[2]),
-                    Snap::In(z) => {
-                        if t.is_finite() {
-                            let (chi, area, _) = self.parts_in_grid_space(p);
-                            *out = chi as f64 + area * INV_4PI;
-                        }
-                        (z, false, f64::NAN)
-                    }
-                    Snap::Low => (-limit, false, qf[2]),
-                    Snap::High => (limit, false, qf[2]),
+            .map(|&t| {
+                if !t.is_finite() {
+                    return None;
                 }
+                let p = at(t);
+                let qz = self.ray.to_frame(p)[2];
+                let (snap, residual) = self.snap_frame(p);
+                let (z, z_exact, rz, high) = match snap[2] {
+                    Snap::In(z) => (z, true, residual[2], false),
+                    Snap::Low => (-limit, false, 0.0, false),
+                    Snap::High => (limit, false, 0.0, true),
+                };
+                Some(Point {
+                    z,
+                    z_exact,
+                    qz,
+                    rz,
+                    high,
+                })
             })
             .collect();
+        // χ. Lattice points share one traversal (below); points off the lattice take their own.
+        let shared = |p: &Point| !transverse_residual && p.rz == 0.0;
+        let mut chis = vec![0i64; ts.len()];
+        for (chi, p) in chis.iter_mut().zip(&points) {
+            if let Some(p) = p.as_ref().filter(|p| !shared(p) && !p.high) {
+                *chi = self.signed_crossings_at([x, y, p.z], [rx, ry, p.rz]);
+            }
+        }
         let mut order: Vec<usize> = (0..ts.len())
-            .filter(|&k| ts[k].is_finite() && !zs[k].2.is_nan())
+            .filter(|&k| points[k].as_ref().is_some_and(&shared))
             .collect();
-        order.sort_by_key(|&k| zs[k].0);
+        order.sort_by_key(|&k| points[k].as_ref().map_or(0, |p| p.z));
+        let at_k = |j: usize| points[order[j]].as_ref().expect("finite");
         // Points strictly above the grid never see a crossing.
-        let active = order
-            .iter()
-            .take_while(|&&k| zs[k].0 < limit || zs[k].1)
+        let active = (0..order.len())
+            .take_while(|&j| at_k(j).z < limit || at_k(j).z_exact)
             .count();
-        // chi_diff[j]: change of χ between sorted points j−1 and j.
-        let mut chi_diff = vec![0i64; active + 1];
-        let u = |v: i64| (v as f64 * self.to_unit) as f32;
-        self.bvh
-            .for_each_on_ray(u(x), u(y), f32::NEG_INFINITY, |f| {
-                let p = self.tri_pts[f as usize];
-                let s = projected_containment::<W>([x, y], p);
-                if s == 0 {
-                    return;
-                }
-                // Hit for the sorted points strictly below the plane: a prefix (the plane side is
-                // monotone in z for a triangle whose projection contains the column).
-                let below = |j: usize| perturbed_plane_side::<W>([x, y, zs[order[j]].0], p) == -s;
-                let (mut lo, mut hi) = (0, active);
-                while lo < hi {
-                    let mid = (lo + hi) / 2;
-                    if below(mid) {
-                        lo = mid + 1;
-                    } else {
-                        hi = mid;
+        if active > 0 {
+            // chi_diff[j]: change of χ between sorted points j−1 and j.
+            let mut chi_diff = vec![0i64; active + 1];
+            let u = |v: i64| (v as f64 * self.to_unit) as f32;
+            self.bvh
+                .for_each_on_ray(u(x), u(y), f32::NEG_INFINITY, |f| {
+                    let p = self.tri_pts[f as usize];
+                    let s = projected_containment::<W>([x, y], p);
+                    if s == 0 {
+                        return;
                     }
-                }
-                chi_diff[0] += i64::from(s);
-                chi_diff[lo] -= i64::from(s);
-            });
-        let mut chi = 0i64;
-        for (j, &k) in order.iter().enumerate() {
-            let (z, exact, qz) = zs[k];
-            let c = if j < active {
+                    // Hit for the sorted points strictly below the plane: a prefix (the plane side is
+                    // monotone in z for a triangle whose projection contains the column).
+                    let below = |j: usize| perturbed_plane_side::<W>([x, y, at_k(j).z], p) == -s;
+                    let (mut lo, mut hi) = (0, active);
+                    while lo < hi {
+                        let mid = (lo + hi) / 2;
+                        if below(mid) {
+                            lo = mid + 1;
+                        } else {
+                            hi = mid;
+                        }
+                    }
+                    chi_diff[0] += i64::from(s);
+                    chi_diff[lo] -= i64::from(s);
+                });
+            let mut chi = 0i64;
+            for (j, &k) in order.iter().take(active).enumerate() {
                 chi += chi_diff[j];
-                chi
+                chis[k] = chi;
+            }
+        }
+        // The boundary term: the points whose `boundary_sum` is the flat loop go through the
+        // column loop together (shared x, y work, bit-identical values), the others one by one.
+        let mut batch: Vec<(usize, ColumnQuery)> = Vec::new();
+        let mut out = vec![f64::NAN; ts.len()];
+        for (k, p) in points.iter().enumerate() {
+            let Some(p) = p else { continue };
+            let qi = [x, y, p.z];
+            let r = [rx, ry, if p.z_exact { p.rz } else { 0.0 }];
+            let qz_units = (p.qz - self.origin[2]) / self.cell;
+            let flat = !self.boundary.needs_accurate_sum::<W>(qi, r, p.z_exact)
+                && self
+                    .tree()
+                    .is_none_or(|t| t.is_flat_at(&self.boundary, qi, p.z_exact, qz_units));
+            if flat {
+                let query = ColumnQuery {
+                    z: p.z,
+                    z_exact: p.z_exact,
+                    qz_units,
+                };
+                batch.push((k, query));
             } else {
-                0
-            };
-            out[k] = c as f64 + self.boundary_sum([x, y, z], [0.0; 3], exact, qz).0 * INV_4PI;
+                let area = self.boundary_sum(qi, r, p.z_exact, p.qz).0;
+                out[k] = chis[k] as f64 + area * INV_4PI;
+            }
+        }
+        let queries: Vec<ColumnQuery> = batch.iter().map(|&(_, c)| c).collect();
+        let mut areas = vec![0.0; queries.len()];
+        self.boundary
+            .column_area_sums::<W>([x, y], &queries, &mut areas);
+        for (&(k, _), area) in batch.iter().zip(areas) {
+            out[k] = chis[k] as f64 + area * INV_4PI;
         }
         out
     }

@@ -271,6 +271,16 @@ impl BoundaryEdges {
         self.heavy.iter().map(|&e| e as usize)
     }
 
+    /// Number of slots (`j → j + 1` pairs) the loops visit.
+    pub(super) fn slots(&self) -> usize {
+        self.slots
+    }
+
+    /// The chain vertices' `x`, `y`, `z` (grid units, padded) and the slot links.
+    pub(super) fn vertex_arrays(&self) -> (&[f64], &[f64], &[f64], &[f64]) {
+        (&self.xs, &self.ys, &self.zs, &self.link)
+    }
+
     /// Slots rounded up to a multiple of 4: the end of the last range a loop may visit.
     pub(crate) fn padded_slots(&self) -> usize {
         self.slots.div_ceil(4) * 4
@@ -379,7 +389,7 @@ impl BoundaryEdges {
     /// and q (≤ u·L each) and the subtraction (≤ u·|offset|), u = 2^-53. Error of
     /// d = ax·by − ay·bx: Σ |other factor|·(offset error) + 3u(|p1| + |p2|). We use twice that:
     /// `bound = conv·(|ax| + |ay| + |bx| + |by|) + rel·(|p1| + |p2|)`.
-    fn filter_constants(&self) -> (f64, f64) {
+    pub(super) fn filter_constants(&self) -> (f64, f64) {
         (
             ORIENT2D_FILTER_CONVERSION * self.limit,
             ORIENT2D_FILTER_RELATIVE,
@@ -569,7 +579,7 @@ impl BoundaryEdges {
 
     /// Calls `undecided(e)` for the edges of the slots `j..j+4` set in `mask`.
     #[inline]
-    fn report_undecided(&self, j: usize, mask: i32, undecided: &mut impl FnMut(u32)) {
+    pub(super) fn report_undecided(&self, j: usize, mask: i32, undecided: &mut impl FnMut(u32)) {
         if mask != 0 {
             for l in 0..4 {
                 if mask & (1 << l) != 0 {
@@ -581,7 +591,7 @@ impl BoundaryEdges {
 
     /// One edge through the exact predicate and the limit formulas.
     #[cold]
-    fn exact_edge_area<W: Width>(
+    pub(super) fn exact_edge_area<W: Width>(
         &self,
         i: usize,
         qi: [i64; 3],

@@ -388,11 +388,7 @@ impl BoundaryTree {
         qz_units: f64,
     ) -> TreeSum {
         let limit = edges.limit();
-        let q = [
-            qi[0] as f64 / limit,
-            qi[1] as f64 / limit,
-            if z_exact { qi[2] as f64 } else { qz_units } / limit,
-        ];
+        let q = lattice_query(edges, qi, z_exact, qz_units);
         // The ray from q (+z) misses a node's box, with a one-cell margin for the residual.
         let misses = |lo: [i64; 3], hi: [i64; 3]| {
             qi[0] < lo[0] - 1
@@ -423,6 +419,20 @@ impl BoundaryTree {
         sum.area += angles.map_or(0.0, |a| 2.0 * a.total()) + scalar + spoke_scalar;
         sum.area += edges.heavy_area_sum::<W>(qi, z_exact, qz_units);
         sum
+    }
+
+    /// Whether [`BoundaryTree::area_sum`] at this lattice query expands nothing and so equals
+    /// [`BoundaryEdges::area_sum`] bit for bit (one range over every slot; the identity factors of
+    /// the padding and of an empty spoke product are exact): the query is closer to the root than
+    /// any node's reach. Column evaluation batches such queries.
+    pub fn is_flat_at(
+        &self,
+        edges: &BoundaryEdges,
+        qi: [i64; 3],
+        z_exact: bool,
+        qz_units: f64,
+    ) -> bool {
+        !self.reaches(lattice_query(edges, qi, z_exact, qz_units))
     }
 
     /// The traversal shared by lattice and far queries: expanded nodes' terms and bounds; the
@@ -498,6 +508,16 @@ impl BoundaryTree {
         }
         out
     }
+}
+
+/// A lattice query in the tree's normalized coordinates (`z` in grid units when it is not exact).
+fn lattice_query(edges: &BoundaryEdges, qi: [i64; 3], z_exact: bool, qz_units: f64) -> [f64; 3] {
+    let limit = edges.limit();
+    [
+        qi[0] as f64 / limit,
+        qi[1] as f64 / limit,
+        if z_exact { qi[2] as f64 } else { qz_units } / limit,
+    ]
 }
 
 /// The spoke terms `−Σ m_v·Area(p, v)` of the expanded nodes at one lattice query, as one angle

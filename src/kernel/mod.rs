@@ -10,6 +10,7 @@
 //! - [`spherical`]: the solid-angle and spherical-triangle formulas;
 //! - [`angle_sum`]: sums of many `atan2` terms as one complex product with turn counting;
 //! - [`boundary_sum`]: the SIMD loop over the boundary edges of the Antipodal formula;
+//! - [`boundary_column`]: the same loop for a column of queries (shared `x, y` work);
 //! - [`boundary_tree`]: the certified hierarchy over the boundary chains (far nodes expanded);
 //! - [`boundary_multipole`]: the far-field expansion of a boundary cluster and its error bound;
 //! - [`compensated`]: Neumaier summation (re-exported from the ground floor, `crate::base`);
@@ -17,6 +18,7 @@
 
 pub mod angle_sum;
 pub use crate::base::compensated;
+pub mod boundary_column;
 pub mod boundary_multipole;
 pub mod boundary_sum;
 pub mod boundary_tree;

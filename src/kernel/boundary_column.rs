@@ -1,0 +1,350 @@
+//! The boundary term for a *column* of queries: points with the same lattice `x, y` (a grid
+//! column along the ray), which is how grids, slices and voxelizations ask for it.
+//!
+//! Everything in the boundary loop that involves only `x, y` — the offsets, `h = x² + y²`, the
+//! orientation `d` and its filter, the dot product of the projected offsets — is the same for
+//! every point of a column: it is computed once per block of slots and shared by four queries.
+//! Each query keeps only its own `z` work (one `sqrt` per vertex) and its angle product. The
+//! per-vertex values are staged in small buffers and read back at `j` and `j + 1` (two loads)
+//! instead of the single-query loop's lane shifts (shuffles compete with the arithmetic for one
+//! port).
+//!
+//! The arithmetic is the single-query loop's, operation for operation ([`BoundaryEdges::area_sum`]
+//! is the reference): every query's value is bit-identical to its own `area_sum` (tested), so a
+//! grid gives the same numbers as point-by-point evaluation.
+
+use super::angle_sum::AngleSum;
+use super::boundary_sum::BoundaryEdges;
+use super::predicates::Width;
+
+/// One query of a column: its lattice `z` (or, when `z_exact` is false, the clamped `z` of a
+/// query outside the grid along the ray with `qz_units` its `z` in grid units; see
+/// [`BoundaryEdges::area_sum`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ColumnQuery {
+    /// Lattice `z` (frame).
+    pub z: i64,
+    /// Whether `z` is the query's exact lattice coordinate.
+    pub z_exact: bool,
+    /// The query's `z` in grid units when `z_exact` is false.
+    pub qz_units: f64,
+}
+
+impl ColumnQuery {
+    /// The `z` the magnitudes use.
+    fn z_units(&self) -> f64 {
+        if self.z_exact {
+            self.z as f64
+        } else {
+            self.qz_units
+        }
+    }
+}
+
+/// Queries per pass: the shared work is split four ways, and four angle products in flight hide
+/// the latency of each one's multiply–add chain.
+const QUERIES: usize = 4;
+
+/// Slots per chunk of the shared pass (a multiple of 8, so that the rescaling schedule of the
+/// single-query loop, every other block, is kept). The chunk's buffers stay in L1.
+const CHUNK: usize = 64;
+
+impl BoundaryEdges {
+    /// [`BoundaryEdges::area_sum`] of every query of the column at lattice `x, y = qxy`, written
+    /// to `out` (same length as `queries`), each bit-identical to its own `area_sum`.
+    pub fn column_area_sums<W: Width>(
+        &self,
+        qxy: [i64; 2],
+        queries: &[ColumnQuery],
+        out: &mut [f64],
+    ) {
+        assert_eq!(queries.len(), out.len());
+        let single =
+            |c: &ColumnQuery| self.area_sum::<W>([qxy[0], qxy[1], c.z], c.z_exact, c.qz_units);
+        #[cfg(target_arch = "x86_64")]
+        if !self.is_empty() && std::arch::is_x86_feature_detected!("avx2") {
+            for (batch, out) in queries.chunks(QUERIES).zip(out.chunks_mut(QUERIES)) {
+                // A short last batch repeats its last query (the extra results are dropped).
+                let pick = |k: usize| batch[k.min(batch.len() - 1)];
+                let zs: [f64; QUERIES] = std::array::from_fn(|k| pick(k).z_units());
+                let mut undecided = Vec::new();
+                // SAFETY: `column_angles_avx2` only needs the AVX2 instructions it is compiled
+                // with, and the CPU was just checked to have them.
+                #[allow(unsafe_code)]
+                let angles = unsafe {
+                    self.column_angles_avx2(
+                        [qxy[0] as f64, qxy[1] as f64],
+                        zs,
+                        0..self.slots(),
+                        &mut |e| undecided.push(e),
+                    )
+                };
+                for (k, out) in out.iter_mut().enumerate() {
+                    let c = batch[k];
+                    let qi = [qxy[0], qxy[1], c.z];
+                    // The single-query loop adds the exact terms in slot order too.
+                    let mut scalar = 0.0;
+                    for &e in &undecided {
+                        scalar += self.exact_edge_area::<W>(e as usize, qi, c.z_exact, c.qz_units);
+                    }
+                    *out = 2.0 * angles[k].total()
+                        + scalar
+                        + self.heavy_area_sum::<W>(qi, c.z_exact, c.qz_units);
+                }
+            }
+            return;
+        }
+        for (c, out) in queries.iter().zip(out.iter_mut()) {
+            *out = single(c);
+        }
+    }
+
+    /// The angle products of four queries `(x, y, zs[k])` (grid units) over `slots`, each
+    /// bit-identical to [`BoundaryEdges::range_area_sum`]'s; `undecided(e)` is called once per
+    /// edge the filter cannot sign (the filter involves `x, y` only, so the same edges for all).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn column_angles_avx2(
+        &self,
+        xy: [f64; 2],
+        zs: [f64; QUERIES],
+        slots: std::ops::Range<usize>,
+        undecided: &mut impl FnMut(u32),
+    ) -> [AngleSum; QUERIES] {
+        use std::arch::x86_64::*;
+        let (xs, ys, vz, link) = self.vertex_arrays();
+        let load = |v: &[f64], j: usize| -> __m256d {
+            bytemuck::cast(<[f64; 4]>::try_from(&v[j..j + 4]).unwrap())
+        };
+        let store = |v: &mut [f64], j: usize, x: __m256d| {
+            let x: [f64; 4] = bytemuck::cast(x);
+            v[j..j + 4].copy_from_slice(&x);
+        };
+        let (qx, qy) = (_mm256_set1_pd(xy[0]), _mm256_set1_pd(xy[1]));
+        let (conv, rel) = self.filter_constants();
+        let (conv, rel) = (_mm256_set1_pd(conv), _mm256_set1_pd(rel));
+        let zero = _mm256_setzero_pd();
+        let one = _mm256_set1_pd(1.0);
+        let sign = _mm256_set1_pd(-0.0);
+        let exponent = _mm256_set1_epi64x(0x7ff0_0000_0000_0000);
+        let twice_bias = _mm256_set1_epi64x(2046 << 52);
+        macro_rules! abs {
+            ($v:expr) => {
+                _mm256_andnot_pd(sign, $v)
+            };
+        }
+        // [a1, a2, a3, b0]: the permute brings [a2, a3, b0, b1], the shuffle interleaves.
+        macro_rules! shift_one {
+            ($a:expr, $b:expr) => {{
+                let mid = _mm256_permute2f128_pd::<0x21>($a, $b);
+                _mm256_shuffle_pd::<0b0101>($a, mid)
+            }};
+        }
+        // Shared per chunk: h of each vertex; per edge the filter mask, the dot product and
+        // −d (see `chain_angles`).
+        let mut h = [0.0; CHUNK + 8];
+        let mut ok = [0.0; CHUNK];
+        let mut dot = [0.0; CHUNK];
+        let mut neg_d = [0.0; CHUNK];
+        let mut acc = [(one, zero, _mm256_setzero_si256(), _mm256_setzero_si256()); QUERIES];
+        let mut j0 = slots.start;
+        while j0 < slots.end {
+            let blocks = (slots.end - j0).min(CHUNK).div_ceil(4);
+            // Vertices j0 .. j0 + 4·blocks + 4: every block's edges end one vertex further.
+            for b in 0..=blocks {
+                let (i, j) = (4 * b, j0 + 4 * b);
+                let x = _mm256_sub_pd(load(xs, j), qx);
+                let y = _mm256_sub_pd(load(ys, j), qy);
+                store(
+                    &mut h,
+                    i,
+                    _mm256_add_pd(_mm256_mul_pd(x, x), _mm256_mul_pd(y, y)),
+                );
+            }
+            for b in 0..blocks {
+                let (i, j) = (4 * b, j0 + 4 * b);
+                // The edge ends' offsets straight from the vertex arrays (unaligned loads of
+                // data not written here: no store forwarding, no shuffles).
+                let (ax, ay) = (
+                    _mm256_sub_pd(load(xs, j), qx),
+                    _mm256_sub_pd(load(ys, j), qy),
+                );
+                let (bx, by) = (
+                    _mm256_sub_pd(load(xs, j + 1), qx),
+                    _mm256_sub_pd(load(ys, j + 1), qy),
+                );
+                let real = _mm256_cmp_pd::<_CMP_GT_OQ>(load(link, j), zero);
+                let p1 = _mm256_mul_pd(ax, by);
+                let p2 = _mm256_mul_pd(ay, bx);
+                let d = _mm256_sub_pd(p1, p2);
+                let sum_abs = _mm256_add_pd(
+                    _mm256_add_pd(_mm256_add_pd(abs!(ax), abs!(ay)), abs!(bx)),
+                    abs!(by),
+                );
+                let bound = _mm256_add_pd(
+                    _mm256_mul_pd(conv, sum_abs),
+                    _mm256_mul_pd(rel, _mm256_add_pd(abs!(p1), abs!(p2))),
+                );
+                let lane_ok = _mm256_and_pd(_mm256_cmp_pd::<_CMP_GT_OQ>(abs!(d), bound), real);
+                store(&mut ok, i, lane_ok);
+                store(
+                    &mut dot,
+                    i,
+                    _mm256_add_pd(_mm256_mul_pd(ax, bx), _mm256_mul_pd(ay, by)),
+                );
+                store(&mut neg_d, i, _mm256_sub_pd(zero, d));
+                let mask = _mm256_movemask_pd(real) & !_mm256_movemask_pd(lane_ok);
+                self.report_undecided(j, mask, undecided);
+            }
+            for (k, acc) in acc.iter_mut().enumerate() {
+                let qz = _mm256_set1_pd(zs[k]);
+                // s and p of vertex block `b` (one `sqrt` per vertex), kept in registers: the
+                // next block's are computed before this block's products, so that the square
+                // roots overlap with them, and the edge ends come by lane shifts (a load
+                // straddling two recent stores stalls on store forwarding: 0.6× when tried).
+                macro_rules! vertices {
+                    ($b:expr) => {{
+                        let (i, j) = (4 * $b, j0 + 4 * $b);
+                        let z = _mm256_sub_pd(load(vz, j), qz);
+                        let hv = load(&h, i);
+                        let l = _mm256_sqrt_pd(_mm256_add_pd(hv, _mm256_mul_pd(z, z)));
+                        let sv = _mm256_add_pd(l, abs!(z));
+                        let up = _mm256_cmp_pd::<_CMP_GT_OQ>(z, zero);
+                        (sv, _mm256_blendv_pd(_mm256_mul_pd(sv, sv), hv, up))
+                    }};
+                }
+                let mut cur = vertices!(0);
+                let (mut re, mut im, mut up_turns, mut down_turns) = *acc;
+                for b in 0..blocks {
+                    let next = vertices!(b + 1);
+                    let (i, j) = (4 * b, j0 + 4 * b);
+                    let (sa, pa) = cur;
+                    let (sb, pb) = (shift_one!(cur.0, next.0), shift_one!(cur.1, next.1));
+                    cur = next;
+                    let lane_ok = load(&ok, i);
+                    let s2 = _mm256_mul_pd(sa, sb);
+                    let den =
+                        _mm256_add_pd(_mm256_mul_pd(pa, pb), _mm256_mul_pd(load(&dot, i), s2));
+                    let t_re = _mm256_blendv_pd(one, den, lane_ok);
+                    let t_im = _mm256_blendv_pd(zero, _mm256_mul_pd(load(&neg_d, i), s2), lane_ok);
+                    // AngleSum::push.
+                    let n_re = _mm256_sub_pd(_mm256_mul_pd(re, t_re), _mm256_mul_pd(im, t_im));
+                    let n_im = _mm256_add_pd(_mm256_mul_pd(re, t_im), _mm256_mul_pd(im, t_re));
+                    let a = _mm256_castpd_si256(im);
+                    let t = _mm256_castpd_si256(t_im);
+                    let n = _mm256_castpd_si256(n_im);
+                    let turn = _mm256_andnot_si256(_mm256_xor_si256(a, t), _mm256_xor_si256(n, a));
+                    up_turns = _mm256_add_epi64(
+                        up_turns,
+                        _mm256_srli_epi64::<63>(_mm256_andnot_si256(a, turn)),
+                    );
+                    down_turns = _mm256_add_epi64(
+                        down_turns,
+                        _mm256_srli_epi64::<63>(_mm256_and_si256(turn, a)),
+                    );
+                    re = n_re;
+                    im = n_im;
+                    if j % 8 == 4 {
+                        // AngleSum::rescale, on the single-query loop's schedule.
+                        let m = _mm256_castpd_si256(_mm256_max_pd(abs!(re), abs!(im)));
+                        let scale = _mm256_castsi256_pd(_mm256_sub_epi64(
+                            twice_bias,
+                            _mm256_and_si256(m, exponent),
+                        ));
+                        re = _mm256_mul_pd(re, scale);
+                        im = _mm256_mul_pd(im, scale);
+                    }
+                }
+                *acc = (re, im, up_turns, down_turns);
+            }
+            j0 += 4 * blocks;
+        }
+        acc.map(|(re, im, up, down)| {
+            AngleSum::from_lanes(
+                bytemuck::cast(re),
+                bytemuck::cast(im),
+                bytemuck::cast(up),
+                bytemuck::cast(down),
+            )
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kernel::predicates::W128;
+
+    /// Every query of a column equals its own `area_sum` to the bit: small grids (queries on
+    /// vertices and edges, undecided lanes, vertical edges), 60-bit coordinates, boundaries long
+    /// enough for several chunks, columns of 1 to 11 queries (short last batches), heavy edges,
+    /// queries outside the grid along the ray.
+    #[test]
+    fn column_sums_are_bit_identical_to_single_queries() {
+        let mut state = 3_u64;
+        let mut next = |m: u64| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 33) % m
+        };
+        let mut undecided_seen = false;
+        for case in 0..120 {
+            let big = case % 2 == 1;
+            let coord = |next: &mut dyn FnMut(u64) -> u64| {
+                if big {
+                    ((next(1 << 31) << 29) as i64) - (1_i64 << 59)
+                } else {
+                    next(9) as i64 - 4
+                }
+            };
+            let n = 1 + next(if case % 3 == 0 { 400 } else { 40 }) as usize;
+            let pts: Vec<[i64; 3]> = (0..=n)
+                .map(|_| [coord(&mut next), coord(&mut next), coord(&mut next)])
+                .collect();
+            let a: Vec<[i64; 3]> = (0..n).map(|i| pts[i]).collect();
+            let b: Vec<[i64; 3]> = (0..n)
+                .map(|i| pts[(i + 1 + next(2) as usize) % (n + 1)])
+                .collect();
+            let weight: Vec<f64> = (0..n)
+                .map(|_| [1.0, 2.0, 3.0, 6.0][next(4) as usize])
+                .collect();
+            let edges = BoundaryEdges::new(a, b, weight, 60);
+            for _ in 0..6 {
+                let on_vertex = pts[next(pts.len() as u64) as usize];
+                let qxy = if next(3) == 0 {
+                    [on_vertex[0], on_vertex[1]]
+                } else {
+                    [coord(&mut next), coord(&mut next)]
+                };
+                let queries: Vec<ColumnQuery> = (0..1 + next(11))
+                    .map(|_| {
+                        let z_exact = next(5) != 0;
+                        let z = if next(3) == 0 {
+                            on_vertex[2]
+                        } else {
+                            coord(&mut next)
+                        };
+                        ColumnQuery {
+                            z,
+                            z_exact,
+                            qz_units: if z_exact { 0.0 } else { z as f64 * 3.0 + 0.5 },
+                        }
+                    })
+                    .collect();
+                let mut got = vec![0.0; queries.len()];
+                edges.column_area_sums::<W128>(qxy, &queries, &mut got);
+                for (c, got) in queries.iter().zip(&got) {
+                    let want = edges.area_sum::<W128>([qxy[0], qxy[1], c.z], c.z_exact, c.qz_units);
+                    assert_eq!(
+                        got.to_bits(),
+                        want.to_bits(),
+                        "case {case} {qxy:?} {c:?}: {got} vs {want}"
+                    );
+                }
+                undecided_seen |= !big && qxy == [on_vertex[0], on_vertex[1]];
+            }
+        }
+        assert!(undecided_seen);
+    }
+}
