@@ -98,6 +98,26 @@ fn tolerance_flag() {
             !ok && err.contains("--tolerance"),
             "voxelize --tolerance {bad}: {err}"
         );
+        let (ok, _, err) = gwn(&["bench", sheet, "--grid", "2", &flag]);
+        assert!(
+            !ok && err.contains("--tolerance") && err.trim().lines().count() == 1,
+            "bench --tolerance {bad}: {err}"
+        );
+    }
+    // `gwn bench` measures the flat loop with --tolerance 0 and the default otherwise.
+    for tol in ["0", "1e-10"] {
+        let (ok, out, err) = gwn(&[
+            "bench",
+            sheet,
+            "--grid",
+            "4",
+            "--threads-list",
+            "1",
+            "--tolerance",
+            tol,
+        ]);
+        assert!(ok, "bench --tolerance {tol}: {err}");
+        assert_eq!(out.lines().count(), 2, "{out}");
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
