@@ -213,29 +213,32 @@ pub fn add_fan_triangle(m: &mut Moments, ra: [f64; 3], rb: [f64; 3], sign: f64) 
         ra[0] * rb[1] - ra[1] * rb[0],
     ];
     let below = coefficients_up_to(MAX_ORDER - 1);
+    // The monomials v(μ)^β at the five nodes side by side (one table lookup serves five products;
+    // node-by-node, the lookups dominated the tree's build), then the weighted sums over nodes.
+    let v: [[f64; 5]; 3] = std::array::from_fn(|k| {
+        std::array::from_fn(|j| (1.0 - NODES[j]) * ra[k] + NODES[j] * rb[k])
+    });
+    let mut power = [[0.0; 5]; COEFFICIENTS + 1];
+    power[0] = [1.0; 5];
     let mut line = [0.0; COEFFICIENTS + 1];
-    let mut power = [0.0; COEFFICIENTS + 1];
-    for (&mu, &w) in NODES.iter().zip(&WEIGHTS) {
-        let v: [f64; 3] = std::array::from_fn(|k| (1.0 - mu) * ra[k] + mu * rb[k]);
-        power[0] = 1.0;
-        line[0] += w;
-        for i in 1..below {
-            let k = t.axis[i] as usize;
-            power[i] = power[t.minus1[i][k] as usize] * v[k];
-            line[i] += w * power[i];
-        }
+    line[0] = WEIGHTS.iter().sum();
+    for i in 1..below {
+        let k = t.axis[i] as usize;
+        let from = power[t.minus1[i][k] as usize];
+        let p: [f64; 5] = std::array::from_fn(|j| from[j] * v[k][j]);
+        power[i] = p;
+        line[i] = (0..5).map(|j| WEIGHTS[j] * p[j]).sum();
     }
-    // N_α = Σ_k α_k ∫ n_k u^(α−e_k) dA, and |α − e_k| + 2 = |α| + 1.
+    // N_α = Σ_k α_k ∫ n_k u^(α−e_k) dA, and |α − e_k| + 2 = |α| + 1. `minus1` is the zero slot
+    // (`line[ZERO] = 0`) where α_k = 0, so the sum needs no branch.
+    let scale: [f64; MAX_ORDER + 1] = std::array::from_fn(|n| sign / (n as f64 + 1.0));
     for i in 1..COEFFICIENTS {
         let a = t.alpha[i];
-        let n = f64::from(a[0] + a[1] + a[2]);
-        let mut sum = 0.0;
-        for k in 0..3 {
-            if a[k] > 0 {
-                sum += f64::from(a[k]) * normal[k] * line[t.minus1[i][k] as usize];
-            }
-        }
-        m[i] += sign * sum / (n + 1.0);
+        let [m0, m1, m2] = t.minus1[i];
+        let sum = f64::from(a[0]) * normal[0] * line[m0 as usize]
+            + f64::from(a[1]) * normal[1] * line[m1 as usize]
+            + f64::from(a[2]) * normal[2] * line[m2 as usize];
+        m[i] += scale[usize::from(a[0] + a[1] + a[2])] * sum;
     }
     0.5 * (normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]).sqrt()
 }

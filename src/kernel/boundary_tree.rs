@@ -169,48 +169,23 @@ impl BoundaryTree {
         };
         let per_edge = 4.0 * std::f64::consts::PI * tolerance / total as f64;
         // The leaves are the LEAF_SLOTS-aligned chunks (every split is aligned): their fan moments
-        // are the bulk of the work, split over scoped OS threads. Not rayon: the evaluator builds
-        // the tree lazily inside a `OnceLock`, often from a rayon worker, and a worker waiting for
-        // a parallel build would steal another query's job, re-enter the `OnceLock` and deadlock;
-        // a scoped thread's join blocks without stealing.
+        // are the bulk of the work, split over scoped OS threads (`scoped_map`), like the
+        // expansions below.
         let slots = edges.padded_slots();
         let leaf_count = slots.div_ceil(LEAF_SLOTS);
         let leaf =
             |c: usize| leaf_moments(edges, c * LEAF_SLOTS..((c + 1) * LEAF_SLOTS).min(slots));
-        let threads = std::thread::available_parallelism()
-            .map_or(1, |n| n.get())
-            .min(8)
-            .min(leaf_count / 64)
-            .max(1);
-        let leaves: Vec<LeafMoments> = if threads == 1 {
-            (0..leaf_count).map(leaf).collect()
-        } else {
-            let per = leaf_count.div_ceil(threads);
-            std::thread::scope(|scope| {
-                let parts: Vec<_> = (0..threads)
-                    .map(|t| {
-                        let range = t * per..((t + 1) * per).min(leaf_count);
-                        scope.spawn(move || range.map(leaf).collect::<Vec<_>>())
-                    })
-                    .collect();
-                parts
-                    .into_iter()
-                    .flat_map(|h| h.join().expect("leaf moments do not panic"))
-                    .collect()
-            })
-        };
+        let leaves: Vec<LeafMoments> = scoped_map(leaf_count, leaf);
         let mut building = Building {
             moments: Vec::new(),
             leaves,
             full_ends: Vec::new(),
         };
         tree.build_node(edges, 0, slots, per_edge, &mut building);
-        tree.expansions = building
-            .moments
-            .iter()
-            .zip(&tree.nodes)
-            .map(|(m, n)| Expansion::new(m, n.area, n.radius))
-            .collect();
+        tree.expansions = scoped_map(tree.nodes.len(), |i| {
+            let n = &tree.nodes[i];
+            Expansion::new(&building.moments[i], n.area, n.radius)
+        });
         tree.nodes.iter_mut().for_each(set_reach);
         // Pre-order: children come after their parent.
         for i in (0..tree.nodes.len()).rev() {
@@ -508,6 +483,35 @@ impl BoundaryTree {
         }
         out
     }
+}
+
+/// `(0..count).map(f)`, split over scoped OS threads when there are many items (at least 64 per
+/// thread). Not rayon: the evaluator builds the tree lazily inside a `OnceLock`, often from a
+/// rayon worker, and a worker waiting for a parallel build would steal another query's job,
+/// re-enter the `OnceLock` and deadlock; a scoped thread's join blocks without stealing.
+fn scoped_map<T: Send>(count: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(8)
+        .min(count / 64)
+        .max(1);
+    if threads == 1 {
+        return (0..count).map(f).collect();
+    }
+    let per = count.div_ceil(threads);
+    let f = &f;
+    std::thread::scope(|scope| {
+        let parts: Vec<_> = (0..threads)
+            .map(|t| {
+                let range = t * per..((t + 1) * per).min(count);
+                scope.spawn(move || range.map(f).collect::<Vec<_>>())
+            })
+            .collect();
+        parts
+            .into_iter()
+            .flat_map(|h| h.join().expect("tree building does not panic"))
+            .collect()
+    })
 }
 
 /// A lattice query in the tree's normalized coordinates (`z` in grid units when it is not exact).
