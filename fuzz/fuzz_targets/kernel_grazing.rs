@@ -1,7 +1,8 @@
 //! Fuzzes the exact kernel on degenerate meshes of the integer grid −4..4 (decoder
 //! `gwn::testing::soup_from_bytes`, shared with `tests/exactness.rs`): off the surface, every
 //! ray direction must give the same winding number; on it, the value must be finite and within
-//! 2e-3 of the direct sum at the perturbed point. Run: `cargo fuzz run --sanitizer none kernel_grazing -- -max_total_time=60`.
+//! 2e-3 of the direct sum at the perturbed point; a column through the query (grids) gives the
+//! query's value to the bit. Run: `cargo fuzz run --sanitizer none kernel_grazing -- -max_total_time=60`.
 #![no_main]
 
 use gwn::eval::antipodal::{Options, WindingNumber};
@@ -26,6 +27,11 @@ fuzz_target!(|data: &[u8]| {
             )
             .unwrap();
             let w = wn.eval(q);
+            // Columns (grids) share the crossing ray and the boundary loop's x, y work: the
+            // same bits as the point on its own, on and off the lattice along the column.
+            let axis = ray.map()[2].0;
+            let column = wn.eval_column(q, &[q[axis] - 1.5, q[axis], q[axis] + 0.25]);
+            assert_eq!(column[1].to_bits(), w.to_bits(), "{ray:?} {q:?}: column");
             if !on {
                 assert!((w - w0).abs() < 1e-10, "{ray:?} {q:?}: {w} vs {w0}");
             }
