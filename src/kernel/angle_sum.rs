@@ -41,8 +41,8 @@ impl AngleSum {
         }
     }
 
-    /// The state of four accumulators computed elsewhere (the AVX2 boundary loop).
-    pub(crate) fn from_lanes(re: [f64; 4], im: [f64; 4], up: [u64; 4], down: [u64; 4]) -> Self {
+    /// The state of four accumulators computed elsewhere ([`AngleSumAvx2`]).
+    fn from_lanes(re: [f64; 4], im: [f64; 4], up: [u64; 4], down: [u64; 4]) -> Self {
         AngleSum {
             re: f64x4::from(re),
             im: f64x4::from(im),
@@ -130,6 +130,86 @@ impl AngleSum {
             (ar, ai) = (nr, ni);
         }
         ai.atan2(ar) + std::f64::consts::TAU * total_turns
+    }
+}
+
+/// [`AngleSum`]'s four accumulators in AVX2 registers, for the boundary loops' run-time AVX2
+/// paths: the operations of [`AngleSum::push`] and [`AngleSum::rescale`] in the same order, so
+/// the results are bit-identical to the portable type (tested through the loops).
+#[cfg(target_arch = "x86_64")]
+#[derive(Clone, Copy)]
+pub(crate) struct AngleSumAvx2 {
+    re: std::arch::x86_64::__m256d,
+    im: std::arch::x86_64::__m256d,
+    up: std::arch::x86_64::__m256i,
+    down: std::arch::x86_64::__m256i,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl AngleSumAvx2 {
+    /// The empty sum.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub(crate) fn new() -> Self {
+        use std::arch::x86_64::*;
+        AngleSumAvx2 {
+            re: _mm256_set1_pd(1.0),
+            im: _mm256_setzero_pd(),
+            up: _mm256_setzero_si256(),
+            down: _mm256_setzero_si256(),
+        }
+    }
+
+    /// [`AngleSum::push`].
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub(crate) fn push(&mut self, x: std::arch::x86_64::__m256d, y: std::arch::x86_64::__m256d) {
+        use std::arch::x86_64::*;
+        let (re, im) = (self.re, self.im);
+        let n_re = _mm256_sub_pd(_mm256_mul_pd(re, x), _mm256_mul_pd(im, y));
+        let n_im = _mm256_add_pd(_mm256_mul_pd(re, y), _mm256_mul_pd(im, x));
+        let a = _mm256_castpd_si256(im);
+        let t = _mm256_castpd_si256(y);
+        let n = _mm256_castpd_si256(n_im);
+        let turn = _mm256_andnot_si256(_mm256_xor_si256(a, t), _mm256_xor_si256(n, a));
+        self.up = _mm256_add_epi64(
+            self.up,
+            _mm256_srli_epi64::<63>(_mm256_andnot_si256(a, turn)),
+        );
+        self.down = _mm256_add_epi64(
+            self.down,
+            _mm256_srli_epi64::<63>(_mm256_and_si256(turn, a)),
+        );
+        self.re = n_re;
+        self.im = n_im;
+    }
+
+    /// [`AngleSum::rescale`].
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub(crate) fn rescale(&mut self) {
+        use std::arch::x86_64::*;
+        let sign = _mm256_set1_pd(-0.0);
+        let m = _mm256_castpd_si256(_mm256_max_pd(
+            _mm256_andnot_pd(sign, self.re),
+            _mm256_andnot_pd(sign, self.im),
+        ));
+        let scale = _mm256_castsi256_pd(_mm256_sub_epi64(
+            _mm256_set1_epi64x(2046 << 52),
+            _mm256_and_si256(m, _mm256_set1_epi64x(0x7ff0_0000_0000_0000)),
+        ));
+        self.re = _mm256_mul_pd(self.re, scale);
+        self.im = _mm256_mul_pd(self.im, scale);
+    }
+
+    /// The same sum as an [`AngleSum`].
+    pub(crate) fn finish(self) -> AngleSum {
+        AngleSum::from_lanes(
+            bytemuck::cast(self.re),
+            bytemuck::cast(self.im),
+            bytemuck::cast(self.up),
+            bytemuck::cast(self.down),
+        )
     }
 }
 

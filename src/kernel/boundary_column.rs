@@ -14,7 +14,11 @@
 //! grid gives the same numbers as point-by-point evaluation.
 
 use super::angle_sum::AngleSum;
+#[cfg(target_arch = "x86_64")]
+use super::angle_sum::AngleSumAvx2;
 use super::boundary_sum::BoundaryEdges;
+#[cfg(target_arch = "x86_64")]
+use super::boundary_sum::shift_one_avx2;
 use super::predicates::Width;
 
 /// One query of a column: its lattice `z` (or, when `z_exact` is false, the clamped `z` of a
@@ -126,19 +130,10 @@ impl BoundaryEdges {
         let zero = _mm256_setzero_pd();
         let one = _mm256_set1_pd(1.0);
         let sign = _mm256_set1_pd(-0.0);
-        let exponent = _mm256_set1_epi64x(0x7ff0_0000_0000_0000);
-        let twice_bias = _mm256_set1_epi64x(2046 << 52);
         macro_rules! abs {
             ($v:expr) => {
                 _mm256_andnot_pd(sign, $v)
             };
-        }
-        // [a1, a2, a3, b0]: the permute brings [a2, a3, b0, b1], the shuffle interleaves.
-        macro_rules! shift_one {
-            ($a:expr, $b:expr) => {{
-                let mid = _mm256_permute2f128_pd::<0x21>($a, $b);
-                _mm256_shuffle_pd::<0b0101>($a, mid)
-            }};
         }
         // Shared per chunk: h of each vertex; per edge the filter mask, the dot product and
         // −d (see `chain_angles`).
@@ -146,7 +141,7 @@ impl BoundaryEdges {
         let mut ok = [0.0; CHUNK];
         let mut dot = [0.0; CHUNK];
         let mut neg_d = [0.0; CHUNK];
-        let mut acc = [(one, zero, _mm256_setzero_si256(), _mm256_setzero_si256()); QUERIES];
+        let mut acc = [AngleSumAvx2::new(); QUERIES];
         let mut j0 = slots.start;
         while j0 < slots.end {
             let blocks = (slots.end - j0).min(CHUNK).div_ceil(4);
@@ -214,12 +209,11 @@ impl BoundaryEdges {
                     }};
                 }
                 let mut cur = vertices!(0);
-                let (mut re, mut im, mut up_turns, mut down_turns) = *acc;
                 for b in 0..blocks {
                     let next = vertices!(b + 1);
                     let (i, j) = (4 * b, j0 + 4 * b);
                     let (sa, pa) = cur;
-                    let (sb, pb) = (shift_one!(cur.0, next.0), shift_one!(cur.1, next.1));
+                    let (sb, pb) = (shift_one_avx2(cur.0, next.0), shift_one_avx2(cur.1, next.1));
                     cur = next;
                     let lane_ok = load(&ok, i);
                     let s2 = _mm256_mul_pd(sa, sb);
@@ -227,46 +221,16 @@ impl BoundaryEdges {
                         _mm256_add_pd(_mm256_mul_pd(pa, pb), _mm256_mul_pd(load(&dot, i), s2));
                     let t_re = _mm256_blendv_pd(one, den, lane_ok);
                     let t_im = _mm256_blendv_pd(zero, _mm256_mul_pd(load(&neg_d, i), s2), lane_ok);
-                    // AngleSum::push.
-                    let n_re = _mm256_sub_pd(_mm256_mul_pd(re, t_re), _mm256_mul_pd(im, t_im));
-                    let n_im = _mm256_add_pd(_mm256_mul_pd(re, t_im), _mm256_mul_pd(im, t_re));
-                    let a = _mm256_castpd_si256(im);
-                    let t = _mm256_castpd_si256(t_im);
-                    let n = _mm256_castpd_si256(n_im);
-                    let turn = _mm256_andnot_si256(_mm256_xor_si256(a, t), _mm256_xor_si256(n, a));
-                    up_turns = _mm256_add_epi64(
-                        up_turns,
-                        _mm256_srli_epi64::<63>(_mm256_andnot_si256(a, turn)),
-                    );
-                    down_turns = _mm256_add_epi64(
-                        down_turns,
-                        _mm256_srli_epi64::<63>(_mm256_and_si256(turn, a)),
-                    );
-                    re = n_re;
-                    im = n_im;
+                    acc.push(t_re, t_im);
                     if j % 8 == 4 {
                         // AngleSum::rescale, on the single-query loop's schedule.
-                        let m = _mm256_castpd_si256(_mm256_max_pd(abs!(re), abs!(im)));
-                        let scale = _mm256_castsi256_pd(_mm256_sub_epi64(
-                            twice_bias,
-                            _mm256_and_si256(m, exponent),
-                        ));
-                        re = _mm256_mul_pd(re, scale);
-                        im = _mm256_mul_pd(im, scale);
+                        acc.rescale();
                     }
                 }
-                *acc = (re, im, up_turns, down_turns);
             }
             j0 += 4 * blocks;
         }
-        acc.map(|(re, im, up, down)| {
-            AngleSum::from_lanes(
-                bytemuck::cast(re),
-                bytemuck::cast(im),
-                bytemuck::cast(up),
-                bytemuck::cast(down),
-            )
-        })
+        acc.map(AngleSumAvx2::finish)
     }
 }
 
@@ -281,13 +245,8 @@ mod tests {
     /// queries outside the grid along the ray.
     #[test]
     fn column_sums_are_bit_identical_to_single_queries() {
-        let mut state = 3_u64;
-        let mut next = |m: u64| {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 33) % m
-        };
+        let mut rng = crate::kernel::test_rng::TestRng::new(3);
+        let mut next = |m: u64| rng.below(m);
         let mut undecided_seen = false;
         for case in 0..120 {
             let big = case % 2 == 1;

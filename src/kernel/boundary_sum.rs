@@ -17,6 +17,8 @@
 use wide::{CmpGt, f64x4};
 
 use super::angle_sum::AngleSum;
+#[cfg(target_arch = "x86_64")]
+use super::angle_sum::AngleSumAvx2;
 use super::compensated::NeumaierSum;
 use super::double_double::DoubleDouble;
 use super::predicates::{
@@ -37,6 +39,19 @@ fn lanes4(v: &[f64], j: usize) -> [f64; 4] {
 fn shift_one(a: f64x4, b: f64x4) -> f64x4 {
     let (a, b) = (a.to_array(), b.to_array());
     f64x4::from([a[1], a[2], a[3], b[0]])
+}
+
+/// [`shift_one`] in AVX2: the permute brings `[a2, a3, b0, b1]`, the shuffle interleaves.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+pub(super) fn shift_one_avx2(
+    a: std::arch::x86_64::__m256d,
+    b: std::arch::x86_64::__m256d,
+) -> std::arch::x86_64::__m256d {
+    use std::arch::x86_64::*;
+    let mid = _mm256_permute2f128_pd::<0x21>(a, b);
+    _mm256_shuffle_pd::<0b0101>(a, mid)
 }
 
 /// Boundary edges of one mesh in the ray frame, in grid units.
@@ -499,26 +514,16 @@ impl BoundaryEdges {
                 [x, y, s, p]
             }};
         }
-        // [a1, a2, a3, b0]: the permute brings [a2, a3, b0, b1], the shuffle interleaves.
-        macro_rules! shift_one {
-            ($a:expr, $b:expr) => {{
-                let mid = _mm256_permute2f128_pd::<0x21>($a, $b);
-                _mm256_shuffle_pd::<0b0101>($a, mid)
-            }};
-        }
-        let (mut re, mut im) = (one, zero);
-        let (mut up_turns, mut down_turns) = (_mm256_setzero_si256(), _mm256_setzero_si256());
-        let exponent = _mm256_set1_epi64x(0x7ff0_0000_0000_0000);
-        let twice_bias = _mm256_set1_epi64x(2046 << 52);
+        let mut angles = AngleSumAvx2::new();
         let mut cur = vertices!(slots.start);
         for j in slots.step_by(4) {
             let next = vertices!(j + 4);
             let [ax, ay, sa, pa] = cur;
             let (bx, by, sb, pb) = (
-                shift_one!(cur[0], next[0]),
-                shift_one!(cur[1], next[1]),
-                shift_one!(cur[2], next[2]),
-                shift_one!(cur[3], next[3]),
+                shift_one_avx2(cur[0], next[0]),
+                shift_one_avx2(cur[1], next[1]),
+                shift_one_avx2(cur[2], next[2]),
+                shift_one_avx2(cur[3], next[3]),
             );
             cur = next;
             let real = _mm256_cmp_pd::<_CMP_GT_OQ>(load(&self.link, j), zero);
@@ -539,42 +544,15 @@ impl BoundaryEdges {
             let den = _mm256_add_pd(_mm256_mul_pd(pa, pb), _mm256_mul_pd(dot, s2));
             let t_re = _mm256_blendv_pd(one, den, ok);
             let t_im = _mm256_blendv_pd(zero, _mm256_mul_pd(_mm256_sub_pd(zero, d), s2), ok);
-            // AngleSum::push.
-            let n_re = _mm256_sub_pd(_mm256_mul_pd(re, t_re), _mm256_mul_pd(im, t_im));
-            let n_im = _mm256_add_pd(_mm256_mul_pd(re, t_im), _mm256_mul_pd(im, t_re));
-            let a = _mm256_castpd_si256(im);
-            let t = _mm256_castpd_si256(t_im);
-            let n = _mm256_castpd_si256(n_im);
-            let turn = _mm256_andnot_si256(_mm256_xor_si256(a, t), _mm256_xor_si256(n, a));
-            up_turns = _mm256_add_epi64(
-                up_turns,
-                _mm256_srli_epi64::<63>(_mm256_andnot_si256(a, turn)),
-            );
-            down_turns = _mm256_add_epi64(
-                down_turns,
-                _mm256_srli_epi64::<63>(_mm256_and_si256(turn, a)),
-            );
-            re = n_re;
-            im = n_im;
+            angles.push(t_re, t_im);
             if j % 8 == 4 {
-                // AngleSum::rescale.
-                let m = _mm256_castpd_si256(_mm256_max_pd(abs!(re), abs!(im)));
-                let scale = _mm256_castsi256_pd(_mm256_sub_epi64(
-                    twice_bias,
-                    _mm256_and_si256(m, exponent),
-                ));
-                re = _mm256_mul_pd(re, scale);
-                im = _mm256_mul_pd(im, scale);
+                // Terms are at most ~2^250 (grid units): two pushes stay in range.
+                angles.rescale();
             }
             let mask = _mm256_movemask_pd(real) & !_mm256_movemask_pd(ok);
             self.report_undecided(j, mask, undecided);
         }
-        AngleSum::from_lanes(
-            bytemuck::cast(re),
-            bytemuck::cast(im),
-            bytemuck::cast(up_turns),
-            bytemuck::cast(down_turns),
-        )
+        angles.finish()
     }
 
     /// Calls `undecided(e)` for the edges of the slots `j..j+4` set in `mask`.
@@ -715,13 +693,8 @@ mod tests {
     #[test]
     fn chains_without_parallel_edges_match_the_per_edge_sum() {
         use crate::kernel::predicates::W128;
-        let mut state = 11_u64;
-        let mut next = |m: u64| {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 33) % m
-        };
+        let mut rng = crate::kernel::test_rng::TestRng::new(11);
+        let mut next = |m: u64| rng.below(m);
         let mut left_out = 0;
         for _ in 0..200 {
             let n = 2 + next(30) as usize;
@@ -844,13 +817,8 @@ mod tests {
     #[test]
     fn chains_use_every_edge_copy_exactly_once_and_connect() {
         // Random multigraphs on few vertices (self-loops, parallel and heavy edges included).
-        let mut state = 99_u64;
-        let mut next = |m: u64| {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 33) % m
-        };
+        let mut rng = crate::kernel::test_rng::TestRng::new(99);
+        let mut next = |m: u64| rng.below(m);
         for _ in 0..500 {
             let n = 1 + next(12) as usize;
             let vert = |k: u64| [k as i64, 0, 0];

@@ -27,3 +27,5 @@ pub mod frame;
 pub mod predicates;
 pub mod quantize;
 pub mod spherical;
+#[cfg(test)]
+mod test_rng;
