@@ -18,7 +18,7 @@ use super::angle_sum::AngleSum;
 use super::angle_sum::AngleSumAvx2;
 use super::boundary_sum::BoundaryEdges;
 #[cfg(target_arch = "x86_64")]
-use super::boundary_sum::shift_one_avx2;
+use super::boundary_sum::{orientation_filter_avx2, shift_one_avx2};
 use super::predicates::Width;
 
 /// One query of a column: its lattice `z` (or, when `z_exact` is false, the clamped `z` of a
@@ -169,18 +169,7 @@ impl BoundaryEdges {
                     _mm256_sub_pd(load(ys, j + 1), qy),
                 );
                 let real = _mm256_cmp_pd::<_CMP_GT_OQ>(load(link, j), zero);
-                let p1 = _mm256_mul_pd(ax, by);
-                let p2 = _mm256_mul_pd(ay, bx);
-                let d = _mm256_sub_pd(p1, p2);
-                let sum_abs = _mm256_add_pd(
-                    _mm256_add_pd(_mm256_add_pd(abs!(ax), abs!(ay)), abs!(bx)),
-                    abs!(by),
-                );
-                let bound = _mm256_add_pd(
-                    _mm256_mul_pd(conv, sum_abs),
-                    _mm256_mul_pd(rel, _mm256_add_pd(abs!(p1), abs!(p2))),
-                );
-                let lane_ok = _mm256_and_pd(_mm256_cmp_pd::<_CMP_GT_OQ>(abs!(d), bound), real);
+                let (d, lane_ok) = orientation_filter_avx2([ax, ay, bx, by], real, conv, rel);
                 store(&mut ok, i, lane_ok);
                 store(
                     &mut dot,

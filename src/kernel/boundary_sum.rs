@@ -41,6 +41,37 @@ fn shift_one(a: f64x4, b: f64x4) -> f64x4 {
     f64x4::from([a[1], a[2], a[3], b[0]])
 }
 
+/// The loops' `f64` orientation `d = a_x b_y − a_y b_x` of four edges (offsets from the query)
+/// and the lanes where it clears its error bound on real edges (`real`): the filter of
+/// [`super::predicates::orient2d_filtered`], with `conv, rel` from
+/// [`BoundaryEdges::filter_constants`].
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+pub(super) fn orientation_filter_avx2(
+    [ax, ay, bx, by]: [std::arch::x86_64::__m256d; 4],
+    real: std::arch::x86_64::__m256d,
+    conv: std::arch::x86_64::__m256d,
+    rel: std::arch::x86_64::__m256d,
+) -> (std::arch::x86_64::__m256d, std::arch::x86_64::__m256d) {
+    use std::arch::x86_64::*;
+    let sign = _mm256_set1_pd(-0.0);
+    let abs = |v| _mm256_andnot_pd(sign, v);
+    let p1 = _mm256_mul_pd(ax, by);
+    let p2 = _mm256_mul_pd(ay, bx);
+    let d = _mm256_sub_pd(p1, p2);
+    let sum_abs = _mm256_add_pd(
+        _mm256_add_pd(_mm256_add_pd(abs(ax), abs(ay)), abs(bx)),
+        abs(by),
+    );
+    let bound = _mm256_add_pd(
+        _mm256_mul_pd(conv, sum_abs),
+        _mm256_mul_pd(rel, _mm256_add_pd(abs(p1), abs(p2))),
+    );
+    let ok = _mm256_and_pd(_mm256_cmp_pd::<_CMP_GT_OQ>(abs(d), bound), real);
+    (d, ok)
+}
+
 /// [`shift_one`] in AVX2: the permute brings `[a2, a3, b0, b1]`, the shuffle interleaves.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
@@ -527,18 +558,7 @@ impl BoundaryEdges {
             );
             cur = next;
             let real = _mm256_cmp_pd::<_CMP_GT_OQ>(load(&self.link, j), zero);
-            let p1 = _mm256_mul_pd(ax, by);
-            let p2 = _mm256_mul_pd(ay, bx);
-            let d = _mm256_sub_pd(p1, p2);
-            let sum_abs = _mm256_add_pd(
-                _mm256_add_pd(_mm256_add_pd(abs!(ax), abs!(ay)), abs!(bx)),
-                abs!(by),
-            );
-            let bound = _mm256_add_pd(
-                _mm256_mul_pd(conv, sum_abs),
-                _mm256_mul_pd(rel, _mm256_add_pd(abs!(p1), abs!(p2))),
-            );
-            let ok = _mm256_and_pd(_mm256_cmp_pd::<_CMP_GT_OQ>(abs!(d), bound), real);
+            let (d, ok) = orientation_filter_avx2([ax, ay, bx, by], real, conv, rel);
             let s2 = _mm256_mul_pd(sa, sb);
             let dot = _mm256_add_pd(_mm256_mul_pd(ax, bx), _mm256_mul_pd(ay, by));
             let den = _mm256_add_pd(_mm256_mul_pd(pa, pb), _mm256_mul_pd(dot, s2));
