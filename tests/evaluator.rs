@@ -388,3 +388,59 @@ fn cli_methods_apply_to_every_product_and_misuse_is_an_error() {
     assert!(err.contains("needs a triangle mesh"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `eval_batch` evaluates runs of points on one line parallel to the ray as columns (numpy grids
+/// with the ray's axis last): every value must be the point's own, bit for bit, for every ray,
+/// with non-finite and signed-zero coordinates inside runs, runs longer than one column batch,
+/// and points in random order (no runs).
+#[test]
+fn batches_with_grid_runs_equal_point_by_point_values() {
+    use gwn::eval::antipodal::Options;
+    use gwn::kernel::frame::RayAxis;
+    let mesh = lion_head();
+    let b = mesh.bounding_box().unwrap().enlarged(0.1);
+    let mut rng = Rng(77);
+    for ray in RayAxis::ALL {
+        let wn = WindingNumber::with_options(
+            &mesh,
+            Options {
+                ray,
+                ..Options::default()
+            },
+        )
+        .unwrap();
+        let axis = ray.map()[2].0;
+        let mut points = Vec::new();
+        for line in 0..40 {
+            let mut q: [f64; 3] = std::array::from_fn(|k| rng.range(b.min[k], b.max[k]));
+            if line % 5 == 0 {
+                // A run that starts (and goes on) with a non-finite or signed-zero coordinate.
+                let mut odd = q;
+                odd[axis] = [f64::NAN, -0.0, f64::INFINITY][line % 3];
+                points.push(odd);
+            }
+            let n = [1, 2, 7, 300][line % 4];
+            for i in 0..n {
+                q[axis] = b.min[axis] + (b.max[axis] - b.min[axis]) * (i as f64 + 0.5) / n as f64;
+                points.push(q);
+            }
+            if line % 5 == 0 {
+                let mut odd = q;
+                odd[axis] = f64::NAN;
+                points.push(odd);
+            }
+        }
+        let batch = wn.eval_batch(&points);
+        let mut by_point = 0;
+        for (q, w) in points.iter().zip(&batch) {
+            let want = wn.eval(*q);
+            assert_eq!(
+                w.to_bits(),
+                want.to_bits(),
+                "{ray:?} at {q:?}: {w} vs {want}"
+            );
+            by_point += 1;
+        }
+        assert!(by_point > 3000);
+    }
+}

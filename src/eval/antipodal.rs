@@ -201,8 +201,47 @@ impl WindingNumber {
     }
 
     /// Winding numbers at many points, in parallel.
+    ///
+    /// Runs of consecutive points on one line parallel to the ray (a numpy grid whose last axis is
+    /// the ray's, e.g. `np.mgrid[...].reshape(3, -1).T` with the default ray `+z`) are evaluated
+    /// as columns ([`WindingNumber::eval_column`]: one crossing traversal per run and the boundary
+    /// loop shared), which gives the same bits as point by point.
     pub fn eval_batch(&self, points: &[[f64; 3]]) -> Vec<f64> {
-        points.par_iter().map(|&q| self.eval(q)).collect()
+        let axis = self.options.ray.map()[2].0;
+        let same_line = |a: &[f64; 3], b: &[f64; 3]| {
+            (0..3).all(|k| k == axis || a[k].to_bits() == b[k].to_bits())
+        };
+        let mut out = vec![0.0; points.len()];
+        // Parallel over chunks (a run that crosses a chunk's end is simply split), so no
+        // allocation grows with the number of runs; small batches still get several chunks per
+        // thread.
+        let chunk = (points.len() / (4 * rayon::current_num_threads())).clamp(16, BATCH_CHUNK);
+        out.par_chunks_mut(chunk)
+            .zip(points.par_chunks(chunk))
+            .for_each(|(out, points)| {
+                let mut start = 0;
+                while start < points.len() {
+                    let mut end = start + 1;
+                    while end < points.len()
+                        && end - start < MAX_RUN
+                        && same_line(&points[end - 1], &points[end])
+                    {
+                        end += 1;
+                    }
+                    if end - start == 1 {
+                        out[start] = self.eval(points[start]);
+                    } else {
+                        // The column's own coordinate is replaced by each point's (a non-finite
+                        // one gives NaN for that point only).
+                        let mut q = points[start];
+                        q[axis] = 0.0;
+                        let ts: Vec<f64> = points[start..end].iter().map(|p| p[axis]).collect();
+                        out[start..end].copy_from_slice(&self.eval_column(q, &ts));
+                    }
+                    start = end;
+                }
+            });
+        out
     }
 
     /// The two parts of the formula: the signed crossing count χ and the boundary sum
@@ -721,3 +760,8 @@ impl<W: Width> FrameEvaluator<W> {
         self.grid.gradient_to_world(g)
     }
 }
+/// The longest run [`WindingNumber::eval_batch`] evaluates as one column.
+const MAX_RUN: usize = 256;
+
+/// The most points per parallel task of [`WindingNumber::eval_batch`].
+const BATCH_CHUNK: usize = 1024;
