@@ -203,3 +203,21 @@ def test_pickle_keeps_the_tolerance(surface, far_queries, tolerance):
     np.testing.assert_array_equal(bound_back, bound)
     if tolerance:
         assert np.any(bound > 1e-10), "a lost tolerance (back to 1e-10) would go unnoticed"
+
+
+@pytest.mark.parametrize("ray", ["+z", "-x", "+y"])
+def test_numpy_grid_points_equal_point_by_point(surface, ray):
+    # A numpy grid listed with the ray's axis last is evaluated line by line (one ray and one
+    # shared boundary loop per line): the same bits as one point at a time.
+    V, F = surface
+    axes = [np.linspace(-0.3, 1.3, 9), np.linspace(-0.2, 1.2, 7), np.linspace(-0.5, 0.5, 33)]
+    last = {"x": 0, "y": 1, "z": 2}[ray[1]]
+    order = [k for k in range(3) if k != last] + [last]
+    mesh = np.meshgrid(*[axes[k] for k in order], indexing="ij")
+    Q = np.empty((mesh[0].size, 3))
+    for i, k in enumerate(order):
+        Q[:, k] = mesh[i].ravel()
+    wn = gwn.WindingNumber(V, F, ray=ray)
+    batch = wn(Q)
+    single = np.array([wn(Q[i:i + 1])[0] for i in range(len(Q))])
+    assert np.array_equal(batch.view(np.int64), single.view(np.int64))
