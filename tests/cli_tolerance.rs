@@ -2,19 +2,9 @@
 //! one-line error; `--tolerance 0` is the flat loop; far queries on a mesh with a large boundary
 //! move by at most the tolerance.
 
-use std::process::Command;
-
-fn gwn(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_gwn"))
-        .args(args)
-        .output()
-        .expect("run gwn");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+#[path = "common/cli.rs"]
+mod cli;
+use cli::gwn;
 
 /// An open wavy sheet of `n × n` quads with every seventh triangle removed: ~n²/3.5 boundary edges.
 fn holey_sheet(dir: &std::path::Path, n: usize) -> std::path::PathBuf {

@@ -2,19 +2,10 @@
 //! mesh, and `gwn info`'s boundary by position beside the index topology.
 
 use std::path::PathBuf;
-use std::process::Command;
 
-fn gwn(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_gwn"))
-        .args(args)
-        .output()
-        .expect("run gwn");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+#[path = "common/cli.rs"]
+mod cli;
+use cli::gwn;
 
 /// The unit cube as an OBJ soup: each of the 12 triangles has its own three vertices.
 fn cube_soup(dir: &std::path::Path) -> PathBuf {
