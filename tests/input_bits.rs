@@ -452,3 +452,258 @@ fn split_vertices_of_a_closed_mesh_leave_no_boundary() {
         assert_eq!(by_position.eval(q), welded.eval(q), "{q:?}");
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// Issue 21: exact to the last bit of the *mesh*, not only of the query. Vertices whose
+// coordinates the 60-bit lattice cannot hold (values far below the extent, translations by
+// 1e15, full-precision decimals) were snapped, and queries one ulp from them got the snapped
+// surface's integer on some rays.
+
+/// `x` moved by `k` ulps (towards +∞ for k > 0).
+fn ulps(x: f64, k: i32) -> f64 {
+    let mut y = x;
+    for _ in 0..k.abs() {
+        y = if k > 0 {
+            gwn::testing::interval::next_up(y)
+        } else {
+            gwn::testing::interval::next_down(y)
+        };
+    }
+    y
+}
+
+/// A closed, full-precision tetrahedron-pair (an open lid makes the boundary term matter too):
+/// coordinates of mixed magnitudes as real meshes have them.
+fn full_precision_mesh(c: &[f64], open: bool) -> Mesh {
+    let p: Vec<[f64; 3]> = c.chunks(3).map(|v| [v[0], v[1], v[2]]).collect();
+    // Two tetrahedra sharing the face 1-2-3 (a closed bipyramid); `open` drops one face.
+    let mut t = vec![
+        [0, 2, 1],
+        [0, 3, 2],
+        [0, 1, 3],
+        [4, 1, 2],
+        [4, 2, 3],
+        [4, 3, 1],
+    ];
+    if open {
+        t.pop();
+    }
+    Mesh::from_slices(&p, &t).unwrap()
+}
+
+/// Coordinates with every bit set and mixed magnitudes (the lattice holds none of the small
+/// ones): `1e-20` next to `10`, and `1e15` translations.
+fn coordinate() -> impl Strategy<Value = f64> {
+    prop_oneof![
+        (-10.0f64..10.0),
+        (-1e-3f64..1e-3),
+        (-1e-20f64..1e-20),
+        Just(0.0),
+        (1e15f64..1.0000001e15),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 40, ..ProptestConfig::default() })]
+
+    /// Queries at ±1 ulp of a vertex along each axis, at an edge's midpoint and ±1 ulp off it,
+    /// and at a face point: every ray's value is the rational oracle's (exact integer part,
+    /// fraction to 1e-9 of the certified interval), on the surface and off it.
+    #[test]
+    fn off_lattice_vertices_are_evaluated_exactly_for_every_ray(
+        c in prop::collection::vec(coordinate(), 15),
+        open in prop::bool::ANY,
+        v in 0usize..5,
+        pick in 0usize..6,
+    ) {
+        let mesh = full_precision_mesh(&c, open);
+        let p = mesh.positions();
+        let a = p[v];
+        let b = p[(v + 1) % 5];
+        let mid: [f64; 3] = std::array::from_fn(|k| 0.5 * a[k] + 0.5 * b[k]);
+        let mut queries = vec![a, mid];
+        for k in 0..3 {
+            for s in [-1, 1] {
+                let mut q = a;
+                q[k] = ulps(q[k], s);
+                queries.push(q);
+                let mut m = mid;
+                m[k] = ulps(m[k], s);
+                queries.push(m);
+            }
+        }
+        let q = queries[pick % queries.len()];
+        let evaluators = all_rays(&mesh);
+        for q in [q, queries[(pick + 7) % queries.len()]] {
+            for (ray, wn) in &evaluators {
+                let want = exact_winding_number_rational(&mesh, q, *ray);
+                let w = wn.eval(q);
+                prop_assert!(want.contains(w, 1e-9), "{:?} q={:?}: {} not in [{}, {}]", ray, q, w, want.lo, want.hi);
+            }
+        }
+    }
+}
+
+/// The issue's sweep on the shared closed meshes: every vertex moved by one ulp along ±x, ±y,
+/// ±z. Off the surface (an exact test decides) the six rays must give one integer; before the
+/// fix they disagreed on 102 of cgal-cow's 17,424 points and 606 of cgal-camel's 58,620.
+#[test]
+fn one_ulp_from_every_vertex_the_rays_agree() {
+    let Some(dir) = common::shared_meshes() else {
+        return;
+    };
+    for name in [
+        "cgal-cow.off",
+        "cgal-camel.off",
+        "cgal-fandisk.off",
+        "cgal-eight.off",
+    ] {
+        let start = std::time::Instant::now();
+        let mesh = gwn::io::load_mesh(dir.join(name)).unwrap().mesh;
+        let rays = all_rays(&mesh);
+        let off_lattice = rays[0].1.snapping().off_lattice;
+        let mut points = Vec::new();
+        for &v in mesh.positions() {
+            for k in 0..3 {
+                for s in [-1, 1] {
+                    let mut q = v;
+                    q[k] = ulps(q[k], s);
+                    points.push(q);
+                }
+            }
+        }
+        let values: Vec<Vec<f64>> = rays.iter().map(|(_, wn)| wn.eval_batch(&points)).collect();
+        let mut disagreements = 0;
+        let mut on_surface = 0;
+        for (i, q) in points.iter().enumerate() {
+            let first = values[0][i];
+            if values.iter().all(|v| v[i] == first) {
+                assert_eq!(first, first.round(), "{name} {q:?}: closed mesh, integer");
+                continue;
+            }
+            if on_surface_near(&mesh, *q) {
+                on_surface += 1;
+                continue;
+            }
+            disagreements += 1;
+            eprintln!(
+                "{name}: rays disagree at {q:?}: {:?}",
+                values.iter().map(|v| v[i]).collect::<Vec<_>>()
+            );
+        }
+        eprintln!(
+            "{name}: {} points, {off_lattice} vertices off the lattice, {on_surface} on the surface with ray-dependent values, {disagreements} disagreements ({:.1} s)",
+            points.len(),
+            start.elapsed().as_secs_f64()
+        );
+        assert_eq!(disagreements, 0, "{name}");
+    }
+}
+
+/// The exact on-surface test on the triangles whose box holds `q` (the others cannot hold it).
+fn on_surface_near(mesh: &Mesh, q: [f64; 3]) -> bool {
+    let p = mesh.positions();
+    let near: Vec<[u32; 3]> = mesh
+        .triangles()
+        .iter()
+        .filter(|t| {
+            (0..3).all(|k| {
+                let (lo, hi) = t
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &i| {
+                        (lo.min(p[i as usize][k]), hi.max(p[i as usize][k]))
+                    });
+                lo <= q[k] && q[k] <= hi
+            })
+        })
+        .copied()
+        .collect();
+    !near.is_empty() && gwn::testing::on_surface(&Mesh::from_slices(p, &near).unwrap(), q)
+}
+
+/// The issue's extreme cases. An open unit box queried `1e-300` from a corner of its hole
+/// (0.875 on +z before; the direct sum is the reference), and a unit cube scaled by 1e200 with a
+/// query 1e-200 outside the face through the origin (1 on four rays before; outside is 0).
+#[test]
+fn extreme_magnitudes_next_to_vertices_and_faces() {
+    let open = common::open_cube();
+    let rays = all_rays(&open);
+    for d in [1e-20, 1e-100, 1e-172, 1e-250, 1e-300, 1e-320] {
+        // Inside the hole, next to its corners (0, 0, 1) and (0, 1, 1): w = 1/2 exactly (w is
+        // continuous across the missing face, and the open box is symmetric about its plane
+        // up to the closed cube's jump of 1).
+        for q in [
+            [d, d, 1.0],
+            [d, 3.0 * d, 1.0],
+            [d, 1.0 - 2f64.powi(-53), 1.0],
+        ] {
+            for (ray, wn) in &rays {
+                let w = wn.eval(q);
+                assert!((w - 0.5).abs() <= 1e-12, "{ray:?} d={d:e} {q:?}: {w}");
+            }
+        }
+    }
+    let cube = common::unit_cube();
+    for scale in [1e200, 1e300, 1e-200] {
+        let p: Vec<[f64; 3]> = cube
+            .positions()
+            .iter()
+            .map(|v| v.map(|c| c * scale))
+            .collect();
+        let scaled = Mesh::from_slices(&p, cube.triangles()).unwrap();
+        for (ray, wn) in all_rays(&scaled) {
+            for (q, want) in [
+                ([-1e-100 * scale.min(1e-100), 0.5 * scale, 0.5 * scale], 0.0),
+                ([1e-300, 0.5 * scale, 0.5 * scale], 1.0),
+                ([0.5 * scale, -5e-324, 0.5 * scale], 0.0),
+                ([0.5 * scale, 0.5 * scale, 5e-324], 1.0),
+            ] {
+                assert_eq!(wn.eval(q), want, "scale {scale:e} {ray:?} {q:?}");
+            }
+        }
+    }
+}
+
+/// Near a hole of real meshes with full-precision coordinates, at 1e-9 … 1e-14 × diagonal from
+/// boundary edges (1.5–2.8e-7 off at 1e-12 before: the double-double near-edge path computed
+/// with snapped vertices). Reference: the direct sum (double-double where ill-conditioned).
+#[test]
+fn near_holes_of_full_precision_meshes_the_fraction_is_right() {
+    let Some(dir) = common::shared_meshes() else {
+        return;
+    };
+    for name in ["cgal-mech-holes-shark.off", "cgal-holes.off"] {
+        let mesh = gwn::io::load_mesh(dir.join(name)).unwrap().mesh;
+        let rays = all_rays(&mesh);
+        let boundary = gwn::mesh::boundary_edges(&mesh);
+        let p = mesh.positions();
+        let bb = mesh.bounding_box().unwrap();
+        let diag = (0..3)
+            .map(|k| (bb.max[k] - bb.min[k]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let mut worst: f64 = 0.0;
+        let mut rng = common::Rng(21);
+        for e in boundary.iter().step_by((boundary.len() / 12).max(1)) {
+            let (a, b) = (p[e.from as usize], p[e.to as usize]);
+            let t = rng.range(0.2, 0.8);
+            let on: [f64; 3] = std::array::from_fn(|k| a[k] + t * (b[k] - a[k]));
+            let dir3: [f64; 3] = std::array::from_fn(|_| rng.range(-1.0, 1.0));
+            let len = dir3.iter().map(|c| c * c).sum::<f64>().sqrt();
+            for exp in 9..=14 {
+                let d = diag * 10f64.powi(-exp);
+                let q: [f64; 3] = std::array::from_fn(|k| on[k] + d * dir3[k] / len);
+                let want = direct::winding_number_direct(&mesh, q);
+                for (ray, wn) in &rays {
+                    let err = (wn.eval(q) - want).abs();
+                    worst = worst.max(err);
+                    assert!(
+                        err <= 1e-12,
+                        "{name} {ray:?} d=1e-{exp}·diag {q:?}: err {err:e}"
+                    );
+                }
+            }
+        }
+        eprintln!("{name}: worst near-hole error {worst:e}");
+    }
+}

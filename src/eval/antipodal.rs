@@ -29,6 +29,9 @@ use crate::kernel::boundary_sum::BoundaryEdges;
 use crate::kernel::boundary_tree::BoundaryTree;
 use crate::kernel::compensated::NeumaierSum;
 use crate::kernel::frame::RayAxis;
+use crate::kernel::input_predicates::{
+    InputPoint, LatticeFrame, input_plane_side, input_projected_containment, input_ray_crossing,
+};
 use crate::kernel::predicates::{
     W64, W128, Width, far_query_numerator_sign, perturbed_plane_side, projected_containment,
     ray_crossing, ray_crossing_at,
@@ -307,6 +310,15 @@ impl WindingNumber {
         self.options
     }
 
+    /// What snapping the vertices to the lattice lost (`gwn info` reports it). Values never
+    /// depend on it: off-lattice vertices are evaluated exactly as given.
+    pub fn snapping(&self) -> Snapping {
+        match &self.core {
+            Dispatch::Narrow(c) => c.snapping,
+            Dispatch::Wide(c) => c.snapping,
+        }
+    }
+
     /// The quantization grid (world coordinates).
     pub fn grid(&self) -> &Grid {
         match &self.core {
@@ -328,6 +340,15 @@ struct FrameEvaluator<W: Width> {
     to_unit: f64,
     /// Triangle corners in grid coordinates (frame), in BVH leaf order.
     tri_pts: Vec<[[i64; 3]; 3]>,
+    /// Per triangle (leaf order): index into `input_tris` when a corner is off the lattice, else
+    /// [`ON_LATTICE`]; empty when every vertex snapped without loss.
+    tri_input: Vec<u32>,
+    /// The exact corners of the triangles with a corner off the lattice.
+    input_tris: Vec<[InputPoint; 3]>,
+    /// How exact values are rebuilt from world coordinates (see `kernel::input_predicates`).
+    lattice: LatticeFrame,
+    /// What the snapping of the vertices lost.
+    snapping: Snapping,
     boundary: BoundaryEdges,
     /// Tolerance of the certified hierarchy over `boundary`.
     tolerance: f64,
@@ -352,43 +373,92 @@ impl<W: Width> FrameEvaluator<W> {
             return Ok(Self::empty(grid, ray));
         };
         let grid = Grid::new(&bbox, W::PRECISION)?;
-        let verts: Vec<[i64; 3]> = mesh
+        let map = ray.map();
+        let lattice = grid.lattice_frame(map);
+        let mut inputs: Vec<InputPoint> = mesh
             .positions()
             .iter()
-            .map(|&p| ray.to_frame(grid.snap_vertex(p)))
+            .map(|&p| grid.input_vertex(p, map))
             .collect();
+        let verts: Vec<[i64; 3]> = inputs.iter().map(|p| p.n).collect();
+        let snapping = Snapping::of(&inputs, grid.cell_in_world());
+        if W::PRECISION == Precision::Bits30 {
+            // The 30-bit grid is the documented approximation: it evaluates the snapped mesh.
+            inputs
+                .iter_mut()
+                .for_each(|p| *p = InputPoint::lattice(p.n));
+        }
         let tris = mesh.triangles();
         let boundary = match options.boundary {
+            // The 60-bit evaluator computes on the input values, so it welds equal input
+            // positions (`+ 0.0` identifies −0 with 0); the 30-bit one on the snapped mesh.
+            BoundaryBy::Position if W::PRECISION == Precision::Bits60 => {
+                let keys: Vec<[u64; 3]> = mesh
+                    .positions()
+                    .iter()
+                    .map(|p| p.map(|c| (c + 0.0).to_bits()))
+                    .collect();
+                boundary_welded_by(tris, &keys)
+            }
             BoundaryBy::Position => boundary_welded_by(tris, &verts),
             BoundaryBy::Index => boundary_edges(mesh),
         };
-        let boundary = BoundaryEdges::new(
+        let boundary = BoundaryEdges::with_inputs(
             boundary.iter().map(|e| verts[e.from as usize]).collect(),
             boundary.iter().map(|e| verts[e.to as usize]).collect(),
             boundary.iter().map(|e| f64::from(e.weight)).collect(),
             grid.precision().bits(),
+            (
+                boundary.iter().map(|e| inputs[e.from as usize]).collect(),
+                boundary.iter().map(|e| inputs[e.to as usize]).collect(),
+            ),
+            lattice,
         );
+        let off_lattice = |t: &[u32; 3]| t.iter().any(|&i| !inputs[i as usize].on_lattice());
         let to_unit = 1.0 / (1_i64 << (grid.precision().bits() - 1)) as f64;
         let boxes: Vec<([f32; 3], [f32; 3])> = tris
             .iter()
             .map(|t| {
                 let p = t.map(|i| verts[i as usize]);
+                // A triangle off the lattice lies within half a cell of its lattice corners: one
+                // cell of margin keeps the box conservative for every exact query it contains.
+                let pad = i64::from(off_lattice(t));
                 let lo = std::array::from_fn(|k| {
-                    (p[0][k].min(p[1][k]).min(p[2][k]) as f64 * to_unit) as f32
+                    ((p[0][k].min(p[1][k]).min(p[2][k]) - pad) as f64 * to_unit) as f32
                 });
                 let hi = std::array::from_fn(|k| {
-                    (p[0][k].max(p[1][k]).max(p[2][k]) as f64 * to_unit) as f32
+                    ((p[0][k].max(p[1][k]).max(p[2][k]) + pad) as f64 * to_unit) as f32
                 });
                 (lo, hi)
             })
             .collect();
         let mut bvh = RayBvh::build(&boxes);
-        let tri_pts = bvh
-            .renumber_in_leaf_order()
-            .into_iter()
-            .map(|f| tris[f as usize].map(|i| verts[i as usize]))
+        let order = bvh.renumber_in_leaf_order();
+        let tri_pts = order
+            .iter()
+            .map(|&f| tris[f as usize].map(|i| verts[i as usize]))
             .collect();
+        let mut input_tris = Vec::new();
+        let mut tri_input = Vec::new();
+        if inputs.iter().any(|p| !p.on_lattice()) {
+            tri_input = order
+                .iter()
+                .map(|&f| {
+                    let t = &tris[f as usize];
+                    if off_lattice(t) {
+                        input_tris.push(t.map(|i| inputs[i as usize]));
+                        (input_tris.len() - 1) as u32
+                    } else {
+                        ON_LATTICE
+                    }
+                })
+                .collect();
+        }
         Ok(FrameEvaluator {
+            tri_input,
+            input_tris,
+            lattice,
+            snapping,
             origin: ray.to_frame(grid.origin()),
             cell: grid.cell(),
             grid,
@@ -411,6 +481,10 @@ impl<W: Width> FrameEvaluator<W> {
             ray,
             to_unit: 1.0,
             tri_pts: Vec::new(),
+            tri_input: Vec::new(),
+            input_tris: Vec::new(),
+            lattice: LatticeFrame::default(),
+            snapping: Snapping::default(),
             boundary: BoundaryEdges::default(),
             tolerance: 0.0,
             tree: std::sync::OnceLock::new(),
@@ -419,25 +493,35 @@ impl<W: Width> FrameEvaluator<W> {
         }
     }
 
-    /// Snaps the grid-space query into the frame, axis by axis: lattice coordinates and the
-    /// exact residuals (cells).
+    /// Snaps the grid-space query `q` (of the world query `world`) into the frame, axis by axis:
+    /// lattice coordinates, the exact residuals (cells), and whether each residual is exact (it
+    /// is not where the world → grid scaling underflowed; see [`Grid::kept_exactly`]).
     #[inline]
-    fn snap_frame(&self, q: [f64; 3]) -> ([Snap; 3], [f64; 3]) {
+    fn snap_frame(&self, q: [f64; 3], world: [f64; 3]) -> ([Snap; 3], [f64; 3], [bool; 3]) {
         // Written out (not `array::map`): the closure version was not inlined into the hot path.
         let [m0, m1, m2] = self.ray.map();
         let one = |(axis, neg): (usize, bool)| {
-            let (s, r) = self.grid.snap_with_residual(q[axis], axis);
-            if neg { (s.negated(), -r) } else { (s, r) }
+            let (s, r, exact) = if self.grid.kept_exactly(world[axis], q[axis]) {
+                let (s, r) = self.grid.snap_with_residual(q[axis], axis);
+                (s, r, true)
+            } else {
+                self.grid.snap_underflowed(world[axis], axis)
+            };
+            if neg {
+                (s.negated(), -r, exact)
+            } else {
+                (s, r, exact)
+            }
         };
-        let (s0, r0) = one(m0);
-        let (s1, r1) = one(m1);
-        let (s2, r2) = one(m2);
+        let (s0, r0, e0) = one(m0);
+        let (s1, r1, e1) = one(m1);
+        let (s2, r2, e2) = one(m2);
         if W::PRECISION == Precision::Bits30 {
             // The 30-bit grid is the documented fast approximation: queries (like vertices) are
             // evaluated at their lattice points, `≤ 1.5e-9·extent` away.
-            return ([s0, s1, s2], [0.0; 3]);
+            return ([s0, s1, s2], [0.0; 3], [true; 3]);
         }
-        ([s0, s1, s2], [r0, r1, r2])
+        ([s0, s1, s2], [r0, r1, r2], [e0, e1, e2])
     }
 
     /// The parts at a world query (finite).
@@ -448,13 +532,14 @@ impl<W: Width> FrameEvaluator<W> {
 
     /// The parts and the bound of the expanded boundary (on `w`) at a world query (finite).
     fn parts_with_bound(&self, q: [f64; 3]) -> (i64, f64, f64) {
-        self.parts_in_grid_space(self.grid.pull_in_far(self.grid.to_grid_space(q)))
+        self.parts_in_grid_space(self.grid.pull_in_far(self.grid.to_grid_space(q)), q)
     }
 
-    /// The parts at a grid-space query already pulled in ([`Grid::pull_in_far`]), and the bound.
-    fn parts_in_grid_space(&self, q: [f64; 3]) -> (i64, f64, f64) {
+    /// The parts at a grid-space query already pulled in ([`Grid::pull_in_far`]) from the world
+    /// query `world`, and the bound.
+    fn parts_in_grid_space(&self, q: [f64; 3], world: [f64; 3]) -> (i64, f64, f64) {
         let qf = self.ray.to_frame(q);
-        let (snap, residual) = self.snap_frame(q);
+        let (snap, residual, exact) = self.snap_frame(q, world);
         let (Snap::In(x), Snap::In(y)) = (snap[0], snap[1]) else {
             let (area, bound) = self.far_boundary_sum(qf);
             return (0, area, bound);
@@ -471,14 +556,19 @@ impl<W: Width> FrameEvaluator<W> {
             residual[1],
             if z_exact { residual[2] } else { 0.0 },
         ];
+        // A clamped z is the lattice proxy of the query (same crossings, see the module doc).
+        let query = InputPoint {
+            n: qi,
+            r,
+            world: self.ray.to_frame(world),
+            exact: [exact[0], exact[1], exact[2] || !z_exact],
+        };
         let chi = if snap[2] == Snap::High {
             0
-        } else if r == [0.0; 3] {
-            self.signed_crossings(qi)
         } else {
-            self.signed_crossings_at(qi, r)
+            self.signed_crossings(&query)
         };
-        let (area, bound) = self.boundary_sum(qi, r, z_exact, qf[2]);
+        let (area, bound) = self.boundary_sum(&query, z_exact, qf[2]);
         (chi, area, bound)
     }
 
@@ -493,21 +583,34 @@ impl<W: Width> FrameEvaluator<W> {
             p[axis] = t;
             self.grid.pull_in_far(self.grid.to_grid_space(p))
         };
-        let (snap, residual) = self.snap_frame(self.grid.pull_in_far(self.grid.to_grid_space(q)));
-        let (Snap::In(x), Snap::In(y)) = (snap[0], snap[1]) else {
-            // Beyond the grid across the ray: far queries, one by one.
-            return ts
-                .iter()
+        let world_at = |t: f64| {
+            let mut p = q;
+            p[axis] = t;
+            p
+        };
+        let one_by_one = || {
+            ts.iter()
                 .map(|&t| {
                     if t.is_finite() {
-                        let (chi, area, _) = self.parts_in_grid_space(at(t));
+                        let (chi, area, _) = self.parts_in_grid_space(at(t), world_at(t));
                         chi as f64 + area * INV_4PI
                     } else {
                         f64::NAN
                     }
                 })
-                .collect();
+                .collect()
         };
+        let (snap, residual, exact) =
+            self.snap_frame(self.grid.pull_in_far(self.grid.to_grid_space(q)), q);
+        let (Snap::In(x), Snap::In(y)) = (snap[0], snap[1]) else {
+            // Beyond the grid across the ray: far queries, one by one.
+            return one_by_one();
+        };
+        if !(exact[0] && exact[1]) {
+            // A transverse coordinate the grid scaling could not hold (a tiny coordinate of a
+            // huge mesh): the exact query path, point by point.
+            return one_by_one();
+        }
         // Every point of the column has these lattice x, y and residuals (the pull-in and the
         // snap act axis by axis).
         let (rx, ry) = (residual[0], residual[1]);
@@ -521,6 +624,9 @@ impl<W: Width> FrameEvaluator<W> {
             qz: f64,
             rz: f64,
             high: bool,
+            /// The world value, for the exact path when the residual along z is not exact.
+            world: [f64; 3],
+            rz_exact: bool,
         }
         let points: Vec<Option<Point>> = ts
             .iter()
@@ -530,7 +636,7 @@ impl<W: Width> FrameEvaluator<W> {
                 }
                 let p = at(t);
                 let qz = self.ray.to_frame(p)[2];
-                let (snap, residual) = self.snap_frame(p);
+                let (snap, residual, exact) = self.snap_frame(p, world_at(t));
                 let (z, z_exact, rz, high) = match snap[2] {
                     Snap::In(z) => (z, true, residual[2], false),
                     Snap::Low => (-limit, false, 0.0, false),
@@ -542,15 +648,24 @@ impl<W: Width> FrameEvaluator<W> {
                     qz,
                     rz,
                     high,
+                    world: world_at(t),
+                    rz_exact: exact[2] || !z_exact,
                 })
             })
             .collect();
         // χ. Lattice points share one traversal (below); points off the lattice take their own.
-        let shared = |p: &Point| !transverse_residual && p.rz == 0.0;
+        let shared = |p: &Point| !transverse_residual && p.rz == 0.0 && p.rz_exact;
+        let frame_world = |p: &Point| self.ray.to_frame(p.world);
+        let input_point = |p: &Point| InputPoint {
+            n: [x, y, p.z],
+            r: [rx, ry, p.rz],
+            world: frame_world(p),
+            exact: [true, true, p.rz_exact],
+        };
         let mut chis = vec![0i64; ts.len()];
         for (chi, p) in chis.iter_mut().zip(&points) {
             if let Some(p) = p.as_ref().filter(|p| !shared(p) && !p.high) {
-                *chi = self.signed_crossings_at([x, y, p.z], [rx, ry, p.rz]);
+                *chi = self.signed_crossings(&input_point(p));
             }
         }
         let mut order: Vec<usize> = (0..ts.len())
@@ -569,13 +684,30 @@ impl<W: Width> FrameEvaluator<W> {
             self.bvh
                 .for_each_on_ray(u(x), u(y), f32::NEG_INFINITY, |f| {
                     let p = self.tri_pts[f as usize];
-                    let s = projected_containment::<W>([x, y], p);
+                    let input = self.input_triangle(f as usize);
+                    let s = match input {
+                        Some(t) => input_projected_containment(
+                            &InputPoint::lattice([x, y, 0]),
+                            t,
+                            &self.lattice,
+                        ),
+                        None => projected_containment::<W>([x, y], p),
+                    };
                     if s == 0 {
                         return;
                     }
                     // Hit for the sorted points strictly below the plane: a prefix (the plane side is
                     // monotone in z for a triangle whose projection contains the column).
-                    let below = |j: usize| perturbed_plane_side::<W>([x, y, at_k(j).z], p) == -s;
+                    let below = |j: usize| {
+                        let z = at_k(j).z;
+                        let side = match input {
+                            Some(t) => {
+                                input_plane_side(&InputPoint::lattice([x, y, z]), t, &self.lattice)
+                            }
+                            None => perturbed_plane_side::<W>([x, y, z], p),
+                        };
+                        side == -s
+                    };
                     let (mut lo, mut hi) = (0, active);
                     while lo < hi {
                         let mid = (lo + hi) / 2;
@@ -603,7 +735,8 @@ impl<W: Width> FrameEvaluator<W> {
             let qi = [x, y, p.z];
             let r = [rx, ry, if p.z_exact { p.rz } else { 0.0 }];
             let qz_units = (p.qz - self.origin[2]) / self.cell;
-            let flat = !self.boundary.needs_accurate_sum::<W>(qi, r, p.z_exact)
+            let flat = p.rz_exact
+                && !self.boundary.needs_accurate_sum::<W>(qi, r, p.z_exact)
                 && self
                     .tree()
                     .is_none_or(|t| t.is_flat_at(&self.boundary, qi, p.z_exact, qz_units));
@@ -612,10 +745,11 @@ impl<W: Width> FrameEvaluator<W> {
                     z: p.z,
                     z_exact: p.z_exact,
                     qz_units,
+                    r,
                 };
                 batch.push((k, query));
             } else {
-                let area = self.boundary_sum(qi, r, p.z_exact, p.qz).0;
+                let area = self.boundary_sum(&input_point(p), p.z_exact, p.qz).0;
                 out[k] = chis[k] as f64 + area * INV_4PI;
             }
         }
@@ -629,25 +763,40 @@ impl<W: Width> FrameEvaluator<W> {
         out
     }
 
-    /// χ: signed crossings of the ray from `q_ε` along `+z` (every candidate, no early exit).
-    fn signed_crossings(&self, qi: [i64; 3]) -> i64 {
+    /// χ: signed crossings of the ray from the exact query `q_ε` along `+z` (every candidate, no
+    /// early exit). The candidates of a query off the lattice are its lattice point's (a box
+    /// containing `n + r` contains `n`, by monotone rounding; boxes of triangles off the lattice
+    /// carry one cell of margin). Each triangle is decided by the lattice predicates when the
+    /// lattice holds it and the query exactly, otherwise on the exact inputs.
+    fn signed_crossings(&self, q: &InputPoint) -> i64 {
+        let (qi, r) = (q.n, q.r);
+        let on_lattice = q.on_lattice();
+        let residual_exact = q.residual_exact();
         let mut chi = 0i64;
         let u = |v: i64| (v as f64 * self.to_unit) as f32;
         self.bvh.for_each_on_ray(u(qi[0]), u(qi[1]), u(qi[2]), |f| {
-            chi += i64::from(ray_crossing::<W>(qi, self.tri_pts[f as usize]));
+            let f = f as usize;
+            let p = self.tri_pts[f];
+            let c = match self.input_triangle(f) {
+                Some(t) => input_ray_crossing(q, t, &self.lattice),
+                None if !residual_exact => {
+                    input_ray_crossing(q, &p.map(InputPoint::lattice), &self.lattice)
+                }
+                None if on_lattice => ray_crossing::<W>(qi, p),
+                None => ray_crossing_at::<W>(qi, r, p),
+            };
+            chi += i64::from(c);
         });
         chi
     }
 
-    /// χ from the exact query `qi + r` (off the lattice): the same candidates (a triangle
-    /// whose box contains `qi + r` contains `qi`, by monotone rounding), the `_at` predicates.
-    fn signed_crossings_at(&self, qi: [i64; 3], r: [f64; 3]) -> i64 {
-        let mut chi = 0i64;
-        let u = |v: i64| (v as f64 * self.to_unit) as f32;
-        self.bvh.for_each_on_ray(u(qi[0]), u(qi[1]), u(qi[2]), |f| {
-            chi += i64::from(ray_crossing_at::<W>(qi, r, self.tri_pts[f as usize]));
-        });
-        chi
+    /// The exact corners of triangle `f` (leaf order) when one is off the lattice.
+    #[inline]
+    fn input_triangle(&self, f: usize) -> Option<&[InputPoint; 3]> {
+        match self.tri_input.get(f) {
+            Some(&i) if i != ON_LATTICE => Some(&self.input_tris[i as usize]),
+            _ => None,
+        }
     }
 
     /// `Σ k·Area(A, B, x1)` with exact branch signs at the query `qi + r` (lattice point and
@@ -655,20 +804,22 @@ impl<W: Width> FrameEvaluator<W> {
     /// query's frame z lies outside the grid (then `qz` is used in floating point for the
     /// magnitudes). Queries near a boundary edge, or whose residual matters for a sign, take the
     /// double-double path, never the hierarchy.
-    fn boundary_sum(&self, qi: [i64; 3], r: [f64; 3], z_exact: bool, qz: f64) -> (f64, f64) {
+    fn boundary_sum(&self, q: &InputPoint, z_exact: bool, qz: f64) -> (f64, f64) {
         let qz_units = (qz - self.origin[2]) / self.cell;
-        if self.boundary.needs_accurate_sum::<W>(qi, r, z_exact) {
-            let area = self
-                .boundary
-                .area_sum_accurate::<W>(qi, r, z_exact, qz_units);
+        let (qi, r) = (q.n, q.r);
+        // A residual the grid scaling could not hold: every edge on the exact inputs.
+        if !self.boundary.is_empty()
+            && (!q.residual_exact() || self.boundary.needs_accurate_sum::<W>(qi, r, z_exact))
+        {
+            let area = self.boundary.area_sum_accurate::<W>(q, z_exact, qz_units);
             return (area, 0.0);
         }
         match self.tree() {
             Some(tree) => {
-                let sum = tree.area_sum::<W>(&self.boundary, qi, z_exact, qz_units);
+                let sum = tree.area_sum::<W>(&self.boundary, qi, r, z_exact, qz_units);
                 (sum.area, sum.bound)
             }
-            None => (self.boundary.area_sum::<W>(qi, z_exact, qz_units), 0.0),
+            None => (self.boundary.area_sum::<W>(qi, r, z_exact, qz_units), 0.0),
         }
     }
 
@@ -760,6 +911,65 @@ impl<W: Width> FrameEvaluator<W> {
         self.grid.gradient_to_world(g)
     }
 }
+/// `tri_input` of a triangle whose corners are all on the lattice.
+const ON_LATTICE: u32 = u32::MAX;
+
+/// What snapping the mesh's vertices to the lattice lost ([`WindingNumber::snapping`]). The
+/// exact evaluator computes on the input values either way (issue 21); this says how often it
+/// needs to: triangles and boundary edges with a vertex off the lattice take the input
+/// predicates' filter.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Snapping {
+    /// Vertices not on the lattice (their coordinates have bits below the cell).
+    pub off_lattice: usize,
+    /// The largest distance along one axis from a vertex to its lattice point, in world units
+    /// (at most half a cell; 0 when the mesh snapped without loss).
+    pub max_displacement: f64,
+    /// The lattice's cell in world units.
+    pub cell: f64,
+}
+
+impl Snapping {
+    fn of(inputs: &[InputPoint], cell: f64) -> Snapping {
+        let mut out = Snapping {
+            cell,
+            ..Snapping::default()
+        };
+        for p in inputs.iter().filter(|p| !p.on_lattice()) {
+            out.off_lattice += 1;
+            let r = p.r.iter().fold(0.0_f64, |m, r| m.max(r.abs()));
+            // An underflowed residual is within 2^-1000 cells of the true one; report the true
+            // bound, half a cell, if it rounded to zero.
+            let r = if p.residual_exact() {
+                r
+            } else {
+                r.max(f64::MIN_POSITIVE)
+            };
+            out.max_displacement = out.max_displacement.max(r * cell);
+        }
+        out
+    }
+
+    /// The snapping of `mesh`'s vertices to the default (60-bit) lattice, without building an
+    /// evaluator (what `gwn info` prints). `None` for an empty mesh or coordinates the grid
+    /// cannot hold.
+    pub fn of_mesh(mesh: &Mesh) -> Option<Snapping> {
+        let grid = Grid::new(&mesh.bounding_box()?, Precision::Bits60).ok()?;
+        let map = RayAxis::PosZ.map();
+        let inputs: Vec<InputPoint> = mesh
+            .positions()
+            .iter()
+            .map(|&p| grid.input_vertex(p, map))
+            .collect();
+        Some(Snapping::of(&inputs, grid.cell_in_world()))
+    }
+
+    /// Whether every vertex lies on the lattice (the mesh snapped without loss).
+    pub fn lossless(&self) -> bool {
+        self.off_lattice == 0
+    }
+}
+
 /// The longest run [`WindingNumber::eval_batch`] evaluates as one column.
 const MAX_RUN: usize = 256;
 

@@ -32,6 +32,9 @@ pub struct ColumnQuery {
     pub z_exact: bool,
     /// The query's `z` in grid units when `z_exact` is false.
     pub qz_units: f64,
+    /// The query's exact residual in cells (`r[2] = 0` when `z_exact` is false): signs of edges
+    /// off the lattice are taken at `(x, y, z) + r` (see [`BoundaryEdges::area_sum`]).
+    pub r: [f64; 3],
 }
 
 impl ColumnQuery {
@@ -64,7 +67,7 @@ impl BoundaryEdges {
     ) {
         assert_eq!(queries.len(), out.len());
         let single =
-            |c: &ColumnQuery| self.area_sum::<W>([qxy[0], qxy[1], c.z], c.z_exact, c.qz_units);
+            |c: &ColumnQuery| self.area_sum::<W>([qxy[0], qxy[1], c.z], c.r, c.z_exact, c.qz_units);
         #[cfg(target_arch = "x86_64")]
         if !self.is_empty() && std::arch::is_x86_feature_detected!("avx2") {
             for (batch, out) in queries.chunks(QUERIES).zip(out.chunks_mut(QUERIES)) {
@@ -89,11 +92,12 @@ impl BoundaryEdges {
                     // The single-query loop adds the exact terms in slot order too.
                     let mut scalar = 0.0;
                     for &e in &undecided {
-                        scalar += self.exact_edge_area::<W>(e as usize, qi, c.z_exact, c.qz_units);
+                        scalar +=
+                            self.exact_edge_area::<W>(e as usize, qi, c.r, c.z_exact, c.qz_units);
                     }
                     *out = 2.0 * angles[k].total()
                         + scalar
-                        + self.heavy_area_sum::<W>(qi, c.z_exact, c.qz_units);
+                        + self.heavy_area_sum::<W>(qi, c.r, c.z_exact, c.qz_units);
                 }
             }
             return;
@@ -277,13 +281,15 @@ mod tests {
                             z,
                             z_exact,
                             qz_units: if z_exact { 0.0 } else { z as f64 * 3.0 + 0.5 },
+                            r: [0.0; 3],
                         }
                     })
                     .collect();
                 let mut got = vec![0.0; queries.len()];
                 edges.column_area_sums::<W128>(qxy, &queries, &mut got);
                 for (c, got) in queries.iter().zip(&got) {
-                    let want = edges.area_sum::<W128>([qxy[0], qxy[1], c.z], c.z_exact, c.qz_units);
+                    let want =
+                        edges.area_sum::<W128>([qxy[0], qxy[1], c.z], c.r, c.z_exact, c.qz_units);
                     assert_eq!(
                         got.to_bits(),
                         want.to_bits(),

@@ -21,6 +21,7 @@ use super::angle_sum::AngleSum;
 use super::angle_sum::AngleSumAvx2;
 use super::compensated::NeumaierSum;
 use super::double_double::DoubleDouble;
+use super::input_predicates::{InputPoint, LatticeFrame, input_inside_segment, input_orient2d};
 use super::predicates::{
     ORIENT2D_FILTER_CONVERSION, ORIENT2D_FILTER_RELATIVE, Width, perturbed_orient2d,
     perturbed_orient2d_at, query_inside_segment, query_inside_segment_at,
@@ -115,6 +116,20 @@ pub struct BoundaryEdges {
     /// The edges' boxes grown by [`near_edge_pad`], in normalized coordinates: finds the edges
     /// near a query (see [`BoundaryEdges::needs_accurate_sum`]).
     near: RayBvh,
+    /// The endpoints exactly as given, when some are off the lattice (`None`: every endpoint
+    /// snapped without loss, and the lattice is the input).
+    inputs: Option<EdgeInputs>,
+    /// How exact values are rebuilt from world coordinates.
+    lattice: LatticeFrame,
+}
+
+/// The exact endpoints of the edges (see [`BoundaryEdges::with_inputs`]).
+#[derive(Clone, Debug)]
+struct EdgeInputs {
+    a: Vec<InputPoint>,
+    b: Vec<InputPoint>,
+    /// Per edge: an endpoint is off the lattice.
+    off_lattice: Vec<bool>,
 }
 
 /// How far around edge `a b` (grid units) a query gets the double-double term: `2^-7` of the
@@ -131,6 +146,21 @@ pub struct BoundaryEdges {
 fn near_edge_pad(a: [i64; 3], b: [i64; 3]) -> i64 {
     let len = (0..3).map(|k| (a[k] - b[k]).abs()).max().unwrap_or(0);
     (len >> 7).max(16)
+}
+
+/// Half-width (grid units) of the column above each boundary vertex in which a query takes the
+/// double-double path: `limit / 2^14` (`2^45` cells at 60 bits, about `1e-5` of the extent).
+///
+/// Why: a vertex `v` seen almost along the ray (transverse offset `h ≪ |v − q|`) enters its
+/// terms through the azimuth of `v − q` around the ray (the on-ray limit of
+/// docs/robustness.md §3), so an absolute error `δ` in the transverse offset moves the term by
+/// `≈ 2δ/h` whatever the distance along the ray. The loop's offsets carry `δ ≤ 2^7` cells (two
+/// conversions of 59-bit integers to `f64`, half a cell of snapping); outside the column the
+/// term errs by `≤ 2·2^7/2^45 = 2^-37` in area, `≤ 6e-13` on `w`. Queries in the column are
+/// rare (`π(1e-5)²` of the box per boundary vertex), so the slow path stays rare.
+#[inline]
+fn ray_tube(limit: f64) -> i64 {
+    (limit as i64) >> 14
 }
 
 /// Whether edge `a → b` is parallel to the ray (equal `x, y` in the frame; zero length included).
@@ -155,7 +185,51 @@ impl BoundaryEdges {
     /// Packs edges `a[i] → b[i]` with positive integer weights `weight[i]` (grid coordinates, ray
     /// frame).
     pub fn new(a: Vec<[i64; 3]>, b: Vec<[i64; 3]>, weight: Vec<f64>, bits: u32) -> Self {
-        let mut chains = chain_edges(&a, &b, &weight);
+        Self::build(a, b, weight, bits, None, LatticeFrame::default())
+    }
+
+    /// [`BoundaryEdges::new`] with the exact endpoints (`a_in[i]`, `b_in[i]` of edge `i`, whose
+    /// lattice points are `a[i]`, `b[i]`): kept when some endpoint is off the lattice. Every sign
+    /// the loops cannot take from their `f64` filter is then decided on these (the filter's own
+    /// decisions are already exact for them, see [`super::predicates::SNAP_WITHIN_FILTER`]), and
+    /// an edge is left out as parallel to the ray only when its input endpoints are (a snapped
+    /// edge can be vertical on the lattice and tilted in the input).
+    pub fn with_inputs(
+        a: Vec<[i64; 3]>,
+        b: Vec<[i64; 3]>,
+        weight: Vec<f64>,
+        bits: u32,
+        (a_in, b_in): (Vec<InputPoint>, Vec<InputPoint>),
+        lattice: LatticeFrame,
+    ) -> Self {
+        debug_assert!(a_in.len() == a.len() && b_in.len() == b.len());
+        let off_lattice: Vec<bool> = a_in
+            .iter()
+            .zip(&b_in)
+            .map(|(p, q)| !p.on_lattice() || !q.on_lattice())
+            .collect();
+        let inputs = off_lattice.iter().any(|&x| x).then_some(EdgeInputs {
+            a: a_in,
+            b: b_in,
+            off_lattice,
+        });
+        Self::build(a, b, weight, bits, inputs, lattice)
+    }
+
+    fn build(
+        a: Vec<[i64; 3]>,
+        b: Vec<[i64; 3]>,
+        weight: Vec<f64>,
+        bits: u32,
+        inputs: Option<EdgeInputs>,
+        lattice: LatticeFrame,
+    ) -> Self {
+        let parallel: Vec<bool> = (0..a.len())
+            .map(|i| {
+                is_parallel_to_ray(a[i], b[i]) && inputs.as_ref().is_none_or(|x| !x.off_lattice[i])
+            })
+            .collect();
+        let mut chains = chain_edges(&a, &b, &weight, &parallel);
         // Chains in Morton order of their first vertex: the hierarchy over slot ranges
         // (`boundary_tree`) then groups nearby chains (a scan's many small holes) into compact
         // nodes. The flat sum does not depend on the order (beyond rounding).
@@ -201,10 +275,7 @@ impl BoundaryEdges {
             edge_of.push(u32::MAX);
         }
         let heavy = (0..weight.len() as u32)
-            .filter(|&i| {
-                weight[i as usize] > MAX_CHAINED_WEIGHT
-                    && !is_parallel_to_ray(a[i as usize], b[i as usize])
-            })
+            .filter(|&i| weight[i as usize] > MAX_CHAINED_WEIGHT && !parallel[i as usize])
             .collect();
         let limit = (1_i64 << (bits - 1)) as f64;
         let to_unit = 1.0 / limit;
@@ -213,8 +284,12 @@ impl BoundaryEdges {
             .zip(&b)
             .map(|(&p, &q)| {
                 let pad = near_edge_pad(p, q);
-                let lo = std::array::from_fn(|k| ((p[k].min(q[k]) - pad) as f64 * to_unit) as f32);
-                let hi = std::array::from_fn(|k| ((p[k].max(q[k]) + pad) as f64 * to_unit) as f32);
+                let tube = ray_tube(limit);
+                let pad = |k: usize| if k < 2 { pad.max(tube) } else { pad };
+                let lo =
+                    std::array::from_fn(|k| ((p[k].min(q[k]) - pad(k)) as f64 * to_unit) as f32);
+                let hi =
+                    std::array::from_fn(|k| ((p[k].max(q[k]) + pad(k)) as f64 * to_unit) as f32);
                 (lo, hi)
             })
             .collect();
@@ -232,7 +307,16 @@ impl BoundaryEdges {
             heavy,
             limit,
             near,
+            inputs,
+            lattice,
         }
+    }
+
+    /// How many edges have an endpoint off the lattice.
+    pub fn off_lattice_edges(&self) -> usize {
+        self.inputs
+            .as_ref()
+            .map_or(0, |x| x.off_lattice.iter().filter(|&&o| o).count())
     }
 
     /// Number of edges.
@@ -253,12 +337,22 @@ impl BoundaryEdges {
     /// `Σ w·Area` for the query `qi` (grid coordinates, frame). When `z_exact` is false the
     /// query's z lies outside the grid: `qz_units` (its z in grid units, `f64`) is used for the
     /// magnitudes and `qi[2]` (clamped) for nothing but the predicates, which do not involve z.
-    pub fn area_sum<W: Width>(&self, qi: [i64; 3], z_exact: bool, qz_units: f64) -> f64 {
+    /// `r` is the query's exact residual (cells; `r[2] = 0` when `z_exact` is false): the
+    /// magnitudes use the lattice point, every sign the exact query (see
+    /// [`BoundaryEdges::exact_edge_area`]; the caller has checked with
+    /// [`BoundaryEdges::needs_accurate_sum`] that `r` changes no lattice edge's sign).
+    pub fn area_sum<W: Width>(
+        &self,
+        qi: [i64; 3],
+        r: [f64; 3],
+        z_exact: bool,
+        qz_units: f64,
+    ) -> f64 {
         if self.a.is_empty() {
             return 0.0;
         }
-        let (angles, scalar) = self.range_area_sum::<W>(qi, z_exact, qz_units, 0..self.slots);
-        2.0 * angles.total() + scalar + self.heavy_area_sum::<W>(qi, z_exact, qz_units)
+        let (angles, scalar) = self.range_area_sum::<W>(qi, r, z_exact, qz_units, 0..self.slots);
+        2.0 * angles.total() + scalar + self.heavy_area_sum::<W>(qi, r, z_exact, qz_units)
     }
 
     /// The chained edges of the slots `range` (a multiple of 4 at the start; see
@@ -267,6 +361,7 @@ impl BoundaryEdges {
     pub(crate) fn range_area_sum<W: Width>(
         &self,
         qi: [i64; 3],
+        r: [f64; 3],
         z_exact: bool,
         qz_units: f64,
         range: std::ops::Range<usize>,
@@ -279,7 +374,7 @@ impl BoundaryEdges {
         ];
         let mut scalar = 0.0;
         let mut undecided = |e: u32| {
-            scalar += self.exact_edge_area::<W>(e as usize, qi, z_exact, qz_units);
+            scalar += self.exact_edge_area::<W>(e as usize, qi, r, z_exact, qz_units);
         };
         #[cfg(target_arch = "x86_64")]
         let range_angles = if std::arch::is_x86_feature_detected!("avx2") {
@@ -301,13 +396,14 @@ impl BoundaryEdges {
     pub(crate) fn heavy_area_sum<W: Width>(
         &self,
         qi: [i64; 3],
+        r: [f64; 3],
         z_exact: bool,
         qz_units: f64,
     ) -> f64 {
         let mut sum = 0.0;
         for &e in &self.heavy {
             let e = e as usize;
-            sum += self.weight[e] * self.exact_edge_area::<W>(e, qi, z_exact, qz_units);
+            sum += self.weight[e] * self.exact_edge_area::<W>(e, qi, r, z_exact, qz_units);
         }
         sum
     }
@@ -356,10 +452,7 @@ impl BoundaryEdges {
             return false;
         }
         let residual = r != [0.0; 3];
-        if !residual && !z_exact {
-            // Beyond the padded box along the ray: farther than the mesh extent from every edge.
-            return false;
-        }
+        let tube = ray_tube(self.limit);
         let u = |v: i64| (v as f64 / self.limit) as f32;
         let z_min = if residual {
             f32::NEG_INFINITY
@@ -372,6 +465,15 @@ impl BoundaryEdges {
                 return;
             }
             let (a, b) = (self.a[e as usize], self.b[e as usize]);
+            let near_ray = |p: [i64; 3]| {
+                (p[0] - qi[0]).abs() <= tube
+                    && (p[1] - qi[1]).abs() <= tube
+                    && (!z_exact || p[2] >= qi[2] - 1)
+            };
+            if near_ray(a) || near_ray(b) {
+                flagged = true;
+                return;
+            }
             let pad = near_edge_pad(a, b);
             if z_exact
                 && (0..3).all(|k| qi[k] >= a[k].min(b[k]) - pad && qi[k] <= a[k].max(b[k]) + pad)
@@ -391,42 +493,60 @@ impl BoundaryEdges {
         flagged
     }
 
-    /// `Σ w·Area` at the exact query `qi + r` (see [`BoundaryEdges::needs_accurate_sum`]): every
-    /// sign from the `_at` predicates, every magnitude from double-double offsets. `O(B)` scalar.
+    /// `Σ w·Area` at the exact query `q = qi + r` (see [`BoundaryEdges::needs_accurate_sum`]):
+    /// every sign from the exact predicates (the `_at` ones on the lattice, the input ones for
+    /// edges with an endpoint off the lattice or a query whose residual underflowed), every
+    /// magnitude from double-double offsets of the exact points. `O(B)` scalar.
     #[cold]
-    pub fn area_sum_accurate<W: Width>(
-        &self,
-        qi: [i64; 3],
-        r: [f64; 3],
-        z_exact: bool,
-        qz_units: f64,
-    ) -> f64 {
-        let offset = |p: [i64; 3]| -> [DoubleDouble; 3] {
+    pub fn area_sum_accurate<W: Width>(&self, q: &InputPoint, z_exact: bool, qz_units: f64) -> f64 {
+        let (qi, r) = (q.n, q.r);
+        let lattice_query = q.residual_exact();
+        // `p − q` in double-double: the lattice difference is exact, the residuals' difference is
+        // exact (two-sum), so near a vertex (same lattice point) the offset is exact however
+        // small — `1e-300` from a corner (the term's scaling is removed in the spherical formula).
+        let offset = |n: [i64; 3], s: [f64; 3]| -> [DoubleDouble; 3] {
             let along =
-                |k: usize| DoubleDouble::from_i64(p[k] - qi[k]) - DoubleDouble::from_f64(r[k]);
+                |k: usize| DoubleDouble::from_i64(n[k] - qi[k]) + DoubleDouble::diff(s[k], r[k]);
             let z = if z_exact {
                 along(2)
             } else {
-                DoubleDouble::from_i64(p[2]) - DoubleDouble::from_f64(qz_units)
+                DoubleDouble::from_i64(n[2]) + DoubleDouble::diff(s[2], qz_units)
             };
             [along(0), along(1), z]
         };
         let mut sum = NeumaierSum::new();
         for i in 0..self.a.len() {
             let (a, b) = (self.a[i], self.b[i]);
-            let o = perturbed_orient2d_at::<W>(
-                [qi[0], qi[1]],
-                [r[0], r[1]],
-                [a[0], a[1]],
-                [b[0], b[1]],
-            );
-            let signs = EdgeSigns {
-                numerator: -o.sign,
-                query_inside_segment: o.degenerate
-                    && z_exact
-                    && query_inside_segment_at(qi, r, a, b),
+            let off_lattice = self.inputs.as_ref().filter(|x| x.off_lattice[i]);
+            let (signs, ra, rb) = if off_lattice.is_some() || !lattice_query {
+                let (pa, pb) = match off_lattice {
+                    Some(x) => (x.a[i], x.b[i]),
+                    None => (InputPoint::lattice(a), InputPoint::lattice(b)),
+                };
+                let o = input_orient2d(q, &pa, &pb, &self.lattice);
+                let signs = EdgeSigns {
+                    numerator: -o.sign,
+                    query_inside_segment: o.degenerate
+                        && z_exact
+                        && input_inside_segment(q, &pa, &pb, &self.lattice),
+                };
+                (signs, offset(pa.n, pa.r), offset(pb.n, pb.r))
+            } else {
+                let o = perturbed_orient2d_at::<W>(
+                    [qi[0], qi[1]],
+                    [r[0], r[1]],
+                    [a[0], a[1]],
+                    [b[0], b[1]],
+                );
+                let signs = EdgeSigns {
+                    numerator: -o.sign,
+                    query_inside_segment: o.degenerate
+                        && z_exact
+                        && query_inside_segment_at(qi, r, a, b),
+                };
+                (signs, offset(a, [0.0; 3]), offset(b, [0.0; 3]))
             };
-            sum.add(self.weight[i] * antipodal_edge_area_accurate(offset(a), offset(b), signs));
+            sum.add(self.weight[i] * antipodal_edge_area_accurate(ra, rb, signs));
         }
         sum.value()
     }
@@ -587,16 +707,38 @@ impl BoundaryEdges {
         }
     }
 
-    /// One edge through the exact predicate and the limit formulas.
+    /// One edge through the exact predicate and the limit formulas. An edge with an endpoint off
+    /// the lattice is signed on the exact inputs, the query `qi + r` included (the lattice sign
+    /// could be the snapped edge's); the magnitudes stay the lattice ones (within a cell).
     #[cold]
     pub(super) fn exact_edge_area<W: Width>(
         &self,
         i: usize,
         qi: [i64; 3],
+        r: [f64; 3],
         z_exact: bool,
         qz_units: f64,
     ) -> f64 {
-        segment_area::<W>(self.a[i], self.b[i], qi, z_exact, qz_units)
+        let (a, b) = (self.a[i], self.b[i]);
+        let Some(inputs) = self.inputs.as_ref().filter(|x| x.off_lattice[i]) else {
+            return segment_area::<W>(a, b, qi, z_exact, qz_units);
+        };
+        let q = InputPoint {
+            n: qi,
+            r: [r[0], r[1], if z_exact { r[2] } else { 0.0 }],
+            world: [0.0; 3],
+            exact: [true; 3],
+        };
+        let (pa, pb) = (&inputs.a[i], &inputs.b[i]);
+        let o = input_orient2d(&q, pa, pb, &self.lattice);
+        let signs = EdgeSigns {
+            numerator: -o.sign,
+            query_inside_segment: o.degenerate
+                && z_exact
+                && input_inside_segment(&q, pa, pb, &self.lattice),
+        };
+        let (ra, rb) = lattice_offsets(a, b, qi, z_exact, qz_units);
+        antipodal_edge_area(ra, rb, signs)
     }
 }
 
@@ -611,6 +753,24 @@ pub(crate) fn segment_area<W: Width>(
     qz_units: f64,
 ) -> f64 {
     let o = perturbed_orient2d::<W>([qi[0], qi[1]], [a[0], a[1]], [b[0], b[1]]);
+    let (ra, rb) = lattice_offsets(a, b, qi, z_exact, qz_units);
+    let signs = EdgeSigns {
+        numerator: -o.sign,
+        query_inside_segment: o.degenerate && z_exact && query_inside_segment(qi, a, b),
+    };
+    antipodal_edge_area(ra, rb, signs)
+}
+
+/// The offsets `a − q`, `b − q` in grid units (`f64`) from the lattice query (`z` from
+/// `qz_units` when `z_exact` is false).
+#[inline]
+fn lattice_offsets(
+    a: [i64; 3],
+    b: [i64; 3],
+    qi: [i64; 3],
+    z_exact: bool,
+    qz_units: f64,
+) -> ([f64; 3], [f64; 3]) {
     let dz = |p: [i64; 3]| {
         if z_exact {
             (p[2] - qi[2]) as f64
@@ -620,11 +780,7 @@ pub(crate) fn segment_area<W: Width>(
     };
     let ra = [(a[0] - qi[0]) as f64, (a[1] - qi[1]) as f64, dz(a)];
     let rb = [(b[0] - qi[0]) as f64, (b[1] - qi[1]) as f64, dz(b)];
-    let signs = EdgeSigns {
-        numerator: -o.sign,
-        query_inside_segment: o.degenerate && z_exact && query_inside_segment(qi, a, b),
-    };
-    antipodal_edge_area(ra, rb, signs)
+    (ra, rb)
 }
 
 /// The Morton (Z-order) key of a grid point: the top 21 bits of each coordinate, interleaved.
@@ -640,12 +796,12 @@ fn morton_key(p: [i64; 3], bits: u32) -> u64 {
 /// Decomposes the edges (edge `i` repeated `weight[i]` times, heavy edges left out) into chains: sequences of edges,
 /// each starting where the previous one ends. Vertices are identified by their grid coordinates.
 /// Returns, per chain, the edge indices in walking order.
-fn chain_edges(a: &[[i64; 3]], b: &[[i64; 3]], weight: &[f64]) -> Vec<Vec<u32>> {
+fn chain_edges(a: &[[i64; 3]], b: &[[i64; 3]], weight: &[f64], parallel: &[bool]) -> Vec<Vec<u32>> {
     use std::collections::HashMap;
     let mut out_edges: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
     let mut in_degree: HashMap<[i64; 3], usize> = HashMap::new();
     for i in 0..a.len() {
-        let copies = if is_parallel_to_ray(a[i], b[i]) {
+        let copies = if parallel[i] {
             0
         } else if weight[i] <= MAX_CHAINED_WEIGHT {
             weight[i].max(0.0) as usize
@@ -744,7 +900,7 @@ mod tests {
                 let want: f64 = (0..a.len())
                     .map(|i| weight[i] * segment_area::<W128>(a[i], b[i], q, true, 0.0))
                     .sum();
-                let got = edges.area_sum::<W128>(q, true, 0.0);
+                let got = edges.area_sum::<W128>(q, [0.0; 3], true, 0.0);
                 assert!((got - want).abs() < 1e-9, "q {q:?}: {got} vs {want}");
             }
         }
@@ -845,7 +1001,8 @@ mod tests {
             let a: Vec<[i64; 3]> = (0..n).map(|_| vert(next(5))).collect();
             let b: Vec<[i64; 3]> = (0..n).map(|_| vert(next(5))).collect();
             let weight: Vec<f64> = (0..n).map(|_| (1 + next(7)) as f64).collect();
-            let chains = chain_edges(&a, &b, &weight);
+            let parallel: Vec<bool> = (0..n).map(|i| is_parallel_to_ray(a[i], b[i])).collect();
+            let chains = chain_edges(&a, &b, &weight, &parallel);
             let mut used = vec![0.0; n];
             for chain in &chains {
                 for w in chain.windows(2) {

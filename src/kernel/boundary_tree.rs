@@ -359,6 +359,7 @@ impl BoundaryTree {
         &self,
         edges: &BoundaryEdges,
         qi: [i64; 3],
+        r: [f64; 3],
         z_exact: bool,
         qz_units: f64,
     ) -> TreeSum {
@@ -375,7 +376,7 @@ impl BoundaryTree {
         let mut angles: Option<AngleSum> = None;
         let mut scalar = 0.0;
         let mut run_exact = |range: std::ops::Range<usize>| {
-            let (a, s) = edges.range_area_sum::<W>(qi, z_exact, qz_units, range);
+            let (a, s) = edges.range_area_sum::<W>(qi, r, z_exact, qz_units, range);
             match &mut angles {
                 Some(acc) => acc.absorb(&a),
                 None => angles = Some(a),
@@ -392,7 +393,7 @@ impl BoundaryTree {
             angles = Some(spoke_angles);
         }
         sum.area += angles.map_or(0.0, |a| 2.0 * a.total()) + scalar + spoke_scalar;
-        sum.area += edges.heavy_area_sum::<W>(qi, z_exact, qz_units);
+        sum.area += edges.heavy_area_sum::<W>(qi, r, z_exact, qz_units);
         sum
     }
 

@@ -7,6 +7,9 @@
 //! - [`predicates`]: the symbolically perturbed orientation sign shared by the ray–triangle test
 //!   and the atan2 branch, and the perturbed depth test (filter + exact fallback), also at
 //!   queries off the lattice;
+//! - [`input_predicates`]: the same predicates, same perturbation, on vertices and queries that
+//!   are not on the lattice (input bits the lattice cannot hold): `f64` filters whose bounds
+//!   include every rounding, then exact dyadic arithmetic (`dyadic`);
 //! - [`spherical`]: the solid-angle and spherical-triangle formulas;
 //! - [`angle_sum`]: sums of many `atan2` terms as one complex product with turn counting;
 //! - [`boundary_sum`]: the SIMD loop over the boundary edges of the Antipodal formula;
@@ -23,7 +26,9 @@ pub mod boundary_multipole;
 pub mod boundary_sum;
 pub mod boundary_tree;
 pub mod double_double;
+mod dyadic;
 pub mod frame;
+pub mod input_predicates;
 pub mod predicates;
 pub mod quantize;
 pub mod spherical;

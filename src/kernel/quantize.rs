@@ -26,6 +26,7 @@
 //! term's products would overflow `f64` (w was NaN at 1e100), and the move changes `w` by less
 //! than `2^-60` (see there).
 
+use super::input_predicates::{InputPoint, LatticeFrame};
 use crate::BoundingBox;
 
 /// Width of the fixed-point grid, and with it the integer type of the predicates.
@@ -310,6 +311,84 @@ impl Grid {
         })
     }
 
+    /// Whether the grid-space coordinate `g = to_grid_space(x)` holds the world coordinate `x`
+    /// exactly. The power-of-two scaling is exact unless it shrinks a tiny coordinate of a huge
+    /// mesh into the subnormal range (or to zero); then the residual of `g` is not the input's,
+    /// and the exact predicates rebuild it from `x` ([`crate::kernel::input_predicates`]).
+    #[inline]
+    pub fn kept_exactly(&self, x: f64, g: f64) -> bool {
+        g.abs() >= f64::MIN_POSITIVE || x == 0.0 || self.rescale.invert(g) == x
+    }
+
+    /// [`Grid::snap_with_residual`] of a world coordinate whose grid-space value underflowed
+    /// ([`Grid::kept_exactly`] false): `|x·2^k| < 2^-1022`, so `|x/cell| < 1/2` and the nearest
+    /// lattice point is the origin's, with residual `x/cell` taken from `x` itself (not from its
+    /// underflowed grid value). Returns whether that residual is exact in `f64` (it is not when
+    /// it is below `2^-1074` cells: a huge mesh and a tiny coordinate; the exact predicates then
+    /// rebuild it from `x`).
+    #[cold]
+    pub fn snap_underflowed(&self, x: f64, axis: usize) -> (Snap, f64, bool) {
+        let shift = self.rescale.exponent - self.cell_exp;
+        let (a, b) = (shift / 2, shift - shift / 2);
+        let r = x * pow2(a.clamp(-1022, 1023)) * pow2(b.clamp(-1022, 1023));
+        let exact = (a.abs() <= 1022 && b.abs() <= 1022)
+            && (r.abs() >= f64::MIN_POSITIVE
+                || r / pow2(a.clamp(-1022, 1023)) / pow2(b.clamp(-1022, 1023)) == x);
+        let (snap, r) = self.classify(-self.origin_cells[axis], r);
+        (snap, r, exact)
+    }
+
+    /// How the exact predicates rebuild a frame coordinate in cells from its world value, for
+    /// the ray frame that reads world axis `map[k].0`, negated when `map[k].1`.
+    pub fn lattice_frame(&self, map: [(usize, bool); 3]) -> LatticeFrame {
+        LatticeFrame {
+            shift: i64::from(self.rescale.exponent) - i64::from(self.cell_exp),
+            origin_cells: map.map(|(axis, neg)| {
+                if neg {
+                    -self.origin_cells[axis]
+                } else {
+                    self.origin_cells[axis]
+                }
+            }),
+        }
+    }
+
+    /// A mesh vertex (world) in the ray frame exactly: lattice point, residual, world bits.
+    pub fn input_vertex(&self, p: [f64; 3], map: [(usize, bool); 3]) -> InputPoint {
+        let g = self.to_grid_space(p);
+        let one = |(axis, neg): (usize, bool)| {
+            let (s, r, exact) = if self.kept_exactly(p[axis], g[axis]) {
+                let (s, r) = self.snap_with_residual(g[axis], axis);
+                (s, r, true)
+            } else {
+                self.snap_underflowed(p[axis], axis)
+            };
+            let n = match s {
+                Snap::In(v) => v,
+                Snap::Low => -self.limit,
+                Snap::High => self.limit,
+            };
+            let w = p[axis];
+            if neg {
+                (-n, -r, -w, exact)
+            } else {
+                (n, r, w, exact)
+            }
+        };
+        let [a, b, c] = map.map(one);
+        InputPoint {
+            n: [a.0, b.0, c.0],
+            r: [a.1, b.1, c.1],
+            world: [a.2, b.2, c.2],
+            exact: [a.3, b.3, c.3],
+        }
+    }
+
+    /// The cell's edge length in world units.
+    pub fn cell_in_world(&self) -> f64 {
+        self.rescale.invert(self.cell)
+    }
+
     /// The grid-space position of integer coordinate `v` along `axis`.
     #[inline]
     pub fn unsnap(&self, v: i64, axis: usize) -> f64 {
@@ -372,13 +451,17 @@ pub fn pull_in(q: [f64; 3], c: [f64; 3], r: f64) -> [f64; 3] {
 pub struct Rescale {
     /// Two representable powers of two (their product may not be, e.g. `2^1074`).
     factors: [f64; 2],
+    /// `log2` of their product.
+    exponent: i32,
 }
 
 impl Rescale {
     /// The scaling for a box of half-extent `half_extent > 0` (finite).
     pub fn for_half_extent(half_extent: f64) -> Rescale {
+        let exponent = -(exponent_of(half_extent) + 1);
         Rescale {
-            factors: split_power_of_two(-(exponent_of(half_extent) + 1)),
+            factors: split_power_of_two(exponent),
+            exponent,
         }
     }
 
@@ -390,7 +473,10 @@ impl Rescale {
         if h > 0.0 && h.is_finite() {
             Self::for_half_extent(h)
         } else {
-            Rescale { factors: [1.0; 2] }
+            Rescale {
+                factors: [1.0; 2],
+                exponent: 0,
+            }
         }
     }
 
@@ -398,6 +484,13 @@ impl Rescale {
     #[inline]
     pub fn apply(&self, p: [f64; 3]) -> [f64; 3] {
         p.map(|c| c * self.factors[0] * self.factors[1])
+    }
+
+    /// The inverse scaling of one coordinate (exact when `g` came from [`Rescale::apply`]
+    /// without underflow).
+    #[inline]
+    fn invert(&self, g: f64) -> f64 {
+        g / self.factors[0] / self.factors[1]
     }
 }
 

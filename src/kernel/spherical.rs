@@ -329,6 +329,11 @@ pub fn antipodal_edge_area_accurate(
     rb: [DoubleDouble; 3],
     signs: EdgeSigns,
 ) -> f64 {
+    // The term depends on the directions of `ra` and `rb` only (numerator and denominator are
+    // both homogeneous of degree 1 in each): scaled by powers of two to unit size, offsets of
+    // `1e-300` (a query next to a boundary vertex) neither underflow their squares nor lose the
+    // formula's bits (issue 21: the open box returned 0.875 for 0.5 below ~1e-172).
+    let (ra, rb) = (unit_scaled(ra), unit_scaled(rb));
     let hi = |r: &[DoubleDouble; 3]| r.map(|c| c.hi);
     let (fa, fb) = (hi(&ra), hi(&rb));
     let degenerate = signs.numerator == 0
@@ -374,6 +379,52 @@ pub fn segment_gradient(ra: [f64; 3], rb: [f64; 3]) -> [f64; 3] {
     let f = (la + lb) / (la * lb * (la * lb + dot(ra, rb)));
     [c[0] * f, c[1] * f, c[2] * f]
 }
+
+/// `r` times the power of two that brings its largest component into `[1, 2)` (exact; `r`
+/// unchanged when zero).
+///
+/// A vertex seen almost exactly along the ray (`|r_xy| ≪ |r|`) is a second case: the term then
+/// depends on the azimuth of `r_xy` (the on-ray limit of §3 of docs/robustness.md, with the
+/// actual direction instead of the perturbation's), and its products would underflow below
+/// `2^-1022`. Its `r_xy` is scaled out to `NEAR_RAY_FLOOR·|r|` along its own azimuth instead,
+/// which changes the term by less than that angle, `2^-500` radians.
+fn unit_scaled(r: [DoubleDouble; 3]) -> [DoubleDouble; 3] {
+    let m = r.iter().fold(0.0_f64, |m, c| m.max(c.hi.abs()));
+    if m == 0.0 || !m.is_finite() {
+        return r;
+    }
+    let h = r[0].hi.abs().max(r[1].hi.abs());
+    let down = -binary_exponent(m);
+    let across = if h > 0.0 {
+        down.max(NEAR_RAY_FLOOR_EXPONENT - binary_exponent(h))
+    } else {
+        down
+    };
+    let scale = |c: DoubleDouble, k: i32| {
+        // `2^k` in two representable steps (`|k|` may exceed 1022 for subnormal parts).
+        let (k1, k2) = (k / 2, k - k / 2);
+        let f1 = f64::from_bits(((k1 + 1023) as u64) << 52);
+        let f2 = f64::from_bits(((k2 + 1023) as u64) << 52);
+        DoubleDouble {
+            hi: c.hi * f1 * f2,
+            lo: c.lo * f1 * f2,
+        }
+    };
+    [scale(r[0], across), scale(r[1], across), scale(r[2], down)]
+}
+
+/// `⌊log2 |x|⌋` for finite non-zero `x` (subnormals included).
+fn binary_exponent(x: f64) -> i32 {
+    let (mant, e) = decompose(x);
+    e + 63 - mant.unsigned_abs().leading_zeros() as i32
+}
+
+/// `log2` of [`NEAR_RAY_FLOOR`].
+const NEAR_RAY_FLOOR_EXPONENT: i32 = -500;
+
+/// The smallest transverse size `|r_xy|/|r|` an accurate edge term computes with, as a power
+/// of two (see `unit_scaled`): far above the underflow of its products (squares of `2^-511`),
+/// far below any error that matters (`2^-500` radians).
 
 /// `|r| − r_z` without cancellation when `r` points up.
 #[inline]

@@ -108,6 +108,11 @@ pub fn run(mut args: Args) -> Result<(), CliError> {
         header += " | exact/direct";
     }
     header += " | fast/direct | fast max err";
+    if !args.skip_exact {
+        // Issue 21's cost: how many vertices the 60-bit lattice does not hold, and how often an
+        // exact query needed big-integer arithmetic on the input values.
+        header += " | off-lattice vertices | exact fallbacks";
+    }
     if args.markdown {
         outln!("| {header} |")?;
         outln!("|{}", "---|".repeat(header.matches('|').count() + 1))?;
@@ -168,6 +173,8 @@ fn bench_mesh(mesh: &Mesh, args: &Args) -> Result<Option<String>, CliError> {
     let mut ratio = 0.0;
     let mut fast_ratio = 0.0;
     let mut max_err = 0.0_f64;
+    let fallbacks_before = gwn::kernel::input_predicates::exact_fallbacks();
+    let mut exact_queries = 0usize;
     for &t in &args.threads_list {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(t)
@@ -177,6 +184,7 @@ fn bench_mesh(mesh: &Mesh, args: &Args) -> Result<Option<String>, CliError> {
             let exact = if args.skip_exact {
                 f64::NAN
             } else {
+                exact_queries += points.len();
                 let t0 = Instant::now();
                 let w = wn.eval_batch(&points);
                 std::hint::black_box(w);
@@ -213,5 +221,12 @@ fn bench_mesh(mesh: &Mesh, args: &Args) -> Result<Option<String>, CliError> {
         row += &format!(" | {ratio:.1}×");
     }
     row += &format!(" | {fast_ratio:.1}× | {max_err:.1e}");
+    if !args.skip_exact {
+        let fallbacks = gwn::kernel::input_predicates::exact_fallbacks() - fallbacks_before;
+        row += &format!(
+            " | {} | {fallbacks} in {exact_queries} queries",
+            wn.snapping().off_lattice
+        );
+    }
     Ok(Some(row))
 }

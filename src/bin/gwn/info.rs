@@ -121,6 +121,19 @@ fn report(path: &std::path::Path, l: &gwn::io::LoadedMesh, s: &MeshStats) -> Str
         rows.push(("bbox max", format!("{:?}", b.max)));
         rows.push(("diagonal", format!("{}", s.diagonal)));
     }
+    if let Some(snap) = gwn::eval::antipodal::Snapping::of_mesh(&l.mesh) {
+        // The exact evaluator computes on the input bits either way; this says whether the
+        // 60-bit lattice holds them (its fast path) or how far the snapped vertices moved.
+        let value = if snap.lossless() {
+            format!("lossless (cell {:e})", snap.cell)
+        } else {
+            format!(
+                "{} vertices off the lattice, largest displacement {:e} (cell {:e}; values use the exact input)",
+                snap.off_lattice, snap.max_displacement, snap.cell
+            )
+        };
+        rows.push(("60-bit snapping", value));
+    }
     let width = rows.iter().map(|(k, _)| k.len()).max().unwrap_or(0);
     let mut out = String::new();
     for (k, v) in rows {

@@ -1,0 +1,428 @@
+//! The perturbed predicates on the input values **exactly as given**, for points that do not lie
+//! on the lattice (issue 21).
+//!
+//! The 60-bit lattice holds every coordinate of a mesh whose significant bits fit it, and then the
+//! integer predicates of [`super::predicates`] are exact. A coordinate much smaller than the
+//! extent (`1e-20` next to `10`), or with more significant bits than the lattice holds, is not on
+//! it: snapping moves such a vertex by up to half a cell, and a query one ulp from it could then
+//! be decided for the snapped surface instead of the input. Here a point is its lattice point `n`
+//! plus its residual `r` (cells, `|r| ≤ 1/2`, a dyadic rational: exact unless the world → grid
+//! scaling underflowed, in which case the world coordinates rebuild it), and each predicate is
+//! - an `f64` filter on the offsets `(n_p − n_q) + (r_p − r_q)`, whose rigorous error bound
+//!   includes the rounding of every input offset (`INPUT_OFFSET_*`), so a sign it gives is the
+//!   sign of the exact input value; otherwise
+//! - the exact evaluation in [`Dyadic`] arithmetic (big-integer significands, unbounded
+//!   exponents), counted by [`exact_fallbacks`].
+//!
+//! **The perturbation is the lattice one, coefficient for coefficient** (docs/robustness.md §2):
+//! `orient2d` is decided by `D0`, then `a_y − b_y`, then `b_x − a_x`; the plane side by
+//! `(q − p0)·n`, then `n_x`, `n_y`, `n_z`; the on-segment limit by the same rules as
+//! [`super::predicates::query_inside_segment`]. On the lattice (all residuals zero) every value
+//! here equals the lattice one, because the lattice is an exact affine image of the input (a
+//! translation and a positive power-of-two scaling) — so the two paths can be mixed freely, one
+//! per triangle or edge, and still decide every sign for the same symbolic point `q_ε`.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use super::dyadic::Dyadic;
+use super::predicates::Orient2d;
+
+/// A point exactly as the user gave it, in the ray frame and in cell units: the lattice point
+/// `n` and the residual `r` (`x = n + r`, `|r_k| ≤ 1/2`, dyadic).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InputPoint {
+    /// Lattice coordinates relative to the grid origin (frame).
+    pub n: [i64; 3],
+    /// Residuals in cells (frame); exact where `exact[k]`, else within `2^-1000` cells.
+    pub r: [f64; 3],
+    /// The world coordinates in frame order (axes permuted and negated, so exact), from which a
+    /// residual that underflowed is rebuilt exactly.
+    pub world: [f64; 3],
+    /// Per axis: whether `n + r` is the exact value (false only where the world → grid scaling
+    /// of a coordinate underflowed: a huge mesh and a tiny coordinate).
+    pub exact: [bool; 3],
+}
+
+impl InputPoint {
+    /// A lattice point (an input that snapped without loss, or a clamped query's proxy).
+    #[inline]
+    pub fn lattice(n: [i64; 3]) -> InputPoint {
+        InputPoint {
+            n,
+            r: [0.0; 3],
+            world: [0.0; 3],
+            exact: [true; 3],
+        }
+    }
+
+    /// Whether the point is its lattice point.
+    #[inline]
+    pub fn on_lattice(&self) -> bool {
+        self.r == [0.0; 3] && self.exact == [true; 3]
+    }
+
+    /// Whether `n + r` is exact on every axis.
+    #[inline]
+    pub fn residual_exact(&self) -> bool {
+        self.exact == [true; 3]
+    }
+}
+
+/// How a frame coordinate's exact value in cells is rebuilt from its world value:
+/// `x_cells = x_world · 2^shift − origin_cells` (the grid's power-of-two rescaling and cell, and
+/// its origin, in frame order).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LatticeFrame {
+    /// `log2(rescale) − log2(cell)`.
+    pub shift: i64,
+    /// The grid origin in cells, frame order and signs.
+    pub origin_cells: [i128; 3],
+}
+
+impl LatticeFrame {
+    fn coordinate(&self, p: &InputPoint, k: usize) -> Dyadic {
+        if p.exact[k] {
+            &Dyadic::from_int(i128::from(p.n[k])) + &Dyadic::from_f64(p.r[k])
+        } else {
+            &Dyadic::from_f64(p.world[k]).scaled(self.shift)
+                - &Dyadic::from_int(self.origin_cells[k])
+        }
+    }
+
+    fn point(&self, p: &InputPoint) -> [Dyadic; 3] {
+        std::array::from_fn(|k| self.coordinate(p, k))
+    }
+}
+
+const U: f64 = f64::EPSILON * 0.5;
+
+/// Relative part of the error bound of an `f64` offset `fl(fl(n_p − n_q) + fl(r_p − r_q))`.
+/// Each of the three roundings errs by `u` of its result; `|n_p − n_q| ≤ |offset| + 1`, so the
+/// total is `≤ 2u·|offset| + 2u` plus `2^-1000` for a residual that underflowed. We use `3u`.
+pub const INPUT_OFFSET_RELATIVE: f64 = 3.0 * U;
+
+/// Absolute part of the offset's error bound, in cells (see [`INPUT_OFFSET_RELATIVE`]).
+pub const INPUT_OFFSET_ABSOLUTE: f64 = 3.0 * U;
+
+/// The filters' bounds are doubled: this covers the rounding of the bound's own evaluation
+/// (relative `O(u)`) with a wide margin.
+pub const INPUT_FILTER_SAFETY: f64 = 2.0;
+
+/// Relative rounding of a difference of two `f64` products: `γ2 ≤ 3u` of the permanent.
+const PRODUCT_DIFFERENCE: f64 = 3.0 * U;
+
+/// Relative rounding of a dot product of three terms (three products, two sums): `≤ 4u`.
+const DOT3: f64 = 4.0 * U;
+
+static EXACT_FALLBACKS: AtomicU64 = AtomicU64::new(0);
+
+/// How many times, since the process started, an input predicate could not be decided by its
+/// `f64` filter and ran in exact big-integer arithmetic (the slow path of issue 21; `gwn bench`
+/// reports it per mesh).
+pub fn exact_fallbacks() -> u64 {
+    EXACT_FALLBACKS.load(Ordering::Relaxed)
+}
+
+#[cold]
+fn count_fallback() {
+    EXACT_FALLBACKS.fetch_add(1, Ordering::Relaxed);
+}
+
+/// `p − q` in `f64` (cells) and its error bound per axis.
+#[inline]
+fn offset(p: &InputPoint, q: &InputPoint) -> ([f64; 3], [f64; 3]) {
+    let v: [f64; 3] = std::array::from_fn(|k| (p.n[k] - q.n[k]) as f64 + (p.r[k] - q.r[k]));
+    let e = v.map(|x| INPUT_OFFSET_RELATIVE * x.abs() + INPUT_OFFSET_ABSOLUTE);
+    (v, e)
+}
+
+/// `x·y` with `|x − x̃| ≤ ex`, `|y − ỹ| ≤ ey`: the bound on `|x̃ỹ − xy|`.
+#[inline]
+fn product_error(x: f64, ex: f64, y: f64, ey: f64) -> f64 {
+    x.abs() * ey + ex * y.abs() + ex * ey
+}
+
+/// The perturbed 2D orientation of `(q_ε, a, b)` seen along the ray, on the exact inputs (the
+/// same definition as [`super::predicates::perturbed_orient2d`]).
+#[inline]
+pub fn input_orient2d(
+    q: &InputPoint,
+    a: &InputPoint,
+    b: &InputPoint,
+    lattice: &LatticeFrame,
+) -> Orient2d {
+    let (u, eu) = offset(a, q);
+    let (v, ev) = offset(b, q);
+    let p1 = u[0] * v[1];
+    let p2 = u[1] * v[0];
+    let d = p1 - p2;
+    let bound = INPUT_FILTER_SAFETY
+        * (product_error(u[0], eu[0], v[1], ev[1])
+            + product_error(u[1], eu[1], v[0], ev[0])
+            + PRODUCT_DIFFERENCE * (p1.abs() + p2.abs()));
+    if d > bound || d < -bound {
+        return Orient2d {
+            sign: if d > 0.0 { 1 } else { -1 },
+            degenerate: false,
+        };
+    }
+    exact_orient2d(q, a, b, lattice)
+}
+
+#[cold]
+fn exact_orient2d(q: &InputPoint, a: &InputPoint, b: &InputPoint, l: &LatticeFrame) -> Orient2d {
+    count_fallback();
+    let (q, a, b) = (l.point(q), l.point(a), l.point(b));
+    let (u0, u1) = (&a[0] - &q[0], &a[1] - &q[1]);
+    let (v0, v1) = (&b[0] - &q[0], &b[1] - &q[1]);
+    let d = &(&u0 * &v1) - &(&u1 * &v0);
+    if d.sign() != 0 {
+        return Orient2d {
+            sign: d.sign(),
+            degenerate: false,
+        };
+    }
+    // The ε1 and ε2 coefficients, as on the lattice.
+    let s1 = (&a[1] - &b[1]).sign();
+    Orient2d {
+        sign: if s1 != 0 { s1 } else { (&b[0] - &a[0]).sign() },
+        degenerate: true,
+    }
+}
+
+/// `sign((q_ε − p0)·n)`, `n = (p1 − p0)×(p2 − p0)`, on the exact inputs (the same definition as
+/// [`super::predicates::perturbed_plane_side`]).
+#[inline]
+pub fn input_plane_side(q: &InputPoint, p: &[InputPoint; 3], lattice: &LatticeFrame) -> i32 {
+    let (d, ed) = offset(q, &p[0]);
+    let (e1, ee1) = offset(&p[1], &p[0]);
+    let (e2, ee2) = offset(&p[2], &p[0]);
+    let mut t = 0.0;
+    let mut permanent = 0.0;
+    let mut propagated = 0.0;
+    for k in 0..3 {
+        let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+        let pa = e1[i] * e2[j];
+        let pb = e1[j] * e2[i];
+        let c = pa - pb;
+        let ec = product_error(e1[i], ee1[i], e2[j], ee2[j])
+            + product_error(e1[j], ee1[j], e2[i], ee2[i])
+            + PRODUCT_DIFFERENCE * (pa.abs() + pb.abs());
+        t += d[k] * c;
+        permanent += (d[k] * c).abs();
+        propagated += product_error(d[k], ed[k], c, ec);
+    }
+    let bound = INPUT_FILTER_SAFETY * (propagated + DOT3 * permanent);
+    if t > bound {
+        return 1;
+    }
+    if t < -bound {
+        return -1;
+    }
+    exact_plane_side(q, p, lattice)
+}
+
+#[cold]
+fn exact_plane_side(q: &InputPoint, p: &[InputPoint; 3], l: &LatticeFrame) -> i32 {
+    count_fallback();
+    let q = l.point(q);
+    let p = p.map(|v| l.point(&v));
+    let sub = |a: &[Dyadic; 3], b: &[Dyadic; 3]| -> [Dyadic; 3] {
+        std::array::from_fn(|k| &a[k] - &b[k])
+    };
+    let (d, e1, e2) = (sub(&q, &p[0]), sub(&p[1], &p[0]), sub(&p[2], &p[0]));
+    let n: [Dyadic; 3] = std::array::from_fn(|k| {
+        let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+        &(&e1[i] * &e2[j]) - &(&e1[j] * &e2[i])
+    });
+    let t = &(&(&d[0] * &n[0]) + &(&d[1] * &n[1])) + &(&d[2] * &n[2]);
+    if t.sign() != 0 {
+        return t.sign();
+    }
+    // The ε1, ε2, ε3 coefficients n_x, n_y, n_z, as on the lattice.
+    n.iter().map(Dyadic::sign).find(|&s| s != 0).unwrap_or(0)
+}
+
+/// The ray from `q_ε` along `+z` against triangle `p` on the exact inputs (the same definition
+/// as [`super::predicates::ray_crossing`]).
+#[inline]
+pub fn input_ray_crossing(q: &InputPoint, p: &[InputPoint; 3], lattice: &LatticeFrame) -> i32 {
+    let s0 = input_projected_containment(q, p, lattice);
+    if s0 == 0 {
+        return 0;
+    }
+    if input_plane_side(q, p, lattice) == -s0 {
+        s0
+    } else {
+        0
+    }
+}
+
+/// `sign(n_z)` when the projection of `q_ε` lies strictly inside the projected triangle, else 0
+/// (the same definition as [`super::predicates::projected_containment`]).
+#[inline]
+pub fn input_projected_containment(
+    q: &InputPoint,
+    p: &[InputPoint; 3],
+    lattice: &LatticeFrame,
+) -> i32 {
+    // Conservative early-out on the lattice: every exact coordinate is within half a cell of its
+    // lattice value, so a query strictly inside lies in the lattice box grown by one cell.
+    for k in 0..2 {
+        let lo = p[0].n[k].min(p[1].n[k]).min(p[2].n[k]);
+        let hi = p[0].n[k].max(p[1].n[k]).max(p[2].n[k]);
+        if q.n[k] < lo - 1 || q.n[k] > hi + 1 {
+            return 0;
+        }
+    }
+    let edge = |i: usize, j: usize| input_orient2d(q, &p[i], &p[j], lattice).sign;
+    let s0 = edge(0, 1);
+    if s0 == 0 || edge(1, 2) != s0 || edge(2, 0) != s0 {
+        return 0;
+    }
+    s0
+}
+
+/// Whether `q_ε` lies strictly inside segment `a b` to first order in ε, on the exact inputs (the
+/// same definition as [`super::predicates::query_inside_segment`]; only asked after a degenerate
+/// orientation, so always exact arithmetic).
+#[cold]
+pub fn input_inside_segment(
+    q: &InputPoint,
+    a: &InputPoint,
+    b: &InputPoint,
+    lattice: &LatticeFrame,
+) -> bool {
+    count_fallback();
+    let q = lattice.point(q);
+    let ra: [Dyadic; 3] = {
+        let a = lattice.point(a);
+        std::array::from_fn(|k| &a[k] - &q[k])
+    };
+    let rb: [Dyadic; 3] = {
+        let b = lattice.point(b);
+        std::array::from_fn(|k| &b[k] - &q[k])
+    };
+    let zero = |r: &[Dyadic; 3]| r.iter().all(|c| c.sign() == 0);
+    let along_pos_x = |r: &[Dyadic; 3]| r[0].sign() > 0 && r[1].sign() == 0 && r[2].sign() == 0;
+    if zero(&ra) {
+        return along_pos_x(&rb);
+    }
+    if zero(&rb) {
+        return along_pos_x(&ra);
+    }
+    for (i, j) in [(1, 2), (2, 0), (0, 1)] {
+        if (&(&ra[i] * &rb[j]) - &(&ra[j] * &rb[i])).sign() != 0 {
+            return false;
+        }
+    }
+    let dot = &(&(&ra[0] * &rb[0]) + &(&ra[1] * &rb[1])) + &(&ra[2] * &rb[2]);
+    dot.sign() < 0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kernel::predicates::{
+        W128, perturbed_orient2d, perturbed_plane_side, query_inside_segment, ray_crossing,
+    };
+    use crate::kernel::test_rng::TestRng;
+
+    /// A point with residual `r` (exact).
+    fn at(n: [i64; 3], r: [f64; 3]) -> InputPoint {
+        InputPoint {
+            n,
+            r,
+            world: [0.0; 3],
+            exact: [true; 3],
+        }
+    }
+
+    #[test]
+    fn on_the_lattice_the_input_predicates_are_the_lattice_predicates() {
+        let l = LatticeFrame::default();
+        let mut rng = TestRng::new(11);
+        for round in 0..4000 {
+            // Small coordinates make every degeneracy common; large ones exercise the filter.
+            let big = round % 2 == 1;
+            let mut c = || {
+                let v = rng.below(7) as i64 - 3;
+                if big { v << 58 } else { v }
+            };
+            let mut pt = || [c(), c(), c()];
+            let (q, a, b, d) = (pt(), pt(), pt(), pt());
+            let ip = InputPoint::lattice;
+            assert_eq!(
+                input_orient2d(&ip(q), &ip(a), &ip(b), &l),
+                perturbed_orient2d::<W128>([q[0], q[1]], [a[0], a[1]], [b[0], b[1]]),
+                "{q:?} {a:?} {b:?}"
+            );
+            let t = [a, b, d];
+            assert_eq!(
+                input_plane_side(&ip(q), &t.map(ip), &l),
+                perturbed_plane_side::<W128>(q, t)
+            );
+            assert_eq!(
+                input_ray_crossing(&ip(q), &t.map(ip), &l),
+                ray_crossing::<W128>(q, t)
+            );
+            assert_eq!(
+                input_inside_segment(&ip(q), &ip(a), &ip(b), &l),
+                query_inside_segment(q, a, b)
+            );
+        }
+    }
+
+    #[test]
+    fn residuals_below_the_filter_are_decided_exactly() {
+        let l = LatticeFrame::default();
+        // Edge from (0,0) to (2^58, 2 + 2^-58) and a query at (2^57, 1 + 2^-59): exactly on the
+        // edge's line; the f64 offsets round the residuals away, so only the exact path sees it.
+        let a = at([0, 0, 0], [0.0; 3]);
+        let b = at([1 << 58, 2, 0], [0.0, 2f64.powi(-58), 0.0]);
+        let q = at([1 << 57, 1, 0], [0.0, 2f64.powi(-59), 0.0]);
+        let before = exact_fallbacks();
+        let o = input_orient2d(&q, &a, &b, &l);
+        assert!(exact_fallbacks() > before);
+        // D = 0: decided by ε1, a_y − b_y < 0.
+        assert_eq!(
+            o,
+            Orient2d {
+                sign: -1,
+                degenerate: true
+            }
+        );
+        // Below the line by 2^-59 cells, and above it by as much.
+        let q2 = at(q.n, [0.0; 3]);
+        assert_eq!(input_orient2d(&q2, &a, &b, &l).sign, -1);
+        let q3 = at(q.n, [0.0, 2f64.powi(-58), 0.0]);
+        assert_eq!(input_orient2d(&q3, &a, &b, &l).sign, 1);
+    }
+
+    #[test]
+    fn underflowed_residuals_are_rebuilt_from_the_world_value() {
+        // A lattice of cell 2^-10 (shift 10), origin 0: a world coordinate 2^-1074 is far below
+        // any f64 residual in cells of a coarse grid once scaled down; with exact = false the
+        // predicate rebuilds it from `world`.
+        let l = LatticeFrame {
+            shift: -2000,
+            origin_cells: [0; 3],
+        };
+        let w = f64::from_bits(1);
+        let q = InputPoint {
+            n: [0; 3],
+            r: [0.0; 3],
+            world: [0.0, w, 0.0],
+            exact: [true, false, true],
+        };
+        let a = InputPoint::lattice([-1, 0, 0]);
+        let b = InputPoint::lattice([1, 0, 0]);
+        // q is above the x axis by 2^-3074 cells: left of a → b.
+        assert_eq!(input_orient2d(&q, &a, &b, &l).sign, 1);
+        let below = InputPoint {
+            world: [0.0, -w, 0.0],
+            ..q
+        };
+        assert_eq!(input_orient2d(&below, &a, &b, &l).sign, -1);
+    }
+}
