@@ -597,6 +597,27 @@ fn classify_points(
     if z1 < -slack {
         return Some(Form::Down);
     }
+    // The same with the points at the query's height allowed (a rim lying in the query's
+    // plane, issue 23): every point either clears the height test or is at the right side's
+    // height (sign exact) and at least `asin μ` away from the ray's line in the direction of
+    // one `h`. The hull then meets the ray's line only at heights of the right sign (a point of
+    // it on the line mixes in a point that clears the height test), and the potential's
+    // denominator `ρ ± z ≥ ρ` keeps its integrand smooth at the scale of `ρ`.
+    if z0 >= 0.0 || z1 <= 0.0 {
+        let up = z0 >= 0.0;
+        let m2 = MARGIN * MARGIN;
+        for h in DIRECTIONS {
+            let nn = h[0] * h[0] + h[1] * h[1];
+            let ok = pts.clone().all(|p| {
+                let clears = if up { p[2] > slack } else { p[2] < -slack };
+                let d = h[0] * p[0] + h[1] * p[1];
+                clears || (d > 0.0 && d * d >= m2 * nn * (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]))
+            });
+            if ok {
+                return Some(if up { Form::Up } else { Form::Down });
+            }
+        }
+    }
     let (mut mx, mut my) = (0.0, 0.0);
     for p in pts.clone() {
         let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
@@ -638,6 +659,10 @@ fn classify_points(
     None
 }
 
+/// Relative distance below which the control points of a side count as one point (see
+/// [`split_net`]).
+const COLLAPSE_TOLERANCE: f64 = 1e-12;
+
 /// The pieces of a mixed net: halved in `s` and in `t` (a direction of degree 0 is not split),
 /// except that a net with a collapsed side (a row or column of equal control points, like the
 /// teapot's knob and bottom poles) is halved only across it. A query at such a pole is a
@@ -646,11 +671,27 @@ fn classify_points(
 /// across it keeps one mixed piece per level.
 fn split_net(net: Net) -> Vec<Net> {
     let (m, n) = (net.m, net.n);
+    // Collapsed: the Euclidean points agree (a pole's homogeneous points differ by their
+    // weights), to a relative [`COLLAPSE_TOLERANCE`] for the rounding of `H / w`. Only the
+    // splitting direction depends on it, never a value.
+    let euclid = |k: usize| {
+        let h = net.h[k];
+        [h[0] / h[3], h[1] / h[3], h[2] / h[3]]
+    };
+    let scale = (0..net.h.len()).fold(0.0f64, |a, k| {
+        let e = euclid(k);
+        a.max(e[0].abs()).max(e[1].abs()).max(e[2].abs())
+    });
     let all_equal = |idx: &mut dyn Iterator<Item = usize>| {
-        let first = idx.next().map(|k| net.h[k]);
+        let Some(first) = idx.next().map(euclid) else {
+            return true;
+        };
         let mut same = true;
         for k in idx {
-            same &= Some(net.h[k]) == first;
+            let e = euclid(k);
+            for a in 0..3 {
+                same &= (e[a] - first[a]).abs() <= COLLAPSE_TOLERANCE * scale;
+            }
         }
         same
     };
