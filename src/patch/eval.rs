@@ -55,6 +55,10 @@ const HOLE_DEPTH: u32 = 26;
 /// from the hole's left-out solid angle, `≈ κ h / 4π ≤ h / L` for a smooth surface (`h` the
 /// hole's size, `L` its patch's, `κ ≲ 1/L`).
 const HOLE_ERROR: f64 = 1.0 / (1u64 << HOLE_DEPTH) as f64;
+/// Error charged per hole piece of a patch that has a surface-boundary edge: a query on an open
+/// boundary curve sits where `w` spans an interval of length 1 around it, and the value left
+/// after cutting the hole is only known to lie in that interval.
+const HOLE_ERROR_AT_BOUNDARY: f64 = 0.5;
 /// At most this many mixed pieces are subdivided per query. With the collapsed-side rule of
 /// [`split_net`] the pieces that stay mixed are those around the query, a few per level, so
 /// this is never reached by a real query; past it the remaining mixed pieces are left out like
@@ -101,7 +105,8 @@ pub struct Evaluation {
     /// The winding number.
     pub value: f64,
     /// Sum of the error estimates of the boundary integrals (`max(|K15 − G7|, rounding)` per
-    /// accepted interval) and of [`HOLE_ERROR`] per on-surface hole piece, in units of `w`.
+    /// accepted interval) and, per on-surface hole piece, [`HOLE_ERROR`] (or
+    /// [`HOLE_ERROR_AT_BOUNDARY`] in a patch with an open boundary edge), in units of `w`.
     pub error_estimate: f64,
     /// Boundary integrals computed.
     pub integrals: usize,
@@ -245,6 +250,8 @@ impl PatchWindingNumber {
             out: Evaluation::default(),
             tasks: Vec::new(),
             pieces: 0,
+            hole_error: HOLE_ERROR,
+            holes_error: 0.0,
         };
         let ray = self.options.ray;
         let patches = self.scaled.patches();
@@ -299,6 +306,11 @@ impl PatchWindingNumber {
                         [w * d[0], w * d[1], w * d[2], w]
                     })
                     .collect();
+                acc.hole_error = if self.links[p].contains(&EdgeLink::Boundary) {
+                    HOLE_ERROR_AT_BOUNDARY
+                } else {
+                    HOLE_ERROR
+                };
                 acc.refine(Net { m, n, h }, 0, &mut leaf_edges);
             }
         }
@@ -334,6 +346,10 @@ struct Accumulator {
     tasks: Vec<(Vec<Homogeneous>, Form)>,
     /// Mixed pieces subdivided so far (capped by [`MAX_PIECES`]).
     pieces: usize,
+    /// Error charged per hole piece of the patch being refined ([`HOLE_ERROR`] or
+    /// [`HOLE_ERROR_AT_BOUNDARY`]), and the sum charged so far (units of `w`).
+    hole_error: f64,
+    holes_error: f64,
 }
 
 impl Accumulator {
@@ -354,7 +370,7 @@ impl Accumulator {
         }
         let mut out = self.out;
         out.value = self.sum.value() / (4.0 * PI);
-        out.error_estimate = out.error_estimate / (4.0 * PI) + out.uncertified_pieces as f64 * HOLE_ERROR;
+        out.error_estimate = out.error_estimate / (4.0 * PI) + self.holes_error;
         out.certified =
             out.uncertified_pieces == 0 && !out.capped && out.error_estimate <= tolerance;
         out
@@ -425,6 +441,7 @@ impl Accumulator {
                 return false;
             }
             self.out.uncertified_pieces += 1;
+            self.holes_error += self.hole_error;
             return true;
         }
         self.pieces += 1;
@@ -438,6 +455,7 @@ impl Accumulator {
                 // rest of the surface sees one hole bounded by this piece's edges.
                 leaves.truncate(mark);
                 self.out.uncertified_pieces += 1;
+                self.holes_error += self.hole_error;
                 return true;
             }
         }
