@@ -103,7 +103,13 @@ fn run(name: &str, set: &PatchSet, queries: &[Query], tolerance: f64) {
     for ((kind, off), r) in rows {
         println!(
             "  {kind:<15} {off:>6} {:>6} {:>9} {:>8.3} {:>6} {:>6} {:>9.1e} {:>9.1e}",
-            r.count, r.max_evaluations, r.max_ms, r.uncertified, r.capped, r.max_error_estimate, r.spread
+            r.count,
+            r.max_evaluations,
+            r.max_ms,
+            r.uncertified,
+            r.capped,
+            r.max_error_estimate,
+            r.spread
         );
     }
 }
@@ -126,7 +132,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for k in 0..150 {
         let phi = 2.0 * std::f64::consts::PI * (k as f64 + 0.37) / 150.0;
         let off = offsets[k % 4];
-        let (dr, dz) = [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0), (0.7, -0.7)][k % 5];
+        let (dr, dz) = [
+            (1.0, 0.0),
+            (-1.0, 0.0),
+            (0.0, 1.0),
+            (0.0, -1.0),
+            (0.7, -0.7),
+        ][k % 5];
         let r = 1.0 + dr * off;
         rim.push(Query {
             kind: "rim",
@@ -143,23 +155,46 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             std::f64::consts::PI * (k as f64 * 0.618).fract(),
             2.0 * std::f64::consts::PI * (k as f64 * 0.377).fract(),
         );
-        let p = [theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()];
-        on.push(Query { kind: "on-surface", offset: 0.0, q: p });
+        let p = [
+            theta.sin() * phi.cos(),
+            theta.sin() * phi.sin(),
+            theta.cos(),
+        ];
+        on.push(Query {
+            kind: "on-surface",
+            offset: 0.0,
+            q: p,
+        });
         on.push(Query {
             kind: "1e-30 off",
             offset: 1e-30,
             q: p.map(|c| c * (1.0 + 1e-30)),
         });
     }
-    for q in [[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [0.0, -1.0, 0.0]] {
-        on.push(Query { kind: "on-seam/pole", offset: 0.0, q });
+    for q in [
+        [1.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+        [0.0, -1.0, 0.0],
+    ] {
+        on.push(Query {
+            kind: "on-seam/pole",
+            offset: 0.0,
+            q,
+        });
     }
     run("closed sphere", &sphere, &on, 1e-10);
     let mut worst: f64 = 0.0;
     for q in &on {
         for ray in RayAxis::ALL {
-            let w = PatchWindingNumber::with_options(&sphere, Options { ray, tolerance: 1e-10 })
-                .eval(q.q);
+            let w = PatchWindingNumber::with_options(
+                &sphere,
+                Options {
+                    ray,
+                    tolerance: 1e-10,
+                },
+            )
+            .eval(q.q);
             worst = worst.max((w - 0.5).abs());
         }
     }

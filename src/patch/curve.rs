@@ -70,9 +70,9 @@ const CASTELJAU_LEVEL_ROUNDING: f64 = 3.0 * f64::EPSILON;
 /// derivative `d·(b − a)` amplifies the error of its two points by `2d`.
 pub fn evaluation_rounding(ctrl: &[Homogeneous]) -> (f64, f64) {
     let d = (ctrl.len() - 1) as f64;
-    let m = ctrl
-        .iter()
-        .fold(0.0f64, |a, h| a.max(h[0].abs()).max(h[1].abs()).max(h[2].abs()));
+    let m = ctrl.iter().fold(0.0f64, |a, h| {
+        a.max(h[0].abs()).max(h[1].abs()).max(h[2].abs())
+    });
     let e = (d + 1.0) * CASTELJAU_LEVEL_ROUNDING * m;
     (e, 2.0 * d.max(1.0) * e + CASTELJAU_LEVEL_ROUNDING * d * m)
 }
@@ -108,8 +108,8 @@ pub fn integrand_with_rounding(
     let n_abs = n[0].abs().max(n[1].abs());
     let num_err = 2.0 * (en * dn_abs + n_abs * edn);
     // √3·en bounds the error of ρ; ρ ∓ z moves by at most twice that.
-    let noise = num_err / den
-        + f.abs() * (1.8 * en / rho + 3.5 * en / rho_minus_z + 8.0 * f64::EPSILON);
+    let noise =
+        num_err / den + f.abs() * (1.8 * en / rho + 3.5 * en / rho_minus_z + 8.0 * f64::EPSILON);
     (f, noise)
 }
 

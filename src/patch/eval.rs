@@ -380,7 +380,13 @@ impl Accumulator {
     /// curve is first halved where it is large compared with its distance from the query
     /// (`CURVE_SPLIT_RATIO`), each piece getting the tolerance share of its parameter length;
     /// then adaptive Gauss–Kronrod with the integrand's rounding bound.
-    fn integrate_curve(&mut self, ctrl: Vec<Homogeneous>, form: Form, tol: f64, budget: &mut Budget) {
+    fn integrate_curve(
+        &mut self,
+        ctrl: Vec<Homogeneous>,
+        form: Form,
+        tol: f64,
+        budget: &mut Budget,
+    ) {
         self.out.integrals += 1;
         let mut stack = vec![(ctrl, 1.0f64, 0u32)];
         while let Some((ctrl, share, depth)) = stack.pop() {
@@ -713,8 +719,8 @@ fn split_net(net: Net) -> Vec<Net> {
         }
         same
     };
-    let collapsed_row = n > 0
-        && (all_equal(&mut (0..=n)) || all_equal(&mut (0..=n).map(|j| m * (n + 1) + j)));
+    let collapsed_row =
+        n > 0 && (all_equal(&mut (0..=n)) || all_equal(&mut (0..=n).map(|j| m * (n + 1) + j)));
     let collapsed_column = m > 0
         && (all_equal(&mut (0..=m).map(|i| i * (n + 1)))
             || all_equal(&mut (0..=m).map(|i| i * (n + 1) + n)));
@@ -824,7 +830,9 @@ fn rescaled(set: &PatchSet) -> (PatchSet, i32) {
         .patches()
         .iter()
         .flat_map(|p| p.points())
-        .fold(0.0f64, |a, p| a.max(p[0].abs()).max(p[1].abs()).max(p[2].abs()));
+        .fold(0.0f64, |a, p| {
+            a.max(p[0].abs()).max(p[1].abs()).max(p[2].abs())
+        });
     let e = exponent_of(max);
     let wmax = set
         .patches()
@@ -850,10 +858,7 @@ fn rescaled(set: &PatchSet) -> (PatchSet, i32) {
                 .unwrap_or_else(|_| p.clone())
         })
         .collect();
-    (
-        PatchSet::new(patches).unwrap_or_else(|_| set.clone()),
-        e,
-    )
+    (PatchSet::new(patches).unwrap_or_else(|_| set.clone()), e)
 }
 
 /// Patch sets plug into grids and products like the triangle evaluators (no gradient yet).
