@@ -148,7 +148,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     run("rational hemisphere", &hemisphere, &rim, 1e-10);
 
-    // The closed sphere: on the surface (seams, poles, patch interiors) and 1e-30 off it.
+    // The closed sphere: on the surface to rounding (seams, poles, patch interiors).
     let mut on = Vec::new();
     for k in 0..40 {
         let (theta, phi) = (

@@ -104,8 +104,8 @@ pub fn poles(set: &PatchSet) -> Vec<Query> {
     let links = link_edges(set);
     let mut out: Vec<Query> = Vec::new();
     for (p, patch) in set.patches().iter().enumerate() {
-        for e in 0..4 {
-            if links[p][e] != EdgeLink::Degenerate {
+        for (e, link) in links[p].iter().enumerate() {
+            if *link != EdgeLink::Degenerate {
                 continue;
             }
             let (m, n) = patch.degree();
