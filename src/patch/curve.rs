@@ -58,6 +58,38 @@ pub fn eval_with_derivative(ctrl: &[Homogeneous], t: f64) -> (Homogeneous, Homog
 /// guard, on the form's singular ray (which the callers' certificates exclude).
 #[inline]
 pub fn integrand(form: Form, n: Homogeneous, dn: Homogeneous) -> f64 {
+    integrand_with_rounding(form, n, dn, 0.0, 0.0).0
+}
+
+/// Relative rounding of one de Casteljau level (a convex combination: two products and a sum).
+const CASTELJAU_LEVEL_ROUNDING: f64 = 3.0 * f64::EPSILON;
+
+/// Bounds on the rounding error of `N` and of `N'` (each component) as evaluated by
+/// [`eval_with_derivative`] on `ctrl` (degree `d`): `d` convex-combination levels, each adding
+/// at most [`CASTELJAU_LEVEL_ROUNDING`] times the largest control coordinate `M`; the
+/// derivative `d·(b − a)` amplifies the error of its two points by `2d`.
+pub fn evaluation_rounding(ctrl: &[Homogeneous]) -> (f64, f64) {
+    let d = (ctrl.len() - 1) as f64;
+    let m = ctrl.iter().fold(0.0f64, |a, h| {
+        a.max(h[0].abs()).max(h[1].abs()).max(h[2].abs())
+    });
+    let e = (d + 1.0) * CASTELJAU_LEVEL_ROUNDING * m;
+    (e, 2.0 * d.max(1.0) * e + CASTELJAU_LEVEL_ROUNDING * d * m)
+}
+
+/// The integrand of `form` and a bound on its rounding error, given bounds `en`, `edn` on the
+/// error of each component of `N`, `N'` (from [`evaluation_rounding`]). The error propagates as
+/// `δ(num)/den + |f|·(δρ/ρ + δ(ρ ∓ z)/(ρ ∓ z))` with `num = (N × N')_z`; near a point where the
+/// curve passes `ρ` from the query this is `≈ ε·M/ρ` relative, which is why the quadrature needs
+/// it (see `quadrature::NOISE_FLOOR`).
+#[inline]
+pub fn integrand_with_rounding(
+    form: Form,
+    n: Homogeneous,
+    dn: Homogeneous,
+    en: f64,
+    edn: f64,
+) -> (f64, f64) {
     let cross_z = n[0] * dn[1] - n[1] * dn[0];
     let xy2 = n[0] * n[0] + n[1] * n[1];
     let rho = (xy2 + n[2] * n[2]).sqrt();
@@ -69,9 +101,16 @@ pub fn integrand(form: Form, n: Homogeneous, dn: Homogeneous) -> f64 {
     let rho_minus_z = if z <= 0.0 { rho - z } else { xy2 / (rho + z) };
     let den = rho * rho_minus_z;
     if den == 0.0 || !den.is_finite() {
-        return 0.0;
+        return (0.0, 0.0);
     }
-    num_sign * cross_z / den
+    let f = num_sign * cross_z / den;
+    let dn_abs = dn[0].abs().max(dn[1].abs());
+    let n_abs = n[0].abs().max(n[1].abs());
+    let num_err = 2.0 * (en * dn_abs + n_abs * edn);
+    // √3·en bounds the error of ρ; ρ ∓ z moves by at most twice that.
+    let noise =
+        num_err / den + f.abs() * (1.8 * en / rho + 3.5 * en / rho_minus_z + 8.0 * f64::EPSILON);
+    (f, noise)
 }
 
 /// Splits a curve at `t = 1/2` (de Casteljau). The two halves share the middle point bit for bit.
@@ -117,11 +156,20 @@ const HALF_PLANES: [[f64; 2]; 8] = [
 /// Otherwise the curve is halved (its pieces' hulls shrink towards the curve). Returns `None` if
 /// no certificate was found within the depth limit (the hull is then within rounding of the
 /// origin; the callers' classification rules this out).
+/// Certified pieces are `≤ 2 × depth` for a curve that approaches the axis at isolated points;
+/// a curve lying along the axis would halve everywhere, so the pieces are also capped.
 pub fn azimuth_change(ctrl: &[Homogeneous]) -> Option<f64> {
-    azimuth_change_at(ctrl, 0)
+    let mut pieces = 0;
+    azimuth_change_at(ctrl, 0, &mut pieces)
 }
 
-fn azimuth_change_at(ctrl: &[Homogeneous], depth: u32) -> Option<f64> {
+/// Halving depth of [`azimuth_change`] (a piece `2^-40` of the curve).
+const AZIMUTH_MAX_DEPTH: u32 = 40;
+/// Pieces [`azimuth_change`] may examine before it gives up (returns `None`).
+const AZIMUTH_MAX_PIECES: usize = 1024;
+
+fn azimuth_change_at(ctrl: &[Homogeneous], depth: u32, pieces: &mut usize) -> Option<f64> {
+    *pieces += 1;
     for h in HALF_PLANES {
         let inside = ctrl.iter().all(|p| h[0] * p[0] + h[1] * p[1] > 0.0);
         if inside {
@@ -133,11 +181,11 @@ fn azimuth_change_at(ctrl: &[Homogeneous], depth: u32) -> Option<f64> {
             return Some(azimuth(&ctrl[ctrl.len() - 1]) - azimuth(&ctrl[0]));
         }
     }
-    if depth >= 40 {
+    if depth >= AZIMUTH_MAX_DEPTH || *pieces >= AZIMUTH_MAX_PIECES {
         return None;
     }
     let (a, b) = split_half(ctrl);
-    Some(azimuth_change_at(&a, depth + 1)? + azimuth_change_at(&b, depth + 1)?)
+    Some(azimuth_change_at(&a, depth + 1, pieces)? + azimuth_change_at(&b, depth + 1, pieces)?)
 }
 
 #[cfg(test)]
@@ -193,11 +241,12 @@ mod tests {
                 crate::patch::quadrature::integrate(
                     |t| {
                         let (n, dn) = eval_with_derivative(&c, t);
-                        integrand(form, n, dn)
+                        (integrand(form, n, dn), 0.0)
                     },
                     0.0,
                     1.0,
                     1e-14,
+                    &mut crate::patch::quadrature::Budget { remaining: 1 << 20 },
                 )
                 .value
             };

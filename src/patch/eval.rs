@@ -25,13 +25,13 @@ use rayon::prelude::*;
 
 use super::boundary::{EdgeLink, edge_counts, edge_indices, link_edges};
 use super::curve::{
-    Form, Homogeneous, azimuth_change, eval_with_derivative, integrand, split_half,
+    Form, Homogeneous, azimuth_change, eval_with_derivative, evaluation_rounding,
+    integrand_with_rounding, split_half,
 };
-use super::model::PatchSet;
-use super::quadrature::{Integral, integrate};
+use super::model::{Patch, PatchSet};
+use super::quadrature::{Budget, GK_EVALUATIONS, integrate};
 use crate::kernel::compensated::NeumaierSum;
 use crate::kernel::frame::RayAxis;
-use crate::kernel::spherical::triangle_solid_angle;
 
 /// Separation margin `μ`: a plane certifies a net only if every control point makes an angle of
 /// at least `asin μ` with it. Keeps the potentials' integrands smooth (bounded by a constant over
@@ -43,14 +43,50 @@ const Z_SLACK: f64 = 1e-12;
 /// Subdivision depth of a mixed patch (each level halves both parameters). A piece still mixed
 /// at this depth is `2^-48` of its patch: the query lies on the surface to `f64` resolution.
 const MAX_DEPTH: u32 = 48;
+/// Size (as a depth: `2^-26` of its patch, ≈ 1.5e-8) of the hole cut around an on-surface
+/// query. When a piece at this depth contains a sub-piece that stays mixed to [`MAX_DEPTH`],
+/// the whole piece is left out and the value is the solid angle of the rest of the surface,
+/// i.e. the principal value (`docs/patches.md`, "On the surface"). Not `MAX_DEPTH` itself: the
+/// rest is bounded by curves about the hole's size from the query, and their integrals carry
+/// rounding `≈ ε·(patch size)/(hole size)` (`2^-26` here; `1/16` at `2^-48`), while leaving the
+/// hole out changes the value by about its curvature times its size (also `≈ 2^-26`).
+const HOLE_DEPTH: u32 = 26;
+/// Error charged per on-surface hole piece, in units of `w`: the principal value's deviation
+/// from the hole's left-out solid angle, `≈ κ h / 4π ≤ h / L` for a smooth surface (`h` the
+/// hole's size, `L` its patch's, `κ ≲ 1/L`).
+const HOLE_ERROR: f64 = 1.0 / (1u64 << HOLE_DEPTH) as f64;
+/// Error charged per hole piece of a patch that has a surface-boundary edge: a query on an open
+/// boundary curve sits where `w` spans an interval of length 1 around it, and the value left
+/// after cutting the hole is only known to lie in that interval.
+const HOLE_ERROR_AT_BOUNDARY: f64 = 0.5;
+/// At most this many mixed pieces are subdivided per query. With the collapsed-side rule of
+/// [`split_net`] the pieces that stay mixed are those around the query, a few per level, so
+/// this is never reached by a real query; past it the remaining mixed pieces are left out like
+/// a hole and the evaluation is marked `capped`.
+pub const MAX_PIECES: usize = 4096;
+/// At most about this many integrand evaluations per query ([`Budget`]): past it no
+/// Gauss–Kronrod interval is bisected and no boundary curve is split any more, and the
+/// evaluation is marked `capped`. With the work of classification and subdivision
+/// ([`MAX_PIECES`]) this bounds the time of every query (`docs/patches.md`, "Time bound").
+pub const MAX_EVALUATIONS: usize = 200_000;
+/// A boundary curve is halved (exact de Casteljau) until each piece's control box is at most
+/// this many times its distance from the query, before the quadrature sees it. The integrand
+/// of a piece is then smooth at the piece's own scale, and its rounding, relative `≈ ε·size /
+/// distance`, stays at `ε` level (evaluated on the whole curve, it is `ε·(curve size)/ρ`,
+/// 1e-10 relative for a curve 1e-6 from the query: the cause of the issue-23 hangs).
+const CURVE_SPLIT_RATIO: f64 = 1.0;
+/// Halving depth limit of a boundary curve (`2^-60` of it: a query on the curve itself).
+const CURVE_MAX_DEPTH: u32 = 60;
 
 /// Options of the patch evaluator.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Options {
     /// Ray direction (default `+z`); every choice gives the same `w` off the surface.
     pub ray: RayAxis,
-    /// Target absolute error of `w` (default `1e-10`). Each boundary integral is run to a tenth
-    /// of it (in units of `w`); [`Evaluation::error_estimate`] reports what was reached.
+    /// Target absolute error of `w` (default `1e-10`): the boundary integrals of a query share
+    /// it (each gets `tolerance / count`, split further by parameter length), so the total
+    /// [`Evaluation::error_estimate`] stays below it unless rounding or the work cap prevents
+    /// that — then the evaluation is not `certified`.
     pub tolerance: f64,
 }
 
@@ -68,7 +104,9 @@ impl Default for Options {
 pub struct Evaluation {
     /// The winding number.
     pub value: f64,
-    /// Sum of the Gauss–Kronrod error estimates of the boundary integrals, in units of `w`.
+    /// Sum of the error estimates of the boundary integrals (`max(|K15 − G7|, rounding)` per
+    /// accepted interval) and, per on-surface hole piece, [`HOLE_ERROR`] (or
+    /// [`HOLE_ERROR_AT_BOUNDARY`] in a patch with an open boundary edge), in units of `w`.
     pub error_estimate: f64,
     /// Boundary integrals computed.
     pub integrals: usize,
@@ -76,15 +114,25 @@ pub struct Evaluation {
     pub evaluations: usize,
     /// Patches that had to be subdivided.
     pub mixed_patches: usize,
-    /// Pieces still unclassified at the depth limit (query on the surface to `f64`
-    /// resolution); their solid angle is the principal value of their corner quad.
+    /// Pieces left out as the hole around an on-surface query (a sub-piece stayed mixed to the
+    /// depth limit: the query is on the surface to `f64` resolution); the value is then the
+    /// principal value of the rest (`docs/patches.md`, "On the surface").
     pub uncertified_pieces: usize,
+    /// The work cap ([`MAX_EVALUATIONS`] or [`MAX_PIECES`]) was reached.
+    pub capped: bool,
+    /// The value is certified: no hole, no cap, and `error_estimate ≤ tolerance`.
+    pub certified: bool,
 }
 
 /// The winding-number evaluator of a patch set.
 #[derive(Clone, Debug)]
 pub struct PatchWindingNumber {
     set: PatchSet,
+    /// The set with coordinates scaled by `2^-coord_exp` and each patch's weights by a power
+    /// of two (exact), so that the largest coordinate and weight are in `[0.5, 1)`.
+    scaled: PatchSet,
+    /// The coordinate scale exponent (see `scaled`).
+    coord_exp: i32,
     links: Vec<[EdgeLink; 4]>,
     edges: Vec<[Vec<usize>; 4]>,
     /// World bounding box of each patch's control points.
@@ -113,6 +161,7 @@ impl PatchWindingNumber {
             options.tolerance = Options::default().tolerance;
         }
         let links = link_edges(set);
+        let (scaled, coord_exp) = rescaled(set);
         let edges = set
             .patches()
             .iter()
@@ -121,7 +170,7 @@ impl PatchWindingNumber {
                 std::array::from_fn(|e| edge_indices(m, n, e))
             })
             .collect();
-        let boxes = set
+        let boxes = scaled
             .patches()
             .iter()
             .map(|p| {
@@ -138,6 +187,8 @@ impl PatchWindingNumber {
             .collect();
         PatchWindingNumber {
             set: set.clone(),
+            scaled,
+            coord_exp,
             links,
             edges,
             boxes,
@@ -170,7 +221,14 @@ impl PatchWindingNumber {
         points.par_iter().map(|&q| self.eval(q)).collect()
     }
 
-    /// The winding number at `q` with its error estimate and work counters.
+    /// [`evaluate`](Self::evaluate) at many points, in parallel.
+    pub fn evaluate_batch(&self, points: &[[f64; 3]]) -> Vec<Evaluation> {
+        points.par_iter().map(|&q| self.evaluate(q)).collect()
+    }
+
+    /// The winding number at `q` with its error estimate and work counters. Bounded work:
+    /// at most [`MAX_PIECES`] subdivided pieces and about [`MAX_EVALUATIONS`] integrand
+    /// evaluations (`docs/patches.md`, "Time bound").
     pub fn evaluate(&self, q: [f64; 3]) -> Evaluation {
         if q.iter().any(|c| !c.is_finite()) {
             return Evaluation {
@@ -178,48 +236,57 @@ impl PatchWindingNumber {
                 ..Evaluation::default()
             };
         }
+        // The same exact power-of-two scaling as the set's (the mesh path's `Rescale`).
+        let q = q.map(|c| scale_by_pow2(c, -self.coord_exp));
+        if q.iter().any(|c| !c.is_finite()) {
+            // Beyond 2^1023 from a set of size ≤ 1: |w| < 2^-2000.
+            return Evaluation {
+                certified: true,
+                ..Evaluation::default()
+            };
+        }
         let mut acc = Accumulator {
             sum: NeumaierSum::new(),
-            tol: self.options.tolerance * 4.0 * PI * 0.1,
             out: Evaluation::default(),
+            tasks: Vec::new(),
+            pieces: 0,
+            hole_error: HOLE_ERROR,
+            holes_error: 0.0,
         };
         let ray = self.options.ray;
+        let patches = self.scaled.patches();
         let frame_point = |p: usize, k: usize| -> [f64; 3] {
-            let pt = self.set.patches()[p].points()[k];
+            let pt = patches[p].points()[k];
             ray.to_frame([pt[0] - q[0], pt[1] - q[1], pt[2] - q[2]])
         };
-        let forms: Vec<Option<Form>> = (0..self.set.patches().len())
+        let forms: Vec<Option<Form>> = (0..patches.len())
             .map(|p| {
                 let z = self.frame_z_range(p, q);
                 classify_points(
-                    (0..self.set.patches()[p].points().len()).map(|k| frame_point(p, k)),
+                    (0..patches[p].points().len()).map(|k| frame_point(p, k)),
                     Some(z),
                 )
             })
             .collect();
-        let mut buf = [[0.0f64; 4]; super::model::MAX_DEGREE + 1];
-        let fill = |p: usize, e: usize, buf: &mut [Homogeneous]| -> usize {
-            let idx = &self.edges[p][e];
-            let weights = self.set.patches()[p].weights();
-            for (slot, &k) in buf.iter_mut().zip(idx) {
-                let d = frame_point(p, k);
-                let w = weights[k];
-                *slot = [w * d[0], w * d[1], w * d[2], w];
-            }
-            idx.len()
-        };
-        let mut edge_ctrl = |p: usize, e: usize| -> Vec<Homogeneous> {
-            let len = fill(p, e, &mut buf);
-            buf[..len].to_vec()
+        let edge_ctrl = |p: usize, e: usize| -> Vec<Homogeneous> {
+            let weights = patches[p].weights();
+            self.edges[p][e]
+                .iter()
+                .map(|&k| {
+                    let d = frame_point(p, k);
+                    let w = weights[k];
+                    [w * d[0], w * d[1], w * d[2], w]
+                })
+                .collect()
         };
         for (p, form) in forms.iter().enumerate() {
             let Some(form) = *form else { continue };
             for e in 0..4 {
                 match self.links[p][e] {
                     EdgeLink::Degenerate => {}
-                    EdgeLink::Boundary => acc.integrate(&edge_ctrl(p, e), form),
+                    EdgeLink::Boundary => acc.integrate(edge_ctrl(p, e), form),
                     EdgeLink::Shared { patch: o, .. } => match forms[o] {
-                        None => acc.integrate(&edge_ctrl(p, e), form),
+                        None => acc.integrate(edge_ctrl(p, e), form),
                         Some(g) if g == form => {}
                         Some(_) if p < o => acc.interface(&edge_ctrl(p, e), form, None),
                         Some(_) => {}
@@ -228,7 +295,7 @@ impl PatchWindingNumber {
             }
         }
         let mut leaf_edges = Vec::new();
-        for (p, patch) in self.set.patches().iter().enumerate() {
+        for (p, patch) in patches.iter().enumerate() {
             if forms[p].is_none() {
                 acc.out.mixed_patches += 1;
                 let (m, n) = patch.degree();
@@ -239,14 +306,16 @@ impl PatchWindingNumber {
                         [w * d[0], w * d[1], w * d[2], w]
                     })
                     .collect();
-                self.subdivide(Net { m, n, h }, &mut leaf_edges, &mut acc);
+                acc.hole_error = if self.links[p].contains(&EdgeLink::Boundary) {
+                    HOLE_ERROR_AT_BOUNDARY
+                } else {
+                    HOLE_ERROR
+                };
+                acc.refine(Net { m, n, h }, 0, &mut leaf_edges);
             }
         }
         acc.leaf_edges(leaf_edges);
-        let mut out = acc.out;
-        out.value = acc.sum.value() / (4.0 * PI);
-        out.error_estimate /= 4.0 * PI;
-        out
+        acc.finish(self.options.tolerance)
     }
 
     /// `(min, max, scale)` of the frame `z` of patch `p`'s control points relative to `q`, from
@@ -266,58 +335,137 @@ impl PatchWindingNumber {
             (a, b, scale)
         }
     }
-
-    /// Halves a mixed net until its pieces are classified; records their edges.
-    fn subdivide(&self, net: Net, leaf_edges: &mut Vec<LeafEdge>, acc: &mut Accumulator) {
-        let mut stack = vec![(net, 0u32)];
-        while let Some((net, depth)) = stack.pop() {
-            if let Some(form) = classify(&net) {
-                for e in 0..4 {
-                    let ctrl: Vec<Homogeneous> = edge_indices(net.m, net.n, e)
-                        .into_iter()
-                        .map(|k| net.h[k])
-                        .collect();
-                    if ctrl.iter().all(|c| *c == ctrl[0]) {
-                        continue;
-                    }
-                    leaf_edges.push(LeafEdge::new(ctrl, form));
-                }
-                continue;
-            }
-            if depth >= MAX_DEPTH {
-                acc.out.uncertified_pieces += 1;
-                acc.sum.add(corner_quad_solid_angle(&net));
-                continue;
-            }
-            for half in split_net(net) {
-                stack.push((half, depth + 1));
-            }
-        }
-    }
 }
 
 /// The sum under construction.
 struct Accumulator {
     sum: NeumaierSum,
-    tol: f64,
     out: Evaluation,
+    /// Boundary curves to integrate (with their piece's form), deferred so that the tolerance
+    /// can be shared among them.
+    tasks: Vec<(Vec<Homogeneous>, Form)>,
+    /// Mixed pieces subdivided so far (capped by [`MAX_PIECES`]).
+    pieces: usize,
+    /// Error charged per hole piece of the patch being refined ([`HOLE_ERROR`] or
+    /// [`HOLE_ERROR_AT_BOUNDARY`]), and the sum charged so far (units of `w`).
+    hole_error: f64,
+    holes_error: f64,
 }
 
 impl Accumulator {
-    fn integrate(&mut self, ctrl: &[Homogeneous], form: Form) {
-        let r: Integral = integrate(
-            |t| {
-                let (n, dn) = eval_with_derivative(ctrl, t);
-                integrand(form, n, dn)
-            },
-            0.0,
-            1.0,
-            self.tol,
-        );
-        self.sum.add(r.value);
-        self.out.error_estimate += r.error;
+    fn integrate(&mut self, ctrl: Vec<Homogeneous>, form: Form) {
+        self.tasks.push((ctrl, form));
+    }
+
+    /// Integrates the deferred curves, each with `tolerance / count` (in units of `w`), and
+    /// returns the evaluation.
+    fn finish(mut self, tolerance: f64) -> Evaluation {
+        let tasks = std::mem::take(&mut self.tasks);
+        let tol = tolerance * 4.0 * PI / tasks.len().max(1) as f64;
+        let mut budget = Budget {
+            remaining: MAX_EVALUATIONS,
+        };
+        for (ctrl, form) in tasks {
+            self.integrate_curve(ctrl, form, tol, &mut budget);
+        }
+        let mut out = self.out;
+        out.value = self.sum.value() / (4.0 * PI);
+        out.error_estimate = out.error_estimate / (4.0 * PI) + self.holes_error;
+        out.certified =
+            out.uncertified_pieces == 0 && !out.capped && out.error_estimate <= tolerance;
+        out
+    }
+
+    /// `∫ α_form` over one boundary curve to absolute tolerance `tol` (units of `4π w`). The
+    /// curve is first halved where it is large compared with its distance from the query
+    /// (`CURVE_SPLIT_RATIO`), each piece getting the tolerance share of its parameter length;
+    /// then adaptive Gauss–Kronrod with the integrand's rounding bound.
+    fn integrate_curve(
+        &mut self,
+        ctrl: Vec<Homogeneous>,
+        form: Form,
+        tol: f64,
+        budget: &mut Budget,
+    ) {
         self.out.integrals += 1;
-        self.out.evaluations += r.evaluations;
+        let mut stack = vec![(ctrl, 1.0f64, 0u32)];
+        while let Some((ctrl, share, depth)) = stack.pop() {
+            let (distance, size) = distance_and_size(&ctrl);
+            if size > CURVE_SPLIT_RATIO * distance
+                && depth < CURVE_MAX_DEPTH
+                && budget.remaining > GK_EVALUATIONS
+            {
+                let (a, b) = split_half(&ctrl);
+                stack.push((b, 0.5 * share, depth + 1));
+                stack.push((a, 0.5 * share, depth + 1));
+                continue;
+            }
+            let (en, edn) = evaluation_rounding(&ctrl);
+            let r = integrate(
+                |t| {
+                    let (n, dn) = eval_with_derivative(&ctrl, t);
+                    integrand_with_rounding(form, n, dn, en, edn)
+                },
+                0.0,
+                1.0,
+                tol * share,
+                budget,
+            );
+            self.sum.add(r.value);
+            self.out.error_estimate += r.error;
+            self.out.evaluations += r.evaluations;
+            self.out.capped |= r.capped > 0;
+        }
+        if budget.remaining <= GK_EVALUATIONS {
+            self.out.capped = true;
+        }
+    }
+
+    /// Halves a mixed net until its pieces are classified and records their edges. Returns
+    /// `false` if a piece deeper than [`HOLE_DEPTH`] stayed mixed to [`MAX_DEPTH`] (the query
+    /// is on it): its ancestor at `HOLE_DEPTH` then drops its whole subtree as the hole.
+    fn refine(&mut self, net: Net, depth: u32, leaves: &mut Vec<LeafEdge>) -> bool {
+        if let Some(form) = classify(&net) {
+            for e in 0..4 {
+                let ctrl: Vec<Homogeneous> = edge_indices(net.m, net.n, e)
+                    .into_iter()
+                    .map(|k| net.h[k])
+                    .collect();
+                if ctrl.iter().all(|c| *c == ctrl[0]) {
+                    continue;
+                }
+                leaves.push(LeafEdge::new(ctrl, form));
+            }
+            return true;
+        }
+        if depth >= MAX_DEPTH {
+            return false;
+        }
+        if self.pieces >= MAX_PIECES {
+            self.out.capped = true;
+            if depth > HOLE_DEPTH {
+                return false;
+            }
+            self.out.uncertified_pieces += 1;
+            self.holes_error += self.hole_error;
+            return true;
+        }
+        self.pieces += 1;
+        let mark = leaves.len();
+        for piece in split_net(net) {
+            if !self.refine(piece, depth + 1, leaves) {
+                if depth > HOLE_DEPTH {
+                    return false;
+                }
+                // The hole: this piece's pieces already recorded are dropped with it, so the
+                // rest of the surface sees one hole bounded by this piece's edges.
+                leaves.truncate(mark);
+                self.out.uncertified_pieces += 1;
+                self.holes_error += self.hole_error;
+                return true;
+            }
+        }
+        true
     }
 
     /// The edge `ctrl` (oriented as in the loop of a piece with form `form`) is shared with a
@@ -337,12 +485,12 @@ impl Accumulator {
                     Form::Up => Form::Down,
                     Form::Down => Form::Up,
                 };
-                self.integrate(ctrl, form);
+                self.integrate(ctrl.to_vec(), form);
                 let reversed: Vec<Homogeneous> = match other_ctrl {
                     Some(c) => c.to_vec(),
                     None => ctrl.iter().rev().copied().collect(),
                 };
-                self.integrate(&reversed, other);
+                self.integrate(reversed, other);
             }
         }
     }
@@ -381,7 +529,7 @@ impl Accumulator {
             }
             for (i, e) in group.iter().enumerate() {
                 if !used[i] {
-                    self.integrate(&e.ctrl, e.form);
+                    self.integrate(e.ctrl.clone(), e.form);
                 }
             }
             start = end;
@@ -473,6 +621,27 @@ fn classify_points(
     if z1 < -slack {
         return Some(Form::Down);
     }
+    // The same with the points at the query's height allowed (a rim lying in the query's
+    // plane, issue 23): every point either clears the height test or is at the right side's
+    // height (sign exact) and at least `asin μ` away from the ray's line in the direction of
+    // one `h`. The hull then meets the ray's line only at heights of the right sign (a point of
+    // it on the line mixes in a point that clears the height test), and the potential's
+    // denominator `ρ ± z ≥ ρ` keeps its integrand smooth at the scale of `ρ`.
+    if z0 >= 0.0 || z1 <= 0.0 {
+        let up = z0 >= 0.0;
+        let m2 = MARGIN * MARGIN;
+        for h in DIRECTIONS {
+            let nn = h[0] * h[0] + h[1] * h[1];
+            let ok = pts.clone().all(|p| {
+                let clears = if up { p[2] > slack } else { p[2] < -slack };
+                let d = h[0] * p[0] + h[1] * p[1];
+                clears || (d > 0.0 && d * d >= m2 * nn * (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]))
+            });
+            if ok {
+                return Some(if up { Form::Up } else { Form::Down });
+            }
+        }
+    }
     let (mut mx, mut my) = (0.0, 0.0);
     for p in pts.clone() {
         let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
@@ -514,9 +683,50 @@ fn classify_points(
     None
 }
 
-/// The four quarters of a net (halved in `s` and in `t`; a direction of degree 0 is not split).
+/// Relative distance below which the control points of a side count as one point (see
+/// [`split_net`]).
+const COLLAPSE_TOLERANCE: f64 = 1e-12;
+
+/// The pieces of a mixed net: halved in `s` and in `t` (a direction of degree 0 is not split),
+/// except that a net with a collapsed side (a row or column of equal control points, like the
+/// teapot's knob and bottom poles) is halved only across it. A query at such a pole is a
+/// control point of every piece along the collapsed side, so halving along the side would
+/// double the mixed pieces at every level (2^48 pieces: one of the issue-23 hangs); halving
+/// across it keeps one mixed piece per level.
 fn split_net(net: Net) -> Vec<Net> {
-    let halves_s = if net.m > 0 {
+    let (m, n) = (net.m, net.n);
+    // Collapsed: the Euclidean points agree (a pole's homogeneous points differ by their
+    // weights), to a relative [`COLLAPSE_TOLERANCE`] for the rounding of `H / w`. Only the
+    // splitting direction depends on it, never a value.
+    let euclid = |k: usize| {
+        let h = net.h[k];
+        [h[0] / h[3], h[1] / h[3], h[2] / h[3]]
+    };
+    let scale = (0..net.h.len()).fold(0.0f64, |a, k| {
+        let e = euclid(k);
+        a.max(e[0].abs()).max(e[1].abs()).max(e[2].abs())
+    });
+    let all_equal = |idx: &mut dyn Iterator<Item = usize>| {
+        let Some(first) = idx.next().map(euclid) else {
+            return true;
+        };
+        let mut same = true;
+        for k in idx {
+            let e = euclid(k);
+            for a in 0..3 {
+                same &= (e[a] - first[a]).abs() <= COLLAPSE_TOLERANCE * scale;
+            }
+        }
+        same
+    };
+    let collapsed_row =
+        n > 0 && (all_equal(&mut (0..=n)) || all_equal(&mut (0..=n).map(|j| m * (n + 1) + j)));
+    let collapsed_column = m > 0
+        && (all_equal(&mut (0..=m).map(|i| i * (n + 1)))
+            || all_equal(&mut (0..=m).map(|i| i * (n + 1) + n)));
+    let split_s = m > 0 && (collapsed_row || !collapsed_column);
+    let split_t = n > 0 && (collapsed_column || !collapsed_row);
+    let halves_s = if split_s {
         let (a, b) = split_rows(&net);
         vec![a, b]
     } else {
@@ -524,7 +734,7 @@ fn split_net(net: Net) -> Vec<Net> {
     };
     let mut out = Vec::with_capacity(4);
     for h in halves_s {
-        if h.n > 0 {
+        if split_t {
             let t = transpose(&h);
             let (a, b) = split_rows(&t);
             out.push(transpose(&a));
@@ -563,21 +773,92 @@ fn transpose(net: &Net) -> Net {
     Net { m: n, n: m, h }
 }
 
-/// Principal-value solid angle of a tiny piece's corner quad (the query lies on it to `f64`
-/// resolution), oriented like the loop `(s,t) = (0,0) → (0,1) → (1,1) → (1,0)`.
-fn corner_quad_solid_angle(net: &Net) -> f64 {
-    let e = |k: usize| {
-        let h = net.h[k];
-        [h[0] / h[3], h[1] / h[3], h[2] / h[3]]
-    };
-    let (m, n) = (net.m, net.n);
-    let c00 = e(0);
-    let c01 = e(n);
-    let c11 = e(m * (n + 1) + n);
-    let c10 = e(m * (n + 1));
-    // Same orientation as the loop (normal ∂S/∂t × ∂S/∂s), and Van Oosterom–Strackee counts
-    // a face positively when its normal points away from the query, as the potentials do.
-    triangle_solid_angle(c00, c01, c11) + triangle_solid_angle(c00, c11, c10)
+/// Distance from the origin (the query) to the box of a curve's Euclidean control points (a
+/// lower bound on the curve's distance, by the convex-hull property), and the box's diagonal.
+fn distance_and_size(ctrl: &[Homogeneous]) -> (f64, f64) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for h in ctrl {
+        for a in 0..3 {
+            let x = h[a] / h[3];
+            lo[a] = lo[a].min(x);
+            hi[a] = hi[a].max(x);
+        }
+    }
+    let mut d2 = 0.0;
+    let mut s2 = 0.0;
+    for a in 0..3 {
+        let gap = lo[a].max(-hi[a]).max(0.0);
+        d2 += gap * gap;
+        s2 += (hi[a] - lo[a]) * (hi[a] - lo[a]);
+    }
+    (d2.sqrt(), s2.sqrt())
+}
+
+/// `x · 2^e`, exact unless the result over- or underflows (then the rounded value).
+fn scale_by_pow2(x: f64, e: i32) -> f64 {
+    // Two steps: 2^e alone may not be representable for |e| > 1023.
+    let half = e / 2;
+    x * 2f64.powi(half) * 2f64.powi(e - half)
+}
+
+/// The exponent `e` with `2^(e-1) ≤ x < 2^e` for a positive finite `x` (0 for 0).
+fn exponent_of(x: f64) -> i32 {
+    if x == 0.0 || !x.is_finite() {
+        return 0;
+    }
+    let mut e = x.log2().floor() as i32 + 1;
+    // Correct the rounding of log2 near powers of two.
+    while scale_by_pow2(x, -e) >= 1.0 {
+        e += 1;
+    }
+    while scale_by_pow2(x, -e) < 0.5 {
+        e -= 1;
+    }
+    e
+}
+
+/// The set scaled exactly by powers of two, as the mesh path's `Rescale` does: coordinates by
+/// `2^-e` so the largest magnitude is in `[0.5, 1)` (products of coordinates and weights can
+/// then neither overflow nor lose the small end of the range to underflow, which made sets
+/// beyond ~1e150 or below ~1e-160 return 0), and all weights by one power of two so the largest
+/// is in `[0.5, 1)` (a rational patch does not change when all its weights are scaled; all-equal
+/// extreme weights overflowed `w·x`). One factor for all patches keeps shared edges' homogeneous
+/// control points bit-identical, which the leaf-edge cancellation relies on. The winding number is scale invariant, so no result is scaled back.
+fn rescaled(set: &PatchSet) -> (PatchSet, i32) {
+    let max = set
+        .patches()
+        .iter()
+        .flat_map(|p| p.points())
+        .fold(0.0f64, |a, p| {
+            a.max(p[0].abs()).max(p[1].abs()).max(p[2].abs())
+        });
+    let e = exponent_of(max);
+    let wmax = set
+        .patches()
+        .iter()
+        .flat_map(|p| p.weights())
+        .fold(0.0f64, |a, &w| a.max(w));
+    let ew = exponent_of(wmax);
+    let patches = set
+        .patches()
+        .iter()
+        .map(|p| {
+            let (m, n) = p.degree();
+            let points: Vec<[f64; 3]> = p
+                .points()
+                .iter()
+                .map(|x| x.map(|c| scale_by_pow2(c, -e)))
+                .collect();
+            let weights = p.weights().iter().map(|&w| scale_by_pow2(w, -ew)).collect();
+            // Scaled weights stay positive unless one underflows to 0 (a weight ratio beyond
+            // 2^1074 in the set); such a patch keeps its weights.
+            Patch::rational(m, n, points.clone(), weights)
+                .or_else(|_| Patch::rational(m, n, points, p.weights().to_vec()))
+                .unwrap_or_else(|_| p.clone())
+        })
+        .collect();
+    (PatchSet::new(patches).unwrap_or_else(|_| set.clone()), e)
 }
 
 /// Patch sets plug into grids and products like the triangle evaluators (no gradient yet).

@@ -184,14 +184,32 @@ fn run_patches(args: &Args) -> Result<(), CliError> {
     let set = gwn::patch::load_patches(&args.mesh)?;
     let points = gwn::io::points::load_points(&args.points)?;
     let values = match args.method.method.unwrap_or(Method::Exact) {
-        Method::Exact => gwn::patch::PatchWindingNumber::with_options(
-            &set,
-            gwn::patch::Options {
-                ray: args.ray.unwrap_or(Ray::PosZ).into(),
-                tolerance: args.tolerance,
-            },
-        )
-        .eval_batch(&points),
+        Method::Exact => {
+            let evaluations = gwn::patch::PatchWindingNumber::with_options(
+                &set,
+                gwn::patch::Options {
+                    ray: args.ray.unwrap_or(Ray::PosZ).into(),
+                    tolerance: args.tolerance,
+                },
+            )
+            .evaluate_batch(&points);
+            // The flag of docs/patches.md ("Error model"): queries on the surface (principal
+            // value), at rounding level from it, or past the work cap.
+            let uncertified = evaluations.iter().filter(|e| !e.certified).count();
+            let worst = evaluations
+                .iter()
+                .filter(|e| !e.certified)
+                .fold(0.0f64, |a, e| a.max(e.error_estimate));
+            if uncertified > 0 {
+                eprintln!(
+                    "gwn eval: warning: {uncertified} of {} values uncertified (on or within \
+                     rounding of the surface, or work cap reached; largest error estimate \
+                     {worst:.1e}); see docs/patches.md",
+                    points.len()
+                );
+            }
+            evaluations.iter().map(|e| e.value).collect()
+        }
         Method::Direct => {
             if args.ray.is_some() {
                 return Err(CliError::msg("--ray applies to --method exact only"));
