@@ -451,7 +451,13 @@ fn fifo_in_a_dataset_is_a_failed_row_not_a_hang() {
         label_dataset(&[fifo], &out2, None, &JobOptions::default(), |_| {}).unwrap()
     });
     assert_eq!(rows[0].status, Status::Failed);
-    assert!(rows[0].error.as_deref().unwrap().contains("not a regular file"));
+    assert!(
+        rows[0]
+            .error
+            .as_deref()
+            .unwrap()
+            .contains("not a regular file")
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -475,9 +481,15 @@ fn two_inputs_never_share_an_output() {
     assert_eq!(rows[0].status, Status::Ok);
     assert_eq!(rows[1].status, Status::Failed, "{rows:?}");
     // One file twice (or two names for one output) is refused before anything is written.
-    let e = label_dataset(&[a.clone(), a.clone()], &dir.join("out3"), None, &opts, |_| {})
-        .unwrap_err()
-        .to_string();
+    let e = label_dataset(
+        &[a.clone(), a.clone()],
+        &dir.join("out3"),
+        None,
+        &opts,
+        |_| {},
+    )
+    .unwrap_err()
+    .to_string();
     assert!(e.contains("m.off.npz") && !e.contains('\n'), "{e}");
     assert!(!dir.join("out3/manifest.jsonl").exists());
     let _ = std::fs::remove_dir_all(&dir);
@@ -512,16 +524,26 @@ fn resume_redoes_outputs_whose_options_or_input_changed_and_keeps_statistics() {
     assert_eq!(other[0].status, Status::Ok);
     let why = other[0].redone.as_deref().unwrap_or_default();
     assert!(why.contains("options"), "{why:?}");
-    assert!(other[0].to_json().contains("\"redone\":"), "{}", other[0].to_json());
+    assert!(
+        other[0].to_json().contains("\"redone\":"),
+        "{}",
+        other[0].to_json()
+    );
     let fresh = dir.join("fresh");
     label_dataset(&meshes, &fresh, None, &with(2), |_| {}).unwrap();
     assert_eq!(outputs(&out), outputs(&fresh));
-    // A changed input is redone too.
-    std::fs::copy(fixture("cube.obj"), &meshes[0]).unwrap();
+    // A changed input (here one more trailing newline) is redone too.
+    let mut bytes = std::fs::read(&meshes[0]).unwrap();
+    bytes.push(b'\n');
+    std::fs::write(&meshes[0], bytes).unwrap();
     let changed = label_dataset(&meshes, &out, None, &with(2), |_| {}).unwrap();
     assert_eq!(changed[0].status, Status::Ok);
     assert!(
-        changed[0].redone.as_deref().unwrap_or_default().contains("input"),
+        changed[0]
+            .redone
+            .as_deref()
+            .unwrap_or_default()
+            .contains("input"),
         "{:?}",
         changed[0]
     );
@@ -580,7 +602,10 @@ fn directory_symlink_loops_list_each_file_once() {
     let manifest = std::fs::read_to_string(dir.join("out/manifest.jsonl")).unwrap();
     assert_eq!(manifest.lines().count(), 5, "{manifest}");
     // Files are named by their real paths, not through the links.
-    assert!(!manifest.contains("b_again") && !manifest.contains("up/"), "{manifest}");
+    assert!(
+        !manifest.contains("b_again") && !manifest.contains("up/"),
+        "{manifest}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -639,7 +664,11 @@ fn full_stdout_is_a_one_line_error() {
         .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
-    assert!(err.lines().any(|l| l.starts_with("gwn: ") && l.contains("stdout")), "{err}");
+    assert!(
+        err.lines()
+            .any(|l| l.starts_with("gwn: ") && l.contains("stdout")),
+        "{err}"
+    );
     assert!(!err.contains("panicked"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
