@@ -8,8 +8,10 @@
 //! the thread that runs it), the random numbers from SplitMix64 and the Gaussian offsets from
 //! `libm` (the same bits on every platform); the labels do not depend on the thread count, and the
 //! `.npz` has no timestamps. Resumable: an output that exists is finished (outputs are written to
-//! a temporary name and renamed), so a rerun skips it. A broken file, a panic or a time-limit
-//! overrun is a manifest row, never the end of the run.
+//! a temporary name and renamed), and a rerun reuses it when its record (`*.meta.json`: options,
+//! input size and modification time, statistics) matches, else redoes it and says why. A broken
+//! file, a FIFO, a panic or a time-limit overrun is a manifest row, never the end (nor a hang) of
+//! the run; two inputs with one output stop the job before it starts.
 //!
 //! ```
 //! use gwn::{Mesh, products::label::{label_mesh, SamplingOptions}};
