@@ -443,6 +443,7 @@ fn fifo_given_as_input_does_not_hang() {
     for args in [
         vec!["info", "pipe.obj"],
         vec!["eval", cube.as_str(), "--points", "pipe.obj"],
+        vec!["curve", "field", "pipe.obj", "--res", "8", "--out", "f.png"],
     ] {
         // No writer ever opens the FIFO: the old blocking open waited for one forever.
         let mut child = Command::new(GWN)

@@ -186,14 +186,14 @@ pub const MAX_STREAM_BYTES: u64 = 1 << 28;
 pub fn read_input(path: &Path) -> Result<Vec<u8>, LoadError> {
     use std::io::Read;
     let io_err = |e| LoadError::new(path, Location::File, LoadErrorKind::Io(e));
-    let file = open_nonblocking(path).map_err(io_err)?;
+    let file = crate::base::file::open_nonblocking(path).map_err(io_err)?;
     let meta = file.metadata().map_err(io_err)?;
     let mut bytes = Vec::new();
     if meta.is_file() {
         bytes.reserve(usize::try_from(meta.len()).unwrap_or(0));
         (&file).read_to_end(&mut bytes).map_err(io_err)?;
     } else {
-        read_stream(&file, &mut bytes, MAX_STREAM_BYTES + 1).map_err(io_err)?;
+        crate::base::file::read_stream(&file, &mut bytes, MAX_STREAM_BYTES + 1).map_err(io_err)?;
         if bytes.len() as u64 > MAX_STREAM_BYTES {
             return Err(LoadError::new(
                 path,
@@ -205,77 +205,6 @@ pub fn read_input(path: &Path) -> Result<Vec<u8>, LoadError> {
         }
     }
     Ok(bytes)
-}
-
-/// Reads a non-blocking stream until its end or `limit` bytes. "No data yet" (`WouldBlock`) is
-/// waited out with short sleeps: std offers no `poll`, and the descriptor stays non-blocking
-/// because clearing the flag needs `fcntl`.
-fn read_stream(mut file: &std::fs::File, out: &mut Vec<u8>, limit: u64) -> std::io::Result<()> {
-    use std::io::{ErrorKind, Read};
-    let mut buf = vec![0u8; 1 << 16];
-    let mut pause = std::time::Duration::from_millis(1);
-    while (out.len() as u64) < limit {
-        let room = usize::try_from(limit - out.len() as u64).unwrap_or(usize::MAX);
-        let want = buf.len().min(room);
-        match file.read(&mut buf[..want]) {
-            Ok(0) => break,
-            Ok(n) => {
-                out.extend_from_slice(&buf[..n]);
-                pause = std::time::Duration::from_millis(1);
-            }
-            Err(e) if e.kind() == ErrorKind::Interrupted => {}
-            Err(e) if e.kind() == ErrorKind::WouldBlock => {
-                std::thread::sleep(pause);
-                pause = (pause * 2).min(std::time::Duration::from_millis(100));
-            }
-            Err(e) => return Err(e),
-        }
-    }
-    Ok(())
-}
-
-/// The `O_NONBLOCK` flag of `open(2)` on this platform, if known. std has no constant for it and
-/// libc is not a dependency; the values are the kernels' ABI (Linux: `0o4000`, `0x80` on MIPS,
-/// `0x4000` on SPARC; Apple and the BSDs: `0x4`). Elsewhere files are opened normally and only the
-/// metadata checks of [`open_regular`] protect against FIFOs.
-#[cfg(unix)]
-const fn o_nonblock() -> Option<i32> {
-    if cfg!(any(target_os = "linux", target_os = "android")) {
-        if cfg!(any(
-            target_arch = "mips",
-            target_arch = "mips64",
-            target_arch = "mips32r6",
-            target_arch = "mips64r6"
-        )) {
-            Some(0x80)
-        } else if cfg!(any(target_arch = "sparc", target_arch = "sparc64")) {
-            Some(0x4000)
-        } else {
-            Some(0o4000)
-        }
-    } else if cfg!(any(
-        target_vendor = "apple",
-        target_os = "freebsd",
-        target_os = "netbsd",
-        target_os = "openbsd",
-        target_os = "dragonfly"
-    )) {
-        Some(0x4)
-    } else {
-        None
-    }
-}
-
-/// Opens `path` for reading without waiting for a FIFO's writer (see [`o_nonblock`]).
-fn open_nonblocking(path: &Path) -> std::io::Result<std::fs::File> {
-    let mut options = std::fs::OpenOptions::new();
-    options.read(true);
-    #[cfg(unix)]
-    if let Some(flag) = o_nonblock() {
-        use std::os::unix::fs::OpenOptionsExt;
-        options.custom_flags(flag);
-    }
-    options.open(path)
 }
 
 /// What kind of non-regular file `meta` describes, for error messages.
@@ -327,7 +256,7 @@ pub fn regular_file_metadata(path: &Path) -> std::io::Result<std::fs::Metadata> 
 /// opened handle (the path may have been swapped in between); the open itself never blocks.
 pub fn open_regular(path: &Path) -> std::io::Result<std::fs::File> {
     regular_file_metadata(path)?;
-    let file = open_nonblocking(path)?;
+    let file = crate::base::file::open_nonblocking(path)?;
     let after = file.metadata()?;
     if !after.is_file() {
         return Err(not_regular(&after));
