@@ -79,7 +79,14 @@ def test_dask_local_cluster_matches_serial(tmp_path):
     serial = gwn.label_dataset(paths, tmp_path / "serial", **OPTS)
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                       dashboard_address=None) as cluster, Client(cluster) as client:
-        rows = gwn.dask.label_dataset(paths, tmp_path / "dask", client, **OPTS)
+        seen = []
+        rows = gwn.dask.label_dataset(paths, tmp_path / "dask", client, **OPTS,
+                                      progress=seen.append)
+        assert sorted(r["mesh"] for r in seen) == sorted(r["mesh"] for r in rows)
+        # Two meshes with one output are refused before any task runs.
+        with pytest.raises(ValueError, match="both be written"):
+            gwn.dask.label_dataset([paths[0], paths[0]], tmp_path / "twice", client, **OPTS)
+        assert not (tmp_path / "twice").exists()
         # A real two-process cluster.
         assert len(client.scheduler_info()["workers"]) == 2
     assert [r["status"] for r in rows] == [r["status"] for r in serial]
