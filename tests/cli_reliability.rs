@@ -425,3 +425,44 @@ element face 4\nproperty list uchar uint vertex_indices\nend_header\n\
         "{stdout}"
     );
 }
+
+#[cfg(unix)]
+#[test]
+fn fifo_given_as_input_does_not_hang() {
+    let dir = scratch("fifo-input");
+    let fifo = dir.join("pipe.obj");
+    let made = Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success());
+    if !made {
+        println!("skipping: mkfifo is not available");
+        return;
+    }
+    let cube = fixture("cube.obj").display().to_string();
+    for args in [
+        vec!["info", "pipe.obj"],
+        vec!["eval", cube.as_str(), "--points", "pipe.obj"],
+        vec!["curve", "field", "pipe.obj", "--res", "8", "--out", "f.png"],
+    ] {
+        // No writer ever opens the FIFO: the old blocking open waited for one forever.
+        let mut child = Command::new(GWN)
+            .current_dir(&*dir)
+            .args(&args)
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let start = std::time::Instant::now();
+        while child.try_wait().unwrap().is_none() {
+            if start.elapsed() > std::time::Duration::from_secs(30) {
+                let _ = child.kill();
+                panic!("gwn {args:?} hangs on a FIFO without a writer");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        let out = child.wait_with_output().unwrap();
+        assert_one_line_error(&out, &["pipe.obj"]);
+    }
+}

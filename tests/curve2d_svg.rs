@@ -173,3 +173,38 @@ fn unreadable_svg_is_one_line_error() {
         assert_eq!(e.lines().count(), 1);
     }
 }
+
+/// `<image href>` names a file on the document's say-so; the paths are all we read, so no file is
+/// opened at all. The old reader opened the href (usvg's default resolver): a FIFO hung it, and
+/// `/dev/zero` read until memory ran out.
+#[cfg(unix)]
+#[test]
+fn image_hrefs_are_never_opened() {
+    let dir = std::env::temp_dir().join(format!("gwn-svg-{}-href", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let fifo = dir.join("pipe.png");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success());
+    if !made {
+        println!("skipping: mkfifo is not available");
+        return;
+    }
+    let text = svg(&format!(
+        "<image href='{}' width='10' height='10'/><polygon points='0,0 10,0 10,10'/>",
+        fifo.display()
+    ));
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = tx.send(parse_svg(&text, "img.svg"));
+    });
+    let curves = rx
+        .recv_timeout(std::time::Duration::from_secs(20))
+        .expect("parsing an SVG whose <image> names a FIFO hangs")
+        .unwrap();
+    let without = parse_svg(&svg("<polygon points='0,0 10,0 10,10'/>"), "p.svg").unwrap();
+    assert_eq!(curves, without);
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -309,3 +309,114 @@ fn every_prefix_and_byte_flip_of_a_glb_is_handled() {
         }
     }
 }
+
+/// A scratch folder for one test (removed first, so a rerun starts clean).
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("gwn-gltf-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Loads `path` on another thread and gives up after 20 s: a loader that blocks (on a FIFO)
+/// fails the test instead of hanging it.
+fn load_with_deadline(path: &Path) -> Result<gwn::io::LoadedMesh, gwn::error::LoadError> {
+    let (tx, rx) = std::sync::mpsc::channel();
+    let p = path.to_path_buf();
+    std::thread::spawn(move || {
+        let _ = tx.send(load_mesh(&p));
+    });
+    rx.recv_timeout(std::time::Duration::from_secs(20))
+        .unwrap_or_else(|_| panic!("loading {} did not return within 20 s", path.display()))
+}
+
+/// `m.gltf` in `X/sub/deeper/` whose buffer URI is `uri`; `X/secret.bin` holds valid cube data.
+fn model_with_uri(dir: &Path, uri: &str) -> PathBuf {
+    let bin = binary_buffer();
+    std::fs::write(dir.join("secret.bin"), &bin).unwrap();
+    let deeper = dir.join("sub/deeper");
+    std::fs::create_dir_all(&deeper).unwrap();
+    std::fs::write(deeper.join("inside.bin"), &bin).unwrap();
+    let m = deeper.join("m.gltf");
+    std::fs::write(&m, scene_json(&format!(r#","uri":"{uri}""#), bin.len())).unwrap();
+    m
+}
+
+#[test]
+fn buffer_uri_leaving_the_model_folder_is_refused() {
+    let dir = scratch("escape");
+    for uri in [
+        "../../secret.bin",
+        "..%2F..%2Fsecret.bin",
+        "%2E%2E/%2E%2E/secret.bin",
+        "inside.bin/../../../secret.bin",
+        "./../../secret.bin",
+        "x/../../../secret.bin",
+        "%2Fetc%2Fpasswd",
+    ] {
+        let m = model_with_uri(&dir, uri);
+        let e = load_with_deadline(&m).expect_err(uri);
+        let msg = e.to_string();
+        assert!(!msg.contains('\n'), "{msg}");
+        assert!(msg.contains("m.gltf") && msg.contains(uri), "{uri}: {msg}");
+        assert!(
+            msg.contains("outside the model's folder") || msg.contains("relative file path"),
+            "{uri}: {msg}"
+        );
+    }
+    // Paths that stay inside the folder after `..` are fine.
+    for uri in [
+        "inside.bin",
+        "./inside.bin",
+        "x/../inside.bin",
+        "%69nside.bin",
+    ] {
+        let m = model_with_uri(&dir, uri);
+        let l = load_with_deadline(&m).unwrap_or_else(|e| panic!("{uri}: {e}"));
+        assert_eq!(l.mesh.triangles().len(), 24, "{uri}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[cfg(unix)]
+#[test]
+fn buffer_uri_must_name_a_regular_file() {
+    let dir = scratch("special");
+    let deeper = dir.join("sub/deeper");
+    std::fs::create_dir_all(deeper.join("folder.bin")).unwrap();
+    std::os::unix::fs::symlink("/dev/null", deeper.join("null.bin")).unwrap();
+    let fifo = deeper.join("pipe.bin");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success());
+    let mut uris = vec!["folder.bin", "null.bin"];
+    if made {
+        uris.push("pipe.bin");
+    } else {
+        println!("skipping the FIFO case: mkfifo is not available");
+    }
+    for uri in uris {
+        let m = model_with_uri(&dir, uri);
+        let msg = load_with_deadline(&m).expect_err(uri).to_string();
+        assert!(msg.contains("not a regular file"), "{uri}: {msg}");
+        assert!(msg.contains(uri) && !msg.contains('\n'), "{msg}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn buffer_file_is_read_up_to_its_byte_length() {
+    let dir = scratch("length");
+    let m = model_with_uri(&dir, "inside.bin");
+    // Trailing bytes beyond byteLength are not read (nor needed).
+    let mut long = binary_buffer();
+    long.extend(std::iter::repeat_n(7u8, 1000));
+    std::fs::write(m.with_file_name("inside.bin"), &long).unwrap();
+    assert_eq!(load_with_deadline(&m).unwrap().mesh.triangles().len(), 24);
+    // A file shorter than byteLength is truncated.
+    std::fs::write(m.with_file_name("inside.bin"), &long[..100]).unwrap();
+    let msg = load_with_deadline(&m).unwrap_err().to_string();
+    assert!(msg.contains("byteLength"), "{msg}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

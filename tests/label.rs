@@ -396,3 +396,279 @@ fn cli_label() {
     assert!(err.contains("sigma"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Runs `work` on another thread and fails the test after 60 s instead of hanging it.
+fn within_a_minute<T: Send + 'static>(what: &str, work: impl FnOnce() -> T + Send + 'static) -> T {
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = tx.send(work());
+    });
+    rx.recv_timeout(Duration::from_secs(60))
+        .unwrap_or_else(|_| panic!("{what} did not finish within 60 s"))
+}
+
+fn mkfifo(path: &Path) -> bool {
+    Command::new("mkfifo")
+        .arg(path)
+        .status()
+        .is_ok_and(|s| s.success())
+}
+
+#[cfg(unix)]
+#[test]
+fn fifo_in_a_dataset_is_a_failed_row_not_a_hang() {
+    let dir = scratch("fifo");
+    dataset(&dir);
+    if !mkfifo(&dir.join("in/b/pipe.obj")) {
+        println!("skipping: mkfifo is not available");
+        return;
+    }
+    let (inp, out) = (dir.join("in"), dir.join("out"));
+    let run = within_a_minute("gwn label on a folder with a FIFO", move || {
+        Command::new(env!("CARGO_BIN_EXE_gwn"))
+            .arg("label")
+            .arg(&inp)
+            .arg("--out")
+            .arg(&out)
+            .args(["--uniform", "50", "--near", "50"])
+            .output()
+            .unwrap()
+    });
+    assert!(run.status.success(), "{run:?}");
+    let manifest = std::fs::read_to_string(dir.join("out/manifest.jsonl")).unwrap();
+    let row = manifest
+        .lines()
+        .find(|l| l.contains("pipe.obj"))
+        .unwrap_or_else(|| panic!("no row for the FIFO: {manifest}"));
+    assert!(
+        row.contains("\"status\":\"failed\"") && row.contains("not a regular file"),
+        "{row}"
+    );
+    // The library, given the FIFO by name, does the same.
+    let fifo = dir.join("in/b/pipe.obj");
+    let out2 = dir.join("out2");
+    let rows = within_a_minute("label_dataset on a FIFO", move || {
+        label_dataset(&[fifo], &out2, None, &JobOptions::default(), |_| {}).unwrap()
+    });
+    assert_eq!(rows[0].status, Status::Failed);
+    assert!(
+        rows[0]
+            .error
+            .as_deref()
+            .unwrap()
+            .contains("not a regular file")
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn two_inputs_never_share_an_output() {
+    let dir = scratch("collide");
+    let a = dir.join("in/a/d/m.off");
+    let d = dir.join("in/d/m.off");
+    std::fs::create_dir_all(a.parent().unwrap()).unwrap();
+    std::fs::create_dir_all(d.parent().unwrap()).unwrap();
+    std::fs::copy(fixture("cube.off"), &a).unwrap();
+    std::fs::copy(fixture("broken_index.off"), &d).unwrap();
+    let opts = JobOptions {
+        sampling: small(1),
+        ..Default::default()
+    };
+    // `a/../d/m.off` is `d/m.off`, another file: it gets its own output.
+    let dotdot = dir.join("in/a/../d/m.off");
+    let rows = label_dataset(&[a.clone(), dotdot], &dir.join("out"), None, &opts, |_| {}).unwrap();
+    assert_ne!(rows[0].output, rows[1].output, "{rows:?}");
+    assert_eq!(rows[0].status, Status::Ok);
+    assert_eq!(rows[1].status, Status::Failed, "{rows:?}");
+    // One file twice (or two names for one output) is refused before anything is written.
+    let e = label_dataset(
+        &[a.clone(), a.clone()],
+        &dir.join("out3"),
+        None,
+        &opts,
+        |_| {},
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("m.off.npz") && !e.contains('\n'), "{e}");
+    assert!(!dir.join("out3/manifest.jsonl").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn resume_redoes_outputs_whose_options_or_input_changed_and_keeps_statistics() {
+    let dir = scratch("options");
+    let meshes = dataset(&dir);
+    let out = dir.join("out");
+    let with = |seed: u64| JobOptions {
+        sampling: small(seed),
+        ..Default::default()
+    };
+    let first = label_dataset(&meshes, &out, None, &with(1), |_| {}).unwrap();
+    assert_eq!(first[0].status, Status::Ok);
+    // Same options: done, with the statistics of the run that made the file.
+    let again = label_dataset(&meshes, &out, None, &with(1), |_| {}).unwrap();
+    for (a, b) in first.iter().zip(&again) {
+        if a.status == Status::Ok {
+            assert_eq!(b.status, Status::Done, "{b:?}");
+            assert_eq!(
+                (b.faces, b.vertices, b.points, b.inside),
+                (a.faces, a.vertices, a.points, a.inside),
+                "{b:?}"
+            );
+            assert!(b.redone.is_none());
+        }
+    }
+    // Another seed: every output is redone, says so, and equals a fresh run's.
+    let other = label_dataset(&meshes, &out, None, &with(2), |_| {}).unwrap();
+    assert_eq!(other[0].status, Status::Ok);
+    let why = other[0].redone.as_deref().unwrap_or_default();
+    assert!(why.contains("options"), "{why:?}");
+    assert!(
+        other[0].to_json().contains("\"redone\":"),
+        "{}",
+        other[0].to_json()
+    );
+    let fresh = dir.join("fresh");
+    label_dataset(&meshes, &fresh, None, &with(2), |_| {}).unwrap();
+    assert_eq!(outputs(&out), outputs(&fresh));
+    // A changed input (here one more trailing newline) is redone too.
+    let mut bytes = std::fs::read(&meshes[0]).unwrap();
+    bytes.push(b'\n');
+    std::fs::write(&meshes[0], bytes).unwrap();
+    let changed = label_dataset(&meshes, &out, None, &with(2), |_| {}).unwrap();
+    assert_eq!(changed[0].status, Status::Ok);
+    assert!(
+        changed[0]
+            .redone
+            .as_deref()
+            .unwrap_or_default()
+            .contains("input"),
+        "{:?}",
+        changed[0]
+    );
+    assert_eq!(changed[1].status, Status::Done);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn partial_files_of_a_killed_run_are_removed() {
+    let dir = scratch("partial");
+    let meshes = dataset(&dir);
+    let out = dir.join("out");
+    std::fs::create_dir_all(out.join("a")).unwrap();
+    let leftovers = [
+        out.join("a/.cube.off.npz.partial-999999-3"),
+        out.join(".manifest.jsonl.partial-999999-0"),
+        out.join("a/.gone.obj.npz.partial-1-0"),
+    ];
+    for p in &leftovers {
+        std::fs::write(p, b"half a file").unwrap();
+    }
+    // Files that merely look alike are the user's.
+    let keep = out.join("a/notes.partial-1-0");
+    std::fs::write(&keep, b"mine").unwrap();
+    let opts = JobOptions {
+        sampling: small(0),
+        ..Default::default()
+    };
+    label_dataset(&meshes, &out, None, &opts, |_| {}).unwrap();
+    for p in &leftovers {
+        assert!(!p.exists(), "{} left behind", p.display());
+    }
+    assert!(keep.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[cfg(unix)]
+#[test]
+fn directory_symlink_loops_list_each_file_once() {
+    let dir = scratch("loop");
+    dataset(&dir);
+    std::os::unix::fs::symlink("..", dir.join("in/a/up")).unwrap();
+    std::os::unix::fs::symlink("../b", dir.join("in/a/b_again")).unwrap();
+    let (inp, out) = (dir.join("in"), dir.join("out"));
+    let run = within_a_minute("gwn label on a symlink loop", move || {
+        Command::new(env!("CARGO_BIN_EXE_gwn"))
+            .arg("label")
+            .arg(&inp)
+            .arg("--out")
+            .arg(&out)
+            .args(["--uniform", "20", "--near", "20"])
+            .output()
+            .unwrap()
+    });
+    assert!(run.status.success(), "{run:?}");
+    let manifest = std::fs::read_to_string(dir.join("out/manifest.jsonl")).unwrap();
+    assert_eq!(manifest.lines().count(), 5, "{manifest}");
+    // Files are named by their real paths, not through the links.
+    assert!(
+        !manifest.contains("b_again") && !manifest.contains("up/"),
+        "{manifest}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn sample_box_must_be_finite() {
+    let cube = common::unit_cube();
+    for opts in [
+        SamplingOptions {
+            padding: 1e308,
+            ..small(0)
+        },
+        SamplingOptions {
+            sigmas: vec![0.01, 1e308],
+            ..small(0)
+        },
+        SamplingOptions {
+            sigmas: vec![1e307],
+            ..small(0)
+        },
+    ] {
+        let e = label_mesh(&cube, "c", &opts, None).expect_err("must refuse");
+        assert!(e.to_string().contains("not finite"), "{e}");
+    }
+    // The CLI's row says so, too.
+    let dir = scratch("hugepad");
+    let meshes = dataset(&dir);
+    let opts = JobOptions {
+        sampling: SamplingOptions {
+            padding: 1e308,
+            ..small(0)
+        },
+        ..Default::default()
+    };
+    let rows = label_dataset(&meshes[..1], &dir.join("out"), None, &opts, |_| {}).unwrap();
+    assert_eq!(rows[0].status, Status::Failed, "{rows:?}");
+    assert!(outputs(&dir.join("out")).is_empty());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn full_stdout_is_a_one_line_error() {
+    let Ok(full) = std::fs::File::options().write(true).open("/dev/full") else {
+        println!("skipping: /dev/full is not available");
+        return;
+    };
+    let dir = scratch("devfull");
+    dataset(&dir);
+    let out = Command::new(env!("CARGO_BIN_EXE_gwn"))
+        .arg("label")
+        .arg(dir.join("in"))
+        .arg("--out")
+        .arg(dir.join("out"))
+        .args(["--uniform", "20", "--near", "20"])
+        .stdout(full)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.lines()
+            .any(|l| l.starts_with("gwn: ") && l.contains("stdout")),
+        "{err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

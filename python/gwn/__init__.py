@@ -54,9 +54,45 @@ __all__ = [
 ]
 
 
+class _ProgressBar:
+    """A one-line text bar on stderr: ``label [=====     ] 3/10 path``, redrawn per mesh."""
+
+    def __init__(self, total, stream):
+        self.total, self.done, self.stream = total, 0, stream
+
+    def __call__(self, row):
+        self.done += 1
+        width = 30
+        filled = width * self.done // max(self.total, 1)
+        self.stream.write("\rlabel [%s%s] %d/%d %s\x1b[K" % (
+            "=" * filled, " " * (width - filled), self.done, self.total, row["mesh"]))
+        if self.done == self.total:
+            self.stream.write("\n")
+        self.stream.flush()
+
+
+def _progress_callback(progress, total):
+    """``progress`` as a function of one row (dict), or None: a callable is used as is,
+    ``True`` draws a bar on stderr, ``None`` draws it only when stderr is a terminal, ``False``
+    draws nothing."""
+    import sys
+
+    if callable(progress):
+        return progress
+    if progress is None:
+        stream = sys.stderr
+        progress = stream is not None and hasattr(stream, "isatty") and stream.isatty()
+    if progress is True:
+        return _ProgressBar(total, sys.stderr)
+    if progress is False:
+        return None
+    raise TypeError("progress must be None, True, False or a callable taking a row dict, got %r"
+                    % (progress,))
+
+
 def label_dataset(paths, out_dir, *, root=None, uniform=50_000, near=50_000,
                   sigmas=(0.005, 0.05), padding=0.05, seed=0, time_limit=None, weld=None,
-                  threads=None):
+                  threads=None, progress=None):
     """Labels a dataset of meshes for learning, exactly as ``gwn label`` does.
 
     Per mesh: ``uniform`` points in the bounding box padded by ``padding`` x diagonal and
@@ -64,19 +100,28 @@ def label_dataset(paths, out_dir, *, root=None, uniform=50_000, near=50_000,
     labelled with the exact winding number ``w``, ``occupancy`` (w > 1/2) and ``sdf`` (negative
     where w > 1/2). Writes ``out_dir/<path below root>.npz`` (arrays ``points``, ``source``,
     ``w``, ``occupancy``, ``sdf``) and ``out_dir/manifest.jsonl``. Reproducible byte for byte
-    (``seed`` and the path below ``root`` fix a mesh's points); resumable (existing outputs are
-    skipped); broken files and ``time_limit`` (seconds per mesh) overruns are manifest rows.
+    (``seed`` and the path below ``root`` fix a mesh's points); resumable (an existing output is
+    reused only when it was made with the same options from the same input, else redone and
+    ``redone`` says why); broken files, FIFOs and ``time_limit`` (seconds per mesh) overruns are
+    manifest rows; two inputs with one output are a ``ValueError`` before anything is written.
     Runs in Rust on ``threads`` threads (default: all cores) with the GIL released.
+
+    ``progress``: ``None`` (default) draws a progress bar on stderr when stderr is a terminal,
+    ``True`` always, ``False`` never; a callable is called with each finished mesh's row (a dict,
+    in completion order) on the calling thread.
 
     Returns the manifest rows (dicts with ``mesh``, ``output``, ``status`` in ``ok``/``done``/
     ``failed``/``timeout``, ``error``, ``faces``, ``vertices``, ``points``, ``inside``,
-    ``seconds``), in input order. For a cluster, see ``gwn.dask.label_dataset``.
+    ``seconds``, ``redone``), in input order. For a cluster, see ``gwn.dask.label_dataset``.
     """
     from . import _gwn
 
+    paths = [_os.fspath(p) for p in paths]
+    callback = _progress_callback(progress, len(paths))
     rows = _gwn.label_dataset(
-        [_os.fspath(p) for p in paths], _os.fspath(out_dir),
+        paths, _os.fspath(out_dir),
         root=None if root is None else _os.fspath(root), uniform=uniform, near=near,
         sigmas=list(sigmas), padding=padding, seed=seed, time_limit=time_limit, weld=weld,
-        threads=threads)
+        threads=threads,
+        progress=None if callback is None else (lambda line: callback(_json.loads(line))))
     return [_json.loads(r) for r in rows]

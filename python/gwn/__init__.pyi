@@ -1,7 +1,7 @@
 """Type stubs of gwn (the functions live in the compiled module gwn._gwn)."""
 
 from os import PathLike
-from typing import Literal, Optional, Sequence, Tuple, Union, overload
+from typing import Any, Callable, Literal, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -241,6 +241,9 @@ def label_dataset(
     time_limit: Optional[float] = None,
     weld: Optional[bool] = None,
     threads: Optional[int] = None,
+    progress: Union[None, bool, Callable[[dict], Any]] = None,
 ) -> list[dict]:
     """Labels meshes (w, occupancy, sdf at seeded sample points), one .npz per mesh and
-    manifest.jsonl in out_dir, like `gwn label`; returns the manifest rows in input order."""
+    manifest.jsonl in out_dir, like `gwn label`; returns the manifest rows in input order.
+    progress: None = a bar on stderr when it is a terminal, True/False = always/never, or a
+    callable given each finished row."""

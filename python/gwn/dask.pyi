@@ -1,5 +1,5 @@
 from os import PathLike
-from typing import Any, Optional, Sequence, Union
+from typing import Any, Callable, Optional, Sequence, Union
 
 _Path = Union[str, PathLike]
 
@@ -17,6 +17,7 @@ def label_dataset(
     time_limit: Optional[float] = None,
     weld: Optional[bool] = None,
     threads_per_task: int = 1,
+    progress: Union[None, bool, Callable[[dict], Any]] = None,
 ) -> list[dict]:
     """gwn.label_dataset with one Dask task per mesh on `client` (default: the current client);
     byte-identical outputs."""

@@ -3,6 +3,7 @@
 //! CLI's, byte for byte, and rows come back as the manifest's JSON lines.
 
 use std::path::PathBuf;
+use std::sync::mpsc;
 use std::time::Duration;
 
 use gwn::io::LoadOptions;
@@ -51,13 +52,15 @@ fn job_options(
 /// ``uniform`` points in the bounding box padded by ``padding`` × diagonal and ``near`` points
 /// near the surface (Gaussian offsets of ``sigmas`` × diagonal), labelled with the exact winding
 /// number ``w``, ``occupancy`` (w > 1/2) and ``sdf``; one ``.npz`` per mesh at
-/// ``out_dir/<path below root>.npz`` and ``out_dir/manifest.jsonl``. Meshes whose output exists
-/// are skipped (resumable); broken files, panics and ``time_limit`` overruns are rows, not
-/// exceptions. Returns the manifest rows as JSON strings, in input order.
+/// ``out_dir/<path below root>.npz`` and ``out_dir/manifest.jsonl``. An existing output is
+/// reused only when made with the same options from the same input (resumable); broken files,
+/// FIFOs, panics and ``time_limit`` overruns are rows, not exceptions. Returns the manifest rows as JSON strings, in input order. ``progress``, when
+/// given, is called with each finished mesh's row (a JSON string) on the calling thread, in the
+/// order the meshes finish; an exception it raises is re-raised after the job ends.
 #[pyfunction]
 #[pyo3(signature = (paths, out_dir, *, root = None, uniform = 50_000, near = 50_000,
     sigmas = vec![0.005, 0.05], padding = 0.05, seed = 0, time_limit = None, weld = None,
-    threads = None))]
+    threads = None, progress = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn label_dataset(
     py: Python<'_>,
@@ -72,17 +75,59 @@ pub fn label_dataset(
     time_limit: Option<f64>,
     weld: Option<bool>,
     threads: Option<usize>,
+    progress: Option<PyObject>,
 ) -> PyResult<Vec<String>> {
     let opts = job_options(uniform, near, sigmas, padding, seed, time_limit, weld)?;
-    let rows = threads::run(py, threads, move || {
-        label::label_dataset(&paths, &out_dir, root.as_deref(), &opts, |_| {})
-    })?
-    .map_err(value_error)?;
+    let Some(progress) = progress else {
+        let rows = threads::run(py, threads, move || {
+            label::label_dataset(&paths, &out_dir, root.as_deref(), &opts, |_| {})
+        })?
+        .map_err(value_error)?;
+        return Ok(rows.iter().map(|r| r.to_json()).collect());
+    };
+    // The job runs on its own thread; this thread waits without the GIL and takes it only to
+    // hand each finished row to `progress`, so the callback runs on the caller's thread.
+    let pool = threads::pool_for(threads)?;
+    let (tx, rx) = mpsc::channel::<String>();
+    let (rows, callback_error) = py.allow_threads(move || {
+        std::thread::scope(|scope| {
+            let job = scope.spawn(move || {
+                let run = || {
+                    label::label_dataset(&paths, &out_dir, root.as_deref(), &opts, |row| {
+                        // The receiver outlives the job, so a send cannot fail.
+                        let _ = tx.send(row.to_json());
+                    })
+                };
+                match pool {
+                    Some(p) => p.install(run),
+                    None => run(),
+                }
+            });
+            let mut callback_error = None;
+            for line in rx.iter() {
+                if callback_error.is_none() {
+                    callback_error = Python::with_gil(|py| progress.call1(py, (line,)).err());
+                }
+            }
+            (job.join(), callback_error)
+        })
+    });
+    let rows = match rows {
+        Ok(r) => r.map_err(value_error)?,
+        Err(_) => {
+            return Err(pyo3::exceptions::PyRuntimeError::new_err(
+                "the labelling job panicked",
+            ));
+        }
+    };
+    if let Some(e) = callback_error {
+        return Err(e);
+    }
     Ok(rows.iter().map(|r| r.to_json()).collect())
 }
 
-/// Labels one mesh into ``out_dir`` (skipped when its output exists) and returns its manifest
-/// row as a JSON string. ``root`` must be the same for every mesh of a dataset (see
+/// Labels one mesh into ``out_dir`` (its existing output is reused when its record shows the
+/// same options and input, else redone) and returns its manifest row as a JSON string. ``root`` must be the same for every mesh of a dataset (see
 /// ``common_root``): it fixes the output path and the mesh's seed.
 #[pyfunction]
 #[pyo3(signature = (path, out_dir, root, *, uniform = 50_000, near = 50_000,
@@ -107,6 +152,21 @@ pub fn label_file(
     let root = std::path::absolute(&root).unwrap_or(root);
     threads::run(py, threads, move || {
         label::label_file(&path, &root, &out_dir, &opts).to_json()
+    })
+}
+
+/// The output of every mesh below ``root`` (relative paths, input order); ``ValueError`` naming
+/// the first two inputs that would share one.
+#[pyfunction]
+pub fn plan_outputs(paths: Vec<PathBuf>, root: PathBuf) -> PyResult<Vec<PathBuf>> {
+    label::plan_outputs(&paths, &root).map_err(value_error)
+}
+
+/// Removes the temporary files a killed run left below ``out_dir``; returns how many.
+#[pyfunction]
+pub fn remove_partial_files(out_dir: PathBuf) -> PyResult<usize> {
+    label::remove_partial_files(&out_dir).map_err(|e| {
+        pyo3::exceptions::PyOSError::new_err(format!("{}: {e}", out_dir.display()))
     })
 }
 

@@ -33,6 +33,8 @@ fn _gwn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(label::label_dataset, m)?)?;
     m.add_function(wrap_pyfunction!(label::label_file, m)?)?;
     m.add_function(wrap_pyfunction!(label::common_root, m)?)?;
+    m.add_function(wrap_pyfunction!(label::plan_outputs, m)?)?;
+    m.add_function(wrap_pyfunction!(label::remove_partial_files, m)?)?;
     m.add_function(wrap_pyfunction!(loaders::load, m)?)?;
     m.add_function(wrap_pyfunction!(loaders::load_point_cloud, m)?)?;
     m.add_function(wrap_pyfunction!(loaders::load_points, m)?)?;

@@ -43,6 +43,11 @@ fn pool(threads: usize) -> PyResult<Arc<ThreadPool>> {
     })
 }
 
+/// The pool for `threads` (`None`: rayon's global pool), for work started on another thread.
+pub fn pool_for(threads: Option<usize>) -> PyResult<Option<Arc<ThreadPool>>> {
+    threads.map(pool).transpose()
+}
+
 /// Runs `work` without the GIL, on `threads` worker threads (all cores when `None`).
 pub fn run<T: Ungil + Send>(
     py: Python<'_>,

@@ -79,10 +79,56 @@ def test_dask_local_cluster_matches_serial(tmp_path):
     serial = gwn.label_dataset(paths, tmp_path / "serial", **OPTS)
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                       dashboard_address=None) as cluster, Client(cluster) as client:
-        rows = gwn.dask.label_dataset(paths, tmp_path / "dask", client, **OPTS)
+        seen = []
+        rows = gwn.dask.label_dataset(paths, tmp_path / "dask", client, **OPTS,
+                                      progress=seen.append)
+        assert sorted(r["mesh"] for r in seen) == sorted(r["mesh"] for r in rows)
+        # Two meshes with one output are refused before any task runs.
+        with pytest.raises(ValueError, match="both be written"):
+            gwn.dask.label_dataset([paths[0], paths[0]], tmp_path / "twice", client, **OPTS)
+        assert not (tmp_path / "twice").exists()
         # A real two-process cluster.
         assert len(client.scheduler_info()["workers"]) == 2
     assert [r["status"] for r in rows] == [r["status"] for r in serial]
     assert [r["output"] for r in rows] == [r["output"] for r in serial]
     assert npz_files(tmp_path / "dask") == npz_files(tmp_path / "serial")
     assert len(npz_files(tmp_path / "dask")) == 4
+
+
+def test_progress_callback_gets_every_row(tmp_path):
+    paths = make_dataset(tmp_path)
+    seen = []
+    rows = gwn.label_dataset(paths, tmp_path / "out", **OPTS, progress=seen.append)
+    assert sorted(r["mesh"] for r in seen) == sorted(r["mesh"] for r in rows)
+    assert all(isinstance(r, dict) and "status" in r for r in seen)
+    # An exception in the callback is raised once the job has finished.
+    def boom(row):
+        raise RuntimeError("stop")
+    with pytest.raises(RuntimeError, match="stop"):
+        gwn.label_dataset(paths, tmp_path / "out2", **OPTS, progress=boom)
+    assert (tmp_path / "out2" / "manifest.jsonl").exists()
+
+
+def test_progress_bar_only_on_a_terminal(tmp_path, capsys):
+    paths = make_dataset(tmp_path)
+    # Under pytest stderr is not a terminal: the default draws nothing.
+    gwn.label_dataset(paths, tmp_path / "quiet", **OPTS)
+    assert capsys.readouterr().err == ""
+    gwn.label_dataset(paths, tmp_path / "bar", **OPTS, progress=True)
+    err = capsys.readouterr().err
+    assert "5/5" in err and "label [" in err
+    gwn.label_dataset(paths, tmp_path / "off", **OPTS, progress=False)
+    assert capsys.readouterr().err == ""
+    with pytest.raises(TypeError, match="progress"):
+        gwn.label_dataset(paths, tmp_path / "x", **OPTS, progress="yes")
+
+
+def test_shared_outputs_and_changed_options(tmp_path):
+    paths = make_dataset(tmp_path)
+    with pytest.raises(ValueError, match="both be written"):
+        gwn.label_dataset([paths[0], paths[0]], tmp_path / "twice", **OPTS)
+    gwn.label_dataset(paths, tmp_path / "out", **OPTS)
+    again = gwn.label_dataset(paths, tmp_path / "out", **dict(OPTS, seed=4))
+    assert again[0]["status"] == "ok" and "seed 3 -> 4" in again[0]["redone"]
+    done = gwn.label_dataset(paths, tmp_path / "out", **dict(OPTS, seed=4))
+    assert done[0]["status"] == "done" and done[0]["points"] == 400 and done[0]["faces"] == 12

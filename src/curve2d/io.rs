@@ -71,11 +71,15 @@ pub fn read_polygon(path: &Path) -> Result<Polygon, CurveIoError> {
     Ok(read_drawing(path)?.curves.polygon)
 }
 
+/// The most bytes read from an input that is not a regular file (a pipe, a device): 256 MiB, as
+/// for meshes (`io::MAX_STREAM_BYTES`; this module does not import `io`).
+const MAX_STREAM_BYTES: u64 = 1 << 28;
+
 /// Reads curves from a text or SVG file (by extension).
 pub fn read_drawing(path: &Path) -> Result<Drawing, CurveIoError> {
     let name = path.display().to_string();
-    let text =
-        std::fs::read_to_string(path).map_err(|e| err(&name, 0, format!("cannot read: {e}")))?;
+    let text = crate::base::file::read_text_nonblocking(path, MAX_STREAM_BYTES)
+        .map_err(|e| err(&name, 0, format!("cannot read: {e}")))?;
     let is_svg = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
@@ -278,7 +282,17 @@ fn has_viewbox_wrapper(text: &str, tree: &usvg::Tree) -> bool {
 
 /// Parses an SVG document as drawn (see the module docs); `name` is used in errors.
 pub fn parse_svg(text: &str, name: &str) -> Result<Curves, CurveIoError> {
-    let tree = usvg::Tree::from_str(text, &usvg::Options::default())
+    // `<image>` elements are never drawn into curves, and usvg's default resolver would open
+    // whatever path an untrusted document names (a FIFO blocks, `/dev/zero` never ends): no
+    // image is resolved at all.
+    let options = usvg::Options {
+        image_href_resolver: usvg::ImageHrefResolver {
+            resolve_data: Box::new(|_, _, _| None),
+            resolve_string: Box::new(|_, _| None),
+        },
+        ..usvg::Options::default()
+    };
+    let tree = usvg::Tree::from_str(text, &options)
         .map_err(|e| err(name, 0, format!("not a readable SVG: {e}")))?;
     let mut loops: Vec<RawLoop> = Vec::new();
     let root = tree.root();
@@ -477,7 +491,8 @@ pub const MAX_POINTS: usize = 100_000_000;
 /// line, `#` comments, blank lines ignored).
 pub fn read_points(path: &Path) -> Result<Vec<Point>, CurveIoError> {
     let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| err(&name, 0, format!("cannot read: {e}")))?;
+    let bytes = crate::base::file::read_nonblocking(path, MAX_STREAM_BYTES)
+        .map_err(|e| err(&name, 0, format!("cannot read: {e}")))?;
     let pts = if bytes.starts_with(b"\x93NUMPY") {
         parse_points_npy(&bytes, &name)?
     } else {

@@ -243,7 +243,7 @@ fn load_buffers<'a>(
                         "buffer {i} refers to the GLB binary chunk, which the file lacks"
                     ))
                 })?),
-                Some(uri) => Cow::Owned(read_uri(uri, base_dir, i)?),
+                Some(uri) => Cow::Owned(read_uri(uri, base_dir, i, buffer.byte_length.0)?),
             };
             let declared = buffer.byte_length.0;
             if (data.len() as u64) < declared {
@@ -260,8 +260,17 @@ fn load_buffers<'a>(
         .collect()
 }
 
-/// A buffer URI: `data:...;base64,...` or a relative file path (percent-encoded).
-fn read_uri(uri: &str, base_dir: Option<&Path>, buffer: usize) -> Result<Vec<u8>, Fail> {
+/// A buffer URI: `data:...;base64,...` or a relative file path (percent-encoded). Files come
+/// from an untrusted document, so the path is percent-decoded, then resolved lexically (`.` and
+/// `..` applied to the text) and refused if it leaves the model's folder; only a regular file is
+/// opened (never blocking on a FIFO), and at most `byte_length` bytes of it are read.
+fn read_uri(
+    uri: &str,
+    base_dir: Option<&Path>,
+    buffer: usize,
+    byte_length: u64,
+) -> Result<Vec<u8>, Fail> {
+    use std::io::Read;
     if let Some(rest) = uri.strip_prefix("data:") {
         let (_, payload) = rest.split_once(";base64,").ok_or_else(|| {
             syntax(format!(
@@ -272,8 +281,16 @@ fn read_uri(uri: &str, base_dir: Option<&Path>, buffer: usize) -> Result<Vec<u8>
             .decode(payload)
             .map_err(|e| syntax(format!("buffer {buffer}: bad base64 data URI: {e}")));
     }
-    let relative = percent_decode(uri);
-    if relative.contains("://") || Path::new(&relative).is_absolute() {
+    let relative = String::from_utf8(percent_decode(uri)).map_err(|_| {
+        syntax(format!(
+            "buffer {buffer}: URI {uri:?} is not UTF-8 once percent-decoded"
+        ))
+    })?;
+    if relative.contains("://")
+        || relative.starts_with(['/', '\\'])
+        || Path::new(&relative).has_root()
+        || Path::new(&relative).is_absolute()
+    {
         return Err(syntax(format!(
             "buffer {buffer}: URI {uri:?} is neither a data URI nor a relative file path"
         )));
@@ -283,17 +300,51 @@ fn read_uri(uri: &str, base_dir: Option<&Path>, buffer: usize) -> Result<Vec<u8>
             "buffer {buffer} is the external file {relative:?}, which cannot be resolved for bytes in memory"
         ))
     })?;
-    let path = dir.join(&relative);
-    std::fs::read(&path).map_err(|e| {
+    let path = resolve_inside(dir, &relative).ok_or_else(|| {
         syntax(format!(
-            "buffer {buffer}: cannot read {}: {e}",
+            "buffer {buffer}: URI {uri:?} points outside the model's folder (refused)"
+        ))
+    })?;
+    let cannot = |e: std::io::Error| {
+        syntax(format!(
+            "buffer {buffer}: URI {uri:?}: cannot read {}: {e}",
             path.display()
         ))
-    })
+    };
+    let file = super::open_regular(&path).map_err(cannot)?;
+    let mut data = Vec::new();
+    file.take(byte_length)
+        .read_to_end(&mut data)
+        .map_err(cannot)?;
+    Ok(data)
+}
+
+/// `dir` joined with the `/`-separated `relative`, with `.` and `..` applied to the text; `None`
+/// when a `..` climbs above `dir` or nothing but `dir` itself remains. Lexical on purpose: a
+/// symlink inside the folder is the folder owner's choice (and is followed), while the document
+/// only gets to name files below it.
+fn resolve_inside(dir: &Path, relative: &str) -> Option<std::path::PathBuf> {
+    let mut parts: Vec<&str> = Vec::new();
+    for part in relative.split('/') {
+        match part {
+            "" | "." => {}
+            ".." => {
+                parts.pop()?;
+            }
+            // On Windows a backslash also separates and `C:` names a drive: such a part could leave
+            // the folder after the join below, so it is refused there.
+            p if cfg!(windows) && p.contains(['\\', ':']) => return None,
+            p => parts.push(p),
+        }
+    }
+    if parts.is_empty() {
+        return None;
+    }
+    Some(parts.iter().fold(dir.to_path_buf(), |p, part| p.join(part)))
 }
 
 /// `%XX` escapes decoded byte-wise; malformed escapes are kept as written.
-fn percent_decode(s: &str) -> String {
+fn percent_decode(s: &str) -> Vec<u8> {
     let b = s.as_bytes();
     let mut out = Vec::with_capacity(b.len());
     let mut i = 0;
@@ -309,7 +360,7 @@ fn percent_decode(s: &str) -> String {
         out.push(b[i]);
         i += 1;
     }
-    String::from_utf8_lossy(&out).into_owned()
+    out
 }
 
 type Matrix = [[f64; 4]; 4];
@@ -652,7 +703,21 @@ mod tests {
 
     #[test]
     fn percent_escapes() {
-        assert_eq!(percent_decode("a%20b.bin"), "a b.bin");
-        assert_eq!(percent_decode("bad%zz%2"), "bad%zz%2");
+        assert_eq!(percent_decode("a%20b.bin"), b"a b.bin");
+        assert_eq!(percent_decode("bad%zz%2"), b"bad%zz%2");
+        assert_eq!(percent_decode("..%2F%2e%2E"), b"../..");
+    }
+
+    #[test]
+    fn uris_resolve_lexically_inside_the_folder() {
+        let d = Path::new("m");
+        assert_eq!(
+            resolve_inside(d, "a/./b/../c.bin"),
+            Some(d.join("a").join("c.bin"))
+        );
+        assert_eq!(resolve_inside(d, "a/../../c.bin"), None);
+        assert_eq!(resolve_inside(d, ".."), None);
+        assert_eq!(resolve_inside(d, "a/.."), None);
+        assert_eq!(resolve_inside(d, ""), None);
     }
 }

@@ -179,19 +179,21 @@ pub const MAX_STREAM_BYTES: u64 = 1 << 28;
 /// Reads a whole input file for a loader. Regular files are read whole; anything else (pipes,
 /// devices, `/dev/stdin`) at most [`MAX_STREAM_BYTES`], beyond which it is a
 /// [`LoadErrorKind::TooLong`] error instead of reading until memory runs out.
+///
+/// The file is opened without blocking (`O_NONBLOCK` on Unix), so a FIFO that no program writes
+/// to reads as empty instead of hanging; a pipe or terminal whose writer is alive is read until
+/// its writer closes it, as any Unix tool would.
 pub fn read_input(path: &Path) -> Result<Vec<u8>, LoadError> {
     use std::io::Read;
     let io_err = |e| LoadError::new(path, Location::File, LoadErrorKind::Io(e));
-    let file = std::fs::File::open(path).map_err(io_err)?;
+    let file = crate::base::file::open_nonblocking(path).map_err(io_err)?;
     let meta = file.metadata().map_err(io_err)?;
     let mut bytes = Vec::new();
     if meta.is_file() {
         bytes.reserve(usize::try_from(meta.len()).unwrap_or(0));
         (&file).read_to_end(&mut bytes).map_err(io_err)?;
     } else {
-        file.take(MAX_STREAM_BYTES + 1)
-            .read_to_end(&mut bytes)
-            .map_err(io_err)?;
+        crate::base::file::read_stream(&file, &mut bytes, MAX_STREAM_BYTES + 1).map_err(io_err)?;
         if bytes.len() as u64 > MAX_STREAM_BYTES {
             return Err(LoadError::new(
                 path,
@@ -203,6 +205,63 @@ pub fn read_input(path: &Path) -> Result<Vec<u8>, LoadError> {
         }
     }
     Ok(bytes)
+}
+
+/// What kind of non-regular file `meta` describes, for error messages.
+fn file_kind(meta: &std::fs::Metadata) -> &'static str {
+    let t = meta.file_type();
+    if t.is_dir() {
+        return "a directory";
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if t.is_fifo() {
+            return "a FIFO";
+        }
+        if t.is_char_device() {
+            return "a character device";
+        }
+        if t.is_block_device() {
+            return "a block device";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+    }
+    "a special file"
+}
+
+/// The error for a file that is not a regular file, saying what it is.
+fn not_regular(meta: &std::fs::Metadata) -> std::io::Error {
+    std::io::Error::new(
+        std::io::ErrorKind::InvalidInput,
+        format!("not a regular file ({})", file_kind(meta)),
+    )
+}
+
+/// The metadata of `path` (symlinks followed) if it is a regular file; otherwise an
+/// `InvalidInput` error saying what it is (`not a regular file (a FIFO)`). Nothing is opened.
+pub fn regular_file_metadata(path: &Path) -> std::io::Result<std::fs::Metadata> {
+    let meta = std::fs::metadata(path)?;
+    if meta.is_file() {
+        Ok(meta)
+    } else {
+        Err(not_regular(&meta))
+    }
+}
+
+/// Opens `path` only if it is a regular file (symlinks are followed): checked before opening (so
+/// platforms without a known `O_NONBLOCK` do not block on a FIFO either) and again through the
+/// opened handle (the path may have been swapped in between); the open itself never blocks.
+pub fn open_regular(path: &Path) -> std::io::Result<std::fs::File> {
+    regular_file_metadata(path)?;
+    let file = crate::base::file::open_nonblocking(path)?;
+    let after = file.metadata()?;
+    if !after.is_file() {
+        return Err(not_regular(&after));
+    }
+    Ok(file)
 }
 
 /// Loads a mesh from bytes in memory. `name_for_errors` is what errors call the file;

@@ -45,7 +45,9 @@ pub fn load_patches(path: &Path) -> Result<PatchSet, PatchError> {
             path.display()
         ))
     })?;
-    let text = std::fs::read_to_string(path)
+    // Opened without blocking (a FIFO without a writer reads as empty); a pipe or device is read
+    // up to 256 MiB.
+    let text = crate::base::file::read_text_nonblocking(path, 1 << 28)
         .map_err(|e| PatchError::Io(format!("{}: {e}", path.display())))?;
     parse_patches(&text, format).map_err(|e| match e {
         PatchError::Io(m) => PatchError::Io(m),

@@ -8,8 +8,10 @@
 //! the thread that runs it), the random numbers from SplitMix64 and the Gaussian offsets from
 //! `libm` (the same bits on every platform); the labels do not depend on the thread count, and the
 //! `.npz` has no timestamps. Resumable: an output that exists is finished (outputs are written to
-//! a temporary name and renamed), so a rerun skips it. A broken file, a panic or a time-limit
-//! overrun is a manifest row, never the end of the run.
+//! a temporary name and renamed), and a rerun reuses it when its record (`*.meta.json`: options,
+//! input size and modification time, statistics) matches, else redoes it and says why. A broken
+//! file, a FIFO, a panic or a time-limit overrun is a manifest row, never the end (nor a hang) of
+//! the run; two inputs with one output stop the job before it starts.
 //!
 //! ```
 //! use gwn::{Mesh, products::label::{label_mesh, SamplingOptions}};
@@ -34,9 +36,9 @@ use rayon::prelude::*;
 use super::npz::NpzWriter;
 use super::sdf::SignedDistance;
 use crate::Mesh;
-use crate::error::LoadError;
+use crate::error::{LoadError, LoadErrorKind, Location};
 use crate::eval::antipodal::BuildError;
-use crate::io::{LoadOptions, load_mesh_with};
+use crate::io::{LoadOptions, load_mesh_with, regular_file_metadata};
 
 /// How points are sampled for one mesh. Distances (`padding`, `sigmas`) are fractions of the
 /// mesh's bounding-box diagonal, so the same options suit meshes of any scale.
@@ -143,6 +145,18 @@ pub enum LabelError {
     Build(BuildError),
     /// The mesh's bounding box is not finite (coordinates near `f64::MAX`).
     Extent,
+    /// The padding or a sigma is so large that sample points would overflow (the message says
+    /// which).
+    SampleBox(String),
+    /// Two inputs would be written to one output.
+    Collision {
+        /// The input listed first.
+        first: PathBuf,
+        /// The input listed later.
+        second: PathBuf,
+        /// Their output, relative to the output folder.
+        output: PathBuf,
+    },
     /// The time limit ran out during `stage`.
     TimeLimit {
         /// What was running.
@@ -178,6 +192,18 @@ impl fmt::Display for LabelError {
             LabelError::Load(e) => write!(f, "{e}"),
             LabelError::Build(e) => write!(f, "{e}"),
             LabelError::Extent => write!(f, "the bounding box of the mesh is not finite"),
+            LabelError::SampleBox(m) => write!(f, "{m}"),
+            LabelError::Collision {
+                first,
+                second,
+                output,
+            } => write!(
+                f,
+                "{} and {} would both be written to {}: give each mesh once",
+                first.display(),
+                second.display(),
+                output.display()
+            ),
             LabelError::TimeLimit { stage, limit } => write!(
                 f,
                 "time limit of {:.3} s exceeded while {stage}",
@@ -245,6 +271,7 @@ pub fn sample_points(
     if !diag.is_finite() {
         return Err(LabelError::Extent);
     }
+    check_sample_box(&bb, diag, opts)?;
     let mut rng = SplitMix64(mesh_seed(opts.seed, key));
     let total = opts.uniform + opts.near;
     let mut points = Vec::with_capacity(total);
@@ -293,6 +320,39 @@ pub fn sample_points(
         }
     }
     Ok((points, source))
+}
+
+/// The largest |N(0, 1)| Box–Muller can return here: `u1 ≥ 2⁻⁵³` gives
+/// `√(−2 ln 2⁻⁵³) ≈ 8.57`.
+const MAX_GAUSSIAN: f64 = 9.0;
+
+/// Refuses options whose points could overflow: the bounding box grown by `padding × diag` (when
+/// uniform points are asked for) and by `MAX_GAUSSIAN × sigma × diag` (near points) must have
+/// finite corners, extent and diagonal, so every point, distance and label stays finite.
+fn check_sample_box(
+    bb: &crate::BoundingBox,
+    diag: f64,
+    opts: &SamplingOptions,
+) -> Result<(), LabelError> {
+    let padding = if opts.uniform > 0 { opts.padding } else { 0.0 };
+    let sigma = if opts.near > 0 {
+        opts.sigmas.iter().copied().fold(0.0, f64::max)
+    } else {
+        0.0
+    };
+    let reach = padding.max(MAX_GAUSSIAN * sigma) * diag;
+    let lo = bb.min.map(|c| c - reach);
+    let hi = bb.max.map(|c| c + reach);
+    let extent: [f64; 3] = std::array::from_fn(|k| hi[k] - lo[k]);
+    let diagonal = extent.iter().map(|e| e * e).sum::<f64>().sqrt();
+    if lo.iter().chain(&hi).chain(&extent).all(|v| v.is_finite()) && diagonal.is_finite() {
+        Ok(())
+    } else {
+        Err(LabelError::SampleBox(format!(
+            "the sample box is not finite: padding {} and sigma {sigma} reach {reach:e} beyond a mesh of diagonal {diag:e}",
+            opts.padding
+        )))
+    }
 }
 
 fn cumulative_areas(mesh: &Mesh) -> Vec<f64> {
@@ -412,6 +472,8 @@ pub struct ManifestRow {
     pub inside: usize,
     /// Wall time of this mesh in this run.
     pub seconds: f64,
+    /// Why an existing output was computed again (its options or input changed), when it was.
+    pub redone: Option<String>,
 }
 
 impl ManifestRow {
@@ -419,7 +481,7 @@ impl ManifestRow {
     pub fn to_json(&self) -> String {
         let opt = |v: Option<usize>| v.map_or("null".to_string(), |v| v.to_string());
         format!(
-            "{{\"mesh\":{},\"output\":{},\"status\":\"{}\",\"error\":{},\"faces\":{},\"vertices\":{},\"points\":{},\"inside\":{},\"seconds\":{:.6}}}",
+            "{{\"mesh\":{},\"output\":{},\"status\":\"{}\",\"error\":{},\"faces\":{},\"vertices\":{},\"points\":{},\"inside\":{},\"seconds\":{:.6},\"redone\":{}}}",
             json_string(&self.mesh.to_string_lossy()),
             json_string(&self.output.to_string_lossy()),
             self.status.as_str(),
@@ -430,7 +492,10 @@ impl ManifestRow {
             opt(self.vertices),
             self.points,
             self.inside,
-            self.seconds
+            self.seconds,
+            self.redone
+                .as_deref()
+                .map_or("null".to_string(), json_string),
         )
     }
 }
@@ -453,13 +518,28 @@ fn json_string(s: &str) -> String {
     out
 }
 
-/// The deepest directory containing every path (lexically, after making them absolute); the
+/// `path` made absolute, with `.` and `..` applied to the text: `a/../d/m.obj` is `d/m.obj`, so
+/// it is named (and seeded) as `d/m.obj` is, and cannot take the output of `a/d/m.obj`.
+pub fn normalize_path(path: &Path) -> PathBuf {
+    let abs = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
+    let mut out = PathBuf::new();
+    for c in abs.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                // `..` at the root stays at the root, as the file system does.
+                out.pop();
+            }
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// The deepest directory containing every path (lexically, after [`normalize_path`]); the
 /// outputs mirror the inputs' layout below it. Empty input: the current directory.
 pub fn common_root(paths: &[PathBuf]) -> PathBuf {
-    let abs: Vec<PathBuf> = paths
-        .iter()
-        .map(|p| std::path::absolute(p).unwrap_or_else(|_| p.clone()))
-        .collect();
+    let abs: Vec<PathBuf> = paths.iter().map(|p| normalize_path(p)).collect();
     let Some(first) = abs.first() else {
         return PathBuf::from(".");
     };
@@ -478,11 +558,13 @@ pub fn common_root(paths: &[PathBuf]) -> PathBuf {
     root.iter().collect()
 }
 
-/// The key of a mesh (its path below `root`, `/`-separated) and its output path relative to the
-/// output directory (`key` + `.npz`, so `a/model.obj` and `a/model.glb` do not collide).
+/// The key of a mesh (its normalized path below `root`, `/`-separated) and its output path
+/// relative to the output directory (`key` + `.npz`, so `a/model.obj` and `a/model.glb` do not
+/// collide). A mesh outside `root` is keyed by its whole absolute path.
 pub fn output_key(root: &Path, mesh: &Path) -> (String, PathBuf) {
-    let abs = std::path::absolute(mesh).unwrap_or_else(|_| mesh.to_path_buf());
-    let rel = abs.strip_prefix(root).unwrap_or(&abs);
+    let abs = normalize_path(mesh);
+    let root = normalize_path(root);
+    let rel = abs.strip_prefix(&root).unwrap_or(&abs);
     let parts: Vec<String> = rel
         .components()
         .filter_map(|c| match c {
@@ -502,8 +584,149 @@ pub fn output_key(root: &Path, mesh: &Path) -> (String, PathBuf) {
     (key, out)
 }
 
+/// The output of every mesh, or a [`LabelError::Collision`] naming the first two inputs that
+/// would share one (the same file listed twice, or names that differ only in ways the key
+/// drops). Checked before anything is written: a second mesh must never be marked `done` with
+/// the first one's labels.
+pub fn plan_outputs(meshes: &[PathBuf], root: &Path) -> Result<Vec<PathBuf>, LabelError> {
+    let mut seen: std::collections::HashMap<PathBuf, usize> = std::collections::HashMap::new();
+    let mut outputs = Vec::with_capacity(meshes.len());
+    for (i, m) in meshes.iter().enumerate() {
+        let (_, output) = output_key(root, m);
+        if let Some(&j) = seen.get(&output) {
+            return Err(LabelError::Collision {
+                first: meshes[j].clone(),
+                second: m.clone(),
+                output,
+            });
+        }
+        seen.insert(output.clone(), i);
+        outputs.push(output);
+    }
+    Ok(outputs)
+}
+
+/// Where the record of an output lives: `m.obj.npz` → `m.obj.meta.json`, beside it (outputs all
+/// end in `.npz`, so a record never shadows an output).
+pub fn record_path(target: &Path) -> PathBuf {
+    let name = target
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let stem = name.strip_suffix(".npz").unwrap_or(&name);
+    target.with_file_name(format!("{stem}.meta.json"))
+}
+
+/// The options that decide an output's bytes, as `(name, JSON value)` in record order.
+fn option_fields(opts: &JobOptions) -> Vec<(&'static str, String)> {
+    let s = &opts.sampling;
+    let sigmas: Vec<String> = s.sigmas.iter().map(|v| format!("{v:?}")).collect();
+    vec![
+        ("uniform", s.uniform.to_string()),
+        ("near", s.near.to_string()),
+        ("sigmas", format!("[{}]", sigmas.join(","))),
+        ("padding", format!("{:?}", s.padding)),
+        ("seed", s.seed.to_string()),
+        (
+            "weld",
+            opts.load.weld.map_or("null".into(), |w| w.to_string()),
+        ),
+    ]
+}
+
+/// The input as the record sees it: size and modification time (nanoseconds since 1970).
+fn input_stamp(meta: &std::fs::Metadata) -> String {
+    let mtime = meta
+        .modified()
+        .ok()
+        .and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok())
+        .map_or("null".into(), |d| d.as_nanos().to_string());
+    format!("{{\"bytes\":{},\"mtime_ns\":{mtime}}}", meta.len())
+}
+
+/// The record's text up to the statistics: what must match for an output to be reused.
+fn record_head(opts: &JobOptions, stamp: &str) -> String {
+    let fields: Vec<String> = option_fields(opts)
+        .iter()
+        .map(|(k, v)| format!("\"{k}\":{v}"))
+        .collect();
+    format!(
+        "{{\"gwn_label\":1,\"options\":{{{}}},\"input\":{stamp},",
+        fields.join(",")
+    )
+}
+
+/// What a rerun does with an output.
+enum Resume {
+    /// No output: label it.
+    Fresh,
+    /// The output matches the options and the input: reuse it, with these statistics
+    /// (faces, vertices, points, inside).
+    Done([Option<usize>; 4]),
+    /// An output exists but cannot be reused, for this reason.
+    Redo(String),
+}
+
+/// Compares an existing output's record with this run.
+fn resume_state(target: &Path, opts: &JobOptions, stamp: &str) -> Resume {
+    if !target.is_file() {
+        return Resume::Fresh;
+    }
+    let record = crate::io::open_regular(&record_path(target)).and_then(|f| {
+        use std::io::Read;
+        let mut text = String::new();
+        // A record is one short line; the cap keeps a planted huge file from being read.
+        f.take(1 << 16).read_to_string(&mut text)?;
+        Ok(text)
+    });
+    let Ok(text) = record else {
+        return Resume::Redo("no record of the options that made the existing output".into());
+    };
+    let head = record_head(opts, stamp);
+    if let Some(rest) = text.strip_prefix(&head) {
+        let stat = |name: &str| -> Option<usize> {
+            let at = rest.find(&format!("\"{name}\":"))? + name.len() + 3;
+            let end = rest[at..].find([',', '}'])? + at;
+            rest[at..end].parse().ok()
+        };
+        return Resume::Done([
+            stat("faces"),
+            stat("vertices"),
+            stat("points"),
+            stat("inside"),
+        ]);
+    }
+    let options_then = text
+        .strip_prefix("{\"gwn_label\":1,\"options\":{")
+        .and_then(|r| r.split_once("},\"input\":"));
+    let Some((then, input_then)) = options_then else {
+        return Resume::Redo("its record is unreadable".into());
+    };
+    let changed: Vec<String> = option_fields(opts)
+        .into_iter()
+        .filter_map(|(k, now)| {
+            let before = then
+                .split(",\"")
+                .map(|f| f.trim_start_matches('"'))
+                .find_map(|f| f.strip_prefix(k)?.strip_prefix("\":"))
+                .unwrap_or("?");
+            (before != now).then(|| format!("{k} {before} -> {now}"))
+        })
+        .collect();
+    if !changed.is_empty() {
+        return Resume::Redo(format!("options changed: {}", changed.join(", ")));
+    }
+    if !input_then.starts_with(stamp) {
+        return Resume::Redo("its input changed (size or modification time)".into());
+    }
+    Resume::Redo("its record is unreadable".into())
+}
+
 /// Labels one mesh file into `out_dir` (the unit of work of the CLI's thread pool and of a Dask
-/// task): skips it when its output exists, otherwise loads, labels and writes it atomically.
+/// task). An existing output is reused (status `done`, with the statistics of the run that made
+/// it) only when its record (`*.meta.json`) shows the same options and the same input size and
+/// modification time; otherwise the mesh is labelled again and `redone` says why. Only regular
+/// files are opened (a FIFO is a failed row, never a hang); outputs are written atomically.
 /// Never panics and never fails: the result is the manifest row.
 pub fn label_file(mesh: &Path, root: &Path, out_dir: &Path, opts: &JobOptions) -> ManifestRow {
     let start = Instant::now();
@@ -518,14 +741,27 @@ pub fn label_file(mesh: &Path, root: &Path, out_dir: &Path, opts: &JobOptions) -
         points: 0,
         inside: 0,
         seconds: 0.0,
+        redone: None,
     };
     let target = out_dir.join(&output);
-    if target.is_file() {
-        row.status = Status::Done;
-        return row;
-    }
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        label_file_inner(mesh, &key, &target, opts, start, &mut row)
+        let meta = regular_file_metadata(mesh).map_err(|e| {
+            LabelError::Load(LoadError::new(mesh, Location::File, LoadErrorKind::Io(e)))
+        })?;
+        let stamp = input_stamp(&meta);
+        match resume_state(&target, opts, &stamp) {
+            Resume::Done([faces, vertices, points, inside]) => {
+                row.status = Status::Done;
+                row.faces = faces;
+                row.vertices = vertices;
+                row.points = points.unwrap_or(0);
+                row.inside = inside.unwrap_or(0);
+                return Ok(());
+            }
+            Resume::Redo(why) => row.redone = Some(why),
+            Resume::Fresh => {}
+        }
+        label_file_inner(mesh, &key, &target, opts, &stamp, start, &mut row)
     }));
     let err = match result {
         Ok(Ok(())) => None,
@@ -554,6 +790,7 @@ fn label_file_inner(
     key: &str,
     target: &Path,
     opts: &JobOptions,
+    stamp: &str,
     start: Instant,
     row: &mut ManifestRow,
 ) -> Result<(), LabelError> {
@@ -576,10 +813,71 @@ fn label_file_inner(
         path: target.to_path_buf(),
         source,
     })?;
+    // The old record goes first: were we killed between the two writes below, a stale record
+    // must not vouch for the new file.
+    let record = record_path(target);
+    match std::fs::remove_file(&record) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            return Err(LabelError::Write {
+                path: record,
+                source: e,
+            });
+        }
+        _ => {}
+    }
     write_atomically(target, &bytes)?;
     row.points = labels.points.len();
     row.inside = labels.occupancy.iter().filter(|&&o| o).count();
-    Ok(())
+    let opt = |v: Option<usize>| v.map_or("null".to_string(), |v| v.to_string());
+    let text = format!(
+        "{}\"faces\":{},\"vertices\":{},\"points\":{},\"inside\":{}}}\n",
+        record_head(opts, stamp),
+        opt(row.faces),
+        opt(row.vertices),
+        row.points,
+        row.inside
+    );
+    write_atomically(&record, text.as_bytes())
+}
+
+/// The name of a temporary file [`write_atomically`] writes for `name`.
+fn partial_name(name: &str, pid: u32, n: u64) -> String {
+    format!(".{name}.partial-{pid}-{n}")
+}
+
+/// True for a name [`partial_name`] makes: `.NAME.partial-PID-N`.
+fn is_partial_name(name: &str) -> bool {
+    let Some(rest) = name.strip_prefix('.') else {
+        return false;
+    };
+    let Some((_, tail)) = rest.rsplit_once(".partial-") else {
+        return false;
+    };
+    let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    tail.split_once('-')
+        .is_some_and(|(pid, n)| digits(pid) && digits(n))
+}
+
+/// Removes the temporary files a killed run (`kill -9`, a lost Dask worker) left below
+/// `out_dir` (names `.NAME.partial-PID-N`; symlinks are not followed). Two jobs must not write
+/// one folder at the same time: this would delete the other job's files in progress. Returns how
+/// many were removed.
+pub fn remove_partial_files(out_dir: &Path) -> std::io::Result<usize> {
+    let mut removed = 0;
+    let mut stack = vec![out_dir.to_path_buf()];
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir)? {
+            let entry = entry?;
+            let kind = entry.file_type()?;
+            if kind.is_dir() {
+                stack.push(entry.path());
+            } else if kind.is_file() && is_partial_name(&entry.file_name().to_string_lossy()) {
+                std::fs::remove_file(entry.path())?;
+                removed += 1;
+            }
+        }
+    }
+    Ok(removed)
 }
 
 /// Writes `bytes` to a unique temporary name next to `target`, then renames it: readers (and a
@@ -598,10 +896,10 @@ pub fn write_atomically(target: &Path, bytes: &[u8]) -> Result<(), LabelError> {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let tmp = target.with_file_name(format!(
-        ".{name}.partial-{}-{}",
+    let tmp = target.with_file_name(partial_name(
+        &name,
         std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed)
+        COUNTER.fetch_add(1, Ordering::Relaxed),
     ));
     let written = std::fs::File::create(&tmp).and_then(|mut f| {
         f.write_all(bytes)?;
@@ -614,7 +912,8 @@ pub fn write_atomically(target: &Path, bytes: &[u8]) -> Result<(), LabelError> {
     Ok(())
 }
 
-/// The whole job: labels every mesh (in parallel on the current rayon pool), calls `progress`
+/// The whole job: checks that no two meshes share an output, removes the temporary files of an
+/// interrupted run, labels every mesh (in parallel on the current rayon pool), calls `progress`
 /// after each, and writes `manifest.jsonl` (rows in input order) into `out_dir`. `root` defaults
 /// to [`common_root`] of the inputs. Returns the rows.
 pub fn label_dataset(
@@ -625,14 +924,14 @@ pub fn label_dataset(
     progress: impl Fn(&ManifestRow) + Sync,
 ) -> Result<Vec<ManifestRow>, LabelError> {
     opts.sampling.validate()?;
-    let root = root.map_or_else(
-        || common_root(meshes),
-        |r| std::path::absolute(r).unwrap_or_else(|_| r.to_path_buf()),
-    );
-    std::fs::create_dir_all(out_dir).map_err(|source| LabelError::Write {
+    let root = root.map_or_else(|| common_root(meshes), normalize_path);
+    plan_outputs(meshes, &root)?;
+    let write_err = |source| LabelError::Write {
         path: out_dir.to_path_buf(),
         source,
-    })?;
+    };
+    std::fs::create_dir_all(out_dir).map_err(write_err)?;
+    remove_partial_files(out_dir).map_err(write_err)?;
     let rows: Vec<ManifestRow> = meshes
         .par_iter()
         .with_max_len(1)

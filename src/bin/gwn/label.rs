@@ -1,13 +1,14 @@
 //! `gwn label`: the dataset labelling job (sample, label with w / occupancy / SDF, one `.npz` per
 //! mesh, a manifest).
 
+use std::collections::{HashSet, VecDeque};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use clap::Args as ClapArgs;
 use gwn::products::label::{JobOptions, SamplingOptions, Status, label_dataset};
 
-use crate::common::{CliError, progress};
+use crate::common::{CliError, outln, progress};
 
 /// Label a dataset of meshes for learning: per mesh, sample points uniform in the padded bounding
 /// box and near the surface (Gaussian offsets), label them with the exact winding number w,
@@ -17,8 +18,11 @@ use crate::common::{CliError, progress};
 /// ok / done / failed / timeout, the error, faces, points, seconds.
 ///
 /// Reproducible byte for byte (per-mesh seeds from --seed and the path below the root; any thread
-/// count). Resumable: meshes whose .npz exists are skipped (outputs are renamed into place when
-/// complete). Broken files are manifest rows; the exit code is 0 unless the job itself cannot run.
+/// count). Resumable: an existing .npz is reused only when its record (.meta.json beside it) shows
+/// the same options and input size and time; otherwise it is redone and the manifest says why
+/// (outputs are renamed into place when complete; temporary files of a killed run are removed).
+/// Broken files, FIFOs and devices are manifest rows; two inputs with one output are refused up
+/// front; the exit code is 0 unless the job itself cannot run.
 ///
 /// Example: gwn label ../shared/meshes --out labels --uniform 20000 --near 20000 --time-limit 60
 #[derive(ClapArgs, Debug)]
@@ -62,9 +66,13 @@ pub struct Args {
 /// Runs `gwn label`.
 pub fn run(args: Args) -> Result<(), CliError> {
     let mut meshes = Vec::new();
+    let mut walked = HashSet::new();
     for p in &args.inputs {
         if p.is_dir() {
-            collect_meshes(p, &mut meshes)?;
+            let mut linked = VecDeque::from([p.clone()]);
+            while let Some(dir) = linked.pop_front() {
+                collect_meshes(&dir, &mut meshes, &mut walked, &mut linked)?;
+            }
         } else {
             meshes.push(p.clone());
         }
@@ -115,15 +123,23 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let count = |s: Status| rows.iter().filter(|r| r.status == s).count();
     let points: usize = rows.iter().map(|r| r.points).sum();
     let ok = count(Status::Ok);
-    println!(
-        "labelled {ok} meshes ({} done before, {} failed, {} timed out), {points} points in {secs:.3} s: {:.2} meshes/s, {:.0} points/s; manifest: {}",
+    let redone = rows.iter().filter(|r| r.redone.is_some()).count();
+    outln!(
+        "labelled {ok} meshes ({} done before, {redone} redone, {} failed, {} timed out), {points} points in {secs:.3} s: {:.2} meshes/s, {:.0} points/s; manifest: {}",
         count(Status::Done),
         count(Status::Failed),
         count(Status::Timeout),
         ok as f64 / secs.max(1e-9),
         points as f64 / secs.max(1e-9),
         args.out.join("manifest.jsonl").display()
-    );
+    )?;
+    for r in rows.iter().filter(|r| r.redone.is_some()) {
+        eprintln!(
+            "gwn label: redone {}: {}",
+            r.mesh.display(),
+            r.redone.as_deref().unwrap_or_default()
+        );
+    }
     for r in rows.iter().filter(|r| r.error.is_some()) {
         eprintln!(
             "gwn label: {} {}: {}",
@@ -135,8 +151,23 @@ pub fn run(args: Args) -> Result<(), CliError> {
     Ok(())
 }
 
-/// Every mesh file below `dir` (known extensions), recursively, sorted.
-fn collect_meshes(dir: &Path, out: &mut Vec<PathBuf>) -> Result<(), CliError> {
+/// Every mesh file below `dir` (known extensions), recursively, sorted; folders reached through a
+/// symlink are put on `linked` for later, so a file is named by its real path when the walk
+/// reaches it both ways. Each real folder is walked once (`walked` holds canonical paths): a link
+/// to an ancestor cannot loop, and two links to one folder do not list its files twice. Files
+/// that are not regular (FIFOs, devices) are listed too: the job makes each a failed row without
+/// opening it.
+fn collect_meshes(
+    dir: &Path,
+    out: &mut Vec<PathBuf>,
+    walked: &mut HashSet<PathBuf>,
+    linked: &mut VecDeque<PathBuf>,
+) -> Result<(), CliError> {
+    let real =
+        std::fs::canonicalize(dir).map_err(|e| CliError(format!("{}: {e}", dir.display())))?;
+    if !walked.insert(real) {
+        return Ok(());
+    }
     let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
         .map_err(|e| CliError(format!("{}: {e}", dir.display())))?
         .filter_map(|e| e.ok().map(|e| e.path()))
@@ -144,7 +175,13 @@ fn collect_meshes(dir: &Path, out: &mut Vec<PathBuf>) -> Result<(), CliError> {
     entries.sort();
     for p in entries {
         if p.is_dir() {
-            collect_meshes(&p, out)?;
+            if p.symlink_metadata()
+                .is_ok_and(|m| m.file_type().is_symlink())
+            {
+                linked.push_back(p);
+            } else {
+                collect_meshes(&p, out, walked, linked)?;
+            }
         } else if gwn::io::format_from_extension(&p).is_some() {
             out.push(p);
         }
