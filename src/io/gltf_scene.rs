@@ -284,11 +284,17 @@ fn read_uri(uri: &str, base_dir: Option<&Path>, buffer: usize) -> Result<Vec<u8>
         ))
     })?;
     let path = dir.join(&relative);
-    std::fs::read(&path).map_err(|e| {
-        syntax(format!(
-            "buffer {buffer}: cannot read {}: {e}",
-            path.display()
-        ))
+    // Its own kind (not a syntax error), so that callers can tell a missing `.bin` (an OS error,
+    // `FileNotFoundError` in Python) from a malformed file.
+    std::fs::read(&path).map_err(|error| {
+        (
+            Location::File,
+            LoadErrorKind::Referenced {
+                what: format!("buffer {buffer}"),
+                file: path.clone(),
+                error,
+            },
+        )
     })
 }
 
