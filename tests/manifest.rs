@@ -3,7 +3,7 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use gwn::io::{Format, LoadOptions, load_mesh_with};
 use gwn::mesh::stats::MeshStats;

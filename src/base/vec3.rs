@@ -35,7 +35,7 @@ pub fn norm(a: [f64; 3]) -> f64 {
 #[inline]
 pub fn norm_safe(a: [f64; 3]) -> f64 {
     let s = dot(a, a);
-    if s >= f64::MIN_POSITIVE && s < f64::INFINITY {
+    if (f64::MIN_POSITIVE..f64::INFINITY).contains(&s) {
         return s.sqrt();
     }
     let m = a[0].abs().max(a[1].abs()).max(a[2].abs());

@@ -28,7 +28,7 @@
 //! them (20,000 nested `<g>` overflowed the stack).
 
 use super::open::Curves;
-use super::polygon::{MAX_COORD, Point, Polygon, PolygonError};
+use super::polygon::{MAX_COORD, Point, Polygon, PolygonError, query_in_range};
 use std::fmt;
 use std::path::Path;
 
@@ -648,7 +648,7 @@ pub fn parse_points_text(text: &str, name: &str) -> Result<Vec<Point>, CurveIoEr
             p[k] = f
                 .parse::<f64>()
                 .ok()
-                .filter(|v| v.abs() <= MAX_COORD)
+                .filter(|&v| query_in_range([v, 0.0]))
                 .ok_or_else(|| {
                     err(
                         name,
@@ -713,7 +713,7 @@ fn parse_points_npy(bytes: &[u8], name: &str) -> Result<Vec<Point>, CurveIoError
         .chunks_exact(8)
         .map(|c| f64::from_le_bytes([c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]]))
         .collect();
-    if let Some(k) = vals.iter().position(|v| !(v.abs() <= MAX_COORD)) {
+    if let Some(k) = vals.iter().position(|&v| !query_in_range([v, 0.0])) {
         return Err(bad(&format!(
             "point {} has a coordinate that is not finite or exceeds {MAX_COORD:e} in magnitude",
             k / 2
