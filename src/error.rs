@@ -103,6 +103,15 @@ pub struct LoadError {
 pub enum LoadErrorKind {
     /// The operating system refused to read the file.
     Io(std::io::Error),
+    /// A file the file refers to (a glTF buffer's `.bin`) could not be read.
+    Referenced {
+        /// What refers to it, e.g. `buffer 0`.
+        what: String,
+        /// The referenced file.
+        file: PathBuf,
+        /// Why it could not be read.
+        error: std::io::Error,
+    },
     /// The format could not be determined from extension or content.
     UnknownFormat,
     /// The file ends before the data its header or structure promises.
@@ -156,6 +165,9 @@ impl fmt::Display for LoadErrorKind {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             LoadErrorKind::Io(e) => write!(f, "cannot read: {e}"),
+            LoadErrorKind::Referenced { what, file, error } => {
+                write!(f, "{what}: cannot read {}: {error}", file.display())
+            }
             LoadErrorKind::UnknownFormat => {
                 f.write_str("unknown format (expected .obj, .stl, .off, .ply, .gltf or .glb)")
             }
@@ -187,6 +199,7 @@ impl std::error::Error for LoadError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match &self.kind {
             LoadErrorKind::Io(e) => Some(e),
+            LoadErrorKind::Referenced { error, .. } => Some(error),
             LoadErrorKind::Mesh(e) => Some(e),
             _ => None,
         }

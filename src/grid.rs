@@ -24,6 +24,8 @@
 //! sample. The result is identical to [`WindingNumber::eval`] at every sample (same perturbation
 //! rule for samples exactly on the surface).
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use rayon::prelude::*;
 
 use crate::BoundingBox;
@@ -49,16 +51,64 @@ pub enum GridError {
     TooLarge,
     /// A bound is not finite or `min > max` on some axis.
     BadBounds,
+    /// More than [`MAX_GRID_CELLS`] cells ([`GridSpec::check_memory`]).
+    TooManyCells {
+        /// `W·H·D`.
+        cells: usize,
+    },
+    /// The arrays of the grid would not fit in the memory available
+    /// ([`GridSpec::check_memory`]).
+    OutOfMemory {
+        /// `W·H·D`.
+        cells: usize,
+        /// Bytes needed.
+        need: u64,
+        /// Bytes available.
+        available: u64,
+    },
 }
 
 impl std::fmt::Display for GridError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            GridError::ZeroDimension => "grid dimensions must be at least 1",
-            GridError::TooLarge => "grid has too many cells",
-            GridError::BadBounds => "grid bounds must be finite with min <= max on every axis",
-        })
+        let gib = |b: u64| b as f64 / f64::from(1u32 << 30);
+        match self {
+            GridError::ZeroDimension => f.write_str("grid dimensions must be at least 1"),
+            GridError::TooLarge => f.write_str("grid has too many cells"),
+            GridError::BadBounds => {
+                f.write_str("grid bounds must be finite with min <= max on every axis")
+            }
+            GridError::TooManyCells { cells } => {
+                write!(f, "a grid of {cells} cells is too large (limit 2^31)")
+            }
+            GridError::OutOfMemory {
+                cells,
+                need,
+                available,
+            } => write!(
+                f,
+                "a grid of {cells} cells needs about {:.1} GiB of memory, more than the {:.1} GiB \
+                 available",
+                gib(*need),
+                gib(*available)
+            ),
+        }
     }
+}
+
+/// Most cells a grid product ([`evaluate`], the signed-distance grid, `gwn voxelize`/`sdf`, the
+/// Python `voxelize`/`sdf`) may have: 2³¹ (16 GiB of `f64`).
+pub const MAX_GRID_CELLS: usize = 1 << 31;
+
+/// Peak bytes per cell of [`evaluate`]: the per-column results and the grid they are copied
+/// into. Products add what they hold besides (see [`GridSpec::check_memory`]).
+pub const EVALUATE_BYTES_PER_CELL: usize = 8 + 8;
+
+/// The memory the system can still give (Linux `MemAvailable`), `None` where unknown.
+pub fn available_memory() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib.saturating_mul(1024))
 }
 
 impl std::error::Error for GridError {}
@@ -148,6 +198,31 @@ impl GridSpec {
         [self.dims[2], self.dims[1], self.dims[0]]
     }
 
+    /// The one size check of grid products, shared by the CLI and the Python package: refuses
+    /// more than [`MAX_GRID_CELLS`] cells, and grids whose arrays (`bytes_per_cell` at the
+    /// product's peak) exceed `available` bytes (pass [`available_memory`]; `None`: unknown,
+    /// not checked). Allocating them would abort the process, or wake the OOM killer, with no
+    /// useful message.
+    pub fn check_memory(
+        &self,
+        bytes_per_cell: usize,
+        available: Option<u64>,
+    ) -> Result<(), GridError> {
+        let cells = self.len();
+        if cells > MAX_GRID_CELLS {
+            return Err(GridError::TooManyCells { cells });
+        }
+        let need = (cells as u64).saturating_mul(bytes_per_cell as u64);
+        match available {
+            Some(available) if need > available => Err(GridError::OutOfMemory {
+                cells,
+                need,
+                available,
+            }),
+            _ => Ok(()),
+        }
+    }
+
     /// Number of columns along world axis `axis`.
     pub fn column_count(&self, axis: usize) -> usize {
         self.len() / self.dims[axis]
@@ -172,9 +247,22 @@ pub fn evaluate_with_progress<E: Evaluator + ?Sized>(
     spec: &GridSpec,
     progress: impl Fn(usize) + Sync,
 ) -> Vec<f64> {
+    let never = AtomicBool::new(false);
+    evaluate_until(evaluator, spec, progress, &never).unwrap_or_default()
+}
+
+/// [`evaluate_with_progress`] that gives up when `stop` becomes true: batches of columns not yet
+/// started are skipped and the result is `None`. How a caller interrupts a long grid from
+/// another thread (the Python package on Ctrl-C); values are those of [`evaluate`] otherwise.
+pub fn evaluate_until<E: Evaluator + ?Sized>(
+    evaluator: &E,
+    spec: &GridSpec,
+    progress: impl Fn(usize) + Sync,
+    stop: &AtomicBool,
+) -> Option<Vec<f64>> {
     let n = spec.len();
     if n == 0 {
-        return Vec::new();
+        return Some(Vec::new());
     }
     let axis = column_axis(evaluator);
     // The two transverse axes, in increasing order; a column is addressed by (a, b).
@@ -192,6 +280,9 @@ pub fn evaluate_with_progress<E: Evaluator + ?Sized>(
         .into_par_iter()
         .chunks(chunk)
         .map(|cols| {
+            if stop.load(Ordering::Relaxed) {
+                return Vec::new();
+            }
             let mut out = Vec::with_capacity(cols.len() * ts.len());
             for c in &cols {
                 let (a, b) = (c % na, c / na);
@@ -205,6 +296,9 @@ pub fn evaluate_with_progress<E: Evaluator + ?Sized>(
             out
         })
         .collect();
+    if stop.load(Ordering::Relaxed) {
+        return None;
+    }
     let mut values = vec![0.0; n];
     let mut c = 0usize;
     for block in results {
@@ -220,7 +314,7 @@ pub fn evaluate_with_progress<E: Evaluator + ?Sized>(
             c += 1;
         }
     }
-    values
+    Some(values)
 }
 
 /// The same grid evaluated point by point ([`Evaluator::eval_batch`]; for the exact evaluator one

@@ -2,7 +2,7 @@
 //! clouds and the FOSSIL-style API.
 #![allow(clippy::needless_range_loop)] // tensor indices as in the formulas
 
-use std::path::PathBuf;
+mod common;
 
 use gwn::Mesh;
 use gwn::eval::direct::winding_number_direct_batch;
@@ -41,13 +41,7 @@ impl Rng {
 }
 
 fn shared_mesh(name: &str) -> Option<Mesh> {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/meshes")
-        .join(name);
-    if !path.exists() {
-        println!("skipping {name}: {} not found", path.display());
-        return None;
-    }
+    let path = common::shared_file(&format!("meshes/{name}"))?;
     Some(gwn::io::load_mesh(&path).expect("shared mesh loads").mesh)
 }
 
@@ -560,4 +554,49 @@ fn near_field_keeps_the_scalar_semantics_on_degenerate_and_remote_triangles() {
     let approx = fast.eval_batch_with(&qs, FastParams::barill(f64::INFINITY, 2));
     let (_, max) = errors(&approx, &exact);
     assert!(max <= 1e-12, "{max:e}");
+}
+
+#[test]
+fn near_field_is_accurate_next_to_an_interior_edge() {
+    // Issue 22: 1e-17 off the diagonal edge shared by the two triangles of the open box's x = 0
+    // face, the two triangles' solid angles are each ≈ ±2π and cancel; the f64 formula errs by
+    // ≈ 2e-17/d there (0.44 at d = 1e-17). The near field must use the direct sum's
+    // accurate (double-double) term for such ill-conditioned triangles.
+    let p = [
+        [0., 0., 0.],
+        [1., 0., 0.],
+        [1., 1., 0.],
+        [0., 1., 0.],
+        [0., 0., 1.],
+        [1., 0., 1.],
+        [1., 1., 1.],
+        [0., 1., 1.],
+    ];
+    let t = [
+        [0, 2, 1],
+        [0, 3, 2],
+        [0, 1, 5],
+        [0, 5, 4],
+        [1, 2, 6],
+        [1, 6, 5],
+        [2, 3, 7],
+        [2, 7, 6],
+        [3, 0, 4],
+        [3, 4, 7],
+    ];
+    let open_box = Mesh::from_slices(&p, &t).unwrap();
+    let fast = FastWindingNumber::new(&open_box);
+    let mut qs = Vec::new();
+    for d in [1e-17, 1e-15, 1e-12, 1e-9, 1e-6] {
+        for s in [-1.0, 1.0] {
+            qs.push([s * d, 0.5, 0.5]);
+            qs.push([s * d, 0.25, 0.75]);
+            qs.push([0.5 + s * d, 0.5 - s * d, 0.0]); // the bottom face's diagonal
+        }
+    }
+    let exact = winding_number_direct_batch(&open_box, &qs);
+    let approx = fast.eval_batch(&qs);
+    for ((q, a), e) in qs.iter().zip(&approx).zip(&exact) {
+        assert!((a - e).abs() <= 1e-13, "{q:?}: fast {a} direct {e}");
+    }
 }

@@ -1,7 +1,9 @@
 //! Every mesh of the shared corpus (`../shared/meshes/manifest.csv`) loads, and its statistics
 //! match the manifest's independently computed ones.
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use std::path::PathBuf;
 
 use gwn::io::{Format, LoadOptions, load_mesh_with};
 use gwn::mesh::stats::MeshStats;
@@ -32,14 +34,12 @@ fn parse_csv_line(line: &str) -> Vec<String> {
 }
 
 fn corpus_dir() -> Option<PathBuf> {
-    let d = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes");
-    d.join("manifest.csv").is_file().then_some(d)
+    common::shared_meshes()
 }
 
 #[test]
 fn manifest_statistics_match() {
     let Some(dir) = corpus_dir() else {
-        println!("skipping: ../shared/meshes not found");
         return;
     };
     let text = std::fs::read_to_string(dir.join("manifest.csv")).unwrap();
@@ -136,7 +136,6 @@ fn manifest_statistics_match() {
 #[test]
 fn every_corpus_file_loads_or_errors_cleanly() {
     let Some(dir) = corpus_dir() else {
-        println!("skipping: ../shared/meshes not found");
         return;
     };
     let mut stack = vec![dir];

@@ -2,7 +2,7 @@
 //! references (Richardson-extrapolated tessellations, the direct surface quadrature) and ray
 //! independence, including rays that pass within 1e-12 of patch edges and degenerate corners.
 
-use std::path::Path;
+mod common;
 
 use gwn::eval::antipodal::WindingNumber;
 use gwn::kernel::frame::RayAxis;
@@ -11,14 +11,9 @@ use gwn::patch::surface_quadrature::winding_number_surface_quadrature;
 use gwn::patch::tessellate::tessellate;
 use gwn::patch::{Options, PatchSet, PatchWindingNumber, load_patches};
 
-const TEAPOT: &str = "../shared/parametric/teapot.bpt";
-
 fn teapot() -> Option<PatchSet> {
-    if !Path::new(TEAPOT).exists() {
-        println!("skipping: {TEAPOT} not found");
-        return None;
-    }
-    Some(load_patches(Path::new(TEAPOT)).expect("teapot loads"))
+    let path = common::shared_file("parametric/teapot.bpt")?;
+    Some(load_patches(&path).expect("teapot loads"))
 }
 
 struct Rng(u64);

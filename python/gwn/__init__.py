@@ -32,6 +32,11 @@ from ._gwn import (
     winding_number,
 )
 
+# pyo3 exposes `__call__` as a type slot, whose run-time docstring is Python's generic "Call
+# self as a function."; calls go through `eval` instead (same code, with the docstring), so that
+# `help(WindingNumber.__call__)` documents the call.
+WindingNumber.__call__ = WindingNumber.eval
+
 __all__ = [
     "WindingNumber",
     "__version__",

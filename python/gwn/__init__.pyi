@@ -47,8 +47,13 @@ class WindingNumber:
         P: _Floats, N: _Floats, A: Optional[_Floats] = None, beta: float = 2.3, order: int = 2
     ) -> "WindingNumber":
         """Barnes-Hut evaluator of an oriented point cloud; areas estimated when ``A`` is None."""
+    @overload
+    def __call__(self, Q: Tuple[float, float, float], threads: Optional[int] = None) -> float: ...
+    @overload
     def __call__(self, Q: _Floats, threads: Optional[int] = None) -> _F64:
-        """Winding numbers at the rows of ``Q`` (n, 3): float64 (n,)."""
+        """Winding numbers at the rows of ``Q`` (n, 3): float64 (n,); a float for one (3,) point."""
+    def eval(self, Q: _Floats, threads: Optional[int] = None) -> Union[_F64, float]:
+        """``self(Q)`` under a name that carries the docstring at run time."""
     def gradient(self, Q: _Floats, threads: Optional[int] = None) -> _F64:
         """Gradients at the rows of ``Q``: float64 (n, 3). Exact and direct methods only."""
     def parts(self, Q: _Floats, threads: Optional[int] = None) -> Tuple[_I64, _F64]:
@@ -69,6 +74,16 @@ class WindingNumber:
     def boundary_edge_count(self) -> Optional[int]:
         """Signed boundary edges of the exact method (None for the other methods)."""
 
+@overload
+def winding_number(
+    V: _Floats,
+    F: _Indices,
+    O: Tuple[float, float, float],
+    threads: Optional[int] = None,
+    *,
+    tolerance: float = 1e-10,
+) -> float: ...
+@overload
 def winding_number(
     V: _Floats,
     F: _Indices,
@@ -84,8 +99,11 @@ def fast_winding_number(
     V: _Floats,
     F: _Indices,
     Q: _Floats,
+    expansion_order_: int = 2,
+    beta_: float = 2.0,
+    /,
     *,
-    beta: float = 2.0,
+    beta: Optional[float] = None,
     order: Optional[int] = None,
     expansion_order: Optional[int] = None,
     threads: Optional[int] = None,
@@ -96,13 +114,17 @@ def fast_winding_number(
     N: _Floats,
     A: Optional[_Floats],
     Q: _Floats,
+    expansion_order_: int = 2,
+    beta_: float = 2.0,
+    /,
     *,
-    beta: float = 2.0,
+    beta: Optional[float] = None,
     order: Optional[int] = None,
     expansion_order: Optional[int] = None,
     threads: Optional[int] = None,
 ) -> _F64:
-    """Barnes-Hut winding numbers of a mesh (V, F, Q) or point cloud (P, N, A, Q); libigl's forms."""
+    """Barnes-Hut winding numbers of a mesh (V, F, Q) or point cloud (P, N, A, Q); libigl's forms,
+    with libigl's positional ``expansion_order, beta`` (default 2, 2.0) after the arrays."""
 
 def voxelize(
     V: _Floats,

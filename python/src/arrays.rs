@@ -12,10 +12,20 @@ use numpy::{Element, PyArray1, PyArray2, PyArrayMethods, PyUntypedArray, PyUntyp
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
-/// `obj` as a numpy array (itself when it already is one).
+/// `obj` as a numpy array (itself when it already is one), in native byte order: a big-endian
+/// array (`'>f8'`, as read from some files) is converted once, as numpy would, instead of being
+/// refused as an unknown dtype.
 fn as_ndarray<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Bound<'py, PyUntypedArray>> {
     if let Ok(a) = obj.downcast::<PyUntypedArray>() {
-        return Ok(a.clone());
+        let dtype = a.dtype();
+        if dtype.getattr("isnative")?.extract::<bool>()? {
+            return Ok(a.clone());
+        }
+        let native = dtype.call_method1("newbyteorder", ("=",))?;
+        return a
+            .call_method1("astype", (native,))?
+            .downcast_into::<PyUntypedArray>()
+            .map_err(|_| PyTypeError::new_err(format!("{name}: not convertible to an array")));
     }
     let converted = obj
         .py()
@@ -211,6 +221,32 @@ pub fn is_integer_array(obj: &Bound<'_, PyAny>) -> bool {
             .and_then(|k| k.extract::<String>())
             .is_ok_and(|k| k == "i" || k == "u")
     })
+}
+
+/// `obj` as an `(n, N)` query array, and whether it was a single point of shape `(N,)` (made a
+/// `(1, N)` array here): libigl accepts one point and returns a float, so do the callers.
+pub fn one_or_many<'py, const N: usize>(
+    obj: &Bound<'py, PyAny>,
+    name: &str,
+) -> PyResult<(Bound<'py, PyAny>, bool)> {
+    let a = as_ndarray(obj, name)?;
+    if a.shape() == [N] {
+        return Ok((a.call_method1("reshape", ((1, N),))?, true));
+    }
+    Ok((a.into_any(), false))
+}
+
+/// `values` as a float64 array, or as a float when the query was a single point
+/// ([`one_or_many`]).
+pub fn values_out<'py>(
+    py: Python<'py>,
+    values: Vec<f64>,
+    single: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    if single {
+        return Ok(pyo3::types::PyFloat::new(py, values[0]).into_any());
+    }
+    Ok(array1(py, values).into_any())
 }
 
 /// A float64 `(n,)` array owning `values`.

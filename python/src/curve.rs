@@ -1,6 +1,7 @@
 //! 2D: GauWN, the Gaussian-smoothed winding number of polygons (Sun et al. 2024), and its
 //! spatial gradient, with the library's closed forms.
 
+use gwn::curve2d::polygon::{MAX_COORD, query_in_range};
 use gwn::curve2d::{GauWn, Point, Polygon};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -9,7 +10,7 @@ use rayon::prelude::*;
 
 use crate::arrays::{array1, array2, points_vec, with_points};
 use crate::errors::value_error;
-use crate::threads;
+use crate::threads::{self, Threads};
 
 /// The loops of `polygon`: one `(n, 2)` array, or a list/tuple of them.
 fn loops_of(polygon: &Bound<'_, PyAny>) -> PyResult<Vec<Vec<Point>>> {
@@ -40,6 +41,8 @@ fn loops_of(polygon: &Bound<'_, PyAny>) -> PyResult<Vec<Vec<Point>>> {
 /// or a list of such loops. ``sigma`` > 0 is the standard deviation of the Gaussian. Returns
 /// float64 (k,), or ``(values, gradients)`` with the spatial gradient float64 (k, 2) when
 /// ``gradient=True``. Closed forms of Sun et al. 2024 (no quadrature, no hierarchy).
+/// Coordinates of the polygon and of ``Q`` must be at most 1e100 in magnitude (``ValueError``
+/// beyond). Ctrl-C interrupts a long call (``KeyboardInterrupt``).
 #[pyfunction]
 #[pyo3(signature = (polygon, sigma, Q, *, gradient = false, threads = None))]
 #[allow(non_snake_case)]
@@ -49,7 +52,7 @@ pub fn gauwn<'py>(
     sigma: f64,
     Q: &Bound<'py, PyAny>,
     gradient: bool,
-    threads: Option<usize>,
+    threads: Option<Threads>,
 ) -> PyResult<Bound<'py, PyAny>> {
     if !(sigma.is_finite() && sigma > 0.0) {
         return Err(PyValueError::new_err(format!(
@@ -59,12 +62,23 @@ pub fn gauwn<'py>(
     let poly = Polygon::new(loops_of(polygon)?).map_err(value_error)?;
     let g = GauWn::new(sigma);
     let (values, grads) = with_points::<2, _>(Q, "Q", |q| {
-        threads::run(py, threads, || {
-            let values: Vec<f64> = q.par_iter().map(|&p| g.value(&poly, p)).collect();
-            let grads: Option<Vec<[f64; 2]>> =
-                gradient.then(|| q.par_iter().map(|&p| g.gradient(&poly, p)).collect());
-            (values, grads)
-        })
+        if let Some(i) = q.iter().position(|&p| !query_in_range(p)) {
+            return Err(PyValueError::new_err(format!(
+                "Q[{i}] = {:?} exceeds {MAX_COORD:e} in magnitude (the 2D limit)",
+                q[i]
+            )));
+        }
+        let values = threads::run_batch(py, threads, q, |piece| {
+            piece.par_iter().map(|&p| g.value(&poly, p)).collect()
+        })?;
+        let grads = gradient
+            .then(|| {
+                threads::run_batch(py, threads, q, |piece| {
+                    piece.par_iter().map(|&p| g.gradient(&poly, p)).collect()
+                })
+            })
+            .transpose()?;
+        Ok((values, grads))
     })?;
     let values = array1(py, values).into_any();
     match grads {

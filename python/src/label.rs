@@ -12,7 +12,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::errors::value_error;
-use crate::threads;
+use crate::threads::{self, Threads};
 
 #[allow(clippy::too_many_arguments)]
 fn job_options(
@@ -74,7 +74,7 @@ pub fn label_dataset(
     seed: u64,
     time_limit: Option<f64>,
     weld: Option<bool>,
-    threads: Option<usize>,
+    threads: Option<Threads>,
     progress: Option<PyObject>,
 ) -> PyResult<Vec<String>> {
     let opts = job_options(uniform, near, sigmas, padding, seed, time_limit, weld)?;
@@ -146,7 +146,7 @@ pub fn label_file(
     seed: u64,
     time_limit: Option<f64>,
     weld: Option<bool>,
-    threads: Option<usize>,
+    threads: Option<Threads>,
 ) -> PyResult<String> {
     let opts = job_options(uniform, near, sigmas, padding, seed, time_limit, weld)?;
     let root = std::path::absolute(&root).unwrap_or(root);

@@ -4,12 +4,12 @@ use std::path::PathBuf;
 
 use gwn::io::LoadOptions;
 use numpy::PyArray1;
-use pyo3::exceptions::{PyOSError, PyValueError};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyList;
 
 use crate::arrays::{array1, array2};
-use crate::errors::{load_error, value_error};
+use crate::errors::{load_error, os_error, value_error};
 
 fn widen<const N: usize>(rows: Vec<[u32; N]>) -> Vec<[i64; N]> {
     rows.into_iter().map(|r| r.map(i64::from)).collect()
@@ -18,7 +18,9 @@ fn widen<const N: usize>(rows: Vec<[u32; N]>) -> Vec<[i64; N]> {
 /// Reads a triangle mesh (OBJ, STL ascii/binary, OFF, PLY ascii/binary; format by extension,
 /// else by content) as ``(V, F)``: float64 (n, 3) and int64 (m, 3). Polygons are
 /// fan-triangulated. ``weld``: merge bit-identical vertices (default: on for STL and glTF/GLB only).
-/// ``OSError`` when the file cannot be read, ``ValueError`` when it is not a valid mesh.
+/// ``OSError`` when the file (or a glTF buffer file it refers to) cannot be read:
+/// ``FileNotFoundError`` when missing, ``PermissionError`` when not readable; ``ValueError`` when
+/// it is not a valid mesh.
 #[pyfunction]
 #[pyo3(signature = (path, weld = None))]
 pub fn load<'py>(
@@ -86,7 +88,7 @@ pub fn load_tets<'py>(
             if path.exists() {
                 value_error(e)
             } else {
-                PyOSError::new_err(e.to_string())
+                os_error(std::io::ErrorKind::NotFound, e.to_string())
             }
         })?;
     Ok((
@@ -101,10 +103,10 @@ pub fn load_tets<'py>(
 #[pyfunction]
 pub fn load_polygon<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyList>> {
     if !path.exists() {
-        return Err(PyOSError::new_err(format!(
-            "{}: no such file",
-            path.display()
-        )));
+        return Err(os_error(
+            std::io::ErrorKind::NotFound,
+            format!("{}: no such file", path.display()),
+        ));
     }
     let poly = py
         .allow_threads(|| gwn::curve2d::io::read_polygon(&path))

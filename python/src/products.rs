@@ -20,7 +20,7 @@ use crate::arrays::{array_nd, array1, indices_vec, with_points};
 use crate::errors::value_error;
 use crate::evaluator::{Method, check_tolerance, fast_params};
 use crate::oneshot::mesh_from;
-use crate::threads;
+use crate::threads::{self, Threads};
 
 /// The evaluator a product uses: any of the library's, through its `Evaluator` trait (the CLI's
 /// `--method/--beta/--order`). `beta`/`order` only apply to `"fast"`; `exact` are the exact
@@ -60,19 +60,20 @@ fn evaluator_for<'m>(
     })
 }
 
-/// Largest grid a call may allocate (the CLI's limit): 2^31 samples, 16 GiB of float64.
-const MAX_GRID_SAMPLES: usize = 1 << 31;
 /// Largest slice side in pixels (the CLI's limit).
 const MAX_SLICE_RES: usize = 1 << 15;
 
 /// The grid of `voxelize` and `sdf`: explicit `bounds` or the mesh's box grown by `margin`,
-/// explicit `dims` (W, H, D) or `res` cells along the longest side.
+/// explicit `dims` (W, H, D) or `res` cells along the longest side; refused (before any
+/// allocation) by the library's size check, the CLI's, when its `bytes_per_cell` exceed the
+/// available memory.
 fn grid_spec(
     mesh: &Mesh,
     res: usize,
     dims: Option<[usize; 3]>,
     bounds: Option<[f64; 6]>,
     margin: f64,
+    bytes_per_cell: usize,
 ) -> PyResult<GridSpec> {
     let bounds = match bounds {
         Some(b) => BoundingBox {
@@ -95,12 +96,8 @@ fn grid_spec(
         None => GridSpec::with_resolution(bounds, res),
     }
     .map_err(|e| PyValueError::new_err(format!("bad grid: {e}")))?;
-    if spec.len() > MAX_GRID_SAMPLES {
-        return Err(PyValueError::new_err(format!(
-            "a grid of {:?} cells is too large (limit 2^31)",
-            spec.dims
-        )));
-    }
+    spec.check_memory(bytes_per_cell, gwn::grid::available_memory())
+        .map_err(|e| PyValueError::new_err(format!("{e}; lower res or dims")))?;
     Ok(spec)
 }
 
@@ -151,16 +148,24 @@ pub fn voxelize<'py>(
     beta: f64,
     order: u8,
     tolerance: f64,
-    threads: Option<usize>,
+    threads: Option<Threads>,
 ) -> PyResult<GridArrays<'py>> {
     let (method, params) = method_of(method, beta, order)?;
     let exact = exact_options(tolerance)?;
     let mesh = mesh_from(V, F, "V", "F")?;
-    let spec = grid_spec(&mesh, res, dims, bounds, margin)?;
-    let values = threads::run(py, threads, || {
-        evaluator_for(&mesh, method, params, exact).map(|wn| gwn::grid::evaluate(&wn, &spec))
-    })?
-    .map_err(value_error)?;
+    let spec = grid_spec(
+        &mesh,
+        res,
+        dims,
+        bounds,
+        margin,
+        gwn::grid::EVALUATE_BYTES_PER_CELL,
+    )?;
+    let wn = threads::run(py, threads, || evaluator_for(&mesh, method, params, exact))?
+        .map_err(value_error)?;
+    let values = threads::run_interruptible(py, threads, |stop| {
+        gwn::grid::evaluate_until(&wn, &spec, |_| {}, stop)
+    })?;
     grid_result(py, &spec, values)
 }
 
@@ -181,15 +186,22 @@ pub fn sdf<'py>(
     bounds: Option<[f64; 6]>,
     margin: f64,
     tolerance: f64,
-    threads: Option<usize>,
+    threads: Option<Threads>,
 ) -> PyResult<GridArrays<'py>> {
     let exact = exact_options(tolerance)?;
     let mesh = mesh_from(V, F, "V", "F")?;
-    let spec = grid_spec(&mesh, res, dims, bounds, margin)?;
-    let values = threads::run(py, threads, || {
-        SignedDistance::with_options(&mesh, exact).map(|s| s.eval_grid(&spec))
-    })?
-    .map_err(value_error)?;
+    let spec = grid_spec(
+        &mesh,
+        res,
+        dims,
+        bounds,
+        margin,
+        gwn::products::sdf::GRID_BYTES_PER_CELL,
+    )?;
+    let sdf = threads::run(py, threads, || SignedDistance::with_options(&mesh, exact))?
+        .map_err(value_error)?;
+    let values =
+        threads::run_interruptible(py, threads, |stop| sdf.eval_grid_until(&spec, |_| {}, stop))?;
     grid_result(py, &spec, values)
 }
 
@@ -204,17 +216,16 @@ pub fn signed_distance<'py>(
     V: &Bound<'py, PyAny>,
     F: &Bound<'py, PyAny>,
     Q: &Bound<'py, PyAny>,
-    threads: Option<usize>,
+    threads: Option<Threads>,
     tolerance: f64,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let exact = exact_options(tolerance)?;
     let mesh = mesh_from(V, F, "V", "F")?;
     let values = with_points(Q, "Q", |q| {
-        threads::run(py, threads, || {
-            SignedDistance::with_options(&mesh, exact).map(|s| s.eval_batch(q))
-        })
-    })?
-    .map_err(value_error)?;
+        let sdf = threads::run(py, threads, || SignedDistance::with_options(&mesh, exact))?
+            .map_err(value_error)?;
+        threads::run_batch(py, threads, q, |piece| sdf.eval_batch(piece))
+    })?;
     Ok(array1(py, values))
 }
 
@@ -255,7 +266,7 @@ pub fn slice<'py>(
     beta: f64,
     order: u8,
     tolerance: f64,
-    threads: Option<usize>,
+    threads: Option<Threads>,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyBytes>)> {
     let (method, params) = method_of(method, beta, order)?;
     let exact = exact_options(tolerance)?;
@@ -332,7 +343,7 @@ pub fn classify<'py>(
     beta: f64,
     order: u8,
     tolerance: f64,
-    threads: Option<usize>,
+    threads: Option<Threads>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let (method, params) = method_of(method, beta, order)?;
     let exact = exact_options(tolerance)?;
@@ -365,7 +376,7 @@ pub fn filter_tets<'py>(
     beta: f64,
     order: u8,
     tolerance: f64,
-    threads: Option<usize>,
+    threads: Option<Threads>,
 ) -> PyResult<Bound<'py, PyArray1<bool>>> {
     let (method, params) = method_of(method, beta, order)?;
     let exact = exact_options(tolerance)?;

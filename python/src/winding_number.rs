@@ -10,13 +10,15 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
-use crate::arrays::{array1, array2, indices_vec, points_vec, values_vec, with_points};
+use crate::arrays::{
+    array1, array2, indices_vec, one_or_many, points_vec, values_out, values_vec, with_points,
+};
 use crate::errors::{mesh_error, value_error};
 use crate::evaluator::{
     Evaluator, Method, PY_DEFAULT_TOLERANCE, check_tolerance, fast_params, parse_precision,
     parse_ray,
 };
-use crate::threads;
+use crate::threads::{self, Threads};
 
 /// `WindingNumber.parts`' result: crossing counts and fractional parts.
 type Parts<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<f64>>);
@@ -174,19 +176,36 @@ impl PyWindingNumber {
         })
     }
 
-    /// Winding numbers at the rows of ``Q`` (n, 3): float64 array (n,).
+    /// Winding numbers at the rows of ``Q`` (n, 3): float64 array (n,); a single point of shape
+    /// (3,) gives a float (as libigl). Ctrl-C interrupts a long call (``KeyboardInterrupt``).
     #[pyo3(signature = (Q, threads = None))]
     #[allow(non_snake_case)]
     fn __call__<'py>(
         &self,
         py: Python<'py>,
         Q: &Bound<'py, PyAny>,
-        threads: Option<usize>,
-    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let values = with_points(Q, "Q", |q| {
-            threads::run(py, threads, || self.evaluator.eval_batch(q))
+        threads: Option<Threads>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.eval(py, Q, threads)
+    }
+
+    /// Winding numbers at the rows of ``Q`` (n, 3): float64 array (n,); a single point of shape
+    /// (3,) gives a float (as libigl). The same as calling the object (``wn(Q)``), under a name
+    /// that carries this docstring at run time. Ctrl-C interrupts a long call
+    /// (``KeyboardInterrupt``).
+    #[pyo3(signature = (Q, threads = None))]
+    #[allow(non_snake_case)]
+    fn eval<'py>(
+        &self,
+        py: Python<'py>,
+        Q: &Bound<'py, PyAny>,
+        threads: Option<Threads>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (q, single) = one_or_many::<3>(Q, "Q")?;
+        let values = with_points(&q, "Q", |q| {
+            threads::run_batch(py, threads, q, |piece| self.evaluator.eval_batch(piece))
         })?;
-        Ok(array1(py, values))
+        values_out(py, values, single)
     }
 
     /// Gradients of the winding number at the rows of ``Q`` (n, 3): float64 array (n, 3).
@@ -197,12 +216,15 @@ impl PyWindingNumber {
         &self,
         py: Python<'py>,
         Q: &Bound<'py, PyAny>,
-        threads: Option<usize>,
+        threads: Option<Threads>,
     ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluator.gradient_batch(&[]).map_err(value_error)?;
         let grads = with_points(Q, "Q", |q| {
-            threads::run(py, threads, || self.evaluator.gradient_batch(q))
-        })?
-        .map_err(value_error)?;
+            threads::run_batch(py, threads, q, |piece| {
+                // Supported (checked above): the error cannot occur here.
+                self.evaluator.gradient_batch(piece).unwrap_or_default()
+            })
+        })?;
         array2(py, grads)
     }
 
@@ -216,12 +238,17 @@ impl PyWindingNumber {
         &self,
         py: Python<'py>,
         Q: &Bound<'py, PyAny>,
-        threads: Option<usize>,
+        threads: Option<Threads>,
     ) -> PyResult<Parts<'py>> {
-        let (chi, fraction) = with_points(Q, "Q", |q| {
-            threads::run(py, threads, || self.evaluator.parts_batch(q))
+        self.evaluator.parts_batch(&[]).map_err(value_error)?;
+        let (chi, fraction): (Vec<i64>, Vec<f64>) = with_points(Q, "Q", |q| {
+            threads::run_batch(py, threads, q, |piece| {
+                let (chi, fraction) = self.evaluator.parts_batch(piece).unwrap_or_default();
+                chi.into_iter().zip(fraction).collect()
+            })
         })?
-        .map_err(value_error)?;
+        .into_iter()
+        .unzip();
         Ok((PyArray1::from_vec(py, chi), array1(py, fraction)))
     }
 
@@ -235,12 +262,17 @@ impl PyWindingNumber {
         &self,
         py: Python<'py>,
         Q: &Bound<'py, PyAny>,
-        threads: Option<usize>,
+        threads: Option<Threads>,
     ) -> PyResult<Bounded<'py>> {
-        let (values, bounds) = with_points(Q, "Q", |q| {
-            threads::run(py, threads, || self.evaluator.bound_batch(q))
+        self.evaluator.bound_batch(&[]).map_err(value_error)?;
+        let (values, bounds): (Vec<f64>, Vec<f64>) = with_points(Q, "Q", |q| {
+            threads::run_batch(py, threads, q, |piece| {
+                let (values, bounds) = self.evaluator.bound_batch(piece).unwrap_or_default();
+                values.into_iter().zip(bounds).collect()
+            })
         })?
-        .map_err(value_error)?;
+        .into_iter()
+        .unzip();
         Ok((array1(py, values), array1(py, bounds)))
     }
 

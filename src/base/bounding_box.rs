@@ -27,14 +27,14 @@ impl BoundingBox {
         Some(b)
     }
 
-    /// Length of the diagonal.
+    /// Length of the diagonal, also for boxes of extent 1e-300 or 1e300 (where the squared
+    /// lengths under- or overflow; `gwn info` printed `diagonal 0` for a cube of side 1e-300).
     pub fn diagonal(&self) -> f64 {
-        let d = [
+        crate::base::vec3::norm_safe([
             self.max[0] - self.min[0],
             self.max[1] - self.min[1],
             self.max[2] - self.min[2],
-        ];
-        (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+        ])
     }
 
     /// Centre of the box.

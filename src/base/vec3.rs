@@ -29,6 +29,35 @@ pub fn norm(a: [f64; 3]) -> f64 {
     dot(a, a).sqrt()
 }
 
+/// `|a|` for any finite `a`, without the overflow (components above ~1e154) or underflow (below
+/// ~1e-154) of the squares: when `a·a` is not a normal `f64`, `a` is scaled by `2^∓600` (exact)
+/// first. Equal to [`norm`] bit for bit whenever `a·a` is normal.
+#[inline]
+pub fn norm_safe(a: [f64; 3]) -> f64 {
+    let s = dot(a, a);
+    if (f64::MIN_POSITIVE..f64::INFINITY).contains(&s) {
+        return s.sqrt();
+    }
+    let m = a[0].abs().max(a[1].abs()).max(a[2].abs());
+    if m == 0.0 || !m.is_finite() {
+        return if a.iter().any(|c| c.is_nan()) {
+            f64::NAN
+        } else {
+            m
+        };
+    }
+    // 2^600 and 2^-600: exact scalings that bring the largest component to ~[1e-143, 1e127].
+    let (up, down) = (
+        f64::from_bits((1023 + 600) << 52),
+        f64::from_bits((1023 - 600) << 52),
+    );
+    if m < 1.0 {
+        norm(a.map(|c| c * up)) * down
+    } else {
+        norm(a.map(|c| c * down)) * up
+    }
+}
+
 /// `|a − b|²`.
 #[inline]
 pub fn dist2(a: [f64; 3], b: [f64; 3]) -> f64 {

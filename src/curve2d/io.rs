@@ -20,9 +20,15 @@
 //! - **Text output** ([`text_string`]): the text format, `open` blocks for open loops.
 //!
 //! Errors name the file and, where known, the line.
+//!
+//! Bounded work on hostile files: a drawing file is read up to [`MAX_DRAWING_BYTES`] and a
+//! query-point file up to [`MAX_POINTS_BYTES`] (a device such as `/dev/zero` is refused after
+//! that many bytes instead of filling memory), and SVG elements nested deeper than
+//! [`MAX_SVG_NESTING`] are refused before usvg, whose conversion recurses once per level, sees
+//! them (20,000 nested `<g>` overflowed the stack).
 
 use super::open::Curves;
-use super::polygon::{Point, Polygon, PolygonError};
+use super::polygon::{MAX_COORD, Point, Polygon, PolygonError, query_in_range};
 use std::fmt;
 use std::path::Path;
 
@@ -71,15 +77,47 @@ pub fn read_polygon(path: &Path) -> Result<Polygon, CurveIoError> {
     Ok(read_drawing(path)?.curves.polygon)
 }
 
-/// The most bytes read from an input that is not a regular file (a pipe, a device): 256 MiB, as
-/// for meshes (`io::MAX_STREAM_BYTES`; this module does not import `io`).
-const MAX_STREAM_BYTES: u64 = 1 << 28;
+/// Largest drawing file (text or SVG) [`read_drawing`] reads: 256 MiB.
+pub const MAX_DRAWING_BYTES: u64 = 1 << 28;
+
+/// Largest query-point file [`read_points`] reads: 2 GiB, more than [`MAX_POINTS`] points as
+/// `.npy` (16 bytes each) need.
+pub const MAX_POINTS_BYTES: u64 = 1 << 31;
+
+/// Deepest element nesting [`parse_svg`] accepts. usvg converts nested elements by recursion
+/// (several kB of stack per level); 256 levels fit in a 2 MiB thread stack with room to spare
+/// (tested), and drawings nest a few tens of levels at most.
+pub const MAX_SVG_NESTING: usize = 256;
+
+/// The bytes of `path`, at most `limit` of them: a longer file (or a device that never ends) is
+/// an error, never an unbounded allocation or a blocking read.
+fn read_capped(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, CurveIoError> {
+    let name = path.display().to_string();
+    let cannot = |e: std::io::Error| err(&name, 0, format!("cannot read: {e}"));
+    let longer = || {
+        err(
+            &name,
+            0,
+            format!("longer than {} MiB, the limit for {what}", limit >> 20),
+        )
+    };
+    // A regular file is read whole: refuse a long one before allocating. Anything else (a pipe,
+    // a device) is opened without blocking and read up to the limit.
+    if std::fs::metadata(path).is_ok_and(|m| m.is_file() && m.len() > limit) {
+        return Err(longer());
+    }
+    let bytes = crate::base::file::read_nonblocking(path, limit).map_err(cannot)?;
+    if bytes.len() as u64 > limit {
+        return Err(longer());
+    }
+    Ok(bytes)
+}
 
 /// Reads curves from a text or SVG file (by extension).
 pub fn read_drawing(path: &Path) -> Result<Drawing, CurveIoError> {
     let name = path.display().to_string();
-    let text = crate::base::file::read_text_nonblocking(path, MAX_STREAM_BYTES)
-        .map_err(|e| err(&name, 0, format!("cannot read: {e}")))?;
+    let bytes = read_capped(path, MAX_DRAWING_BYTES, "drawings")?;
+    let text = String::from_utf8(bytes).map_err(|_| err(&name, 0, "not UTF-8 text"))?;
     let is_svg = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
@@ -258,10 +296,7 @@ impl Affine {
 
 /// Whether usvg wrapped the document in a group carrying the `viewBox` → viewport map: it does
 /// exactly when the root has a valid `viewBox` that is not `0 0 width height`.
-fn has_viewbox_wrapper(text: &str, tree: &usvg::Tree) -> bool {
-    let Ok(doc) = usvg::roxmltree::Document::parse(text) else {
-        return false;
-    };
+fn has_viewbox_wrapper(doc: &usvg::roxmltree::Document<'_>, tree: &usvg::Tree) -> bool {
     let Some(vb) = doc.root_element().attribute("viewBox") else {
         return false;
     };
@@ -282,6 +317,20 @@ fn has_viewbox_wrapper(text: &str, tree: &usvg::Tree) -> bool {
 
 /// Parses an SVG document as drawn (see the module docs); `name` is used in errors.
 pub fn parse_svg(text: &str, name: &str) -> Result<Curves, CurveIoError> {
+    let unreadable = |e: usvg::Error| err(name, 0, format!("not a readable SVG: {e}"));
+    // Both roxmltree's parser and usvg's conversion recurse once per nesting level: the raw text
+    // is scanned first, and the parsed tree (which may nest deeper through entities) is checked
+    // again before usvg sees it.
+    prescan_nesting(text, name)?;
+    let doc = usvg::roxmltree::Document::parse_with_options(
+        text,
+        usvg::roxmltree::ParsingOptions {
+            allow_dtd: true,
+            ..Default::default()
+        },
+    )
+    .map_err(|e| unreadable(usvg::Error::ParsingFailed(e)))?;
+    check_nesting(&doc, name)?;
     // `<image>` elements are never drawn into curves, and usvg's default resolver would open
     // whatever path an untrusted document names (a FIFO blocks, `/dev/zero` never ends): no
     // image is resolved at all.
@@ -292,11 +341,10 @@ pub fn parse_svg(text: &str, name: &str) -> Result<Curves, CurveIoError> {
         },
         ..usvg::Options::default()
     };
-    let tree = usvg::Tree::from_str(text, &options)
-        .map_err(|e| err(name, 0, format!("not a readable SVG: {e}")))?;
+    let tree = usvg::Tree::from_xmltree(&doc, &options).map_err(unreadable)?;
     let mut loops: Vec<RawLoop> = Vec::new();
     let root = tree.root();
-    if has_viewbox_wrapper(text, &tree) {
+    if has_viewbox_wrapper(&doc, &tree) {
         // Skip the viewBox → viewport map: coordinates stay in the root's user units.
         for child in root.children() {
             match child {
@@ -315,6 +363,87 @@ pub fn parse_svg(text: &str, name: &str) -> Result<Curves, CurveIoError> {
         return Err(err(name, 0, "no visible shape or path found"));
     }
     build(loops, name)
+}
+
+/// Refuses text whose tags nest deeper than [`MAX_SVG_NESTING`], before any recursive parser
+/// sees it. A conservative scan of the raw text: comments, CDATA and processing instructions are
+/// skipped; every other `<name …>` opens a level (also inside a DTD's entity values, which
+/// only overestimates), `</…>` closes one, `<…/>` none.
+fn prescan_nesting(text: &str, name: &str) -> Result<(), CurveIoError> {
+    let b = text.as_bytes();
+    let skip_past = |from: usize, end: &str| {
+        text[from..]
+            .find(end)
+            .map_or(b.len(), |k| from + k + end.len())
+    };
+    let (mut i, mut depth) = (0usize, 0usize);
+    while let Some(k) = text[i..].find('<') {
+        i += k;
+        let rest = &text[i..];
+        if rest.starts_with("<!--") {
+            i = skip_past(i + 4, "-->");
+        } else if rest.starts_with("<![CDATA[") {
+            i = skip_past(i + 9, "]]>");
+        } else if rest.starts_with("<?") {
+            i = skip_past(i + 2, "?>");
+        } else if rest.starts_with("<!") {
+            i += 2; // a declaration: its content is scanned as text
+        } else if rest.starts_with("</") {
+            depth = depth.saturating_sub(1);
+            i = skip_past(i + 2, ">");
+        } else {
+            // A start tag: up to its `>` outside quoted attribute values.
+            let mut j = i + 1;
+            let mut quote = None;
+            while j < b.len() {
+                match (quote, b[j]) {
+                    (Some(q), c) if c == q => quote = None,
+                    (None, c @ (b'"' | b'\'')) => quote = Some(c),
+                    (None, b'>') => break,
+                    _ => {}
+                }
+                j += 1;
+            }
+            if b.get(j.wrapping_sub(1)) != Some(&b'/') {
+                depth += 1;
+                if depth > MAX_SVG_NESTING {
+                    let line = 1 + b[..i].iter().filter(|&&c| c == b'\n').count();
+                    return Err(err(
+                        name,
+                        line,
+                        format!("elements nested more than {MAX_SVG_NESTING} levels deep"),
+                    ));
+                }
+            }
+            i = (j + 1).min(b.len());
+        }
+    }
+    Ok(())
+}
+
+/// Refuses elements nested deeper than [`MAX_SVG_NESTING`]. Iterative (document order, each
+/// node's depth from its parent's, which comes first), so the check itself cannot overflow the
+/// stack.
+fn check_nesting(doc: &usvg::roxmltree::Document<'_>, name: &str) -> Result<(), CurveIoError> {
+    let mut depth: Vec<u32> = Vec::new();
+    for node in doc.descendants() {
+        let id = node.id().get_usize();
+        let parent = node.parent().map_or(0, |p| depth[p.id().get_usize()]);
+        let d = parent + u32::from(node.is_element());
+        if d as usize > MAX_SVG_NESTING {
+            let line = doc.text_pos_at(node.range().start).row as usize;
+            return Err(err(
+                name,
+                line,
+                format!("elements nested more than {MAX_SVG_NESTING} levels deep"),
+            ));
+        }
+        if depth.len() <= id {
+            depth.resize(id + 1, 0);
+        }
+        depth[id] = d;
+    }
+    Ok(())
 }
 
 fn collect_group(g: &usvg::Group, parent: Affine, out: &mut Vec<RawLoop>) {
@@ -491,8 +620,7 @@ pub const MAX_POINTS: usize = 100_000_000;
 /// line, `#` comments, blank lines ignored).
 pub fn read_points(path: &Path) -> Result<Vec<Point>, CurveIoError> {
     let name = path.display().to_string();
-    let bytes = crate::base::file::read_nonblocking(path, MAX_STREAM_BYTES)
-        .map_err(|e| err(&name, 0, format!("cannot read: {e}")))?;
+    let bytes = read_capped(path, MAX_POINTS_BYTES, "query-point files")?;
     let pts = if bytes.starts_with(b"\x93NUMPY") {
         parse_points_npy(&bytes, &name)?
     } else {
@@ -533,8 +661,14 @@ pub fn parse_points_text(text: &str, name: &str) -> Result<Vec<Point>, CurveIoEr
             p[k] = f
                 .parse::<f64>()
                 .ok()
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| err(name, i + 1, format!("`{f}` is not a finite number")))?;
+                .filter(|&v| query_in_range([v, 0.0]))
+                .ok_or_else(|| {
+                    err(
+                        name,
+                        i + 1,
+                        format!("`{f}` is not a number of magnitude at most {MAX_COORD:e}"),
+                    )
+                })?;
         }
         out.push(p);
     }
@@ -592,8 +726,11 @@ fn parse_points_npy(bytes: &[u8], name: &str) -> Result<Vec<Point>, CurveIoError
         .chunks_exact(8)
         .map(|c| f64::from_le_bytes([c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]]))
         .collect();
-    if let Some(k) = vals.iter().position(|v| !v.is_finite()) {
-        return Err(bad(&format!("point {} has a non-finite coordinate", k / 2)));
+    if let Some(k) = vals.iter().position(|&v| !query_in_range([v, 0.0])) {
+        return Err(bad(&format!(
+            "point {} has a coordinate that is not finite or exceeds {MAX_COORD:e} in magnitude",
+            k / 2
+        )));
     }
     Ok(vals.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
 }

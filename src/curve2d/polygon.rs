@@ -15,7 +15,16 @@ use std::fmt;
 pub type Point = [f64; 2];
 
 /// Largest accepted coordinate magnitude: products of two coordinates stay far from overflow.
+/// Query points obey the same limit ([`query_in_range`]): beyond it values would be NaN.
 pub const MAX_COORD: f64 = 1e100;
+
+/// Whether a query point is one the 2D evaluators answer: both coordinates finite and at most
+/// [`MAX_COORD`] in magnitude. Readers and bindings refuse the others with an error (a query at
+/// 1e101 evaluated to NaN).
+#[inline]
+pub fn query_in_range(q: Point) -> bool {
+    q.iter().all(|c| c.abs() <= MAX_COORD)
+}
 
 /// A polygon that cannot be used as given.
 #[derive(Clone, Debug, PartialEq)]

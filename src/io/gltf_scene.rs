@@ -305,11 +305,17 @@ fn read_uri(
             "buffer {buffer}: URI {uri:?} points outside the model's folder (refused)"
         ))
     })?;
-    let cannot = |e: std::io::Error| {
-        syntax(format!(
-            "buffer {buffer}: URI {uri:?}: cannot read {}: {e}",
-            path.display()
-        ))
+    // Its own kind (not a syntax error), so that callers can tell a missing or unreadable `.bin`
+    // (an OS error, `FileNotFoundError` in Python) from a malformed file.
+    let cannot = |error: std::io::Error| {
+        (
+            Location::File,
+            LoadErrorKind::Referenced {
+                what: format!("buffer {buffer}: URI {uri:?}"),
+                file: path.clone(),
+                error,
+            },
+        )
     };
     let file = super::open_regular(&path).map_err(cannot)?;
     let mut data = Vec::new();

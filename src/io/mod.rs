@@ -336,11 +336,30 @@ fn load_mesh_from_bytes_in(
     })
 }
 
-/// Splits text into lines `(1-based number, line without terminator)`; accepts `\n` and `\r\n`.
+/// Splits text into lines `(1-based number, line without terminator)`; accepts `\n`, `\r\n` and
+/// a lone `\r` (classic Mac OS files, which otherwise read as one long line with a misleading
+/// error), so every text format reads them and errors name the right line.
 pub(crate) fn text_lines(bytes: &[u8]) -> impl Iterator<Item = (usize, &[u8])> {
-    bytes.split(|&b| b == b'\n').enumerate().map(|(i, l)| {
-        let l = l.strip_suffix(b"\r").unwrap_or(l);
-        (i + 1, l)
+    let mut rest = Some(bytes);
+    let mut number = 0usize;
+    std::iter::from_fn(move || {
+        let r = rest?;
+        number += 1;
+        match r.iter().position(|&b| b == b'\n' || b == b'\r') {
+            Some(i) => {
+                let skip = if r[i] == b'\r' && r.get(i + 1) == Some(&b'\n') {
+                    2
+                } else {
+                    1
+                };
+                rest = Some(&r[i + skip..]);
+                Some((number, &r[..i]))
+            }
+            None => {
+                rest = None;
+                Some((number, r))
+            }
+        }
     })
 }
 

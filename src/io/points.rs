@@ -167,6 +167,17 @@ fn parse_npy(bytes: &[u8]) -> Result<Vec<[f64; 3]>, super::Fail> {
             format!("NPY shape ({n}, 3) needs {need} data bytes, the file has {have}"),
         ));
     }
+    if have > need {
+        // Trailing bytes mean the header does not describe the file (a wrong shape or dtype, or
+        // two arrays concatenated): reading the first `need` bytes would silently mix them up.
+        return Err(npy_err(
+            data + need as usize,
+            format!(
+                "{} bytes after the {need} data bytes of shape ({n}, 3)",
+                have - need
+            ),
+        ));
+    }
     let n = n as usize;
     let body = &bytes[data..];
     let value = |k: usize| -> f64 {

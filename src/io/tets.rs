@@ -11,7 +11,8 @@
 //! - **MEDIT** (`.mesh`, ascii): free-format keywords `MeshVersionFormatted`, `Dimension 3`,
 //!   `Vertices`, `Tetrahedra` (1-based, with a reference that is kept), and `Triangles`, `Edges`,
 //!   `Quadrilaterals`, `Hexahedra`, `Corners`, `Ridges`, `Required*`, `Normals`, `Tangents`,
-//!   `NormalAtVertices` which are skipped; `End` stops reading. Other keywords are errors.
+//!   `NormalAtVertices` which are skipped; `End` stops reading. Other keywords are errors, and
+//!   so is a file without a `Tetrahedra` section (an empty file).
 
 use std::fmt;
 use std::io::{self, Write};
@@ -185,6 +186,7 @@ pub fn parse_medit(bytes: &[u8]) -> Result<TetMesh, Fail> {
     let mut it = toks.iter().copied().peekable();
     let mut mesh = TetMesh::default();
     let mut raw_tets: Vec<([u64; 4], usize)> = Vec::new();
+    let mut has_tets = false;
     let mut next = |what: &str, last: usize| -> Result<(usize, &[u8]), Fail> {
         it.next()
             .ok_or_else(|| (last, format!("file ends where {what} was expected")))
@@ -242,6 +244,7 @@ pub fn parse_medit(bytes: &[u8]) -> Result<TetMesh, Fail> {
                 }
             }
             "Tetrahedra" => {
+                has_tets = true;
                 let (l, v) = next("a tet count", last)?;
                 let n: usize = num(l, v, "a tet count")?;
                 raw_tets.reserve(capped(n, bytes.len(), 10));
@@ -273,6 +276,11 @@ pub fn parse_medit(bytes: &[u8]) -> Result<TetMesh, Fail> {
                 }
             }
         }
+    }
+    if !has_tets {
+        // An empty or header-only file is a mistake, not an empty mesh: `gwn filter-tets`
+        // exited 0 having done nothing. (`Tetrahedra 0`, as written for an empty result, reads.)
+        return Err((last, "no `Tetrahedra` section (empty file?)".into()));
     }
     let np = mesh.points.len() as u64;
     if np > u64::from(u32::MAX) {

@@ -4,6 +4,44 @@
 use std::io::{self, Write};
 use std::path::Path;
 
+/// A value that `float32` cannot hold ([`check_f32`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct F32RangeError {
+    /// Index of the first such value.
+    pub index: usize,
+    /// The value.
+    pub value: f64,
+}
+
+impl std::fmt::Display for F32RangeError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "value {:e} (index {}) does not fit float32 (it would become {})",
+            self.value, self.index, self.value as f32
+        )
+    }
+}
+
+impl std::error::Error for F32RangeError {}
+
+/// Checks that every finite value survives conversion to `f32`: none beyond `f32::MAX` (it would
+/// become infinite) and none non-zero below the smallest `f32` (it would become 0). Products
+/// whose magnitude matters (signed distances of a mesh at 1e60 or 1e-50) refuse a `float32`
+/// output with this rather than write infinities or zeros.
+pub fn check_f32(values: &[f64]) -> Result<(), F32RangeError> {
+    match values.iter().position(|&v| {
+        let f = v as f32;
+        v.is_finite() && (f.is_infinite() || (f == 0.0 && v != 0.0))
+    }) {
+        Some(index) => Err(F32RangeError {
+            index,
+            value: values[index],
+        }),
+        None => Ok(()),
+    }
+}
+
 /// An element type that `.npy` can hold.
 pub trait NpyElement: Copy {
     /// The NumPy type descriptor, e.g. `'<f8'`.

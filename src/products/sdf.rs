@@ -25,6 +25,7 @@
 use crate::base::vec3::{cross, dot, sub};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
+use std::sync::atomic::{AtomicBool, Ordering as AtomicOrdering};
 
 use obvhs::{BvhBuildParams, aabb::Aabb, bvh2::builder::build_bvh2};
 use rayon::prelude::*;
@@ -70,10 +71,87 @@ struct Node {
 /// [`Evaluator`] (by default the exact one).
 #[derive(Clone, Debug)]
 pub struct SignedDistance<E = WindingNumber> {
+    /// The triangles, in `frame`'s coordinates when there is one.
     tris: Vec<[[f64; 3]; 3]>,
     nodes: Vec<Node>,
     prims: Vec<u32>,
     wn: E,
+    /// The frame the distances are computed in (`None` without triangles).
+    frame: Option<Frame>,
+}
+
+/// Peak bytes per cell of [`SignedDistance::eval_grid`]: the winding-number grid
+/// ([`crate::grid::EVALUATE_BYTES_PER_CELL`]), the sample points and the distances. The CLI and
+/// the Python package check this against the available memory
+/// ([`GridSpec::check_memory`]), the CLI adding its `f32` copy.
+pub const GRID_BYTES_PER_CELL: usize = crate::grid::EVALUATE_BYTES_PER_CELL + 24 + 8;
+
+/// Half-extents between which distances are computed in world coordinates (unchanged bits).
+/// Outside, squared distances and the degree-4 terms of the closest-point test under- or
+/// overflow (a cube of side 1e-170 had distance 0, one of side 1e160 distance ∞).
+const MODERATE_EXTENT: std::ops::RangeInclusive<f64> = 1e-30..=1e30;
+
+/// The frame distances are computed in. For meshes outside [`MODERATE_EXTENT`]: translation to
+/// the box centre and an exact power-of-two scaling to half-extent `[1, 2)`, so that the
+/// distance, scaled back by the inverse power of two, is right to rounding at any magnitude.
+/// Otherwise world coordinates, unchanged.
+#[derive(Clone, Copy, Debug)]
+struct Frame {
+    /// The centre of the triangles' box (also the far-query fallback, see `closest`).
+    center: [f64; 3],
+    /// Whether the coordinates are translated and scaled (else world coordinates).
+    scaled: bool,
+    /// Two powers of two whose product is the scaling (the product may not be representable).
+    to: [f64; 2],
+    back: [f64; 2],
+}
+
+impl Frame {
+    fn for_triangles(tris: &[[[f64; 3]; 3]]) -> Option<Frame> {
+        let b = crate::BoundingBox::of_points(tris.iter().flatten())?;
+        let center = std::array::from_fn(|i| 0.5 * b.min[i] + 0.5 * b.max[i]);
+        let h = (0..3)
+            .map(|k| 0.5 * b.max[k] - 0.5 * b.min[k])
+            .fold(0.0_f64, f64::max);
+        if h == 0.0 || !h.is_finite() || MODERATE_EXTENT.contains(&h) {
+            return Some(Frame {
+                center,
+                scaled: false,
+                to: [1.0; 2],
+                back: [1.0; 2],
+            });
+        }
+        let k = -(h.log2().floor() as i32);
+        let pow2 = |e: i32| f64::from_bits(((e + 1023) as u64) << 52);
+        let (k1, k2) = (k / 2, k - k / 2);
+        Some(Frame {
+            center,
+            scaled: true,
+            to: [pow2(k1), pow2(k2)],
+            back: [pow2(-k1), pow2(-k2)],
+        })
+    }
+
+    fn point(&self, p: [f64; 3]) -> [f64; 3] {
+        if !self.scaled {
+            return p;
+        }
+        std::array::from_fn(|i| (p[i] - self.center[i]) * self.to[0] * self.to[1])
+    }
+
+    fn world_point(&self, p: [f64; 3]) -> [f64; 3] {
+        if !self.scaled {
+            return p;
+        }
+        std::array::from_fn(|i| p[i] * self.back[0] * self.back[1] + self.center[i])
+    }
+
+    fn world_length(&self, d: f64) -> f64 {
+        if !self.scaled {
+            return d;
+        }
+        d * self.back[0] * self.back[1]
+    }
 }
 
 impl SignedDistance {
@@ -107,12 +185,18 @@ impl<E: Evaluator> SignedDistance<E> {
     }
 
     fn from_triangles(tris: Vec<[[f64; 3]; 3]>, wn: E) -> Self {
+        let frame = Frame::for_triangles(&tris);
+        let tris = match frame {
+            Some(f) if f.scaled => tris.iter().map(|t| t.map(|p| f.point(p))).collect(),
+            _ => tris,
+        };
         let (nodes, prims) = build_tree(&tris);
         SignedDistance {
             tris,
             nodes,
             prims,
             wn,
+            frame,
         }
     }
 
@@ -152,11 +236,28 @@ impl<E: Evaluator> SignedDistance<E> {
         spec: &GridSpec,
         progress: impl Fn(usize) + Sync,
     ) -> Vec<f64> {
-        let w = crate::grid::evaluate_with_progress(&self.wn, spec, &progress);
+        let never = AtomicBool::new(false);
+        self.eval_grid_until(spec, progress, &never)
+            .unwrap_or_default()
+    }
+
+    /// [`SignedDistance::eval_grid_with_progress`] that gives up (`None`) when `stop` becomes
+    /// true, as [`crate::grid::evaluate_until`] does.
+    pub fn eval_grid_until(
+        &self,
+        spec: &GridSpec,
+        progress: impl Fn(usize) + Sync,
+        stop: &AtomicBool,
+    ) -> Option<Vec<f64>> {
+        let w = crate::grid::evaluate_until(&self.wn, spec, &progress, stop)?;
         let pts = spec.points();
-        pts.par_chunks(4096)
+        let values: Vec<f64> = pts
+            .par_chunks(4096)
             .zip(w.par_chunks(4096))
             .flat_map_iter(|(p, w)| {
+                if stop.load(AtomicOrdering::Relaxed) {
+                    return Vec::new();
+                }
                 let out: Vec<f64> = p
                     .iter()
                     .zip(w)
@@ -165,7 +266,8 @@ impl<E: Evaluator> SignedDistance<E> {
                 progress(p.len());
                 out
             })
-            .collect()
+            .collect();
+        (!stop.load(AtomicOrdering::Relaxed)).then_some(values)
     }
 
     /// Unsigned distance to the closest point of the mesh.
@@ -174,10 +276,37 @@ impl<E: Evaluator> SignedDistance<E> {
     }
 
     /// The closest point of the mesh (`None` for a mesh without triangles or a non-finite query).
+    /// Right to rounding for meshes of any extent (1e-300 to 1e300). For a query so far that
+    /// the squared distance overflows (≳1e150 extents away), the distance is the distance to the
+    /// box centre (relative error below the extent ratio, ≲1e-120) and the point the first
+    /// triangle's first corner.
     pub fn closest(&self, q: [f64; 3]) -> Option<Closest> {
-        if self.nodes.is_empty() || q.iter().any(|c| !c.is_finite()) {
+        if q.iter().any(|c| !c.is_finite()) {
             return None;
         }
+        let frame = self.frame?;
+        let local = frame.point(q);
+        if local.iter().all(|c| c.is_finite()) {
+            if let Some(c) = self.closest_in_frame(local) {
+                if c.distance.is_finite() {
+                    return Some(Closest {
+                        distance: frame.world_length(c.distance),
+                        point: frame.world_point(c.point),
+                        ..c
+                    });
+                }
+            }
+        }
+        Some(Closest {
+            distance: crate::base::vec3::norm_safe(sub(q, frame.center)),
+            point: frame.world_point(self.tris[0][0]),
+            face: 0,
+            feature: Feature::Vertex(0),
+        })
+    }
+
+    /// [`Self::closest`] in the coordinates the triangles are stored in.
+    fn closest_in_frame(&self, q: [f64; 3]) -> Option<Closest> {
         let mut best: Option<(f64, [f64; 3], usize, Feature)> = None;
         let mut heap = BinaryHeap::new();
         heap.push(Entry {

@@ -13,16 +13,42 @@ pub fn open_cube() -> Mesh {
     gwn::testing::unit_cube(true)
 }
 
-/// `../shared/meshes` if present, else prints why the caller skips and returns `None`.
+/// Reports that the running test skips its body for want of `what` (e.g. `../shared/meshes`),
+/// visibly: libtest captures the `print!`/`eprint!` output of passing tests, so a skipped test
+/// used to show as `ok` in 0.00 s. A direct write to the process's stderr is not captured, and
+/// `cargo test` shows `SKIPPED <test>: needs <what>` next to the test's `ok`.
+pub fn report_skip(what: &str) {
+    use std::io::Write;
+    let thread = std::thread::current();
+    let test = thread.name().unwrap_or("(unnamed test)");
+    // Ignoring a failed write: the report is informative, the test result stands either way.
+    let _ = writeln!(
+        std::io::stderr().lock(),
+        "SKIPPED {test}: needs {what} (absent)"
+    );
+}
+
+/// `../shared/meshes` if present, else reports the skip ([`report_skip`]) and returns `None`.
 pub fn shared_meshes() -> Option<std::path::PathBuf> {
     let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes");
     if p.join("manifest.csv").exists() {
         Some(p)
     } else {
-        eprintln!(
-            "skipping: {} not found (shared mesh corpus absent)",
-            p.display()
-        );
+        report_skip("../shared/meshes");
+        None
+    }
+}
+
+/// A file of the shared corpus (`../shared/…`, `relative` below `../shared`), or `None` after
+/// reporting the skip ([`report_skip`]).
+pub fn shared_file(relative: &str) -> Option<std::path::PathBuf> {
+    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared")
+        .join(relative);
+    if p.exists() {
+        Some(p)
+    } else {
+        report_skip(&format!("../shared/{relative}"));
         None
     }
 }

@@ -119,7 +119,8 @@ fn report(path: &std::path::Path, l: &gwn::io::LoadedMesh, s: &MeshStats) -> Str
     if let Some(b) = s.bounding_box {
         rows.push(("bbox min", format!("{:?}", b.min)));
         rows.push(("bbox max", format!("{:?}", b.max)));
-        rows.push(("diagonal", format!("{}", s.diagonal)));
+        // `{:?}`, as the box corners: `{}` would print 1e-300 as 301 digits.
+        rows.push(("diagonal", format!("{:?}", s.diagonal)));
     }
     if let Some(snap) = gwn::eval::antipodal::Snapping::of_mesh(&l.mesh) {
         // The exact evaluator computes on the input bits either way; this says whether the

@@ -32,9 +32,8 @@ pub struct Args {
     pub boundary: crate::common::ToleranceArgs,
 }
 
-/// Peak bytes per cell of `gwn sdf`: the winding numbers (with the per-column results they are
-/// copied from), the sample points, the distances and their `f32` copy.
-const SDF_BYTES_PER_CELL: usize = 8 + 8 + 24 + 8 + 4;
+/// Peak bytes per cell of `gwn sdf`: the library's signed-distance grid and the `f32` copy.
+const SDF_BYTES_PER_CELL: usize = gwn::products::sdf::GRID_BYTES_PER_CELL + 4;
 
 /// Runs `gwn sdf`.
 pub fn run(args: Args) -> Result<(), CliError> {
@@ -60,7 +59,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let values = sdf.eval_grid_with_progress(&spec, |n| pb.inc(n as u64));
     pb.finish_and_clear();
     let secs = start.elapsed().as_secs_f64();
-    let written = args.grid.write(&spec, &values, &args.out, "sdf")?;
+    let written = args.grid.write(&spec, &values, &args.out, "sdf", true)?;
     let inside = values.iter().filter(|v| v.is_sign_negative()).count();
     crate::voxelize::report_grid(
         &spec,

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use clap::{Args as ClapArgs, ValueEnum};
 use gwn::BoundingBox;
-use gwn::grid::GridSpec;
+use gwn::grid::{GridError, GridSpec};
 use gwn::products::{npy, vti};
 
 use crate::common::{CliError, outln, progress};
@@ -108,25 +108,31 @@ impl GridArgs {
             None => GridSpec::with_resolution(bounds, self.res),
         }
         .map_err(|e| CliError::msg(format!("bad grid: {e}")))?;
-        const MAX: usize = 1 << 31;
-        if spec.len() > MAX {
-            return Err(CliError::msg(format!(
-                "grid of {:?} cells is too large (limit 2^31)",
-                spec.dims
-            )));
-        }
-        check_memory(spec.len(), bytes_per_cell, available_memory())?;
+        // The library's check, shared with the Python package.
+        spec.check_memory(bytes_per_cell, gwn::grid::available_memory())
+            .map_err(|e| match e {
+                GridError::OutOfMemory { .. } => CliError(format!("{e}; lower --res or --dims")),
+                e => CliError(e.to_string()),
+            })?;
         Ok(spec)
     }
 
-    /// Writes `values` as `.npy` (and `.vti` if asked); returns the paths written.
+    /// Writes `values` as `.npy` (and `.vti` if asked); returns the paths written. With
+    /// `check_f32`, a `float32` output that cannot hold the values ([`npy::check_f32`]) is
+    /// refused before anything is written (signed distances; winding numbers only lose
+    /// negligible far-field digits).
     pub fn write(
         &self,
         spec: &GridSpec,
         values: &[f64],
         out: &Path,
         name: &str,
+        check_f32: bool,
     ) -> Result<Vec<PathBuf>, CliError> {
+        if check_f32 && self.dtype == Dtype::F32 {
+            npy::check_f32(values)
+                .map_err(|e| CliError(format!("{}: {e}; use --dtype f64", out.display())))?;
+        }
         let shape = spec.shape();
         match self.dtype {
             Dtype::F64 => npy::save(out, &shape, values).map_err(|e| io_err(out, e))?,
@@ -148,50 +154,9 @@ fn io_err(p: &Path, e: std::io::Error) -> CliError {
     CliError::msg(format!("{}: cannot write: {e}", p.display()))
 }
 
-/// Peak bytes per cell of `gwn voxelize`: the per-column `f64` results and the grid they are
-/// copied into, the `f32` copy for `.npy` and the occupancy.
-pub const VOXELIZE_BYTES_PER_CELL: usize = 8 + 8 + 4 + 1;
-
-/// The memory the system can still give (Linux `MemAvailable`), `None` where unknown.
-fn available_memory() -> Option<u64> {
-    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib.saturating_mul(1024))
-}
-
-/// Refuses a grid whose arrays would not fit in the available memory: allocating them would
-/// abort the process (or wake the OOM killer) after the mesh is loaded, with no useful message.
-fn check_memory(
-    cells: usize,
-    bytes_per_cell: usize,
-    available: Option<u64>,
-) -> Result<(), CliError> {
-    let need = (cells as u64).saturating_mul(bytes_per_cell as u64);
-    match available {
-        Some(have) if need > have => Err(CliError(format!(
-            "a grid of {cells} cells needs about {:.1} GiB of memory, more than the {:.1} GiB \
-             available; lower --res or --dims",
-            need as f64 / f64::from(1 << 30),
-            have as f64 / f64::from(1 << 30)
-        ))),
-        _ => Ok(()),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::check_memory;
-
-    #[test]
-    fn grids_larger_than_the_available_memory_are_refused() {
-        assert!(check_memory(1 << 20, 13, Some(1 << 30)).is_ok());
-        let e = check_memory(1 << 30, 13, Some(8 << 30)).unwrap_err();
-        assert!(e.0.contains("13.0 GiB") && e.0.contains("8.0 GiB"), "{e}");
-        assert!(check_memory(usize::MAX, 44, Some(u64::MAX - 1)).is_err());
-        assert!(check_memory(1 << 31, 44, None).is_ok());
-    }
-}
+/// Peak bytes per cell of `gwn voxelize`: the library's grid evaluation, the `f32` copy for
+/// `.npy` and the occupancy.
+pub const VOXELIZE_BYTES_PER_CELL: usize = gwn::grid::EVALUATE_BYTES_PER_CELL + 4 + 1;
 
 /// Winding numbers on a voxel grid, written as `.npy` (and optionally `.vti`).
 ///
@@ -248,7 +213,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let values = gwn::grid::evaluate_with_progress(&wn, &spec, |n| pb.inc(n as u64));
     pb.finish_and_clear();
     let secs = start.elapsed().as_secs_f64();
-    let mut written = args.grid.write(&spec, &values, &args.out, "w")?;
+    let mut written = args.grid.write(&spec, &values, &args.out, "w", false)?;
     if let Some(t) = args.occupancy {
         let path = args.occupancy_out.clone().unwrap_or_else(|| {
             let stem = args

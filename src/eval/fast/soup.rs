@@ -6,12 +6,12 @@ use super::InputScale;
 use super::barnes_hut::{FastParams, Hierarchy};
 use super::moments::Moments;
 use super::tree::Tree;
-use wide::{CmpGt, CmpLt, f64x4};
+use wide::{CmpGe, CmpGt, CmpLt, f64x4};
 
 pub(crate) use crate::base::vec3::dist2;
 use crate::base::vec3::sub;
 use crate::kernel::angle_sum::AngleSum;
-use crate::kernel::spherical::{segment_gradient, triangle_solid_angle};
+use crate::kernel::spherical::{SOLID_ANGLE_CONDITION, segment_gradient, triangle_solid_angle_at};
 use crate::{BoundingBox, Mesh};
 
 use crate::kernel::spherical::INV_4PI;
@@ -142,8 +142,9 @@ impl FastWindingNumber {
             if ok != 0b1111 {
                 for (l, t) in self.triangles[range].iter().enumerate() {
                     if ok & (1 << l) == 0 {
-                        *sum += triangle_solid_angle(sub(t[0], q), sub(t[1], q), sub(t[2], q))
-                            * INV_4PI;
+                        // The direct sum's term: exact offsets and double-double where the f64
+                        // formula is ill-conditioned (next to an edge).
+                        *sum += triangle_solid_angle_at(*t, q) * INV_4PI;
                     }
                 }
             }
@@ -242,32 +243,40 @@ impl FastWindingNumber {
 }
 
 /// Pushes `atan2(det, den)` of the Van Oosterom–Strackee formula (half the solid angle; see
-/// [`triangle_solid_angle`]) for the four triangles of a leaf seen from `q`, computed exactly as
-/// the scalar formula does, lane by lane. Returns the mask of the lanes done: the others are
-/// either `det = 0` (they contribute 0, as in the scalar formula) or need the scalar formula's
-/// zero-area test (`|det| ≤ 1e-12·|a||b||c|`) or overflowed; the caller recomputes those.
+/// [`triangle_solid_angle_at`]) for the four triangles of a leaf seen from `q`, computed exactly
+/// as that function's `f64` fast path does, lane by lane, and only on the lanes where it would
+/// take that path. Returns the mask of the lanes done; the caller recomputes the others with the
+/// scalar function: `det = 0` (coplanar query, zero-area triangle, underflow), the zero-area
+/// test (`|det| ≤ 1e-12·|a||b||c|`), `|r|²` outside `(1e-180, 1e180)`, an overflow, and the
+/// ill-conditioned triangles (`√(det² + den²) < SOLID_ANGLE_CONDITION·|a||b||c|`, a query near
+/// an edge), whose `f64` value errs by `≈ 2e-17/d` at distance `d` (issue 22: 0.44 at 1e-17).
 #[inline]
 fn push_solid_angles(angles: &mut AngleSum, t: &[f64x4; 9], q: [f64; 3]) -> u32 {
     let [qx, qy, qz] = q.map(f64x4::splat);
     let (ax, ay, az) = (t[0] - qx, t[1] - qy, t[2] - qz);
     let (bx, by, bz) = (t[3] - qx, t[4] - qy, t[5] - qz);
     let (cx, cy, cz) = (t[6] - qx, t[7] - qy, t[8] - qz);
-    let la = (ax * ax + ay * ay + az * az).sqrt();
-    let lb = (bx * bx + by * by + bz * bz).sqrt();
-    let lc = (cx * cx + cy * cy + cz * cz).sqrt();
+    let la2 = ax * ax + ay * ay + az * az;
+    let lb2 = bx * bx + by * by + bz * bz;
+    let lc2 = cx * cx + cy * cy + cz * cz;
+    let (la, lb, lc) = (la2.sqrt(), lb2.sqrt(), lc2.sqrt());
     let det = ax * (by * cz - bz * cy) + ay * (bz * cx - bx * cz) + az * (bx * cy - by * cx);
     let labc = la * lb * lc;
     let den = labc
         + (ax * bx + ay * by + az * bz) * lc
         + (bx * cx + by * cy + bz * cz) * la
         + (cx * ax + cy * ay + cz * az) * lb;
-    // Coordinates are scaled to extent ~1 (`InputScale`), so only a query within ~1e-140 of a
-    // vertex can underflow `|r|²` (then `|r| = 0` with `r ≠ 0` corrupts `den`): such lanes go to
-    // the magnitude-free scalar formula.
-    let tiny = f64x4::splat(1e-140);
+    // The conditions of the scalar function's f64 path, so that a lane is summed here exactly
+    // when the direct sum would use the same f64 formula: every `|r|²` a normal `f64` far from
+    // over- and underflow (a query within ~1e-90 of a vertex, or a far one, goes to the
+    // magnitude-free scalar form), no zero-area doubt, and a well-conditioned `(det, den)`.
+    // Far from the leaf all of these hold: the compares are the only cost on far queries.
+    let cond = f64x4::splat(SOLID_ANGLE_CONDITION) * labc;
     let ok = det.abs().cmp_gt(f64x4::splat(1e-12) * labc)
         & den.abs().cmp_lt(f64x4::splat(f64::INFINITY))
-        & la.min(lb).min(lc).cmp_gt(tiny);
+        & la2.min(lb2).min(lc2).cmp_gt(f64x4::splat(1e-180))
+        & la2.max(lb2).max(lc2).cmp_lt(f64x4::splat(1e180))
+        & (det * det + den * den).cmp_ge(cond * cond);
     angles.push(ok.blend(den, f64x4::ONE), ok.blend(det, f64x4::ZERO));
     // World coordinates have any magnitude: keep the products near 1 after every factor.
     angles.rescale();
