@@ -178,8 +178,9 @@ impl RayBvh {
 
     /// Calls `f` for every primitive whose padded box contains `(x, y)` transversally and reaches
     /// `z_min` or above along `+z` (`z_min = −∞` gives the whole column). Each primitive at most
-    /// once.
-    #[inline]
+    /// once. Always inlined: it is the crossing loop's body, and as an out-of-line call per ray
+    /// (with the visitor a call per candidate) it cost ~10 % of a closed mesh's query.
+    #[inline(always)]
     pub fn for_each_on_ray(&self, x: f32, y: f32, z_min: f32, mut f: impl FnMut(u32)) {
         if let Some(((lo, hi), count)) = self.root_leaf {
             if x >= lo[0] && x <= hi[0] && y >= lo[1] && y <= hi[1] && hi[2] >= z_min {

@@ -31,6 +31,7 @@ use crate::kernel::compensated::NeumaierSum;
 use crate::kernel::frame::RayAxis;
 use crate::kernel::input_predicates::{
     InputPoint, LatticeFrame, input_plane_side, input_projected_containment, input_ray_crossing,
+    snapped_projected_containment,
 };
 use crate::kernel::predicates::{
     W64, W128, Width, far_query_numerator_sign, perturbed_plane_side, projected_containment,
@@ -496,32 +497,41 @@ impl<W: Width> FrameEvaluator<W> {
     /// Snaps the grid-space query `q` (of the world query `world`) into the frame, axis by axis:
     /// lattice coordinates, the exact residuals (cells), and whether each residual is exact (it
     /// is not where the world → grid scaling underflowed; see [`Grid::kept_exactly`]).
-    #[inline]
+    #[inline(always)]
     fn snap_frame(&self, q: [f64; 3], world: [f64; 3]) -> ([Snap; 3], [f64; 3], [bool; 3]) {
         // Written out (not `array::map`): the closure version was not inlined into the hot path.
         let [m0, m1, m2] = self.ray.map();
-        let one = |(axis, neg): (usize, bool)| {
-            let (s, r, exact) = if self.grid.kept_exactly(world[axis], q[axis]) {
-                let (s, r) = self.grid.snap_with_residual(q[axis], axis);
-                (s, r, true)
-            } else {
-                self.grid.snap_underflowed(world[axis], axis)
-            };
-            if neg {
-                (s.negated(), -r, exact)
-            } else {
-                (s, r, exact)
-            }
-        };
-        let (s0, r0, e0) = one(m0);
-        let (s1, r1, e1) = one(m1);
-        let (s2, r2, e2) = one(m2);
+        let (s0, r0, e0) = self.snap_axis(q, world, m0);
+        let (s1, r1, e1) = self.snap_axis(q, world, m1);
+        let (s2, r2, e2) = self.snap_axis(q, world, m2);
         if W::PRECISION == Precision::Bits30 {
             // The 30-bit grid is the documented fast approximation: queries (like vertices) are
             // evaluated at their lattice points, `≤ 1.5e-9·extent` away.
             return ([s0, s1, s2], [0.0; 3], [true; 3]);
         }
         ([s0, s1, s2], [r0, r1, r2], [e0, e1, e2])
+    }
+
+    /// One frame axis of [`FrameEvaluator::snap_frame`].
+    #[inline(always)]
+    fn snap_axis(
+        &self,
+        q: [f64; 3],
+        world: [f64; 3],
+        (axis, neg): (usize, bool),
+    ) -> (Snap, f64, bool) {
+        let (s, r, exact) =
+            if q[axis].abs() >= f64::MIN_POSITIVE || self.grid.kept_exactly(world[axis], q[axis]) {
+                let (s, r) = self.grid.snap_with_residual(q[axis], axis);
+                (s, r, true)
+            } else {
+                self.grid.snap_underflowed(world[axis], axis)
+            };
+        if neg {
+            (s.negated(), -r, exact)
+        } else {
+            (s, r, exact)
+        }
     }
 
     /// The parts at a world query (finite).
@@ -768,33 +778,55 @@ impl<W: Width> FrameEvaluator<W> {
     /// containing `n + r` contains `n`, by monotone rounding; boxes of triangles off the lattice
     /// carry one cell of margin). Each triangle is decided by the lattice predicates when the
     /// lattice holds it and the query exactly, otherwise on the exact inputs.
+    #[inline(always)]
     fn signed_crossings(&self, q: &InputPoint) -> i64 {
         let (qi, r) = (q.n, q.r);
-        let on_lattice = q.on_lattice();
-        let residual_exact = q.residual_exact();
+        let residual_exact = q.exact[0] && q.exact[1] && q.exact[2];
+        let on_lattice = residual_exact && r[0] == 0.0 && r[1] == 0.0 && r[2] == 0.0;
         let mut chi = 0i64;
         let u = |v: i64| (v as f64 * self.to_unit) as f32;
-        self.bvh.for_each_on_ray(u(qi[0]), u(qi[1]), u(qi[2]), |f| {
-            let f = f as usize;
-            let p = self.tri_pts[f];
-            let c = match self.input_triangle(f) {
-                Some(t) => input_ray_crossing(q, t, &self.lattice),
-                None if !residual_exact => {
-                    input_ray_crossing(q, &p.map(InputPoint::lattice), &self.lattice)
-                }
-                None if on_lattice => ray_crossing::<W>(qi, p),
-                None => ray_crossing_at::<W>(qi, r, p),
-            };
-            chi += i64::from(c);
-        });
+        let (x, y, z) = (u(qi[0]), u(qi[1]), u(qi[2]));
+        // Separate loops, so that a mesh the lattice holds runs the lattice loop unchanged.
+        if self.tri_input.is_empty() && on_lattice {
+            self.bvh.for_each_on_ray(x, y, z, |f| {
+                chi += i64::from(ray_crossing::<W>(qi, self.tri_pts[f as usize]));
+            });
+        } else if self.tri_input.is_empty() && residual_exact {
+            self.bvh.for_each_on_ray(x, y, z, |f| {
+                chi += i64::from(ray_crossing_at::<W>(qi, r, self.tri_pts[f as usize]));
+            });
+        } else {
+            self.bvh.for_each_on_ray(x, y, z, |f| {
+                let f = f as usize;
+                let p = self.tri_pts[f];
+                let c = match self.input_triangle_index(f) {
+                    Some(i) => match snapped_projected_containment([qi[0], qi[1]], &p) {
+                        Some(0) => 0,
+                        _ => input_ray_crossing(q, &self.input_tris[i], &self.lattice),
+                    },
+                    None if !residual_exact => {
+                        input_ray_crossing(q, &p.map(InputPoint::lattice), &self.lattice)
+                    }
+                    None if on_lattice => ray_crossing::<W>(qi, p),
+                    None => ray_crossing_at::<W>(qi, r, p),
+                };
+                chi += i64::from(c);
+            });
+        }
         chi
     }
 
     /// The exact corners of triangle `f` (leaf order) when one is off the lattice.
     #[inline]
     fn input_triangle(&self, f: usize) -> Option<&[InputPoint; 3]> {
+        self.input_triangle_index(f).map(|i| &self.input_tris[i])
+    }
+
+    /// The index into `input_tris` of triangle `f` (leaf order) when a corner is off the lattice.
+    #[inline(always)]
+    fn input_triangle_index(&self, f: usize) -> Option<usize> {
         match self.tri_input.get(f) {
-            Some(&i) if i != ON_LATTICE => Some(&self.input_tris[i as usize]),
+            Some(&i) if i != ON_LATTICE => Some(i as usize),
             _ => None,
         }
     }

@@ -58,13 +58,13 @@ impl InputPoint {
     /// Whether the point is its lattice point.
     #[inline]
     pub fn on_lattice(&self) -> bool {
-        self.r == [0.0; 3] && self.exact == [true; 3]
+        self.residual_exact() && self.r[0] == 0.0 && self.r[1] == 0.0 && self.r[2] == 0.0
     }
 
     /// Whether `n + r` is exact on every axis.
     #[inline]
     pub fn residual_exact(&self) -> bool {
-        self.exact == [true; 3]
+        self.exact[0] && self.exact[1] && self.exact[2]
     }
 }
 
@@ -111,6 +111,10 @@ pub const INPUT_FILTER_SAFETY: f64 = 2.0;
 /// Relative rounding of a difference of two `f64` products: `γ2 ≤ 3u` of the permanent.
 const PRODUCT_DIFFERENCE: f64 = 3.0 * U;
 
+/// Relative rounding of [`input_orient2d`]'s lattice stage: two conversions (`u` each) per
+/// product and the difference of the products (`3u`), `≤ 5u` of the permanent; we use `6u`.
+const LATTICE_STAGE_ROUNDING: f64 = 6.0 * U;
+
 /// Relative rounding of a dot product of three terms (three products, two sums): `≤ 4u`.
 const DOT3: f64 = 4.0 * U;
 
@@ -142,6 +146,60 @@ fn product_error(x: f64, ex: f64, y: f64, ey: f64) -> f64 {
     x.abs() * ey + ex * y.abs() + ex * ey
 }
 
+/// Stage 0 of [`input_orient2d`], from the lattice points alone (as cheap as the lattice
+/// filter, and it needs no more memory): the determinant of the lattice offsets, with the slack
+/// of the residuals (each offset moves by at most 1 per axis, so `D` by at most
+/// `Σ|lattice offsets| + 2`) and of the roundings (`2u` per converted offset, `3u` for the
+/// products' difference). It decides unless the query is within a few cells of the edge's line.
+#[inline(always)]
+fn snapped_orient2d(q: [i64; 2], a: [i64; 2], b: [i64; 2]) -> Option<i32> {
+    let (u0, u1) = ((a[0] - q[0]) as f64, (a[1] - q[1]) as f64);
+    let (v0, v1) = ((b[0] - q[0]) as f64, (b[1] - q[1]) as f64);
+    let (p1, p2) = (u0 * v1, u1 * v0);
+    let d = p1 - p2;
+    let bound = INPUT_FILTER_SAFETY
+        * (LATTICE_STAGE_ROUNDING * (p1.abs() + p2.abs())
+            + (u0.abs() + u1.abs() + v0.abs() + v1.abs())
+            + 2.0);
+    if d > bound {
+        Some(1)
+    } else if d < -bound {
+        Some(-1)
+    } else {
+        None
+    }
+}
+
+/// [`input_projected_containment`] from the lattice points of the query and the triangle alone,
+/// when [`snapped_orient2d`] decides it: `Some(0)` when the query is outside (the lattice box
+/// grown by a cell misses it, or two edges disagree), `Some(sign(n_z))` when every edge puts it
+/// inside, `None` when the exact points are needed. The crossing loop asks this first, so a
+/// triangle off the lattice costs about what a lattice one does.
+#[inline]
+pub fn snapped_projected_containment(q: [i64; 2], p: &[[i64; 3]; 3]) -> Option<i32> {
+    for k in 0..2 {
+        let lo = p[0][k].min(p[1][k]).min(p[2][k]);
+        let hi = p[0][k].max(p[1][k]).max(p[2][k]);
+        if q[k] < lo - 1 || q[k] > hi + 1 {
+            return Some(0);
+        }
+    }
+    let edge = |i: usize, j: usize| snapped_orient2d(q, [p[i][0], p[i][1]], [p[j][0], p[j][1]]);
+    let signs = [edge(0, 1), edge(1, 2), edge(2, 0)];
+    let mut seen = 0;
+    for s in signs.into_iter().flatten() {
+        if seen != 0 && s != seen {
+            return Some(0);
+        }
+        seen = s;
+    }
+    if signs.iter().all(Option::is_some) {
+        Some(seen)
+    } else {
+        None
+    }
+}
+
 /// The perturbed 2D orientation of `(q_ε, a, b)` seen along the ray, on the exact inputs (the
 /// same definition as [`super::predicates::perturbed_orient2d`]).
 #[inline]
@@ -151,6 +209,12 @@ pub fn input_orient2d(
     b: &InputPoint,
     lattice: &LatticeFrame,
 ) -> Orient2d {
+    if let Some(sign) = snapped_orient2d([q.n[0], q.n[1]], [a.n[0], a.n[1]], [b.n[0], b.n[1]]) {
+        return Orient2d {
+            sign,
+            degenerate: false,
+        };
+    }
     let (u, eu) = offset(a, q);
     let (v, ev) = offset(b, q);
     let p1 = u[0] * v[1];
