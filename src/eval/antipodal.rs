@@ -31,7 +31,7 @@ use crate::kernel::compensated::NeumaierSum;
 use crate::kernel::frame::RayAxis;
 use crate::kernel::input_predicates::{
     InputPoint, LatticeFrame, input_plane_side, input_projected_containment, input_ray_crossing,
-    snapped_projected_containment,
+    snapped_plane_side, snapped_projected_containment,
 };
 use crate::kernel::predicates::{
     W64, W128, Width, far_query_numerator_sign, perturbed_plane_side, projected_containment,
@@ -800,9 +800,15 @@ impl<W: Width> FrameEvaluator<W> {
                 let f = f as usize;
                 let p = self.tri_pts[f];
                 let c = match self.input_triangle_index(f) {
+                    // Triangles off the lattice: the lattice points with the snapping slack
+                    // first (the common case), the exact points only when that cannot decide.
                     Some(i) => match snapped_projected_containment([qi[0], qi[1]], &p) {
                         Some(0) => 0,
-                        _ => input_ray_crossing(q, &self.input_tris[i], &self.lattice),
+                        Some(s0) => match snapped_plane_side(qi, &p) {
+                            Some(side) => i32::from(side == -s0) * s0,
+                            None => input_ray_crossing(q, &self.input_tris[i], &self.lattice),
+                        },
+                        None => input_ray_crossing(q, &self.input_tris[i], &self.lattice),
                     },
                     None if !residual_exact => {
                         input_ray_crossing(q, &p.map(InputPoint::lattice), &self.lattice)

@@ -200,6 +200,41 @@ pub fn snapped_projected_containment(q: [i64; 2], p: &[[i64; 3]; 3]) -> Option<i
     }
 }
 
+/// Stage 0 of [`input_plane_side`] from the lattice points alone: `T = (q − p0)·(e1 × e2)` of the
+/// lattice offsets, with the slack of moving every offset coordinate by at most 1 (the residuals
+/// of both ends) and the roundings of the conversions and products. `None` when the query is
+/// within that slack of the triangle's plane.
+#[inline]
+pub fn snapped_plane_side(q: [i64; 3], p: &[[i64; 3]; 3]) -> Option<i32> {
+    let f =
+        |a: [i64; 3], b: [i64; 3]| -> [f64; 3] { std::array::from_fn(|k| (a[k] - b[k]) as f64) };
+    let (d, e1, e2) = (f(q, p[0]), f(p[1], p[0]), f(p[2], p[0]));
+    let mut t = 0.0;
+    let mut slack = 0.0;
+    for k in 0..3 {
+        let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+        let (pa, pb) = (e1[i] * e2[j], e1[j] * e2[i]);
+        let c = pa - pb;
+        // |Δc| ≤ |e1_i| + |e1_j| + |e2_i| + |e2_j| + 2 from the offsets, plus rounding.
+        let dc = e1[i].abs()
+            + e1[j].abs()
+            + e2[i].abs()
+            + e2[j].abs()
+            + 2.0
+            + LATTICE_STAGE_ROUNDING * (pa.abs() + pb.abs());
+        t += d[k] * c;
+        slack += (d[k].abs() + 1.0) * dc + c.abs() + LATTICE_STAGE_ROUNDING * (d[k] * c).abs();
+    }
+    let bound = INPUT_FILTER_SAFETY * slack;
+    if t > bound {
+        Some(1)
+    } else if t < -bound {
+        Some(-1)
+    } else {
+        None
+    }
+}
+
 /// The perturbed 2D orientation of `(q_ε, a, b)` seen along the ray, on the exact inputs (the
 /// same definition as [`super::predicates::perturbed_orient2d`]).
 #[inline]
