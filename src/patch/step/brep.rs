@@ -642,11 +642,7 @@ impl<'a> Reader<'a> {
             }
         }
         let (period_u, period_v) = detect_periods(&patches, tol);
-        Ok(Surface::Patches {
-            patches,
-            period_u,
-            period_v,
-        })
+        Ok(Surface::from_patches(patches, period_u, period_v))
     }
 
     /// A face: `ADVANCED_FACE` / `FACE_SURFACE`.
@@ -856,9 +852,5 @@ fn revolution(pieces: &Pieces, a: [f64; 3], d: [f64; 3], tol: f64) -> Result<Sur
         }
     }
     let (_, period_v) = detect_periods(&patches, tol);
-    Ok(Surface::Patches {
-        patches,
-        period_u: Some(std::f64::consts::TAU),
-        period_v,
-    })
+    Ok(Surface::from_patches(patches, Some(std::f64::consts::TAU), period_v))
 }

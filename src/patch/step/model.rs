@@ -322,7 +322,10 @@ fn sample(c: &[Homogeneous], surface: &Surface, hint: &mut Option<[f64; 2]>, cho
         let ratio = if duv > 0.0 { norm(sub(q1, q0)) / duv } else { 0.0 };
         let devuv =
             ((wm[0] - 0.5 * (w0[0] + w1[0])).powi(2) + (wm[1] - 0.5 * (w0[1] + w1[1])).powi(2)).sqrt() * ratio;
-        if depth < 22 && (depth < 2 || dev3 > chord || devuv > chord) {
+        // A piece shorter than the chord tolerance is not refined for its uv deviation: at a
+        // pole or a collapsed edge the uv image of one 3D point is a whole segment.
+        let short = norm(sub(q1, q0)) <= chord && dev3 <= chord;
+        if depth < 22 && (depth < 2 || dev3 > chord || (devuv > chord && !short)) {
             stack.push((t1, q1, w1, depth + 1));
             stack.push((tm, qm, wm, depth + 1));
         } else {

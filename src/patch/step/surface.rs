@@ -88,10 +88,31 @@ pub enum Surface {
         period_u: Option<f64>,
         /// Period in `v` likewise.
         period_v: Option<f64>,
+        /// Sample points `(patch, (s, t), point)`: starting points of the inversion.
+        samples: Vec<(usize, [f64; 2], [f64; 3])>,
     },
 }
 
 impl Surface {
+    /// A patch-set surface with its inversion samples (7 × 7 per patch).
+    pub fn from_patches(patches: Vec<UvPatch>, period_u: Option<f64>, period_v: Option<f64>) -> Surface {
+        let mut samples = Vec::with_capacity(patches.len() * 49);
+        for (k, up) in patches.iter().enumerate() {
+            for i in 0..=6 {
+                for j in 0..=6 {
+                    let st = [i as f64 / 6.0, j as f64 / 6.0];
+                    samples.push((k, st, up.patch.eval(st[0], st[1])));
+                }
+            }
+        }
+        Surface::Patches {
+            patches,
+            period_u,
+            period_v,
+            samples,
+        }
+    }
+
     /// A short name for statistics.
     pub fn kind(&self) -> &'static str {
         match self {
@@ -175,7 +196,9 @@ impl Surface {
                 let c = curve_point(pieces, u);
                 [u, dot(sub(p, c), *v) / vv]
             }
-            Surface::Patches { patches, .. } => invert_patches(patches, p, hint),
+            Surface::Patches {
+                patches, samples, ..
+            } => invert_patches(patches, samples, p, hint),
         };
         if let (Some(h), (pu, pv)) = (hint, self.periods()) {
             if let Some(pu) = pu {
@@ -294,7 +317,12 @@ impl Surface {
                     });
                 }
             }
-            Surface::Patches { patches, period_u, period_v } => {
+            Surface::Patches {
+                patches,
+                period_u,
+                period_v,
+                ..
+            } => {
                 // With a period, the trimming rectangle may sit in a shifted copy of the domain;
                 // keep all patches then (the trimming test works modulo the period).
                 for p in patches {
@@ -367,33 +395,16 @@ pub fn invert_curve(pieces: &[(f64, f64, Vec<Homogeneous>)], p: [f64; 3]) -> f64
     a + t * (b - a)
 }
 
-/// Closest point on a set of patches: Gauss–Newton on the patch holding `hint` and on the patch
-/// of the nearest sample, in patch parameters clamped to `[0, 1]²`; the nearer result wins.
-fn invert_patches(patches: &[UvPatch], p: [f64; 3], hint: Option<[f64; 2]>) -> [f64; 2] {
-    let mut starts: Vec<(usize, [f64; 2])> = Vec::new();
-    if let Some(h) = hint {
-        for (k, up) in patches.iter().enumerate() {
-            let st = up.local(h);
-            if (-1e-9..=1.0 + 1e-9).contains(&st[0]) && (-1e-9..=1.0 + 1e-9).contains(&st[1]) {
-                starts.push((k, [st[0].clamp(0.0, 1.0), st[1].clamp(0.0, 1.0)]));
-            }
-        }
-    }
-    let mut nearest = (f64::INFINITY, 0, [0.5, 0.5]);
-    for (k, up) in patches.iter().enumerate() {
-        for i in 0..=6 {
-            for j in 0..=6 {
-                let st = [i as f64 / 6.0, j as f64 / 6.0];
-                let d = norm(sub(up.patch.eval(st[0], st[1]), p));
-                if d < nearest.0 {
-                    nearest = (d, k, st);
-                }
-            }
-        }
-    }
-    starts.push((nearest.1, nearest.2));
-    let mut best = (f64::INFINITY, [0.0, 0.0]);
-    for (k, mut st) in starts {
+/// Closest point on a set of patches: Gauss–Newton from `hint` (on the patch holding it); if
+/// that ends farther away than the nearest precomputed sample, also from that sample. Patch
+/// parameters are clamped to `[0, 1]²`; the nearer result wins.
+fn invert_patches(
+    patches: &[UvPatch],
+    samples: &[(usize, [f64; 2], [f64; 3])],
+    p: [f64; 3],
+    hint: Option<[f64; 2]>,
+) -> [f64; 2] {
+    let newton = |k: usize, mut st: [f64; 2]| -> (f64, [f64; 2]) {
         let patch = &patches[k].patch;
         for _ in 0..50 {
             let (x, ds, dt) = patch.eval_with_partials(st[0], st[1]);
@@ -401,7 +412,7 @@ fn invert_patches(patches: &[UvPatch], p: [f64; 3], hint: Option<[f64; 2]>) -> [
             let (a, b, c) = (dot(ds, ds), dot(ds, dt), dot(dt, dt));
             let (g0, g1) = (dot(ds, r), dot(dt, r));
             let det = a * c - b * b;
-            let (d0, d1) = if det.abs() > 1e-300 && det > 1e-14 * a * c {
+            let (d0, d1) = if det > 1e-14 * a * c && det > 0.0 {
                 ((-c * g0 + b * g1) / det, (b * g0 - a * g1) / det)
             } else if a + c > 0.0 {
                 (-g0 / (a + c), -g1 / (a + c))
@@ -415,9 +426,29 @@ fn invert_patches(patches: &[UvPatch], p: [f64; 3], hint: Option<[f64; 2]>) -> [
                 break;
             }
         }
-        let d = norm(sub(patch.eval(st[0], st[1]), p));
-        if d < best.0 {
-            best = (d, patches[k].global(st));
+        (norm(sub(patch.eval(st[0], st[1]), p)), patches[k].global(st))
+    };
+    let mut best = (f64::INFINITY, [0.0, 0.0]);
+    if let Some(h) = hint {
+        if let Some((k, up)) = patches.iter().enumerate().find(|(_, up)| {
+            let st = up.local(h);
+            (-1e-9..=1.0 + 1e-9).contains(&st[0]) && (-1e-9..=1.0 + 1e-9).contains(&st[1])
+        }) {
+            let st = up.local(h);
+            best = newton(k, [st[0].clamp(0.0, 1.0), st[1].clamp(0.0, 1.0)]);
+        }
+    }
+    let mut nearest = (f64::INFINITY, 0, [0.5, 0.5]);
+    for (k, st, x) in samples {
+        let d = norm(sub(*x, p));
+        if d < nearest.0 {
+            nearest = (d, *k, *st);
+        }
+    }
+    if best.0 > nearest.0 {
+        let r = newton(nearest.1, nearest.2);
+        if r.0 < best.0 {
+            best = r;
         }
     }
     best.1
