@@ -219,6 +219,37 @@ impl StepWindingNumber {
         e
     }
 
+    /// The value along one given ray direction `d` (unit), without choosing: `None` if the
+    /// direction fails the certificates. For diagnostics and tests of direction independence.
+    pub fn evaluate_along(&self, q: [f64; 3], d: [f64; 3]) -> Option<StepEvaluation> {
+        self.try_ray(q, d, MU, self.margin, true).ok()
+    }
+
+    /// Every hit of the ray from `q` along `d` on every face's patches: `(face #id, point,
+    /// (u, v), trimming side)`, before any test. For diagnostics.
+    pub fn hits_along(&self, q: [f64; 3], d: [f64; 3]) -> Vec<(u64, [f64; 3], [f64; 2], Side)> {
+        let frame = RayFrame::new(d);
+        let mut out = Vec::new();
+        for face in &self.model.faces {
+            let mut hits = Vec::new();
+            for fp in &face.patches {
+                if ray_meets_box(q, frame.d, fp.lo, fp.hi, 1e-9 * self.model.diagonal()) {
+                    patch_hits(fp, q, &frame, &mut hits);
+                }
+            }
+            for h in hits {
+                let side = face.trim.classify(h.uv, h.su, h.sv, self.margin);
+                out.push((face.id, h.point, h.uv, side));
+            }
+        }
+        out
+    }
+
+    /// The candidate ray directions, in the order they are tried.
+    pub fn directions(&self) -> &[[f64; 3]] {
+        &self.dirs
+    }
+
     fn try_ray(
         &self,
         q: [f64; 3],

@@ -94,14 +94,20 @@ pub enum Surface {
 }
 
 impl Surface {
-    /// A patch-set surface with its inversion samples (7 × 7 per patch).
+    /// A patch-set surface with its inversion samples (7 × 7 per patch, without those on a
+    /// collapsed edge: at a pole every `u` is the same point, and Newton's method started
+    /// there on the wrong side — up to 180° away — cannot turn `u`).
     pub fn from_patches(patches: Vec<UvPatch>, period_u: Option<f64>, period_v: Option<f64>) -> Surface {
         let mut samples = Vec::with_capacity(patches.len() * 49);
         for (k, up) in patches.iter().enumerate() {
             for i in 0..=6 {
                 for j in 0..=6 {
                     let st = [i as f64 / 6.0, j as f64 / 6.0];
-                    samples.push((k, st, up.patch.eval(st[0], st[1])));
+                    let (x, ds, dt) = up.patch.eval_with_partials(st[0], st[1]);
+                    let (a, b) = (norm(ds), norm(dt));
+                    if a.min(b) > 1e-9 * a.max(b) {
+                        samples.push((k, st, x));
+                    }
                 }
             }
         }
@@ -395,22 +401,51 @@ pub fn invert_curve(pieces: &[(f64, f64, Vec<Homogeneous>)], p: [f64; 3]) -> f64
     a + t * (b - a)
 }
 
-/// Closest point on a set of patches: Gauss–Newton from `hint` (on the patch holding it); if
-/// that ends farther away than the nearest precomputed sample, also from that sample. Patch
-/// parameters are clamped to `[0, 1]²`; the nearer result wins.
+/// Closest point on a set of patches: Gauss–Newton in the surface's own `(u, v)` (moving from
+/// patch to patch, clamped to the domain) from `hint` and from the nearest precomputed sample;
+/// the nearer result wins.
 fn invert_patches(
     patches: &[UvPatch],
     samples: &[(usize, [f64; 2], [f64; 3])],
     p: [f64; 3],
     hint: Option<[f64; 2]>,
 ) -> [f64; 2] {
-    let newton = |k: usize, mut st: [f64; 2]| -> (f64, [f64; 2]) {
-        let patch = &patches[k].patch;
-        for _ in 0..50 {
-            let (x, ds, dt) = patch.eval_with_partials(st[0], st[1]);
+    let mut dom = [f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY];
+    for up in patches {
+        dom = [dom[0].min(up.u[0]), dom[1].max(up.u[1]), dom[2].min(up.v[0]), dom[3].max(up.v[1])];
+    }
+    let clamp = |uv: [f64; 2]| [uv[0].clamp(dom[0], dom[1]), uv[1].clamp(dom[2], dom[3])];
+    // Point and partials in (u, v) at a domain point.
+    let eval = |uv: [f64; 2]| -> ([f64; 3], [f64; 3], [f64; 3]) {
+        let up = patches
+            .iter()
+            .find(|up| up.u[0] <= uv[0] && uv[0] <= up.u[1] && up.v[0] <= uv[1] && uv[1] <= up.v[1])
+            .unwrap_or(&patches[0]);
+        let st = up.local(uv);
+        let (x, ds, dt) = up.patch.eval_with_partials(st[0].clamp(0.0, 1.0), st[1].clamp(0.0, 1.0));
+        let (du, dv) = (up.u[1] - up.u[0], up.v[1] - up.v[0]);
+        (x, scale(ds, 1.0 / du), scale(dt, 1.0 / dv))
+    };
+    let newton = |start: [f64; 2]| -> (f64, [f64; 2]) {
+        let mut uv = clamp(start);
+        // On a collapsed edge (a pole: one partial vanishes) the other parameter cannot move
+        // under Newton's method; start just inside the domain instead.
+        let (_, su, sv) = eval(uv);
+        let (nu, nv) = (norm(su) * (dom[1] - dom[0]), norm(sv) * (dom[3] - dom[2]));
+        let inward = |x: f64, lo: f64, hi: f64| {
+            let e = 1e-3 * (hi - lo);
+            if x - lo < 0.5 * (hi - lo) { x.max(lo + e) } else { x.min(hi - e) }
+        };
+        if nu <= 1e-9 * nv {
+            uv[1] = inward(uv[1], dom[2], dom[3]);
+        } else if nv <= 1e-9 * nu {
+            uv[0] = inward(uv[0], dom[0], dom[1]);
+        }
+        for _ in 0..60 {
+            let (x, su, sv) = eval(uv);
             let r = sub(x, p);
-            let (a, b, c) = (dot(ds, ds), dot(ds, dt), dot(dt, dt));
-            let (g0, g1) = (dot(ds, r), dot(dt, r));
+            let (a, b, c) = (dot(su, su), dot(su, sv), dot(sv, sv));
+            let (g0, g1) = (dot(su, r), dot(sv, r));
             let det = a * c - b * b;
             let (d0, d1) = if det > 1e-14 * a * c && det > 0.0 {
                 ((-c * g0 + b * g1) / det, (b * g0 - a * g1) / det)
@@ -419,35 +454,29 @@ fn invert_patches(
             } else {
                 break;
             };
-            let next = [(st[0] + d0).clamp(0.0, 1.0), (st[1] + d1).clamp(0.0, 1.0)];
-            let moved = (next[0] - st[0]).abs() + (next[1] - st[1]).abs();
-            st = next;
+            // Limit a step to a quarter of the domain (Gauss–Newton can overshoot far from
+            // the solution), then clamp.
+            let lim = |d: f64, w: f64| d.clamp(-0.25 * w, 0.25 * w);
+            let next = clamp([uv[0] + lim(d0, dom[1] - dom[0]), uv[1] + lim(d1, dom[3] - dom[2])]);
+            let moved = (next[0] - uv[0]).abs() / (dom[1] - dom[0]) + (next[1] - uv[1]).abs() / (dom[3] - dom[2]);
+            uv = next;
             if moved < 1e-15 {
                 break;
             }
         }
-        (norm(sub(patch.eval(st[0], st[1]), p)), patches[k].global(st))
+        (norm(sub(eval(uv).0, p)), uv)
     };
-    let mut best = (f64::INFINITY, [0.0, 0.0]);
-    if let Some(h) = hint {
-        if let Some((k, up)) = patches.iter().enumerate().find(|(_, up)| {
-            let st = up.local(h);
-            (-1e-9..=1.0 + 1e-9).contains(&st[0]) && (-1e-9..=1.0 + 1e-9).contains(&st[1])
-        }) {
-            let st = up.local(h);
-            best = newton(k, [st[0].clamp(0.0, 1.0), st[1].clamp(0.0, 1.0)]);
-        }
-    }
-    let mut nearest = (f64::INFINITY, 0, [0.5, 0.5]);
+    let mut nearest = (f64::INFINITY, [0.0, 0.0]);
     for (k, st, x) in samples {
         let d = norm(sub(*x, p));
         if d < nearest.0 {
-            nearest = (d, *k, *st);
+            nearest = (d, patches[*k].global(*st));
         }
     }
-    if best.0 > nearest.0 {
-        let r = newton(nearest.1, nearest.2);
-        if r.0 < best.0 {
+    let mut best = newton(nearest.1);
+    if let Some(h) = hint {
+        let r = newton(h);
+        if r.0 <= best.0 {
             best = r;
         }
     }
@@ -546,4 +575,38 @@ pub fn frame(o: [f64; 3], axis: Option<[f64; 3]>, refd: Option<[f64; 3]>) -> Res
 pub fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
     let n = norm(v);
     (n > 0.0 && n.is_finite()).then(|| scale(v, 1.0 / n))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn inversion_near_a_pole_of_a_patch_surface() {
+        // A quarter of a sphere's upper half as rational patches; points on the meridian at
+        // the far end of the u range, approaching the pole.
+        let f = frame([0.0; 3], None, None).unwrap();
+        let sphere = Surface::Sphere(f, 0.5);
+        let patches = sphere.patches([0.0, FRAC_PI_2], [0.0, FRAC_PI_2]).unwrap();
+        let s = Surface::from_patches(patches, None, None);
+        for lat in [1e-9, 1e-6, 1e-3, 0.05, 0.3] {
+            let v = FRAC_PI_2 - lat;
+            let p = [0.0, 0.5 * v.cos(), 0.5 * v.sin()]; // u = π/2
+            for hint in [None, Some([0.0, FRAC_PI_2])] {
+                // The patch parameters are not angles (rational arcs): check the point.
+                let uv = s.invert(p, hint);
+                let Surface::Patches { patches, .. } = &s else { unreachable!() };
+                let up = patches
+                    .iter()
+                    .find(|up| up.u[0] <= uv[0] && uv[0] <= up.u[1] && up.v[0] <= uv[1] && uv[1] <= up.v[1])
+                    .unwrap();
+                let st = up.local(uv);
+                let x = up.patch.eval(st[0], st[1]);
+                assert!(norm(sub(x, p)) < 1e-12, "{lat} {hint:?} {uv:?} {x:?} {p:?}");
+                if lat >= 1e-6 {
+                    assert_eq!(uv[0], FRAC_PI_2, "{lat} {hint:?} {uv:?}");
+                }
+            }
+        }
+    }
 }
