@@ -8,7 +8,10 @@ use std::time::Instant;
 use gwn::patch::step::{StepWindingNumber, load_step};
 
 fn main() {
-    let n = std::env::var("GWN_GRID").ok().and_then(|s| s.parse().ok()).unwrap_or(32usize);
+    let n = std::env::var("GWN_GRID")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(32usize);
     for path in std::env::args().skip(1) {
         let t = Instant::now();
         let model = match load_step(std::path::Path::new(&path)) {
@@ -28,7 +31,11 @@ fn main() {
         for i in 0..n {
             for j in 0..n {
                 for k in 0..n {
-                    pts.push([lin(i, lo[0], hi[0]), lin(j, lo[1], hi[1]), lin(k, lo[2], hi[2])]);
+                    pts.push([
+                        lin(i, lo[0], hi[0]),
+                        lin(j, lo[1], hi[1]),
+                        lin(k, lo[2], hi[2]),
+                    ]);
                 }
             }
         }

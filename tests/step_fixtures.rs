@@ -7,7 +7,9 @@ use std::path::Path;
 use gwn::patch::step::{StepError, StepWindingNumber, load_step, parse_step};
 
 fn fixture(name: &str) -> std::path::PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/step").join(name)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/step")
+        .join(name)
 }
 
 #[test]
@@ -79,10 +81,18 @@ fn plate_with_hole_is_trimmed_and_open() {
         );
     }
     // Crossing the plate: the jump is 1 where the plate is, 0 in the hole and outside.
-    for (x, y, jump) in [(0.75, 0.1, 1.0), (0.1, -0.2, 0.0), (1.3, 0.0, 0.0), (-0.8, 0.8, 1.0)] {
+    for (x, y, jump) in [
+        (0.75, 0.1, 1.0),
+        (0.1, -0.2, 0.0),
+        (1.3, 0.0, 0.0),
+        (-0.8, 0.8, 1.0),
+    ] {
         let below = wn.eval([x, y, -1e-6]);
         let above = wn.eval([x, y, 1e-6]);
-        assert!((below - above - jump).abs() < 1e-5, "({x},{y}): {below} {above}");
+        assert!(
+            (below - above - jump).abs() < 1e-5,
+            "({x},{y}): {below} {above}"
+        );
     }
 }
 
@@ -112,11 +122,17 @@ fn malformed_files_are_one_line_errors() {
     let e = one_line(parse_step(&unknown).unwrap_err());
     assert!(e.contains("#14") && e.contains("OFFSET_SURFACE"), "{e}");
     // Dangling reference.
-    let dangling = good.replace("#12=CYLINDRICAL_SURFACE('',#10,1.);", "#12=CYLINDRICAL_SURFACE('',#99,1.);");
+    let dangling = good.replace(
+        "#12=CYLINDRICAL_SURFACE('',#10,1.);",
+        "#12=CYLINDRICAL_SURFACE('',#99,1.);",
+    );
     let e = one_line(parse_step(&dangling).unwrap_err());
     assert!(e.contains("#12") && e.contains("#99"), "{e}");
     // Wrong parameter type.
-    let bad = good.replace("#12=CYLINDRICAL_SURFACE('',#10,1.);", "#12=CYLINDRICAL_SURFACE('',#10,'one');");
+    let bad = good.replace(
+        "#12=CYLINDRICAL_SURFACE('',#10,1.);",
+        "#12=CYLINDRICAL_SURFACE('',#10,'one');",
+    );
     let e = one_line(parse_step(&bad).unwrap_err());
     assert!(e.contains("#12 CYLINDRICAL_SURFACE"), "{e}");
     // Absurd B-spline counts: degree, multiplicities, knot count.
@@ -135,11 +151,21 @@ fn malformed_files_are_one_line_errors() {
     }
     // No faces; nesting too deep; duplicate id.
     one_line(parse_step(&minimal("#1=CARTESIAN_POINT('',(0.,0.,0.));")).unwrap_err());
-    one_line(parse_step(&minimal(&format!("#1=A({}1{});", "(".repeat(40), ")".repeat(40)))).unwrap_err());
+    one_line(
+        parse_step(&minimal(&format!(
+            "#1=A({}1{});",
+            "(".repeat(40),
+            ")".repeat(40)
+        )))
+        .unwrap_err(),
+    );
     one_line(parse_step(&minimal("#1=A(1);\n#1=A(2);")).unwrap_err());
     // A huge count in the text is not an allocation: a list of a million references to
     // nothing fails on the first dangling one.
-    let many = format!("#1=CLOSED_SHELL('',({}));\n#2=MANIFOLD_SOLID_BREP('',#1);", vec!["#5"; 100_000].join(","));
+    let many = format!(
+        "#1=CLOSED_SHELL('',({}));\n#2=MANIFOLD_SOLID_BREP('',#1);",
+        vec!["#5"; 100_000].join(",")
+    );
     let e = one_line(parse_step(&minimal(&many)).unwrap_err());
     assert!(e.contains("#5"), "{e}");
     // Missing file.

@@ -15,7 +15,10 @@ fn shared() -> Option<PathBuf> {
     if p.join("tet.step").exists() {
         Some(p)
     } else {
-        eprintln!("skipping: {} not found (shared STEP models absent)", p.display());
+        eprintln!(
+            "skipping: {} not found (shared STEP models absent)",
+            p.display()
+        );
         None
     }
 }
@@ -31,7 +34,13 @@ fn npy(path: &Path) -> (Vec<f64>, Vec<usize>) {
     };
     let header = std::str::from_utf8(&b[start..start + hlen]).unwrap();
     assert!(header.contains("'fortran_order': False"));
-    let shape_txt = header.split("'shape': (").nth(1).unwrap().split(')').next().unwrap();
+    let shape_txt = header
+        .split("'shape': (")
+        .nth(1)
+        .unwrap()
+        .split(')')
+        .next()
+        .unwrap();
     let shape: Vec<usize> = shape_txt
         .split(',')
         .filter(|s| !s.trim().is_empty())
@@ -65,7 +74,11 @@ fn refs(dir: &Path, model: &str) -> Refs {
         queries: q.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
         w: npy(&d.join("ref.npy")).0,
         err: npy(&d.join("err.npy")).0,
-        kind: npy(&d.join("kind.npy")).0.into_iter().map(|k| k as i64).collect(),
+        kind: npy(&d.join("kind.npy"))
+            .0
+            .into_iter()
+            .map(|k| k as i64)
+            .collect(),
     }
 }
 
@@ -76,7 +89,11 @@ fn check(model: &str, closed: bool, stride: usize) {
     let m = load_step(&dir.join(format!("{model}.step"))).unwrap();
     let wn = StepWindingNumber::new(&m);
     let r = refs(&dir, model);
-    let stride = if std::env::var("GWN_STEP_ALL").is_ok() { 1 } else { stride };
+    let stride = if std::env::var("GWN_STEP_ALL").is_ok() {
+        1
+    } else {
+        stride
+    };
     let mut picked = Vec::new();
     let mut seen = [0usize; 3];
     for i in 0..r.queries.len() {
@@ -95,10 +112,14 @@ fn check(model: &str, closed: bool, stride: usize) {
     for (j, &i) in picked.iter().enumerate() {
         let k = r.kind[i] as usize;
         let e = (got[j] - r.w[i]).abs();
-        let allowed = if closed { 1e-9 } else { (3.0 * r.err[i]).max(1e-7) };
+        let allowed = if closed {
+            1e-9
+        } else {
+            (3.0 * r.err[i]).max(1e-7)
+        };
         worst[k].0 = worst[k].0.max(e);
         worst[k].2 += 1;
-        if !(e <= allowed) {
+        if e.is_nan() || e > allowed {
             worst[k].1 += 1;
             if failures.len() < 10 {
                 failures.push(format!(

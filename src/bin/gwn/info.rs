@@ -67,7 +67,11 @@ fn step_report(path: &std::path::Path, model: &gwn::patch::step::StepModel) -> S
         ("bbox min", format!("{lo:?}")),
         ("bbox max", format!("{hi:?}")),
     ];
-    let width = rows.iter().map(|(k, _)| k.chars().count()).max().unwrap_or(0);
+    let width = rows
+        .iter()
+        .map(|(k, _)| k.chars().count())
+        .max()
+        .unwrap_or(0);
     let mut out = String::new();
     for (k, v) in rows {
         out.push_str(&format!("{k:<width$}  {v}\n"));

@@ -198,14 +198,20 @@ impl<'a> Reader<'a> {
     }
 
     fn inst(&self, from: u64, id: u64) -> Result<&'a Instance, StepError> {
-        self.file
-            .instances
-            .get(&id)
-            .ok_or(StepError::Dangling { id: from, target: id })
+        self.file.instances.get(&id).ok_or(StepError::Dangling {
+            id: from,
+            target: id,
+        })
     }
 
     /// The single part of a simple entity named one of `names`.
-    fn simple(&self, from: u64, id: u64, names: &[&str], context: &str) -> Result<Params<'a>, StepError> {
+    fn simple(
+        &self,
+        from: u64,
+        id: u64,
+        names: &[&str],
+        context: &str,
+    ) -> Result<Params<'a>, StepError> {
         let inst = self.inst(from, id)?;
         match inst.parts.as_slice() {
             [part] if names.contains(&part.name.as_str()) => Ok(Params { id, inst, part }),
@@ -218,11 +224,17 @@ impl<'a> Reader<'a> {
     fn find_angle_factor(&self) -> f64 {
         for id in &self.file.order {
             let inst = &self.file.instances[id];
-            let Some(ctx) = inst.part("GLOBAL_UNIT_ASSIGNED_CONTEXT") else { continue };
-            let Some(Value::List(units)) = ctx.params.first() else { continue };
+            let Some(ctx) = inst.part("GLOBAL_UNIT_ASSIGNED_CONTEXT") else {
+                continue;
+            };
+            let Some(Value::List(units)) = ctx.params.first() else {
+                continue;
+            };
             for u in units {
                 let Value::Ref(uid) = u else { continue };
-                let Some(unit) = self.file.instances.get(uid) else { continue };
+                let Some(unit) = self.file.instances.get(uid) else {
+                    continue;
+                };
                 if unit.part("PLANE_ANGLE_UNIT").is_none() {
                     continue;
                 }
@@ -246,11 +258,17 @@ impl<'a> Reader<'a> {
     pub(crate) fn length_unit(&self) -> String {
         for id in &self.file.order {
             let inst = &self.file.instances[id];
-            let Some(ctx) = inst.part("GLOBAL_UNIT_ASSIGNED_CONTEXT") else { continue };
-            let Some(Value::List(units)) = ctx.params.first() else { continue };
+            let Some(ctx) = inst.part("GLOBAL_UNIT_ASSIGNED_CONTEXT") else {
+                continue;
+            };
+            let Some(Value::List(units)) = ctx.params.first() else {
+                continue;
+            };
             for u in units {
                 let Value::Ref(uid) = u else { continue };
-                let Some(unit) = self.file.instances.get(uid) else { continue };
+                let Some(unit) = self.file.instances.get(uid) else {
+                    continue;
+                };
                 if unit.part("LENGTH_UNIT").is_none() {
                     continue;
                 }
@@ -317,7 +335,11 @@ impl<'a> Reader<'a> {
         let c = if inst.parts.len() > 1 {
             self.bspline_curve(id, inst)?
         } else {
-            let p = Params { id, inst, part: &inst.parts[0] };
+            let p = Params {
+                id,
+                inst,
+                part: &inst.parts[0],
+            };
             match p.part.name.as_str() {
                 "LINE" => {
                     let o = self.point(id, p.refid(1)?)?;
@@ -370,8 +392,16 @@ impl<'a> Reader<'a> {
             let w = inst.part("RATIONAL_B_SPLINE_CURVE");
             (head, 0, kp, 0, w)
         };
-        let h = Params { id, inst, part: head };
-        let k = Params { id, inst, part: knots_part };
+        let h = Params {
+            id,
+            inst,
+            part: head,
+        };
+        let k = Params {
+            id,
+            inst,
+            part: knots_part,
+        };
         let degree = h.int(off)?;
         let ctrl_ids = h.refs(off + 1)?;
         let closed = h.boolean(off + 3).unwrap_or(false);
@@ -382,10 +412,15 @@ impl<'a> Reader<'a> {
             None => vec![1.0; ctrl_ids.len()],
         };
         if ws.len() != ctrl_ids.len() || ws.iter().any(|&w| w <= 0.0) {
-            return Err(invalid(id, inst, "weights must be positive, one per control point"));
+            return Err(invalid(
+                id,
+                inst,
+                "weights must be positive, one per control point",
+            ));
         }
         let p = usize::try_from(degree).map_err(|_| invalid(id, inst, "negative degree"))?;
-        let u = expand_knots(&mults, &knots, ctrl_ids.len(), p).map_err(|m| invalid(id, inst, m))?;
+        let u =
+            expand_knots(&mults, &knots, ctrl_ids.len(), p).map_err(|m| invalid(id, inst, m))?;
         let mut ctrl = Vec::with_capacity(ctrl_ids.len());
         for (&c, &w) in ctrl_ids.iter().zip(&ws) {
             ctrl.push(vec![hom(self.point(id, c)?, w)]);
@@ -404,7 +439,13 @@ impl<'a> Reader<'a> {
     }
 
     /// Bézier pieces of `c` from point `a` to point `b`, running in the curve's direction.
-    fn between(&self, c: &Curve, a: [f64; 3], b: [f64; 3], tol: f64) -> Result<Vec<Vec<Homogeneous>>, String> {
+    fn between(
+        &self,
+        c: &Curve,
+        a: [f64; 3],
+        b: [f64; 3],
+        tol: f64,
+    ) -> Result<Vec<Vec<Homogeneous>>, String> {
         let same = norm(sub(a, b)) <= tol;
         Ok(match c {
             Curve::Line(..) => {
@@ -420,7 +461,10 @@ impl<'a> Reader<'a> {
                 } else {
                     next_turn(t0, conic_angle(f, *ra, *rb, b))
                 };
-                conic_pieces(f, *ra, *rb, t0, t1).into_iter().map(|p| p.2).collect()
+                conic_pieces(f, *ra, *rb, t0, t1)
+                    .into_iter()
+                    .map(|p| p.2)
+                    .collect()
             }
             Curve::Pieces(pieces, closed) => {
                 let lo = pieces[0].0;
@@ -454,7 +498,12 @@ impl<'a> Reader<'a> {
     }
 
     /// The geometry of `EDGE_CURVE` `id` from its start to its end vertex (cached).
-    pub(crate) fn edge(&mut self, from: u64, id: u64, tol: f64) -> Result<Vec<Vec<Homogeneous>>, StepError> {
+    pub(crate) fn edge(
+        &mut self,
+        from: u64,
+        id: u64,
+        tol: f64,
+    ) -> Result<Vec<Vec<Homogeneous>>, StepError> {
         if let Some(e) = self.edges.get(&id) {
             return Ok(e.clone());
         }
@@ -479,7 +528,11 @@ impl<'a> Reader<'a> {
         if inst.parts.len() > 1 {
             return self.bspline_surface(id, inst, tol);
         }
-        let p = Params { id, inst, part: &inst.parts[0] };
+        let p = Params {
+            id,
+            inst,
+            part: &inst.parts[0],
+        };
         let positive = |v: f64, what: &str| {
             if v > 0.0 {
                 Ok(v)
@@ -489,19 +542,21 @@ impl<'a> Reader<'a> {
         };
         Ok(match p.part.name.as_str() {
             "PLANE" => Surface::Plane(self.placement(id, p.refid(1)?)?),
-            "CYLINDRICAL_SURFACE" => {
-                Surface::Cylinder(self.placement(id, p.refid(1)?)?, positive(p.real(2)?, "radius")?)
-            }
+            "CYLINDRICAL_SURFACE" => Surface::Cylinder(
+                self.placement(id, p.refid(1)?)?,
+                positive(p.real(2)?, "radius")?,
+            ),
             "CONICAL_SURFACE" => {
                 let angle = p.real(3)? * self.angle_factor;
-                if !(angle.abs() < std::f64::consts::FRAC_PI_2) {
+                if angle.is_nan() || angle.abs() >= std::f64::consts::FRAC_PI_2 {
                     return Err(invalid(id, inst, "semi-angle must be below 90°"));
                 }
                 Surface::Cone(self.placement(id, p.refid(1)?)?, p.real(2)?, angle.tan())
             }
-            "SPHERICAL_SURFACE" => {
-                Surface::Sphere(self.placement(id, p.refid(1)?)?, positive(p.real(2)?, "radius")?)
-            }
+            "SPHERICAL_SURFACE" => Surface::Sphere(
+                self.placement(id, p.refid(1)?)?,
+                positive(p.real(2)?, "radius")?,
+            ),
             "TOROIDAL_SURFACE" => Surface::Torus(
                 self.placement(id, p.refid(1)?)?,
                 positive(p.real(2)?, "major radius")?,
@@ -520,7 +575,12 @@ impl<'a> Reader<'a> {
             }
             "SURFACE_OF_REVOLUTION" => {
                 let pieces = self.swept_pieces(id, p.refid(1)?)?;
-                let ax = self.simple(id, p.refid(2)?, &["AXIS1_PLACEMENT"], "as a revolution axis")?;
+                let ax = self.simple(
+                    id,
+                    p.refid(2)?,
+                    &["AXIS1_PLACEMENT"],
+                    "as a revolution axis",
+                )?;
                 let a = self.point(ax.id, ax.refid(1)?)?;
                 let d = match ax.opt_ref(2)? {
                     Some(r) => self.direction(ax.id, r)?,
@@ -539,7 +599,11 @@ impl<'a> Reader<'a> {
             Curve::Conic(f, a, b) => Ok(conic_pieces(&f, a, b, 0.0, std::f64::consts::TAU)),
             _ => {
                 let inst = self.inst(from, id)?;
-                Err(unsupported(id, inst, "as a swept curve (unbounded or trimmed)"))
+                Err(unsupported(
+                    id,
+                    inst,
+                    "as a swept curve (unbounded or trimmed)",
+                ))
             }
         }
     }
@@ -557,10 +621,15 @@ impl<'a> Reader<'a> {
                 .ok_or_else(|| unsupported(id, inst, "as a face surface (no knots)"))?;
             (head, 0, kp, 0, inst.part("RATIONAL_B_SPLINE_SURFACE"))
         };
-        let h = Params { id, inst, part: head };
+        let h = Params {
+            id,
+            inst,
+            part: head,
+        };
         let k = Params { id, inst, part: kp };
         let pu = usize::try_from(h.int(off)?).map_err(|_| invalid(id, inst, "negative degree"))?;
-        let pv = usize::try_from(h.int(off + 1)?).map_err(|_| invalid(id, inst, "negative degree"))?;
+        let pv =
+            usize::try_from(h.int(off + 1)?).map_err(|_| invalid(id, inst, "negative degree"))?;
         let rows = h.list(off + 2)?;
         let mut net: Vec<Vec<u64>> = Vec::with_capacity(rows.len().min(super::nurbs::MAX_CONTROL));
         for r in rows {
@@ -600,8 +669,16 @@ impl<'a> Reader<'a> {
             }
             None => vec![vec![1.0; nv]; nu],
         };
-        if weights.len() != nu || weights.iter().any(|r| r.len() != nv || r.iter().any(|&w| w <= 0.0)) {
-            return Err(invalid(id, inst, "weights must be positive, one per control point"));
+        if weights.len() != nu
+            || weights
+                .iter()
+                .any(|r| r.len() != nv || r.iter().any(|&w| w <= 0.0))
+        {
+            return Err(invalid(
+                id,
+                inst,
+                "weights must be positive, one per control point",
+            ));
         }
         let uk = expand_knots(&k.ints(koff)?, &k.reals(koff + 2)?, nu, pu)
             .map_err(|m| invalid(id, inst, format!("u knots: {m}")))?;
@@ -621,7 +698,9 @@ impl<'a> Reader<'a> {
         let mut patches = Vec::new();
         for (u0, u1, urows) in extract(pu, &uk, &hnet) {
             // urows: pu+1 rows of nv points; extract along v for the transposed net.
-            let cols: Vec<Vec<Homogeneous>> = (0..nv).map(|j| urows.iter().map(|r| r[j]).collect()).collect();
+            let cols: Vec<Vec<Homogeneous>> = (0..nv)
+                .map(|j| urows.iter().map(|r| r[j]).collect())
+                .collect();
             for (v0, v1, vcols) in extract(pv, &vk, &cols) {
                 // vcols: pv+1 entries, each a column of pu+1 points (over u).
                 let mut pts = Vec::with_capacity((pu + 1) * (pv + 1));
@@ -633,7 +712,8 @@ impl<'a> Reader<'a> {
                         ws.push(hh[3]);
                     }
                 }
-                let patch = Patch::rational(pu, pv, pts, ws).map_err(|e| invalid(id, inst, e.to_string()))?;
+                let patch = Patch::rational(pu, pv, pts, ws)
+                    .map_err(|e| invalid(id, inst, e.to_string()))?;
                 patches.push(UvPatch {
                     patch,
                     u: [u0, u1],
@@ -652,14 +732,23 @@ impl<'a> Reader<'a> {
         let same_sense = p.boolean(3)?;
         let mut loops = Vec::new();
         for b in p.refs(1)? {
-            let bp = self.simple(id, b, &["FACE_OUTER_BOUND", "FACE_BOUND"], "as a face bound")?;
+            let bp = self.simple(
+                id,
+                b,
+                &["FACE_OUTER_BOUND", "FACE_BOUND"],
+                "as a face bound",
+            )?;
             let orientation = bp.boolean(2)?;
             let lid = bp.refid(1)?;
             let linst = self.inst(b, lid)?;
             match linst.parts.as_slice() {
                 [part] if part.name == "VERTEX_LOOP" => continue,
                 [part] if part.name == "EDGE_LOOP" => {
-                    let lp = Params { id: lid, inst: linst, part };
+                    let lp = Params {
+                        id: lid,
+                        inst: linst,
+                        part,
+                    };
                     let mut uses = Vec::new();
                     for oe in lp.refs(1)? {
                         let op = self.simple(lid, oe, &["ORIENTED_EDGE"], "in an edge loop")?;
@@ -695,7 +784,9 @@ impl<'a> Reader<'a> {
         let mut roots = false;
         for &id in &self.file.order {
             let inst = &self.file.instances[&id];
-            let [part] = inst.parts.as_slice() else { continue };
+            let [part] = inst.parts.as_slice() else {
+                continue;
+            };
             let p = Params { id, inst, part };
             match part.name.as_str() {
                 "MANIFOLD_SOLID_BREP" => {
@@ -723,7 +814,8 @@ impl<'a> Reader<'a> {
         if !roots {
             for &id in &self.file.order {
                 let inst = &self.file.instances[&id];
-                if matches!(inst.parts.as_slice(), [p] if p.name == "CLOSED_SHELL" || p.name == "OPEN_SHELL") {
+                if matches!(inst.parts.as_slice(), [p] if p.name == "CLOSED_SHELL" || p.name == "OPEN_SHELL")
+                {
                     shells.push((id, id));
                 }
             }
@@ -734,7 +826,12 @@ impl<'a> Reader<'a> {
             if !seen_shells.insert(s) {
                 continue;
             }
-            let sp = self.simple(from, s, &["CLOSED_SHELL", "OPEN_SHELL", "ORIENTED_CLOSED_SHELL"], "as a shell")?;
+            let sp = self.simple(
+                from,
+                s,
+                &["CLOSED_SHELL", "OPEN_SHELL", "ORIENTED_CLOSED_SHELL"],
+                "as a shell",
+            )?;
             if sp.part.name == "ORIENTED_CLOSED_SHELL" {
                 return Err(unsupported(s, sp.inst, "(oriented shells)"));
             }
@@ -789,7 +886,11 @@ impl<'a> Reader<'a> {
             }
         }
         let d = norm(sub(hi, lo));
-        if d.is_finite() && d > 0.0 { 1e-9 * d } else { 1e-12 }
+        if d.is_finite() && d > 0.0 {
+            1e-9 * d
+        } else {
+            1e-12
+        }
     }
 }
 
@@ -852,5 +953,9 @@ fn revolution(pieces: &Pieces, a: [f64; 3], d: [f64; 3], tol: f64) -> Result<Sur
         }
     }
     let (_, period_v) = detect_periods(&patches, tol);
-    Ok(Surface::from_patches(patches, Some(std::f64::consts::TAU), period_v))
+    Ok(Surface::from_patches(
+        patches,
+        Some(std::f64::consts::TAU),
+        period_v,
+    ))
 }

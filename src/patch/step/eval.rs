@@ -104,12 +104,12 @@ impl RayFrame {
         let e2 = cross(d, e1);
         RayFrame { e1, e2, d }
     }
-    fn to_frame(&self, r: [f64; 3]) -> [f64; 3] {
+    fn map(&self, r: [f64; 3]) -> [f64; 3] {
         [dot(self.e1, r), dot(self.e2, r), dot(self.d, r)]
     }
     fn hom(&self, h: Homogeneous, q: [f64; 3]) -> Homogeneous {
         let r = [h[0] - h[3] * q[0], h[1] - h[3] * q[1], h[2] - h[3] * q[2]];
-        let f = self.to_frame(r);
+        let f = self.map(r);
         [f[0], f[1], f[2], h[3]]
     }
 }
@@ -147,6 +147,10 @@ fn directions() -> Vec<[f64; 3]> {
     }
     out
 }
+
+/// One ray hit for diagnostics: face `#id`, point, `(u, v)`, trimming side, distance to the
+/// face's loops (to a factor of 2).
+pub type HitReport = (u64, [f64; 3], [f64; 2], Side, f64);
 
 /// Why a direction was rejected.
 enum Reject {
@@ -227,7 +231,7 @@ impl StepWindingNumber {
 
     /// Every hit of the ray from `q` along `d` on every face's patches: `(face #id, point,
     /// (u, v), trimming side)`, before any test. For diagnostics.
-    pub fn hits_along(&self, q: [f64; 3], d: [f64; 3]) -> Vec<(u64, [f64; 3], [f64; 2], Side)> {
+    pub fn hits_along(&self, q: [f64; 3], d: [f64; 3]) -> Vec<HitReport> {
         let frame = RayFrame::new(d);
         let mut out = Vec::new();
         for face in &self.model.faces {
@@ -239,7 +243,16 @@ impl StepWindingNumber {
             }
             for h in hits {
                 let side = face.trim.classify(h.uv, h.su, h.sv, self.margin);
-                out.push((face.id, h.point, h.uv, side));
+                // Distance to the loops, to a factor of 2 (first smallest margin that is near).
+                let mut dist = f64::INFINITY;
+                let mut m = self.model.diagonal();
+                while m > 1e-12 * self.model.diagonal() {
+                    if face.trim.classify(h.uv, h.su, h.sv, m) == Side::Near {
+                        dist = m;
+                    }
+                    m *= 0.5;
+                }
+                out.push((face.id, h.point, h.uv, side, dist));
             }
         }
         out
@@ -294,7 +307,13 @@ impl StepWindingNumber {
     }
 
     /// Signed count of trimmed-face crossings of the ray; `Err` if some hit is ambiguous.
-    fn crossings(&self, q: [f64; 3], frame: &RayFrame, margin: f64, strict: bool) -> Result<i64, Reject> {
+    fn crossings(
+        &self,
+        q: [f64; 3],
+        frame: &RayFrame,
+        margin: f64,
+        strict: bool,
+    ) -> Result<i64, Reject> {
         let mut chi = 0i64;
         let dedup = 1e-9 * self.model.diagonal();
         for face in &self.model.faces {
@@ -315,7 +334,9 @@ impl StepWindingNumber {
                 let n = cross(h.su, h.sv);
                 let nn = norm(n);
                 let c = face.sense * dot(n, frame.d) / nn;
-                if strict && (!(nn > 0.0) || c.abs() < MIN_COSINE || h.tau.abs() <= margin) {
+                if strict
+                    && (nn.is_nan() || nn <= 0.0 || c.abs() < MIN_COSINE || h.tau.abs() <= margin)
+                {
                     return Err(Reject::Hit);
                 }
                 if h.tau <= 0.0 {
@@ -341,7 +362,10 @@ impl StepWindingNumber {
 /// halving it up to [`CERT_DEPTH`] times; certified pieces go to `out`. Returns `false` (and
 /// still pushes the pieces) if some part could not be certified.
 fn certify(h: Vec<Homogeneous>, mu: f64, depth: u32, out: &mut Vec<Vec<Homogeneous>>) -> bool {
-    let pts: Vec<[f64; 3]> = h.iter().map(|p| [p[0] / p[3], p[1] / p[3], p[2] / p[3]]).collect();
+    let pts: Vec<[f64; 3]> = h
+        .iter()
+        .map(|p| [p[0] / p[3], p[1] / p[3], p[2] / p[3]])
+        .collect();
     if pts.iter().all(|p| p[2] < 0.0) {
         out.push(h);
         return true;
@@ -359,7 +383,10 @@ fn certify(h: Vec<Homogeneous>, mu: f64, depth: u32, out: &mut Vec<Vec<Homogeneo
         let (hx, hy) = (mx / m, my / m);
         let s = std::f64::consts::FRAC_1_SQRT_2;
         for n in [[hx, hy, 0.0], [s * hx, s * hy, -s]] {
-            if pts.iter().all(|p| dot(n, *p) >= mu * norm(*p) && dot(n, *p) > 0.0) {
+            if pts
+                .iter()
+                .all(|p| dot(n, *p) >= mu * norm(*p) && dot(n, *p) > 0.0)
+            {
                 out.push(h);
                 return true;
             }
@@ -425,7 +452,7 @@ fn patch_hits(fp: &FacePatch, q: [f64; 3], frame: &RayFrame, out: &mut Vec<Hit>)
         .iter()
         .zip(patch.weights())
         .map(|(p, &w)| {
-            let f = frame.to_frame(sub(*p, q));
+            let f = frame.map(sub(*p, q));
             [w * f[0], w * f[1], w * f[2], w]
         })
         .collect();
@@ -453,7 +480,9 @@ fn patch_hits(fp: &FacePatch, q: [f64; 3], frame: &RayFrame, out: &mut Vec<Hit>)
             continue;
         }
         let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]).max(hi[2] - lo[2]);
-        if depth >= HIT_DEPTH || (depth >= 2 && extent <= 0.05 * size) {
+        if depth >= HIT_DEPTH
+            || (depth >= 2 && extent <= 0.05 * size && single_root(fp, frame, &piece))
+        {
             if let Some(hit) = newton(fp, q, frame, &piece) {
                 out.push(hit);
             }
@@ -464,6 +493,37 @@ fn patch_hits(fp: &FacePatch, q: [f64; 3], frame: &RayFrame, out: &mut Vec<Hit>)
             stack.push((b, depth + 1));
         }
     }
+}
+
+/// Whether a small piece can hold only one crossing of the ray: its normals at the corners and
+/// the centre lie within 30° of each other and all make an angle of at least ~6° with the
+/// ray's plane (`|n̂·d| ≥ 0.1`), so the piece is a graph over the plane normal to the ray. A
+/// ray that enters and leaves one piece (near tangency) is subdivided further.
+fn single_root(fp: &FacePatch, frame: &RayFrame, piece: &Piece) -> bool {
+    let at = |s: f64, t: f64| {
+        let (_, ds, dt) = fp.patch.eval_with_partials(s, t);
+        let n = cross(ds, dt);
+        let l = norm(n);
+        if l > 0.0 {
+            Some([n[0] / l, n[1] / l, n[2] / l])
+        } else {
+            None
+        }
+    };
+    let (s0, s1, t0, t1) = (piece.s[0], piece.s[1], piece.t[0], piece.t[1]);
+    let Some(c) = at(0.5 * (s0 + s1), 0.5 * (t0 + t1)) else {
+        return false;
+    };
+    let side = dot(c, frame.d);
+    if side.abs() < 0.1 {
+        return false;
+    }
+    [(s0, t0), (s0, t1), (s1, t0), (s1, t1)]
+        .iter()
+        .all(|&(s, t)| match at(s, t) {
+            Some(n) => dot(n, c) >= 0.866 && dot(n, frame.d) * side.signum() >= 0.1,
+            None => false,
+        })
 }
 
 /// Halves a piece in `s` and in `t` (four pieces, returned in pairs).
@@ -491,7 +551,12 @@ fn split4(piece: &Piece, m: usize, n: usize) -> Vec<(Piece, Piece)> {
 }
 
 /// Halves a row-major `(m+1) × (n+1)` net along `s` (rows) or `t` (columns).
-fn split_dir(h: &[Homogeneous], m: usize, n: usize, along_s: bool) -> (Vec<Homogeneous>, Vec<Homogeneous>) {
+fn split_dir(
+    h: &[Homogeneous],
+    m: usize,
+    n: usize,
+    along_s: bool,
+) -> (Vec<Homogeneous>, Vec<Homogeneous>) {
     let mut a = vec![[0.0; 4]; h.len()];
     let mut b = vec![[0.0; 4]; h.len()];
     if along_s {
@@ -516,7 +581,10 @@ fn split_dir(h: &[Homogeneous], m: usize, n: usize, along_s: bool) -> (Vec<Homog
 
 /// Newton's method for `x(s, t) = y(s, t) = 0` in the ray frame, from the piece's centre.
 fn newton(fp: &FacePatch, q: [f64; 3], frame: &RayFrame, piece: &Piece) -> Option<Hit> {
-    let mut st = [0.5 * (piece.s[0] + piece.s[1]), 0.5 * (piece.t[0] + piece.t[1])];
+    let mut st = [
+        0.5 * (piece.s[0] + piece.s[1]),
+        0.5 * (piece.t[0] + piece.t[1]),
+    ];
     let centre = [
         0.5 * (fp.lo[0] + fp.hi[0]),
         0.5 * (fp.lo[1] + fp.hi[1]),
@@ -526,7 +594,7 @@ fn newton(fp: &FacePatch, q: [f64; 3], frame: &RayFrame, piece: &Piece) -> Optio
     let mut converged = false;
     for _ in 0..40 {
         let (p, ds, dt) = fp.patch.eval_with_partials(st[0], st[1]);
-        let r = frame.to_frame(sub(p, q));
+        let r = frame.map(sub(p, q));
         let a = [dot(frame.e1, ds), dot(frame.e1, dt)];
         let b = [dot(frame.e2, ds), dot(frame.e2, dt)];
         let det = a[0] * b[1] - a[1] * b[0];
@@ -545,14 +613,18 @@ fn newton(fp: &FacePatch, q: [f64; 3], frame: &RayFrame, piece: &Piece) -> Optio
         return None;
     }
     let tol = 1e-10;
-    if st[0] < piece.s[0] - tol || st[0] > piece.s[1] + tol || st[1] < piece.t[0] - tol || st[1] > piece.t[1] + tol {
+    if st[0] < piece.s[0] - tol
+        || st[0] > piece.s[1] + tol
+        || st[1] < piece.t[0] - tol
+        || st[1] > piece.t[1] + tol
+    {
         return None;
     }
     // Roots on a piece's border are found by both neighbours; `tol` keeps the one at the
     // patch border inside [0, 1]².
     let st = [st[0].clamp(0.0, 1.0), st[1].clamp(0.0, 1.0)];
     let (p, ds, dt) = fp.patch.eval_with_partials(st[0], st[1]);
-    let r = frame.to_frame(sub(p, q));
+    let r = frame.map(sub(p, q));
     if (r[0] * r[0] + r[1] * r[1]).sqrt() > 1e-9 * scale {
         return None;
     }

@@ -72,7 +72,10 @@ impl fmt::Display for StepError {
             StepError::Io(m) | StepError::TooLarge(m) => write!(f, "{m}"),
             StepError::Syntax { line, message } => write!(f, "line {line}: {message}"),
             StepError::Dangling { id, target } => {
-                write!(f, "#{id} refers to #{target}, which the file does not define")
+                write!(
+                    f,
+                    "#{id} refers to #{target}, which the file does not define"
+                )
             }
             StepError::Unsupported {
                 id,
@@ -101,7 +104,8 @@ pub fn is_step_path(path: &Path) -> bool {
 /// Reads a STEP file into a trimmed model. Errors are one line naming the file.
 pub fn load_step(path: &Path) -> Result<StepModel, StepError> {
     let named = |e: StepError| StepError::Io(format!("{}: {e}", path.display()));
-    let meta = std::fs::metadata(path).map_err(|e| StepError::Io(format!("{}: {e}", path.display())))?;
+    let meta =
+        std::fs::metadata(path).map_err(|e| StepError::Io(format!("{}: {e}", path.display())))?;
     if meta.len() > part21::MAX_BYTES as u64 {
         return Err(named(StepError::TooLarge(format!(
             "{} bytes, more than the {} accepted",
@@ -109,7 +113,8 @@ pub fn load_step(path: &Path) -> Result<StepModel, StepError> {
             part21::MAX_BYTES
         ))));
     }
-    let bytes = std::fs::read(path).map_err(|e| StepError::Io(format!("{}: {e}", path.display())))?;
+    let bytes =
+        std::fs::read(path).map_err(|e| StepError::Io(format!("{}: {e}", path.display())))?;
     // Part 21 is ISO 8859-1 / ASCII with escapes; non-UTF-8 bytes only occur inside strings,
     // which the reader does not interpret.
     let text = String::from_utf8_lossy(&bytes);

@@ -244,11 +244,14 @@ impl StepModel {
                     message: "its loops enclose no area in the surface's parameters".into(),
                 });
             }
-            let uvp = f.surface.patches([u0, u1], [v0, v1]).map_err(|m| StepError::Invalid {
-                id: f.id,
-                entity: "ADVANCED_FACE".into(),
-                message: m,
-            })?;
+            let uvp = f
+                .surface
+                .patches([u0, u1], [v0, v1])
+                .map_err(|m| StepError::Invalid {
+                    id: f.id,
+                    entity: "ADVANCED_FACE".into(),
+                    message: m,
+                })?;
             let patches: Vec<FacePatch> = uvp
                 .into_iter()
                 .map(|p| {
@@ -302,7 +305,12 @@ impl StepModel {
 /// Samples a Bézier piece into `(u, v)` points (start and end included): bisection until the
 /// curve's midpoint is within `chord` of the chord in 3D and the inverted midpoint within
 /// `chord` (to first order, scaled by the chord's 3D/uv length ratio) of the uv chord.
-fn sample(c: &[Homogeneous], surface: &Surface, hint: &mut Option<[f64; 2]>, chord: f64) -> Vec<[f64; 2]> {
+fn sample(
+    c: &[Homogeneous],
+    surface: &Surface,
+    hint: &mut Option<[f64; 2]>,
+    chord: f64,
+) -> Vec<[f64; 2]> {
     let p0 = point_at(c, 0.0);
     let uv0 = surface.invert(p0, *hint);
     let mut out = vec![uv0];
@@ -316,12 +324,22 @@ fn sample(c: &[Homogeneous], surface: &Surface, hint: &mut Option<[f64; 2]>, cho
         let tm = 0.5 * (t0 + t1);
         let qm = point_at(c, tm);
         let wm = surface.invert(qm, Some(w0));
-        let mid3 = [0.5 * (q0[0] + q1[0]), 0.5 * (q0[1] + q1[1]), 0.5 * (q0[2] + q1[2])];
+        let mid3 = [
+            0.5 * (q0[0] + q1[0]),
+            0.5 * (q0[1] + q1[1]),
+            0.5 * (q0[2] + q1[2]),
+        ];
         let dev3 = norm(sub(qm, mid3));
         let duv = ((w1[0] - w0[0]).powi(2) + (w1[1] - w0[1]).powi(2)).sqrt();
-        let ratio = if duv > 0.0 { norm(sub(q1, q0)) / duv } else { 0.0 };
-        let devuv =
-            ((wm[0] - 0.5 * (w0[0] + w1[0])).powi(2) + (wm[1] - 0.5 * (w0[1] + w1[1])).powi(2)).sqrt() * ratio;
+        let ratio = if duv > 0.0 {
+            norm(sub(q1, q0)) / duv
+        } else {
+            0.0
+        };
+        let devuv = ((wm[0] - 0.5 * (w0[0] + w1[0])).powi(2)
+            + (wm[1] - 0.5 * (w0[1] + w1[1])).powi(2))
+        .sqrt()
+            * ratio;
         // A piece shorter than the chord tolerance is not refined for its uv deviation: at a
         // pole or a collapsed edge the uv image of one 3D point is a whole segment.
         let short = norm(sub(q1, q0)) <= chord && dev3 <= chord;
@@ -387,8 +405,12 @@ fn surface_boundary(
             break;
         }
     }
-    let out: Vec<Vec<Vec<Homogeneous>>> =
-        left.into_iter().zip(used).filter(|(_, u)| !u).map(|(g, _)| g).collect();
+    let out: Vec<Vec<Vec<Homogeneous>>> = left
+        .into_iter()
+        .zip(used)
+        .filter(|(_, u)| !u)
+        .map(|(g, _)| g)
+        .collect();
     info.boundary_edges = out.len();
     out.into_iter().flatten().collect()
 }
@@ -426,8 +448,11 @@ impl Probe {
         if norm(sub(self.start, other.end)) > tol || norm(sub(self.end, other.start)) > tol {
             return false;
         }
-        let pieces: Vec<(f64, f64, Vec<Homogeneous>)> =
-            g.iter().enumerate().map(|(k, c)| (k as f64, k as f64 + 1.0, c.clone())).collect();
+        let pieces: Vec<(f64, f64, Vec<Homogeneous>)> = g
+            .iter()
+            .enumerate()
+            .map(|(k, c)| (k as f64, k as f64 + 1.0, c.clone()))
+            .collect();
         self.inner.iter().all(|(p, d)| {
             let t = invert_curve(&pieces, *p);
             let k = (t.floor() as usize).min(g.len() - 1);

@@ -11,7 +11,12 @@ pub const MAX_CONTROL: usize = 1 << 16;
 
 /// The full knot vector from STEP's (multiplicities, distinct knots). Checks the counts
 /// against `n_ctrl` control points of degree `p`; `Err` is a message.
-pub fn expand_knots(mults: &[i64], knots: &[f64], n_ctrl: usize, p: usize) -> Result<Vec<f64>, String> {
+pub fn expand_knots(
+    mults: &[i64],
+    knots: &[f64],
+    n_ctrl: usize,
+    p: usize,
+) -> Result<Vec<f64>, String> {
     if mults.len() != knots.len() {
         return Err(format!(
             "{} knot multiplicities for {} knots",
@@ -116,7 +121,9 @@ pub fn extract(
 /// at most 90°: per arc its three control points `(x, y)` and weights.
 pub fn unit_arcs(a0: f64, a1: f64) -> Vec<[([f64; 2], f64); 3]> {
     let span = a1 - a0;
-    let n = ((span.abs() / std::f64::consts::FRAC_PI_2) - 1e-9).ceil().max(1.0) as usize;
+    let n = ((span.abs() / std::f64::consts::FRAC_PI_2) - 1e-9)
+        .ceil()
+        .max(1.0) as usize;
     (0..n)
         .map(|k| {
             let b0 = a0 + span * k as f64 / n as f64;
@@ -194,7 +201,10 @@ mod tests {
     fn arcs_are_on_the_circle() {
         for (a0, a1) in [(0.0, 2.0 * std::f64::consts::PI), (1.0, -2.5), (0.3, 0.4)] {
             for arc in unit_arcs(a0, a1) {
-                let ctrl: Vec<Homogeneous> = arc.iter().map(|(p, w)| hom([p[0], p[1], 0.0], *w)).collect();
+                let ctrl: Vec<Homogeneous> = arc
+                    .iter()
+                    .map(|(p, w)| hom([p[0], p[1], 0.0], *w))
+                    .collect();
                 for t in [0.0, 0.3, 0.5, 0.9] {
                     let p = point_at(&ctrl, t);
                     assert!((p[0].hypot(p[1]) - 1.0).abs() < 1e-14);
@@ -211,7 +221,12 @@ mod tests {
         // Uniform cubic with 6 control points: 3 spans.
         let u = expand_knots(&[4, 1, 1, 4], &[0.0, 1.0, 2.0, 3.0], 6, 3).unwrap();
         let pts: Vec<Vec<Homogeneous>> = (0..6)
-            .map(|i| vec![hom([i as f64, ((i * i) % 5) as f64, 0.0], 1.0 + 0.1 * i as f64)])
+            .map(|i| {
+                vec![hom(
+                    [i as f64, ((i * i) % 5) as f64, 0.0],
+                    1.0 + 0.1 * i as f64,
+                )]
+            })
             .collect();
         let spans = extract(3, &u, &pts);
         assert_eq!(spans.len(), 3);

@@ -269,9 +269,7 @@ impl<'a> Lexer<'a> {
                 }) {
                     // A sign is part of the number only right after an exponent marker.
                     let ch = self.s[self.pos];
-                    if matches!(ch, b'+' | b'-')
-                        && !matches!(self.s[self.pos - 1], b'e' | b'E')
-                    {
+                    if matches!(ch, b'+' | b'-') && !matches!(self.s[self.pos - 1], b'e' | b'E') {
                         break;
                     }
                     self.pos += 1;
@@ -422,8 +420,7 @@ pub fn parse(text: &str) -> Result<Part21, StepError> {
     let mut in_data = false;
     let mut saw_end = false;
     let mut saw_data = false;
-    loop {
-        let Some((t, line)) = p.bump()? else { break };
+    while let Some((t, line)) = p.bump()? {
         match t {
             Token::Keyword(k) if k == "END-ISO-10303-21" => {
                 p.expect(Token::Semicolon, "`;` after END-ISO-10303-21")?;

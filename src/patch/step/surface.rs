@@ -97,7 +97,11 @@ impl Surface {
     /// A patch-set surface with its inversion samples (7 × 7 per patch, without those on a
     /// collapsed edge: at a pole every `u` is the same point, and Newton's method started
     /// there on the wrong side — up to 180° away — cannot turn `u`).
-    pub fn from_patches(patches: Vec<UvPatch>, period_u: Option<f64>, period_v: Option<f64>) -> Surface {
+    pub fn from_patches(
+        patches: Vec<UvPatch>,
+        period_u: Option<f64>,
+        period_v: Option<f64>,
+    ) -> Surface {
         let mut samples = Vec::with_capacity(patches.len() * 49);
         for (k, up) in patches.iter().enumerate() {
             for i in 0..=6 {
@@ -217,6 +221,19 @@ impl Surface {
         uv
     }
 
+    /// The point at `(u, v)` of a patch-set surface (`None` for the others, whose inversion is
+    /// in closed form, and outside the domain).
+    pub fn patch_point(&self, uv: [f64; 2]) -> Option<[f64; 3]> {
+        let Surface::Patches { patches, .. } = self else {
+            return None;
+        };
+        let up = patches.iter().find(|up| {
+            up.u[0] <= uv[0] && uv[0] <= up.u[1] && up.v[0] <= uv[1] && uv[1] <= up.v[1]
+        })?;
+        let st = up.local(uv);
+        Some(up.patch.eval(st[0], st[1]))
+    }
+
     /// The surface's natural `v` bounds where it has them (the sphere's poles).
     pub fn v_bounds(&self) -> Option<[f64; 2]> {
         match self {
@@ -248,33 +265,38 @@ impl Surface {
                 })
                 .collect()
         };
-        let line = |a0: f64, a1: f64| -> Factor { vec![(a0, a1, vec![([a0, 0.0], 1.0), ([a1, 0.0], 1.0)])] };
-        let mut product = |fu: Factor, fv: Factor, point: &dyn Fn([f64; 2], [f64; 2]) -> [f64; 3]| {
-            for (u0, u1, cu) in &fu {
-                for (v0, v1, cv) in &fv {
-                    let mut pts = Vec::new();
-                    let mut ws = Vec::new();
-                    for (a, wa) in cu {
-                        for (b, wb) in cv {
-                            pts.push(point(*a, *b));
-                            ws.push(wa * wb);
-                        }
-                    }
-                    let patch = Patch::rational(cu.len() - 1, cv.len() - 1, pts, ws)
-                        .map_err(|e| e.to_string())?;
-                    out.push(UvPatch {
-                        patch,
-                        u: [*u0, *u1],
-                        v: [*v0, *v1],
-                    });
-                }
-            }
-            Ok::<(), String>(())
+        let line = |a0: f64, a1: f64| -> Factor {
+            vec![(a0, a1, vec![([a0, 0.0], 1.0), ([a1, 0.0], 1.0)])]
         };
+        let mut product =
+            |fu: Factor, fv: Factor, point: &dyn Fn([f64; 2], [f64; 2]) -> [f64; 3]| {
+                for (u0, u1, cu) in &fu {
+                    for (v0, v1, cv) in &fv {
+                        let mut pts = Vec::new();
+                        let mut ws = Vec::new();
+                        for (a, wa) in cu {
+                            for (b, wb) in cv {
+                                pts.push(point(*a, *b));
+                                ws.push(wa * wb);
+                            }
+                        }
+                        let patch = Patch::rational(cu.len() - 1, cv.len() - 1, pts, ws)
+                            .map_err(|e| e.to_string())?;
+                        out.push(UvPatch {
+                            patch,
+                            u: [*u0, *u1],
+                            v: [*v0, *v1],
+                        });
+                    }
+                }
+                Ok::<(), String>(())
+            };
         match self {
             Surface::Plane(f) => {
                 let f = *f;
-                product(line(u[0], u[1]), line(v[0], v[1]), &|a, b| f.world(a[0], b[0], 0.0))?
+                product(line(u[0], u[1]), line(v[0], v[1]), &|a, b| {
+                    f.world(a[0], b[0], 0.0)
+                })?
             }
             Surface::Cylinder(f, r) => {
                 let (f, r) = (*f, *r);
@@ -315,7 +337,8 @@ impl Surface {
                             ws.push(h[3]);
                         }
                     }
-                    let patch = Patch::rational(c.len() - 1, 1, pts, ws).map_err(|e| e.to_string())?;
+                    let patch =
+                        Patch::rational(c.len() - 1, 1, pts, ws).map_err(|e| e.to_string())?;
                     out.push(UvPatch {
                         patch,
                         u: [*t0, *t1],
@@ -410,9 +433,19 @@ fn invert_patches(
     p: [f64; 3],
     hint: Option<[f64; 2]>,
 ) -> [f64; 2] {
-    let mut dom = [f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY];
+    let mut dom = [
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    ];
     for up in patches {
-        dom = [dom[0].min(up.u[0]), dom[1].max(up.u[1]), dom[2].min(up.v[0]), dom[3].max(up.v[1])];
+        dom = [
+            dom[0].min(up.u[0]),
+            dom[1].max(up.u[1]),
+            dom[2].min(up.v[0]),
+            dom[3].max(up.v[1]),
+        ];
     }
     let clamp = |uv: [f64; 2]| [uv[0].clamp(dom[0], dom[1]), uv[1].clamp(dom[2], dom[3])];
     // Point and partials in (u, v) at a domain point.
@@ -422,7 +455,9 @@ fn invert_patches(
             .find(|up| up.u[0] <= uv[0] && uv[0] <= up.u[1] && up.v[0] <= uv[1] && uv[1] <= up.v[1])
             .unwrap_or(&patches[0]);
         let st = up.local(uv);
-        let (x, ds, dt) = up.patch.eval_with_partials(st[0].clamp(0.0, 1.0), st[1].clamp(0.0, 1.0));
+        let (x, ds, dt) = up
+            .patch
+            .eval_with_partials(st[0].clamp(0.0, 1.0), st[1].clamp(0.0, 1.0));
         let (du, dv) = (up.u[1] - up.u[0], up.v[1] - up.v[0]);
         (x, scale(ds, 1.0 / du), scale(dt, 1.0 / dv))
     };
@@ -434,7 +469,11 @@ fn invert_patches(
         let (nu, nv) = (norm(su) * (dom[1] - dom[0]), norm(sv) * (dom[3] - dom[2]));
         let inward = |x: f64, lo: f64, hi: f64| {
             let e = 1e-3 * (hi - lo);
-            if x - lo < 0.5 * (hi - lo) { x.max(lo + e) } else { x.min(hi - e) }
+            if x - lo < 0.5 * (hi - lo) {
+                x.max(lo + e)
+            } else {
+                x.min(hi - e)
+            }
         };
         if nu <= 1e-9 * nv {
             uv[1] = inward(uv[1], dom[2], dom[3]);
@@ -457,8 +496,12 @@ fn invert_patches(
             // Limit a step to a quarter of the domain (Gauss–Newton can overshoot far from
             // the solution), then clamp.
             let lim = |d: f64, w: f64| d.clamp(-0.25 * w, 0.25 * w);
-            let next = clamp([uv[0] + lim(d0, dom[1] - dom[0]), uv[1] + lim(d1, dom[3] - dom[2])]);
-            let moved = (next[0] - uv[0]).abs() / (dom[1] - dom[0]) + (next[1] - uv[1]).abs() / (dom[3] - dom[2]);
+            let next = clamp([
+                uv[0] + lim(d0, dom[1] - dom[0]),
+                uv[1] + lim(d1, dom[3] - dom[2]),
+            ]);
+            let moved = (next[0] - uv[0]).abs() / (dom[1] - dom[0])
+                + (next[1] - uv[1]).abs() / (dom[3] - dom[2]);
             uv = next;
             if moved < 1e-15 {
                 break;
@@ -486,7 +529,12 @@ fn invert_patches(
 /// Whether a patch set closes up across its `u` (or `v`) domain: the first and last
 /// iso-curves agree within `tol` at several points.
 pub fn detect_periods(patches: &[UvPatch], tol: f64) -> (Option<f64>, Option<f64>) {
-    let (mut u0, mut u1, mut v0, mut v1) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+    let (mut u0, mut u1, mut v0, mut v1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
     for p in patches {
         u0 = u0.min(p.u[0]);
         u1 = u1.max(p.u[1]);
@@ -523,14 +571,24 @@ pub fn conic_angle(f: &Frame, a: f64, b: f64, p: [f64; 3]) -> f64 {
 
 /// Rational quadratic pieces of a circle/ellipse from angle `t0` to `t1`, with their angle
 /// ranges.
-pub fn conic_pieces(f: &Frame, a: f64, b: f64, t0: f64, t1: f64) -> Vec<(f64, f64, Vec<Homogeneous>)> {
+pub fn conic_pieces(
+    f: &Frame,
+    a: f64,
+    b: f64,
+    t0: f64,
+    t1: f64,
+) -> Vec<(f64, f64, Vec<Homogeneous>)> {
     let arcs = unit_arcs(t0, t1);
     let n = arcs.len();
     arcs.into_iter()
         .enumerate()
         .map(|(k, arc)| {
             let lo = t0 + (t1 - t0) * k as f64 / n as f64;
-            let hi = if k + 1 == n { t1 } else { t0 + (t1 - t0) * (k + 1) as f64 / n as f64 };
+            let hi = if k + 1 == n {
+                t1
+            } else {
+                t0 + (t1 - t0) * (k + 1) as f64 / n as f64
+            };
             let c = arc
                 .iter()
                 .map(|(q, w)| hom(f.world(a * q[0], b * q[1], 0.0), *w))
@@ -595,10 +653,14 @@ mod tests {
             for hint in [None, Some([0.0, FRAC_PI_2])] {
                 // The patch parameters are not angles (rational arcs): check the point.
                 let uv = s.invert(p, hint);
-                let Surface::Patches { patches, .. } = &s else { unreachable!() };
+                let Surface::Patches { patches, .. } = &s else {
+                    unreachable!()
+                };
                 let up = patches
                     .iter()
-                    .find(|up| up.u[0] <= uv[0] && uv[0] <= up.u[1] && up.v[0] <= uv[1] && uv[1] <= up.v[1])
+                    .find(|up| {
+                        up.u[0] <= uv[0] && uv[0] <= up.u[1] && up.v[0] <= uv[1] && uv[1] <= up.v[1]
+                    })
                     .unwrap();
                 let st = up.local(uv);
                 let x = up.patch.eval(st[0], st[1]);

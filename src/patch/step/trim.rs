@@ -51,7 +51,12 @@ pub enum Side {
 impl Trim {
     /// Builds the trim from segments.
     pub fn new(segments: Vec<Segment>, period_u: Option<f64>, sense: f64) -> Trim {
-        let mut bbox = [f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY];
+        let mut bbox = [
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ];
         for s in &segments {
             for p in [s.a, s.b] {
                 bbox[0] = bbox[0].min(p[0]);
@@ -89,7 +94,11 @@ impl Trim {
         }
     }
 
-    fn classify_with(&self, uv: [f64; 2], metric: Option<([f64; 3], [f64; 3], f64)>) -> (bool, i64) {
+    fn classify_with(
+        &self,
+        uv: [f64; 2],
+        metric: Option<([f64; 3], [f64; 3], f64)>,
+    ) -> (bool, i64) {
         let mut top: Option<(f64, i64)> = None;
         let mut above = 0i64;
         let mut near = false;
@@ -165,7 +174,14 @@ mod tests {
         assert_eq!(t.classify([5., 1.5], su, sv, 0.1), Side::Outside);
         assert_eq!(t.classify([3.95, 3.], su, sv, 0.1), Side::Near);
         // The same loops reversed describe a face whose normal is −S_u×S_v.
-        let rev: Vec<Segment> = s.iter().map(|g| Segment { a: g.b, b: g.a, real: true }).collect();
+        let rev: Vec<Segment> = s
+            .iter()
+            .map(|g| Segment {
+                a: g.b,
+                b: g.a,
+                real: true,
+            })
+            .collect();
         let t = Trim::new(rev, None, -1.0);
         assert_eq!(t.classify([3., 3.], su, sv, 0.1), Side::Inside);
         assert_eq!(t.classify([1.5, 1.5], su, sv, 0.1), Side::Outside);
@@ -176,10 +192,26 @@ mod tests {
         use std::f64::consts::TAU;
         // Cylinder band 0 < v < 1: bottom +u, seam up, top −u, seam down.
         let band = vec![
-            Segment { a: [0., 0.], b: [TAU, 0.], real: true },
-            Segment { a: [TAU, 0.], b: [TAU, 1.], real: false },
-            Segment { a: [TAU, 1.], b: [0., 1.], real: true },
-            Segment { a: [0., 1.], b: [0., 0.], real: false },
+            Segment {
+                a: [0., 0.],
+                b: [TAU, 0.],
+                real: true,
+            },
+            Segment {
+                a: [TAU, 0.],
+                b: [TAU, 1.],
+                real: false,
+            },
+            Segment {
+                a: [TAU, 1.],
+                b: [0., 1.],
+                real: true,
+            },
+            Segment {
+                a: [0., 1.],
+                b: [0., 0.],
+                real: false,
+            },
         ];
         let t = Trim::new(band, Some(TAU), 1.0);
         for u in [-7.0, 0.1, 3.0, 6.2, 20.0] {
@@ -188,7 +220,11 @@ mod tests {
             assert_eq!(t.indicator([u, -0.5]), 0);
         }
         // A cap above v = 0.3 (one loop in +u, not closed in the plane).
-        let cap = vec![Segment { a: [1.0, 0.3], b: [1.0 + TAU, 0.3], real: true }];
+        let cap = vec![Segment {
+            a: [1.0, 0.3],
+            b: [1.0 + TAU, 0.3],
+            real: true,
+        }];
         let t = Trim::new(cap, Some(TAU), 1.0);
         assert_eq!(t.indicator([0.2, 1.0]), 1);
         assert_eq!(t.indicator([0.2, 0.0]), 0);
