@@ -8,7 +8,8 @@
 //! - [`quadrature`]: adaptive Gauss–Kronrod 7/15;
 //! - [`eval`]: the evaluator [`PatchWindingNumber`];
 //! - [`tessellate`]: triangle meshes of patch sets (reference values, products);
-//! - [`surface_quadrature`]: the direct surface integral (the benchmark's baseline).
+//! - [`surface_quadrature`]: the direct surface integral (the benchmark's baseline);
+//! - `step` (feature `io`): trimmed B-rep models from STEP files and their evaluator.
 
 // Homogeneous points are `[f64; 4]` updated component by component in de Casteljau loops;
 // index loops over `0..4` read more plainly than zipped iterators there.
@@ -20,6 +21,8 @@ pub mod eval;
 pub mod io;
 pub mod model;
 pub mod quadrature;
+#[cfg(feature = "io")]
+pub mod step;
 pub mod surface_quadrature;
 pub mod tessellate;
 

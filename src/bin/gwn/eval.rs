@@ -64,11 +64,12 @@ impl From<Ray> for RayAxis {
 ///   gwn eval soup.stl --points q.csv --method fast --beta 2 --order 2
 ///   gwn eval cloud.xyz --points q.csv
 ///   gwn eval teapot.bpt --points q.npy --ray -x       # Bézier patches (.bpt / rational .rbpt)
+///   gwn eval part.step --points q.npy --out w.npy     # trimmed B-rep (STEP AP203/AP214/AP242)
 #[derive(ClapArgs, Debug)]
 #[command(verbatim_doc_comment)]
 pub struct Args {
-    /// Mesh file (.obj, .stl, .off, .ply), oriented point cloud (.xyz, .csv, .pts, .ply), or
-    /// Bézier patch set (.bpt, rational .rbpt).
+    /// Mesh file (.obj, .stl, .off, .ply), oriented point cloud (.xyz, .csv, .pts, .ply),
+    /// Bézier patch set (.bpt, rational .rbpt), or trimmed B-rep model (.step, .stp).
     pub mesh: PathBuf,
     /// Query points file (.csv/.txt/.xyz text or .npy).
     #[arg(long)]
@@ -114,6 +115,9 @@ fn parse_precision(s: &str) -> Result<u32, String> {
 pub fn run(args: Args) -> Result<(), CliError> {
     if gwn::patch::is_patch_path(&args.mesh) {
         return run_patches(&args);
+    }
+    if gwn::patch::step::is_step_path(&args.mesh) {
+        return run_step(&args);
     }
     if let Some(beta) = args.method.beta {
         check_beta(beta)?;
@@ -226,6 +230,44 @@ fn run_patches(args: &Args) -> Result<(), CliError> {
             ));
         }
     };
+    write_outputs(args, &values, None)
+}
+
+/// Trimmed B-rep STEP models: the crossing count plus the surface-boundary integral.
+fn run_step(args: &Args) -> Result<(), CliError> {
+    if args.gradient {
+        return Err(CliError::msg("--gradient is not available for STEP models"));
+    }
+    if !(args.tolerance.is_finite() && args.tolerance > 0.0) {
+        return Err(CliError(format!(
+            "--tolerance must be a positive number, not {}",
+            args.tolerance
+        )));
+    }
+    if args.method.beta.is_some() || args.method.order.is_some() || args.precision.is_some() {
+        return Err(CliError::msg(
+            "--beta, --order and --precision do not apply to STEP models",
+        ));
+    }
+    if args.ray.is_some() {
+        return Err(CliError::msg(
+            "--ray does not apply to STEP models (the evaluator chooses a ray per query)",
+        ));
+    }
+    if !matches!(args.method.method, None | Some(Method::Exact)) {
+        return Err(CliError::msg(
+            "only --method exact is available for STEP models",
+        ));
+    }
+    let model = gwn::patch::step::load_step(&args.mesh)?;
+    let points = gwn::io::points::load_points(&args.points)?;
+    let wn = gwn::patch::step::StepWindingNumber::with_options(
+        &model,
+        gwn::patch::step::StepOptions {
+            tolerance: args.tolerance,
+        },
+    );
+    let values = wn.eval_batch(&points);
     write_outputs(args, &values, None)
 }
 

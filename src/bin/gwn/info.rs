@@ -12,7 +12,7 @@ use crate::common::CliError;
 #[derive(clap::Args)]
 pub struct Args {
     /// Mesh file (.obj, .stl, .off, .ply; detected by content if the extension is unknown), or
-    /// Bézier patch set (.bpt, rational .rbpt).
+    /// Bézier patch set (.bpt, rational .rbpt), or trimmed B-rep model (.step, .stp).
     pub mesh: PathBuf,
     #[command(flatten)]
     pub weld: crate::common::WeldArgs,
@@ -20,6 +20,11 @@ pub struct Args {
 
 /// Loads the mesh and prints its statistics.
 pub fn run(args: Args) -> Result<(), CliError> {
+    if gwn::patch::step::is_step_path(&args.mesh) {
+        let model = gwn::patch::step::load_step(&args.mesh)?;
+        crate::common::write_stdout(format_args!("{}", step_report(&args.mesh, &model)))?;
+        return Ok(());
+    }
     if gwn::patch::is_patch_path(&args.mesh) {
         let set = gwn::patch::load_patches(&args.mesh)?;
         crate::common::write_stdout(format_args!("{}", patch_report(&args.mesh, &set)))?;
@@ -32,6 +37,46 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .write_all(report(&args.mesh, &loaded, &s).as_bytes())
         .map_err(crate::common::stdout_error)?;
     Ok(())
+}
+
+/// The text block `gwn info` prints for a STEP model.
+fn step_report(path: &std::path::Path, model: &gwn::patch::step::StepModel) -> String {
+    let i = model.info();
+    let (lo, hi) = model.bounding_box();
+    let surfaces = i
+        .surfaces
+        .iter()
+        .map(|(k, n)| format!("{n} {k}"))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let rows: Vec<(&str, String)> = vec![
+        ("file", path.display().to_string()),
+        ("format", "STEP (ISO 10303-21) B-rep, trimmed".into()),
+        ("length unit", i.topology.length_unit.clone()),
+        ("solids", i.topology.solids.to_string()),
+        ("shells", i.topology.shells.to_string()),
+        ("faces", i.faces.to_string()),
+        ("surfaces", surfaces),
+        ("Bézier patches", i.patches.to_string()),
+        ("trim polygon segments", i.trim_segments.to_string()),
+        ("edges", i.edges.to_string()),
+        ("edge pairs cancelled", i.cancelled_exact.to_string()),
+        ("edge pairs matched", i.cancelled_matched.to_string()),
+        ("boundary edges", i.boundary_edges.to_string()),
+        ("closed", yes(i.boundary_edges == 0).to_string()),
+        ("bbox min", format!("{lo:?}")),
+        ("bbox max", format!("{hi:?}")),
+    ];
+    let width = rows
+        .iter()
+        .map(|(k, _)| k.chars().count())
+        .max()
+        .unwrap_or(0);
+    let mut out = String::new();
+    for (k, v) in rows {
+        out.push_str(&format!("{k:<width$}  {v}\n"));
+    }
+    out
 }
 
 /// The text block `gwn info` prints for a Bézier patch set.

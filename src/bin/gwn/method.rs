@@ -59,6 +59,8 @@ pub enum Input {
     Cloud(PointCloud),
     /// A set of (rational) Bézier patches (`.bpt`, `.rbpt`).
     Patches(gwn::patch::PatchSet),
+    /// A trimmed B-rep model (`.step`, `.stp`).
+    Step(Box<gwn::patch::step::StepModel>),
 }
 
 impl Input {
@@ -66,6 +68,9 @@ impl Input {
     pub fn load(path: &Path, weld: WeldArgs) -> Result<Input, CliError> {
         if gwn::patch::is_patch_path(path) {
             return Ok(Input::Patches(gwn::patch::load_patches(path)?));
+        }
+        if gwn::patch::step::is_step_path(path) {
+            return Ok(Input::Step(Box::new(gwn::patch::step::load_step(path)?)));
         }
         if is_point_cloud(path) {
             let (cloud, warnings) = gwn::io::cloud::load_point_cloud_with_warnings(path)?;
@@ -85,6 +90,10 @@ impl Input {
                 let (min, max) = p.bounding_box();
                 Some(BoundingBox { min, max })
             }
+            Input::Step(m) => {
+                let (min, max) = m.bounding_box();
+                Some(BoundingBox { min, max })
+            }
         }
     }
 
@@ -98,6 +107,10 @@ impl Input {
             ))),
             Input::Patches(_) => Err(CliError::msg(format!(
                 "{}: is a patch set, but {what} needs a triangle mesh",
+                path.display()
+            ))),
+            Input::Step(_) => Err(CliError::msg(format!(
+                "{}: is a STEP B-rep model, but {what} needs a triangle mesh",
                 path.display()
             ))),
         }
@@ -128,7 +141,7 @@ impl MethodArgs {
     /// The method for `input`: the one asked for, else exact for meshes and fast for clouds.
     pub fn method(&self, input: &Input) -> Method {
         self.method.unwrap_or(match input {
-            Input::Mesh(_) | Input::Patches(_) => Method::Exact,
+            Input::Mesh(_) | Input::Patches(_) | Input::Step(_) => Method::Exact,
             Input::Cloud(_) => Method::Fast,
         })
     }
@@ -179,6 +192,18 @@ impl MethodArgs {
                         ..Default::default()
                     },
                 ))
+            }
+            // The trimmed-model evaluator picks its own ray per query (a product's ray choice,
+            // e.g. a slice's in-plane ray, only serves ray reuse, which it does not do).
+            (Input::Step(model), Method::Exact) => {
+                Box::new(gwn::patch::step::StepWindingNumber::new(model))
+            }
+            (Input::Step(_), m) => {
+                return Err(CliError::msg(format!(
+                    "{}: {} does not apply to a STEP model (use --method exact)",
+                    path.display(),
+                    m.flag()
+                )));
             }
             (Input::Patches(_), m) => {
                 return Err(CliError::msg(format!(

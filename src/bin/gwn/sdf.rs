@@ -46,7 +46,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let sdf = match &input {
         Input::Mesh(mesh) => SignedDistance::with_evaluator(mesh, wn),
         Input::Cloud(cloud) => SignedDistance::with_points(cloud.positions(), wn),
-        Input::Patches(_) => {
+        Input::Patches(_) | Input::Step(_) => {
             return Err(CliError::msg(format!(
                 "{}: sdf needs a triangle mesh or a point cloud (tessellate the patches)",
                 args.mesh.display()

@@ -1,0 +1,653 @@
+//! The winding number of a trimmed B-rep model (paper Eq. 15 with trimming):
+//!
+//! `w(q) = χ + (1/4π) ∮_{∂S} α↓`,
+//!
+//! with `χ` the signed number of crossings of a ray from `q` with the *trimmed* faces (a ray
+//! hit on a patch counts only if its `(u, v)` is inside the face's loops, [`super::trim`]) and
+//! `∂S` the surface boundary (edge uses no other use cancels; empty for a closed model, whose
+//! `w` is then exactly the integer `χ`). `α↓ = −(1 + cos θ) dφ` is the potential of the
+//! solid-angle form singular on the ray (`super::super::curve`), integrated by adaptive
+//! Gauss–Kronrod.
+//!
+//! The ray is chosen per query among fixed directions so that the decision is well posed:
+//! - every boundary curve is certified to stay at an angle of at least `asin μ` from the ray
+//!   (a plane through `q` separates the curve's control hull from the ray with that margin;
+//!   pieces are halved up to [`CERT_DEPTH`] times), so the integrand is smooth and `χ` cannot
+//!   jump without the integral jumping with it;
+//! - every hit is transversal (`|n̂·d| ≥` [`MIN_COSINE`]) and farther than the margin
+//!   [`super::model::HIT_MARGIN`] from its face's trimming loops, so rounding in the loops'
+//!   polygons cannot move it across a shared edge.
+//!
+//! A direction failing either test is dropped and the next is tried. If every direction fails
+//! (the query is on the surface, within the margin of an edge, or surrounded by boundary
+//! curves), a relaxed second pass runs and the result is flagged `uncertified`.
+
+use std::f64::consts::PI;
+
+use rayon::prelude::*;
+
+use super::super::curve::{Form, Homogeneous, integrand, split_half};
+use super::super::quadrature::integrate;
+use super::model::{FacePatch, HIT_MARGIN, StepModel};
+use super::trim::Side;
+use crate::base::compensated::NeumaierSum;
+use crate::base::vec3::{cross, dot, norm, sub};
+
+/// Angular margin of the boundary certificate (`sin` of the angle), first pass.
+const MU: f64 = 0.25;
+/// Relaxed margin of the second pass.
+const MU_RELAXED: f64 = 0.02;
+/// Halvings of a boundary piece when looking for its certificate.
+pub const CERT_DEPTH: u32 = 5;
+/// Smallest `|cos|` between a hit's normal and the ray (grazing hits are ambiguous).
+pub const MIN_COSINE: f64 = 1e-4;
+/// Subdivision depth of a patch before Newton's method starts from the piece's centre.
+const HIT_DEPTH: u32 = 12;
+
+/// Options of the trimmed-model evaluator.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepOptions {
+    /// Target absolute error of `w` from the boundary integral (default `1e-10`; closed
+    /// models have no boundary and are exact integers off the surface).
+    pub tolerance: f64,
+}
+
+impl Default for StepOptions {
+    fn default() -> Self {
+        StepOptions { tolerance: 1e-10 }
+    }
+}
+
+/// One evaluation with diagnostics.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepEvaluation {
+    /// The winding number.
+    pub value: f64,
+    /// The crossing count `χ`.
+    pub crossings: i64,
+    /// Error estimate of the boundary integral (units of `w`).
+    pub error_estimate: f64,
+    /// Ray directions tried.
+    pub rays: usize,
+    /// No direction passed the tests (query on or within the margins of the surface or an
+    /// edge): the value is a best effort.
+    pub uncertified: bool,
+}
+
+/// The evaluator.
+#[derive(Clone, Debug)]
+pub struct StepWindingNumber {
+    model: StepModel,
+    options: StepOptions,
+    dirs: Vec<[f64; 3]>,
+    margin: f64,
+}
+
+/// A ray frame: `e1`, `e2`, `d` right-handed.
+#[derive(Clone, Copy)]
+struct RayFrame {
+    e1: [f64; 3],
+    e2: [f64; 3],
+    d: [f64; 3],
+}
+
+impl RayFrame {
+    fn new(d: [f64; 3]) -> RayFrame {
+        let a = if d[0].abs() < 0.6 {
+            [1.0, 0.0, 0.0]
+        } else {
+            [0.0, 1.0, 0.0]
+        };
+        let e1 = cross(d, a);
+        let n = norm(e1);
+        let e1 = [e1[0] / n, e1[1] / n, e1[2] / n];
+        let e2 = cross(d, e1);
+        RayFrame { e1, e2, d }
+    }
+    fn map(&self, r: [f64; 3]) -> [f64; 3] {
+        [dot(self.e1, r), dot(self.e2, r), dot(self.d, r)]
+    }
+    fn hom(&self, h: Homogeneous, q: [f64; 3]) -> Homogeneous {
+        let r = [h[0] - h[3] * q[0], h[1] - h[3] * q[1], h[2] - h[3] * q[2]];
+        let f = self.map(r);
+        [f[0], f[1], f[2], h[3]]
+    }
+}
+
+/// 14 directions: the axes and the cube diagonals, turned by a fixed irrational rotation so
+/// that none is parallel to the coordinate planes CAD models are full of.
+fn directions() -> Vec<[f64; 3]> {
+    let (a, b, c) = (0.3125_f64, 0.6875_f64, 1.0625_f64);
+    let rot = |v: [f64; 3]| {
+        let (s, co) = a.sin_cos();
+        let v = [v[0], co * v[1] - s * v[2], s * v[1] + co * v[2]];
+        let (s, co) = b.sin_cos();
+        let v = [co * v[0] + s * v[2], v[1], -s * v[0] + co * v[2]];
+        let (s, co) = c.sin_cos();
+        [co * v[0] - s * v[1], s * v[0] + co * v[1], v[2]]
+    };
+    let mut out = Vec::new();
+    for v in [
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+        [1.0, 0.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, -1.0, 0.0],
+    ] {
+        out.push(rot(v));
+    }
+    let k = 1.0 / 3f64.sqrt();
+    for sx in [1.0, -1.0] {
+        for sy in [1.0, -1.0] {
+            for sz in [1.0, -1.0] {
+                out.push(rot([sx * k, sy * k, sz * k]));
+            }
+        }
+    }
+    out
+}
+
+/// One ray hit for diagnostics: face `#id`, point, `(u, v)`, trimming side, distance to the
+/// face's loops (to a factor of 2).
+pub type HitReport = (u64, [f64; 3], [f64; 2], Side, f64);
+
+/// Why a direction was rejected.
+enum Reject {
+    Boundary,
+    Hit,
+}
+
+impl StepWindingNumber {
+    /// An evaluator with default options.
+    pub fn new(model: &StepModel) -> Self {
+        Self::with_options(model, StepOptions::default())
+    }
+
+    /// An evaluator with the given options (a non-positive tolerance becomes the default).
+    pub fn with_options(model: &StepModel, mut options: StepOptions) -> Self {
+        if !(options.tolerance.is_finite() && options.tolerance > 0.0) {
+            options.tolerance = StepOptions::default().tolerance;
+        }
+        StepWindingNumber {
+            margin: HIT_MARGIN * model.diagonal(),
+            model: model.clone(),
+            options,
+            dirs: directions(),
+        }
+    }
+
+    /// The model.
+    pub fn model(&self) -> &StepModel {
+        &self.model
+    }
+
+    /// The winding number at `q` (NaN for a non-finite query).
+    pub fn eval(&self, q: [f64; 3]) -> f64 {
+        self.evaluate(q).value
+    }
+
+    /// Winding numbers at many points, in parallel.
+    pub fn eval_batch(&self, points: &[[f64; 3]]) -> Vec<f64> {
+        points.par_iter().map(|&q| self.eval(q)).collect()
+    }
+
+    /// The winding number with diagnostics.
+    pub fn evaluate(&self, q: [f64; 3]) -> StepEvaluation {
+        if q.iter().any(|c| !c.is_finite()) {
+            return StepEvaluation {
+                value: f64::NAN,
+                ..StepEvaluation::default()
+            };
+        }
+        let mut rays = 0;
+        for (mu, margin, strict) in [(MU, self.margin, true), (MU_RELAXED, 0.0, false)] {
+            for &d in &self.dirs {
+                rays += 1;
+                match self.try_ray(q, d, mu, margin, strict) {
+                    Ok(mut e) => {
+                        e.rays = rays;
+                        e.uncertified = !strict;
+                        return e;
+                    }
+                    Err(Reject::Boundary) | Err(Reject::Hit) => continue,
+                }
+            }
+        }
+        // Nothing passed even relaxed: the first direction without any test.
+        let mut e = self
+            .try_ray(q, self.dirs[0], 0.0, 0.0, false)
+            .unwrap_or_default();
+        e.rays = rays + 1;
+        e.uncertified = true;
+        e
+    }
+
+    /// The value along one given ray direction `d` (unit), without choosing: `None` if the
+    /// direction fails the certificates. For diagnostics and tests of direction independence.
+    pub fn evaluate_along(&self, q: [f64; 3], d: [f64; 3]) -> Option<StepEvaluation> {
+        self.try_ray(q, d, MU, self.margin, true).ok()
+    }
+
+    /// Every hit of the ray from `q` along `d` on every face's patches: `(face #id, point,
+    /// (u, v), trimming side)`, before any test. For diagnostics.
+    pub fn hits_along(&self, q: [f64; 3], d: [f64; 3]) -> Vec<HitReport> {
+        let frame = RayFrame::new(d);
+        let mut out = Vec::new();
+        for face in &self.model.faces {
+            let mut hits = Vec::new();
+            for fp in &face.patches {
+                if ray_meets_box(q, frame.d, fp.lo, fp.hi, 1e-9 * self.model.diagonal()) {
+                    patch_hits(fp, q, &frame, &mut hits);
+                }
+            }
+            for h in hits {
+                let side = face.trim.classify(h.uv, h.su, h.sv, self.margin);
+                // Distance to the loops, to a factor of 2 (first smallest margin that is near).
+                let mut dist = f64::INFINITY;
+                let mut m = self.model.diagonal();
+                while m > 1e-12 * self.model.diagonal() {
+                    if face.trim.classify(h.uv, h.su, h.sv, m) == Side::Near {
+                        dist = m;
+                    }
+                    m *= 0.5;
+                }
+                out.push((face.id, h.point, h.uv, side, dist));
+            }
+        }
+        out
+    }
+
+    /// The candidate ray directions, in the order they are tried.
+    pub fn directions(&self) -> &[[f64; 3]] {
+        &self.dirs
+    }
+
+    fn try_ray(
+        &self,
+        q: [f64; 3],
+        d: [f64; 3],
+        mu: f64,
+        margin: f64,
+        strict: bool,
+    ) -> Result<StepEvaluation, Reject> {
+        let frame = RayFrame::new(d);
+        // Certify the boundary first (cheap), then the hits.
+        let mut pieces = Vec::new();
+        for c in &self.model.boundary {
+            let h: Vec<Homogeneous> = c.iter().map(|&p| frame.hom(p, q)).collect();
+            if !certify(h, mu, 0, &mut pieces) && strict {
+                return Err(Reject::Boundary);
+            }
+        }
+        let chi = self.crossings(q, &frame, margin, strict)?;
+        let mut sum = NeumaierSum::new();
+        let mut err = 0.0;
+        let tol = self.options.tolerance * 4.0 * PI / (pieces.len().max(1) as f64);
+        for c in &pieces {
+            let r = integrate(
+                |t| {
+                    let (n, dn) = super::super::curve::eval_with_derivative(c, t);
+                    integrand(Form::Down, n, dn)
+                },
+                0.0,
+                1.0,
+                tol,
+            );
+            sum.add(r.value);
+            err += r.error;
+        }
+        Ok(StepEvaluation {
+            value: chi as f64 + sum.value() / (4.0 * PI),
+            crossings: chi,
+            error_estimate: err / (4.0 * PI),
+            rays: 0,
+            uncertified: false,
+        })
+    }
+
+    /// Signed count of trimmed-face crossings of the ray; `Err` if some hit is ambiguous.
+    fn crossings(
+        &self,
+        q: [f64; 3],
+        frame: &RayFrame,
+        margin: f64,
+        strict: bool,
+    ) -> Result<i64, Reject> {
+        let mut chi = 0i64;
+        let dedup = 1e-9 * self.model.diagonal();
+        for face in &self.model.faces {
+            let mut hits: Vec<Hit> = Vec::new();
+            for fp in &face.patches {
+                if !ray_meets_box(q, frame.d, fp.lo, fp.hi, dedup) {
+                    continue;
+                }
+                patch_hits(fp, q, frame, &mut hits);
+            }
+            let mut kept: Vec<Hit> = Vec::new();
+            for h in hits {
+                if kept.iter().all(|k| norm(sub(k.point, h.point)) > dedup) {
+                    kept.push(h);
+                }
+            }
+            for h in kept {
+                let n = cross(h.su, h.sv);
+                let nn = norm(n);
+                let c = face.sense * dot(n, frame.d) / nn;
+                if strict
+                    && (nn.is_nan() || nn <= 0.0 || c.abs() < MIN_COSINE || h.tau.abs() <= margin)
+                {
+                    return Err(Reject::Hit);
+                }
+                if h.tau <= 0.0 {
+                    continue;
+                }
+                match face.trim.classify(h.uv, h.su, h.sv, margin) {
+                    Side::Inside => chi += if c > 0.0 { 1 } else { -1 },
+                    Side::Outside => {}
+                    Side::Near if strict => return Err(Reject::Hit),
+                    Side::Near => {
+                        if face.trim.indicator(h.uv) == 1 {
+                            chi += if c > 0.0 { 1 } else { -1 };
+                        }
+                    }
+                }
+            }
+        }
+        Ok(chi)
+    }
+}
+
+/// Certifies a boundary piece (homogeneous, ray frame) against the ray `+z` with margin `mu`,
+/// halving it up to [`CERT_DEPTH`] times; certified pieces go to `out`. Returns `false` (and
+/// still pushes the pieces) if some part could not be certified.
+fn certify(h: Vec<Homogeneous>, mu: f64, depth: u32, out: &mut Vec<Vec<Homogeneous>>) -> bool {
+    let pts: Vec<[f64; 3]> = h
+        .iter()
+        .map(|p| [p[0] / p[3], p[1] / p[3], p[2] / p[3]])
+        .collect();
+    if pts.iter().all(|p| p[2] < 0.0) {
+        out.push(h);
+        return true;
+    }
+    let (mut mx, mut my) = (0.0, 0.0);
+    for p in &pts {
+        let r = norm(*p);
+        if r > 0.0 {
+            mx += p[0] / r;
+            my += p[1] / r;
+        }
+    }
+    let m = (mx * mx + my * my).sqrt();
+    if m > 0.0 {
+        let (hx, hy) = (mx / m, my / m);
+        let s = std::f64::consts::FRAC_1_SQRT_2;
+        for n in [[hx, hy, 0.0], [s * hx, s * hy, -s]] {
+            if pts
+                .iter()
+                .all(|p| dot(n, *p) >= mu * norm(*p) && dot(n, *p) > 0.0)
+            {
+                out.push(h);
+                return true;
+            }
+        }
+    }
+    if depth >= CERT_DEPTH {
+        out.push(h);
+        return false;
+    }
+    let (a, b) = split_half(&h);
+    let ok_a = certify(a, mu, depth + 1, out);
+    let ok_b = certify(b, mu, depth + 1, out);
+    ok_a && ok_b
+}
+
+/// Slab test of the ray `q + τ d, τ ≥ 0` against a box grown by `pad`.
+fn ray_meets_box(q: [f64; 3], d: [f64; 3], lo: [f64; 3], hi: [f64; 3], pad: f64) -> bool {
+    let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
+    for k in 0..3 {
+        let (a, b) = (lo[k] - pad - q[k], hi[k] + pad - q[k]);
+        if d[k] == 0.0 {
+            if a > 0.0 || b < 0.0 {
+                return false;
+            }
+            continue;
+        }
+        let (mut ta, mut tb) = (a / d[k], b / d[k]);
+        if ta > tb {
+            std::mem::swap(&mut ta, &mut tb);
+        }
+        t0 = t0.max(ta);
+        t1 = t1.min(tb);
+        if t0 > t1 {
+            return false;
+        }
+    }
+    true
+}
+
+struct Hit {
+    point: [f64; 3],
+    uv: [f64; 2],
+    su: [f64; 3],
+    sv: [f64; 3],
+    tau: f64,
+}
+
+/// A piece of a patch in the ray frame: homogeneous net and its parameter rectangle.
+struct Piece {
+    h: Vec<Homogeneous>,
+    s: [f64; 2],
+    t: [f64; 2],
+}
+
+/// Ray hits on one patch: subdivision culls pieces whose control hull misses the ray's line
+/// (xy box not containing the origin) or lies behind `q`; at depth [`HIT_DEPTH`] or once a piece
+/// is small, Newton's method from its centre; a root counts for the piece containing it.
+fn patch_hits(fp: &FacePatch, q: [f64; 3], frame: &RayFrame, out: &mut Vec<Hit>) {
+    let patch = &fp.patch;
+    let (m, n) = patch.degree();
+    let h: Vec<Homogeneous> = patch
+        .points()
+        .iter()
+        .zip(patch.weights())
+        .map(|(p, &w)| {
+            let f = frame.map(sub(*p, q));
+            [w * f[0], w * f[1], w * f[2], w]
+        })
+        .collect();
+    let size = norm(sub(fp.hi, fp.lo));
+    let mut stack = vec![(
+        Piece {
+            h,
+            s: [0.0, 1.0],
+            t: [0.0, 1.0],
+        },
+        0u32,
+    )];
+    while let Some((piece, depth)) = stack.pop() {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in &piece.h {
+            for k in 0..3 {
+                let x = p[k] / p[3];
+                lo[k] = lo[k].min(x);
+                hi[k] = hi[k].max(x);
+            }
+        }
+        let pad = 1e-12 * size;
+        if lo[0] > pad || hi[0] < -pad || lo[1] > pad || hi[1] < -pad || hi[2] < -pad {
+            continue;
+        }
+        let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]).max(hi[2] - lo[2]);
+        if depth >= HIT_DEPTH
+            || (depth >= 2 && extent <= 0.05 * size && single_root(fp, frame, &piece))
+        {
+            if let Some(hit) = newton(fp, q, frame, &piece) {
+                out.push(hit);
+            }
+            continue;
+        }
+        for (a, b) in split4(&piece, m, n) {
+            stack.push((a, depth + 1));
+            stack.push((b, depth + 1));
+        }
+    }
+}
+
+/// Whether a small piece can hold only one crossing of the ray: its normals at the corners and
+/// the centre lie within 30° of each other and all make an angle of at least ~6° with the
+/// ray's plane (`|n̂·d| ≥ 0.1`), so the piece is a graph over the plane normal to the ray. A
+/// ray that enters and leaves one piece (near tangency) is subdivided further.
+fn single_root(fp: &FacePatch, frame: &RayFrame, piece: &Piece) -> bool {
+    let at = |s: f64, t: f64| {
+        let (_, ds, dt) = fp.patch.eval_with_partials(s, t);
+        let n = cross(ds, dt);
+        let l = norm(n);
+        if l > 0.0 {
+            Some([n[0] / l, n[1] / l, n[2] / l])
+        } else {
+            None
+        }
+    };
+    let (s0, s1, t0, t1) = (piece.s[0], piece.s[1], piece.t[0], piece.t[1]);
+    let Some(c) = at(0.5 * (s0 + s1), 0.5 * (t0 + t1)) else {
+        return false;
+    };
+    let side = dot(c, frame.d);
+    if side.abs() < 0.1 {
+        return false;
+    }
+    [(s0, t0), (s0, t1), (s1, t0), (s1, t1)]
+        .iter()
+        .all(|&(s, t)| match at(s, t) {
+            Some(n) => dot(n, c) >= 0.866 && dot(n, frame.d) * side.signum() >= 0.1,
+            None => false,
+        })
+}
+
+/// Halves a piece in `s` and in `t` (four pieces, returned in pairs).
+fn split4(piece: &Piece, m: usize, n: usize) -> Vec<(Piece, Piece)> {
+    let (sa, sb) = split_dir(&piece.h, m, n, true);
+    let sm = 0.5 * (piece.s[0] + piece.s[1]);
+    let tm = 0.5 * (piece.t[0] + piece.t[1]);
+    let mut out = Vec::new();
+    for (hs, s) in [(sa, [piece.s[0], sm]), (sb, [sm, piece.s[1]])] {
+        let (ta, tb) = split_dir(&hs, m, n, false);
+        out.push((
+            Piece {
+                h: ta,
+                s,
+                t: [piece.t[0], tm],
+            },
+            Piece {
+                h: tb,
+                s,
+                t: [tm, piece.t[1]],
+            },
+        ));
+    }
+    out
+}
+
+/// Halves a row-major `(m+1) × (n+1)` net along `s` (rows) or `t` (columns).
+fn split_dir(
+    h: &[Homogeneous],
+    m: usize,
+    n: usize,
+    along_s: bool,
+) -> (Vec<Homogeneous>, Vec<Homogeneous>) {
+    let mut a = vec![[0.0; 4]; h.len()];
+    let mut b = vec![[0.0; 4]; h.len()];
+    if along_s {
+        for j in 0..=n {
+            let col: Vec<Homogeneous> = (0..=m).map(|i| h[i * (n + 1) + j]).collect();
+            let (l, r) = split_half(&col);
+            for i in 0..=m {
+                a[i * (n + 1) + j] = l[i];
+                b[i * (n + 1) + j] = r[i];
+            }
+        }
+    } else {
+        for i in 0..=m {
+            let row = &h[i * (n + 1)..(i + 1) * (n + 1)];
+            let (l, r) = split_half(row);
+            a[i * (n + 1)..(i + 1) * (n + 1)].copy_from_slice(&l);
+            b[i * (n + 1)..(i + 1) * (n + 1)].copy_from_slice(&r);
+        }
+    }
+    (a, b)
+}
+
+/// Newton's method for `x(s, t) = y(s, t) = 0` in the ray frame, from the piece's centre.
+fn newton(fp: &FacePatch, q: [f64; 3], frame: &RayFrame, piece: &Piece) -> Option<Hit> {
+    let mut st = [
+        0.5 * (piece.s[0] + piece.s[1]),
+        0.5 * (piece.t[0] + piece.t[1]),
+    ];
+    let centre = [
+        0.5 * (fp.lo[0] + fp.hi[0]),
+        0.5 * (fp.lo[1] + fp.hi[1]),
+        0.5 * (fp.lo[2] + fp.hi[2]),
+    ];
+    let scale = norm(sub(fp.hi, fp.lo)) + norm(sub(centre, q));
+    let mut converged = false;
+    for _ in 0..40 {
+        let (p, ds, dt) = fp.patch.eval_with_partials(st[0], st[1]);
+        let r = frame.map(sub(p, q));
+        let a = [dot(frame.e1, ds), dot(frame.e1, dt)];
+        let b = [dot(frame.e2, ds), dot(frame.e2, dt)];
+        let det = a[0] * b[1] - a[1] * b[0];
+        if det == 0.0 || !det.is_finite() {
+            return None;
+        }
+        let d0 = (r[0] * b[1] - a[1] * r[1]) / det;
+        let d1 = (a[0] * r[1] - r[0] * b[0]) / det;
+        st = [(st[0] - d0).clamp(-0.5, 1.5), (st[1] - d1).clamp(-0.5, 1.5)];
+        if d0.abs() + d1.abs() < 1e-14 || (r[0].abs() + r[1].abs()) < 1e-15 * scale {
+            converged = true;
+            break;
+        }
+    }
+    if !converged {
+        return None;
+    }
+    let tol = 1e-10;
+    if st[0] < piece.s[0] - tol
+        || st[0] > piece.s[1] + tol
+        || st[1] < piece.t[0] - tol
+        || st[1] > piece.t[1] + tol
+    {
+        return None;
+    }
+    // Roots on a piece's border are found by both neighbours; `tol` keeps the one at the
+    // patch border inside [0, 1]².
+    let st = [st[0].clamp(0.0, 1.0), st[1].clamp(0.0, 1.0)];
+    let (p, ds, dt) = fp.patch.eval_with_partials(st[0], st[1]);
+    let r = frame.map(sub(p, q));
+    if (r[0] * r[0] + r[1] * r[1]).sqrt() > 1e-9 * scale {
+        return None;
+    }
+    let du = fp.u[1] - fp.u[0];
+    let dv = fp.v[1] - fp.v[0];
+    Some(Hit {
+        point: p,
+        uv: [fp.u[0] + st[0] * du, fp.v[0] + st[1] * dv],
+        su: [ds[0] / du, ds[1] / du, ds[2] / du],
+        sv: [dt[0] / dv, dt[1] / dv, dt[2] / dv],
+        tau: r[2],
+    })
+}
+
+/// Trimmed models plug into grids and products like the other evaluators.
+impl crate::eval::Evaluator for StepWindingNumber {
+    fn eval(&self, q: [f64; 3]) -> f64 {
+        StepWindingNumber::eval(self, q)
+    }
+    fn name(&self) -> &'static str {
+        "exact (trimmed B-rep)"
+    }
+    fn eval_batch(&self, points: &[[f64; 3]]) -> Vec<f64> {
+        StepWindingNumber::eval_batch(self, points)
+    }
+}

@@ -1,0 +1,469 @@
+//! A trimmed B-rep model ready for evaluation: per face its Bézier patches and trimming
+//! polygon in `(u, v)`; for the whole model the surface boundary (edge uses that no other use
+//! cancels) as rational Bézier curves.
+
+use std::collections::{BTreeMap, HashMap};
+
+use super::super::curve::{Homogeneous, eval_with_derivative};
+use super::super::model::Patch;
+use super::StepError;
+use super::brep::{Reader, Topology, reverse};
+use super::nurbs::{euc, point_at};
+use super::part21::Part21;
+use super::surface::{Surface, invert_curve};
+use super::trim::{Segment, Trim};
+use crate::base::vec3::{dot, norm, sub};
+
+/// Chord tolerance of the trimming polygons, relative to the model's diagonal: a loop's
+/// polygon in `(u, v)`, mapped back to 3D, stays this close to the edge curves.
+pub const TRIM_CHORD: f64 = 2e-7;
+/// Near-boundary margin of ray hits, relative to the diagonal: a hit this close to a trimming
+/// loop (in 3D, to first order) makes the evaluator choose another ray. Ten times the chord
+/// tolerance, so the polygons of two faces sharing an edge cannot disagree outside it
+/// (nor can faces whose surfaces miss the shared edge by up to this much, as in
+/// `sliced_cylinder.step`, where the cylinder's radius is 10.0000038 and its circles' 10).
+pub const HIT_MARGIN: f64 = 2e-6;
+/// Edge uses left over after exact cancellation (same `EDGE_CURVE`, opposite directions) are
+/// matched geometrically: two uses cancel when their end points swap and three interior points
+/// of one lie on the other, all within this tolerance relative to the diagonal, and their
+/// tangents are opposite. For files that store each face in its own shell with its own copy
+/// of every edge (`open_cylinder`, `spring`).
+pub const EDGE_MATCH: f64 = 1e-6;
+
+/// One patch of a face with its parameter rectangle and control-point box.
+#[derive(Clone, Debug)]
+pub struct FacePatch {
+    /// The patch (rows along `u`).
+    pub patch: Patch,
+    /// `[u0, u1]`.
+    pub u: [f64; 2],
+    /// `[v0, v1]`.
+    pub v: [f64; 2],
+    /// Box of the control points (contains the patch).
+    pub lo: [f64; 3],
+    /// Upper corner.
+    pub hi: [f64; 3],
+}
+
+/// One trimmed face.
+#[derive(Clone, Debug)]
+pub struct Face {
+    /// `#id` in the file.
+    pub id: u64,
+    /// Patches covering the face's parameter rectangle.
+    pub patches: Vec<FacePatch>,
+    /// The trimming loops.
+    pub trim: Trim,
+    /// `+1` if the face normal is `S_u × S_v`, `−1` otherwise (`same_sense`).
+    pub sense: f64,
+}
+
+/// Counts for `gwn info`.
+#[derive(Clone, Debug, Default)]
+pub struct StepInfo {
+    /// Faces.
+    pub faces: usize,
+    /// Bézier patches over all faces.
+    pub patches: usize,
+    /// Faces per surface kind.
+    pub surfaces: BTreeMap<&'static str, usize>,
+    /// Distinct `EDGE_CURVE`s used by the faces.
+    pub edges: usize,
+    /// Edge-use pairs cancelled exactly (one `EDGE_CURVE`, opposite directions).
+    pub cancelled_exact: usize,
+    /// Edge-use pairs cancelled by the geometric match ([`EDGE_MATCH`]).
+    pub cancelled_matched: usize,
+    /// Edge uses left as the surface boundary.
+    pub boundary_edges: usize,
+    /// Solids and shells, length unit.
+    pub topology: Topology,
+    /// Segments of all trimming polygons.
+    pub trim_segments: usize,
+}
+
+/// A trimmed B-rep model read from a STEP file.
+#[derive(Clone, Debug)]
+pub struct StepModel {
+    pub(crate) faces: Vec<Face>,
+    /// Surface boundary: homogeneous Bézier curves in world coordinates, oriented as the
+    /// boundary of their faces.
+    pub(crate) boundary: Vec<Vec<Homogeneous>>,
+    pub(crate) lo: [f64; 3],
+    pub(crate) hi: [f64; 3],
+    pub(crate) info: StepInfo,
+}
+
+impl StepModel {
+    /// Counts and units.
+    pub fn info(&self) -> &StepInfo {
+        &self.info
+    }
+
+    /// Bounding box of the faces' patch control points (contains the model).
+    pub fn bounding_box(&self) -> ([f64; 3], [f64; 3]) {
+        (self.lo, self.hi)
+    }
+
+    /// Diagonal of the bounding box.
+    pub fn diagonal(&self) -> f64 {
+        norm(sub(self.hi, self.lo))
+    }
+
+    /// The faces.
+    pub fn faces(&self) -> &[Face] {
+        &self.faces
+    }
+
+    /// Surface-boundary curves (homogeneous control points, world coordinates).
+    pub fn boundary(&self) -> &[Vec<Homogeneous>] {
+        &self.boundary
+    }
+
+    /// Builds the model from a parsed file.
+    pub fn from_part21(file: &Part21) -> Result<StepModel, StepError> {
+        let mut reader = Reader::new(file);
+        let (raw, topology) = reader.faces()?;
+        // Model size from the edge geometry (the faces' extent before their patches exist).
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for pieces in reader.edges.values() {
+            for c in pieces {
+                for h in c {
+                    let p = euc(*h);
+                    for k in 0..3 {
+                        lo[k] = lo[k].min(p[k]);
+                        hi[k] = hi[k].max(p[k]);
+                    }
+                }
+            }
+        }
+        let diag = norm(sub(hi, lo));
+        if !(diag.is_finite() && diag > 0.0) {
+            return Err(StepError::NoFaces);
+        }
+        let chord = TRIM_CHORD * diag;
+        let mut info = StepInfo {
+            topology,
+            ..StepInfo::default()
+        };
+        let mut faces = Vec::with_capacity(raw.len());
+        // Edge uses over the whole model, for the boundary.
+        let mut uses: Vec<(u64, bool)> = Vec::new();
+        for f in &raw {
+            *info.surfaces.entry(f.surface.kind()).or_default() += 1;
+            let (period_u, period_v) = f.surface.periods();
+            let sense = if f.same_sense { 1.0 } else { -1.0 };
+            let mut count: HashMap<u64, usize> = HashMap::new();
+            for l in &f.loops {
+                for u in l {
+                    *count.entry(u.edge).or_default() += 1;
+                    uses.push((u.edge, u.forward));
+                }
+            }
+            let mut segments = Vec::new();
+            for l in &f.loops {
+                let mut poly: Vec<[f64; 2]> = Vec::new();
+                let mut real: Vec<bool> = Vec::new();
+                let mut hint: Option<[f64; 2]> = None;
+                for u in l {
+                    let geom = reader.edges[&u.edge].clone();
+                    let geom = if u.forward { geom } else { reverse(geom) };
+                    let seam = count[&u.edge] > 1;
+                    for c in &geom {
+                        let pts = sample(c, &f.surface, &mut hint, chord);
+                        for (k, uv) in pts.into_iter().enumerate() {
+                            if k == 0 && !poly.is_empty() {
+                                continue; // shared with the previous piece's end
+                            }
+                            if !poly.is_empty() {
+                                real.push(!seam);
+                            }
+                            poly.push(uv);
+                        }
+                    }
+                }
+                if poly.len() < 2 {
+                    continue;
+                }
+                for k in 0..poly.len() - 1 {
+                    segments.push(Segment {
+                        a: poly[k],
+                        b: poly[k + 1],
+                        real: real[k],
+                    });
+                }
+                // Close the loop in the period copy next to its end (a band's end is its start
+                // moved by a whole period: nothing to add).
+                let (first, last) = (poly[0], poly[poly.len() - 1]);
+                let mut target = first;
+                if let Some(p) = period_u {
+                    target[0] += p * ((last[0] - first[0]) / p).round();
+                }
+                if let Some(p) = period_v {
+                    target[1] += p * ((last[1] - first[1]) / p).round();
+                }
+                if target != last {
+                    segments.push(Segment {
+                        a: last,
+                        b: target,
+                        real: true,
+                    });
+                }
+            }
+            if segments.is_empty() {
+                return Err(StepError::Invalid {
+                    id: f.id,
+                    entity: "ADVANCED_FACE".into(),
+                    message: "no edge loop (faces bounded only by vertex loops are not supported)"
+                        .into(),
+                });
+            }
+            info.trim_segments += segments.len();
+            let trim = Trim::new(segments, period_u, sense);
+            let [u0, mut u1, mut v0, mut v1] = trim.bbox;
+            if let Some(p) = period_u {
+                u1 = u1.min(u0 + p);
+            }
+            if let Some(p) = period_v {
+                v1 = v1.min(v0 + p);
+            }
+            if let Some([b0, b1]) = f.surface.v_bounds() {
+                // A cap: the face reaches the pole when the indicator is 1 next to it.
+                let um = u0 + 0.371 * (u1 - u0);
+                if trim.indicator([um, b1 - 1e-12]) == 1 {
+                    v1 = b1;
+                }
+                if trim.indicator([um, b0 + 1e-12]) == 1 {
+                    v0 = b0;
+                }
+            }
+            if !(u1 > u0 && v1 > v0) {
+                return Err(StepError::Invalid {
+                    id: f.id,
+                    entity: "ADVANCED_FACE".into(),
+                    message: "its loops enclose no area in the surface's parameters".into(),
+                });
+            }
+            let uvp = f
+                .surface
+                .patches([u0, u1], [v0, v1])
+                .map_err(|m| StepError::Invalid {
+                    id: f.id,
+                    entity: "ADVANCED_FACE".into(),
+                    message: m,
+                })?;
+            let patches: Vec<FacePatch> = uvp
+                .into_iter()
+                .map(|p| {
+                    let mut plo = [f64::INFINITY; 3];
+                    let mut phi = [f64::NEG_INFINITY; 3];
+                    for x in p.patch.points() {
+                        for k in 0..3 {
+                            plo[k] = plo[k].min(x[k]);
+                            phi[k] = phi[k].max(x[k]);
+                        }
+                    }
+                    FacePatch {
+                        patch: p.patch,
+                        u: p.u,
+                        v: p.v,
+                        lo: plo,
+                        hi: phi,
+                    }
+                })
+                .collect();
+            info.patches += patches.len();
+            faces.push(Face {
+                id: f.id,
+                patches,
+                trim,
+                sense,
+            });
+        }
+        info.faces = faces.len();
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for f in &faces {
+            for p in &f.patches {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(p.lo[k]);
+                    hi[k] = hi[k].max(p.hi[k]);
+                }
+            }
+        }
+        let boundary = surface_boundary(&reader, &uses, EDGE_MATCH * diag, &mut info);
+        Ok(StepModel {
+            faces,
+            boundary,
+            lo,
+            hi,
+            info,
+        })
+    }
+}
+
+/// Samples a Bézier piece into `(u, v)` points (start and end included): bisection until the
+/// curve's midpoint is within `chord` of the chord in 3D and the inverted midpoint within
+/// `chord` (to first order, scaled by the chord's 3D/uv length ratio) of the uv chord.
+fn sample(
+    c: &[Homogeneous],
+    surface: &Surface,
+    hint: &mut Option<[f64; 2]>,
+    chord: f64,
+) -> Vec<[f64; 2]> {
+    let p0 = point_at(c, 0.0);
+    let uv0 = surface.invert(p0, *hint);
+    let mut out = vec![uv0];
+    // Explicit stack of intervals (t0, t1, depth) in order; points carried with their uv.
+    let p1 = point_at(c, 1.0);
+    let uv1 = surface.invert(p1, Some(uv0));
+    let mut stack = vec![(1.0, p1, uv1, 0u32)];
+    let mut cur = (0.0, p0, uv0);
+    while let Some((t1, q1, w1, depth)) = stack.pop() {
+        let (t0, q0, w0) = cur;
+        let tm = 0.5 * (t0 + t1);
+        let qm = point_at(c, tm);
+        let wm = surface.invert(qm, Some(w0));
+        let mid3 = [
+            0.5 * (q0[0] + q1[0]),
+            0.5 * (q0[1] + q1[1]),
+            0.5 * (q0[2] + q1[2]),
+        ];
+        let dev3 = norm(sub(qm, mid3));
+        let duv = ((w1[0] - w0[0]).powi(2) + (w1[1] - w0[1]).powi(2)).sqrt();
+        let ratio = if duv > 0.0 {
+            norm(sub(q1, q0)) / duv
+        } else {
+            0.0
+        };
+        let devuv = ((wm[0] - 0.5 * (w0[0] + w1[0])).powi(2)
+            + (wm[1] - 0.5 * (w0[1] + w1[1])).powi(2))
+        .sqrt()
+            * ratio;
+        // A piece shorter than the chord tolerance is not refined for its uv deviation: at a
+        // pole or a collapsed edge the uv image of one 3D point is a whole segment.
+        let short = norm(sub(q1, q0)) <= chord && dev3 <= chord;
+        if depth < 22 && (depth < 2 || dev3 > chord || (devuv > chord && !short)) {
+            stack.push((t1, q1, w1, depth + 1));
+            stack.push((tm, qm, wm, depth + 1));
+        } else {
+            out.push(w1);
+            cur = (t1, q1, w1);
+        }
+    }
+    *hint = out.last().copied();
+    out
+}
+
+/// The edge uses that no other use cancels, as Bézier pieces. Exact cancellation first (one
+/// `EDGE_CURVE` used in both directions), then the geometric match of [`EDGE_MATCH`].
+fn surface_boundary(
+    reader: &Reader<'_>,
+    uses: &[(u64, bool)],
+    tol: f64,
+    info: &mut StepInfo,
+) -> Vec<Vec<Homogeneous>> {
+    let mut per_edge: HashMap<u64, (usize, usize)> = HashMap::new();
+    for &(e, fwd) in uses {
+        let c = per_edge.entry(e).or_default();
+        if fwd {
+            c.0 += 1;
+        } else {
+            c.1 += 1;
+        }
+    }
+    info.edges = per_edge.len();
+    let mut left: Vec<Vec<Vec<Homogeneous>>> = Vec::new();
+    let mut ids: Vec<u64> = per_edge.keys().copied().collect();
+    ids.sort_unstable();
+    for e in ids {
+        let (f, r) = per_edge[&e];
+        let pairs = f.min(r);
+        info.cancelled_exact += pairs;
+        let geom = &reader.edges[&e];
+        for _ in pairs..f {
+            left.push(geom.clone());
+        }
+        for _ in pairs..r {
+            left.push(reverse(geom.clone()));
+        }
+    }
+    // Geometric match among the leftovers.
+    let probes: Vec<Probe> = left.iter().map(|g| Probe::new(g)).collect();
+    let mut used = vec![false; left.len()];
+    for i in 0..left.len() {
+        if used[i] {
+            continue;
+        }
+        for j in i + 1..left.len() {
+            if used[j] || !probes[i].cancels(&probes[j], &left[j], tol) {
+                continue;
+            }
+            used[i] = true;
+            used[j] = true;
+            info.cancelled_matched += 1;
+            break;
+        }
+    }
+    let out: Vec<Vec<Vec<Homogeneous>>> = left
+        .into_iter()
+        .zip(used)
+        .filter(|(_, u)| !u)
+        .map(|(g, _)| g)
+        .collect();
+    info.boundary_edges = out.len();
+    out.into_iter().flatten().collect()
+}
+
+/// End points, interior points and tangents of an edge use, for the geometric match.
+struct Probe {
+    start: [f64; 3],
+    end: [f64; 3],
+    inner: Vec<([f64; 3], [f64; 3])>,
+}
+
+impl Probe {
+    fn new(g: &[Vec<Homogeneous>]) -> Probe {
+        let start = point_at(&g[0], 0.0);
+        let end = point_at(&g[g.len() - 1], 1.0);
+        let mut inner = Vec::new();
+        for f in [0.25, 0.5, 0.75] {
+            let x = f * g.len() as f64;
+            let k = (x.floor() as usize).min(g.len() - 1);
+            let t = x - k as f64;
+            let (n, dn) = eval_with_derivative(&g[k], t);
+            let p = euc(n);
+            let d = [
+                dn[0] - p[0] * dn[3],
+                dn[1] - p[1] * dn[3],
+                dn[2] - p[2] * dn[3],
+            ];
+            inner.push((p, d));
+        }
+        Probe { start, end, inner }
+    }
+
+    /// Whether `other` (with geometry `g`) runs along this use in the opposite direction.
+    fn cancels(&self, other: &Probe, g: &[Vec<Homogeneous>], tol: f64) -> bool {
+        if norm(sub(self.start, other.end)) > tol || norm(sub(self.end, other.start)) > tol {
+            return false;
+        }
+        let pieces: Vec<(f64, f64, Vec<Homogeneous>)> = g
+            .iter()
+            .enumerate()
+            .map(|(k, c)| (k as f64, k as f64 + 1.0, c.clone()))
+            .collect();
+        self.inner.iter().all(|(p, d)| {
+            let t = invert_curve(&pieces, *p);
+            let k = (t.floor() as usize).min(g.len() - 1);
+            let (n, dn) = eval_with_derivative(&g[k], t - k as f64);
+            let q = euc(n);
+            let dq = [
+                dn[0] - q[0] * dn[3],
+                dn[1] - q[1] * dn[3],
+                dn[2] - q[2] * dn[3],
+            ];
+            norm(sub(q, *p)) <= tol && dot(*d, dq) < 0.0
+        })
+    }
+}
