@@ -26,8 +26,11 @@ use std::f64::consts::PI;
 
 use rayon::prelude::*;
 
-use super::super::curve::{Form, Homogeneous, integrand, split_half};
-use super::super::quadrature::integrate;
+use super::super::curve::{
+    Form, Homogeneous, evaluation_rounding, integrand_with_rounding, split_half,
+};
+use super::super::eval::MAX_EVALUATIONS;
+use super::super::quadrature::{Budget, integrate};
 use super::model::{FacePatch, HIT_MARGIN, StepModel};
 use super::trim::Side;
 use crate::base::compensated::NeumaierSum;
@@ -284,25 +287,34 @@ impl StepWindingNumber {
         let mut sum = NeumaierSum::new();
         let mut err = 0.0;
         let tol = self.options.tolerance * 4.0 * PI / (pieces.len().max(1) as f64);
+        // The patch evaluator's work cap and rounding-aware integrand (docs/patches.md: a
+        // bounded time per query; an integral that hits the cap is reported uncertified).
+        let mut budget = Budget {
+            remaining: MAX_EVALUATIONS,
+        };
+        let mut capped = 0;
         for c in &pieces {
+            let (en, edn) = evaluation_rounding(c);
             let r = integrate(
                 |t| {
                     let (n, dn) = super::super::curve::eval_with_derivative(c, t);
-                    integrand(Form::Down, n, dn)
+                    integrand_with_rounding(Form::Down, n, dn, en, edn)
                 },
                 0.0,
                 1.0,
                 tol,
+                &mut budget,
             );
             sum.add(r.value);
             err += r.error;
+            capped += r.capped;
         }
         Ok(StepEvaluation {
             value: chi as f64 + sum.value() / (4.0 * PI),
             crossings: chi,
             error_estimate: err / (4.0 * PI),
             rays: 0,
-            uncertified: false,
+            uncertified: capped > 0,
         })
     }
 
