@@ -106,7 +106,14 @@ fn read_capped(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, CurveIoEr
     if std::fs::metadata(path).is_ok_and(|m| m.is_file() && m.len() > limit) {
         return Err(longer());
     }
-    let bytes = crate::base::file::read_nonblocking(path, limit).map_err(cannot)?;
+    // Beyond `limit` a stream is an `InvalidData` error of `read_nonblocking`.
+    let bytes = crate::base::file::read_nonblocking(path, limit).map_err(|e| {
+        if e.kind() == std::io::ErrorKind::InvalidData {
+            longer()
+        } else {
+            cannot(e)
+        }
+    })?;
     if bytes.len() as u64 > limit {
         return Err(longer());
     }

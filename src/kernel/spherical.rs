@@ -419,12 +419,10 @@ fn binary_exponent(x: f64) -> i32 {
     e + 63 - mant.unsigned_abs().leading_zeros() as i32
 }
 
-/// `log2` of [`NEAR_RAY_FLOOR`].
+/// `log2` of `NEAR_RAY_FLOOR`, the smallest transverse size `|r_xy|/|r|` an accurate edge term
+/// computes with (see `unit_scaled`): far above the underflow of its products (squares of
+/// `2^-511`), far below any error that matters (`2^-500` radians).
 const NEAR_RAY_FLOOR_EXPONENT: i32 = -500;
-
-/// The smallest transverse size `|r_xy|/|r|` an accurate edge term computes with, as a power
-/// of two (see `unit_scaled`): far above the underflow of its products (squares of `2^-511`),
-/// far below any error that matters (`2^-500` radians).
 
 /// `|r| − r_z` without cancellation when `r` points up.
 #[inline]
