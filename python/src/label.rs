@@ -165,9 +165,8 @@ pub fn plan_outputs(paths: Vec<PathBuf>, root: PathBuf) -> PyResult<Vec<PathBuf>
 /// Removes the temporary files a killed run left below ``out_dir``; returns how many.
 #[pyfunction]
 pub fn remove_partial_files(out_dir: PathBuf) -> PyResult<usize> {
-    label::remove_partial_files(&out_dir).map_err(|e| {
-        pyo3::exceptions::PyOSError::new_err(format!("{}: {e}", out_dir.display()))
-    })
+    label::remove_partial_files(&out_dir)
+        .map_err(|e| pyo3::exceptions::PyOSError::new_err(format!("{}: {e}", out_dir.display())))
 }
 
 /// The deepest folder holding every path (absolute): the default ``root`` of a dataset.
