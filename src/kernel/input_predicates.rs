@@ -211,7 +211,7 @@ pub fn snapped_plane_side(q: [i64; 3], p: &[[i64; 3]; 3]) -> Option<i32> {
     let (d, e1, e2) = (f(q, p[0]), f(p[1], p[0]), f(p[2], p[0]));
     let mut t = 0.0;
     let mut slack = 0.0;
-    for k in 0..3 {
+    for (k, dk) in d.into_iter().enumerate() {
         let (i, j) = ((k + 1) % 3, (k + 2) % 3);
         let (pa, pb) = (e1[i] * e2[j], e1[j] * e2[i]);
         let c = pa - pb;
@@ -222,8 +222,8 @@ pub fn snapped_plane_side(q: [i64; 3], p: &[[i64; 3]; 3]) -> Option<i32> {
             + e2[j].abs()
             + 2.0
             + LATTICE_STAGE_ROUNDING * (pa.abs() + pb.abs());
-        t += d[k] * c;
-        slack += (d[k].abs() + 1.0) * dc + c.abs() + LATTICE_STAGE_ROUNDING * (d[k] * c).abs();
+        t += dk * c;
+        slack += (dk.abs() + 1.0) * dc + c.abs() + LATTICE_STAGE_ROUNDING * (dk * c).abs();
     }
     let bound = INPUT_FILTER_SAFETY * slack;
     if t > bound {
