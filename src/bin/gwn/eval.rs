@@ -169,10 +169,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
     write_outputs(&args, &values, grads.as_deref())
 }
 
-/// Bézier patch sets: the boundary method (`exact`) or the surface quadrature (`direct`).
-fn run_patches(args: &Args) -> Result<(), CliError> {
+/// The options every curved-surface input (patch sets, STEP models) refuses or needs: no
+/// gradient, a positive tolerance, no mesh-only options (`what` names the input in the errors).
+fn check_curved_surface_options(args: &Args, what: &str) -> Result<(), CliError> {
     if args.gradient {
-        return Err(CliError::msg("--gradient is not available for patch sets"));
+        return Err(CliError(format!("--gradient is not available for {what}")));
     }
     if !(args.tolerance.is_finite() && args.tolerance > 0.0) {
         return Err(CliError(format!(
@@ -181,10 +182,16 @@ fn run_patches(args: &Args) -> Result<(), CliError> {
         )));
     }
     if args.method.beta.is_some() || args.method.order.is_some() || args.precision.is_some() {
-        return Err(CliError::msg(
-            "--beta, --order and --precision do not apply to patch sets",
-        ));
+        return Err(CliError(format!(
+            "--beta, --order and --precision do not apply to {what}"
+        )));
     }
+    Ok(())
+}
+
+/// Bézier patch sets: the boundary method (`exact`) or the surface quadrature (`direct`).
+fn run_patches(args: &Args) -> Result<(), CliError> {
+    check_curved_surface_options(args, "patch sets")?;
     let set = gwn::patch::load_patches(&args.mesh)?;
     let points = gwn::io::points::load_points(&args.points)?;
     let values = match args.method.method.unwrap_or(Method::Exact) {
@@ -235,20 +242,7 @@ fn run_patches(args: &Args) -> Result<(), CliError> {
 
 /// Trimmed B-rep STEP models: the crossing count plus the surface-boundary integral.
 fn run_step(args: &Args) -> Result<(), CliError> {
-    if args.gradient {
-        return Err(CliError::msg("--gradient is not available for STEP models"));
-    }
-    if !(args.tolerance.is_finite() && args.tolerance > 0.0) {
-        return Err(CliError(format!(
-            "--tolerance must be a positive number, not {}",
-            args.tolerance
-        )));
-    }
-    if args.method.beta.is_some() || args.method.order.is_some() || args.precision.is_some() {
-        return Err(CliError::msg(
-            "--beta, --order and --precision do not apply to STEP models",
-        ));
-    }
+    check_curved_surface_options(args, "STEP models")?;
     if args.ray.is_some() {
         return Err(CliError::msg(
             "--ray does not apply to STEP models (the evaluator chooses a ray per query)",
