@@ -18,8 +18,12 @@ use super::angle_sum::AngleSum;
 use super::angle_sum::AngleSumAvx2;
 use super::boundary_sum::BoundaryEdges;
 #[cfg(target_arch = "x86_64")]
-use super::boundary_sum::{orientation_filter_avx2, shift_one_avx2};
+use super::boundary_sum::shift_one_avx2;
+#[cfg(target_arch = "x86_64")]
+use super::lanes::{Avx2, edge_term, horizontal_sq, projected_dot, vertex_factors};
 use super::predicates::Width;
+#[cfg(target_arch = "x86_64")]
+use super::predicates::orient2d_filter_lanes;
 
 /// One query of a column: its lattice `z` (or, when `z_exact` is false, the clamped `z` of a
 /// query outside the grid along the ray with `qz_units` its `z` in grid units; see
@@ -128,17 +132,11 @@ impl BoundaryEdges {
             let x: [f64; 4] = bytemuck::cast(x);
             v[j..j + 4].copy_from_slice(&x);
         };
-        let (qx, qy) = (_mm256_set1_pd(xy[0]), _mm256_set1_pd(xy[1]));
+        let o = Avx2;
+        let (qx, qy) = (o.splat(xy[0]), o.splat(xy[1]));
         let (conv, rel) = self.filter_constants();
-        let (conv, rel) = (_mm256_set1_pd(conv), _mm256_set1_pd(rel));
-        let zero = _mm256_setzero_pd();
-        let one = _mm256_set1_pd(1.0);
-        let sign = _mm256_set1_pd(-0.0);
-        macro_rules! abs {
-            ($v:expr) => {
-                _mm256_andnot_pd(sign, $v)
-            };
-        }
+        let (conv, rel) = (o.splat(conv), o.splat(rel));
+        let zero = o.splat(0.0);
         // Shared per chunk: h of each vertex; per edge the filter mask, the dot product and
         // −d (see `chain_angles`).
         let mut h = [0.0; CHUNK + 8];
@@ -152,40 +150,26 @@ impl BoundaryEdges {
             // Vertices j0 .. j0 + 4·blocks + 4: every block's edges end one vertex further.
             for b in 0..=blocks {
                 let (i, j) = (4 * b, j0 + 4 * b);
-                let x = _mm256_sub_pd(load(xs, j), qx);
-                let y = _mm256_sub_pd(load(ys, j), qy);
-                store(
-                    &mut h,
-                    i,
-                    _mm256_add_pd(_mm256_mul_pd(x, x), _mm256_mul_pd(y, y)),
-                );
+                let x = o.sub(load(xs, j), qx);
+                let y = o.sub(load(ys, j), qy);
+                store(&mut h, i, horizontal_sq!(o, x, y));
             }
             for b in 0..blocks {
                 let (i, j) = (4 * b, j0 + 4 * b);
                 // The edge ends' offsets straight from the vertex arrays (unaligned loads of
                 // data not written here: no store forwarding, no shuffles).
-                let (ax, ay) = (
-                    _mm256_sub_pd(load(xs, j), qx),
-                    _mm256_sub_pd(load(ys, j), qy),
-                );
-                let (bx, by) = (
-                    _mm256_sub_pd(load(xs, j + 1), qx),
-                    _mm256_sub_pd(load(ys, j + 1), qy),
-                );
-                let real = _mm256_cmp_pd::<_CMP_GT_OQ>(load(link, j), zero);
-                let (d, lane_ok) = orientation_filter_avx2([ax, ay, bx, by], real, conv, rel);
+                let (ax, ay) = (o.sub(load(xs, j), qx), o.sub(load(ys, j), qy));
+                let (bx, by) = (o.sub(load(xs, j + 1), qx), o.sub(load(ys, j + 1), qy));
+                let real = o.gt(load(link, j), zero);
+                let (d, lane_ok) = orient2d_filter_lanes!(o, [ax, ay, bx, by], real, conv, rel);
                 store(&mut ok, i, lane_ok);
-                store(
-                    &mut dot,
-                    i,
-                    _mm256_add_pd(_mm256_mul_pd(ax, bx), _mm256_mul_pd(ay, by)),
-                );
-                store(&mut neg_d, i, _mm256_sub_pd(zero, d));
+                store(&mut dot, i, projected_dot!(o, ax, ay, bx, by));
+                store(&mut neg_d, i, o.sub(zero, d));
                 let mask = _mm256_movemask_pd(real) & !_mm256_movemask_pd(lane_ok);
                 self.report_undecided(j, mask, undecided);
             }
             for (k, acc) in acc.iter_mut().enumerate() {
-                let qz = _mm256_set1_pd(zs[k]);
+                let qz = o.splat(zs[k]);
                 // s and p of vertex block `b` (one `sqrt` per vertex), kept in registers: the
                 // next block's are computed before this block's products, so that the square
                 // roots overlap with them, and the edge ends come by lane shifts (a load
@@ -193,12 +177,7 @@ impl BoundaryEdges {
                 macro_rules! vertices {
                     ($b:expr) => {{
                         let (i, j) = (4 * $b, j0 + 4 * $b);
-                        let z = _mm256_sub_pd(load(vz, j), qz);
-                        let hv = load(&h, i);
-                        let l = _mm256_sqrt_pd(_mm256_add_pd(hv, _mm256_mul_pd(z, z)));
-                        let sv = _mm256_add_pd(l, abs!(z));
-                        let up = _mm256_cmp_pd::<_CMP_GT_OQ>(z, zero);
-                        (sv, _mm256_blendv_pd(_mm256_mul_pd(sv, sv), hv, up))
+                        vertex_factors!(o, load(&h, i), o.sub(load(vz, j), qz))
                     }};
                 }
                 let mut cur = vertices!(0);
@@ -208,12 +187,14 @@ impl BoundaryEdges {
                     let (sa, pa) = cur;
                     let (sb, pb) = (shift_one_avx2(cur.0, next.0), shift_one_avx2(cur.1, next.1));
                     cur = next;
-                    let lane_ok = load(&ok, i);
-                    let s2 = _mm256_mul_pd(sa, sb);
-                    let den =
-                        _mm256_add_pd(_mm256_mul_pd(pa, pb), _mm256_mul_pd(load(&dot, i), s2));
-                    let t_re = _mm256_blendv_pd(one, den, lane_ok);
-                    let t_im = _mm256_blendv_pd(zero, _mm256_mul_pd(load(&neg_d, i), s2), lane_ok);
+                    let (t_re, t_im) = edge_term!(
+                        o,
+                        (sa, pa),
+                        (sb, pb),
+                        load(&dot, i),
+                        load(&neg_d, i),
+                        load(&ok, i)
+                    );
                     acc.push(t_re, t_im);
                     if j % 8 == 4 {
                         // AngleSum::rescale, on the single-query loop's schedule.

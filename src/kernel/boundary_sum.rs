@@ -14,7 +14,7 @@
 //! exact sign of [`super::predicates::perturbed_orient2d`], so the branch agrees with the
 //! crossing test.
 
-use wide::{CmpGt, f64x4};
+use wide::f64x4;
 
 use super::angle_sum::AngleSum;
 #[cfg(target_arch = "x86_64")]
@@ -22,9 +22,12 @@ use super::angle_sum::AngleSumAvx2;
 use super::compensated::NeumaierSum;
 use super::double_double::DoubleDouble;
 use super::input_predicates::{InputPoint, LatticeFrame, input_inside_segment, input_orient2d};
+#[cfg(target_arch = "x86_64")]
+use super::lanes::Avx2;
+use super::lanes::{Portable, edge_term, horizontal_sq, projected_dot, vertex_factors};
 use super::predicates::{
-    ORIENT2D_FILTER_CONVERSION, ORIENT2D_FILTER_RELATIVE, Width, perturbed_orient2d,
-    perturbed_orient2d_at, query_inside_segment, query_inside_segment_at,
+    ORIENT2D_FILTER_CONVERSION, ORIENT2D_FILTER_RELATIVE, Width, orient2d_filter_lanes,
+    perturbed_orient2d, perturbed_orient2d_at, query_inside_segment, query_inside_segment_at,
 };
 use super::spherical::{EdgeSigns, antipodal_edge_area, antipodal_edge_area_accurate};
 use crate::bvh::RayBvh;
@@ -40,37 +43,6 @@ fn lanes4(v: &[f64], j: usize) -> [f64; 4] {
 fn shift_one(a: f64x4, b: f64x4) -> f64x4 {
     let (a, b) = (a.to_array(), b.to_array());
     f64x4::from([a[1], a[2], a[3], b[0]])
-}
-
-/// The loops' `f64` orientation `d = a_x b_y − a_y b_x` of four edges (offsets from the query)
-/// and the lanes where it clears its error bound on real edges (`real`): the filter of
-/// [`super::predicates::orient2d_filtered`], with `conv, rel` from
-/// [`BoundaryEdges::filter_constants`].
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-#[inline]
-pub(super) fn orientation_filter_avx2(
-    [ax, ay, bx, by]: [std::arch::x86_64::__m256d; 4],
-    real: std::arch::x86_64::__m256d,
-    conv: std::arch::x86_64::__m256d,
-    rel: std::arch::x86_64::__m256d,
-) -> (std::arch::x86_64::__m256d, std::arch::x86_64::__m256d) {
-    use std::arch::x86_64::*;
-    let sign = _mm256_set1_pd(-0.0);
-    let abs = |v| _mm256_andnot_pd(sign, v);
-    let p1 = _mm256_mul_pd(ax, by);
-    let p2 = _mm256_mul_pd(ay, bx);
-    let d = _mm256_sub_pd(p1, p2);
-    let sum_abs = _mm256_add_pd(
-        _mm256_add_pd(_mm256_add_pd(abs(ax), abs(ay)), abs(bx)),
-        abs(by),
-    );
-    let bound = _mm256_add_pd(
-        _mm256_mul_pd(conv, sum_abs),
-        _mm256_mul_pd(rel, _mm256_add_pd(abs(p1), abs(p2))),
-    );
-    let ok = _mm256_and_pd(_mm256_cmp_pd::<_CMP_GT_OQ>(abs(d), bound), real);
-    (d, ok)
 }
 
 /// [`shift_one`] in AVX2: the permute brings `[a2, a3, b0, b1]`, the shuffle interleaves.
@@ -570,21 +542,18 @@ impl BoundaryEdges {
         slots: std::ops::Range<usize>,
         undecided: &mut impl FnMut(u32),
     ) -> AngleSum {
+        let o = Portable;
         let [qx, qy, qz] = q.map(f64x4::splat);
         let (conv, rel) = self.filter_constants();
-        let (conv, rel) = (f64x4::splat(conv), f64x4::splat(rel));
-        let zero = f64x4::ZERO;
-        let one = f64x4::ONE;
+        let (conv, rel) = (o.splat(conv), o.splat(rel));
+        let zero = o.splat(0.0);
         let lanes = |v: &[f64], j: usize| f64x4::from(lanes4(v, j));
-        // Per-vertex factors of the 4 vertices from slot `j`: offsets x, y; s = |r| + |r_z|; and
-        // p, where (|r| − r_z)·s = p: h² = x² + y² when r_z > 0, s² otherwise (no cancellation).
+        // Offsets x, y and the factors s, p (`vertex_factors!`) of the 4 vertices from slot `j`.
         let vertices = |j: usize| {
-            let x = lanes(&self.xs, j) - qx;
-            let y = lanes(&self.ys, j) - qy;
-            let z = lanes(&self.zs, j) - qz;
-            let h = x * x + y * y;
-            let s = (h + z * z).sqrt() + z.abs();
-            let p = z.cmp_gt(zero).blend(h, s * s);
+            let x = o.sub(lanes(&self.xs, j), qx);
+            let y = o.sub(lanes(&self.ys, j), qy);
+            let z = o.sub(lanes(&self.zs, j), qz);
+            let (s, p) = vertex_factors!(o, horizontal_sq!(o, x, y), z);
             [x, y, s, p]
         };
         let mut angles = AngleSum::new();
@@ -596,29 +565,16 @@ impl BoundaryEdges {
             let [ax, ay, sa, pa] = cur;
             let [bx, by, sb, pb] = std::array::from_fn(|k| shift_one(cur[k], next[k]));
             cur = next;
-            let real = lanes(&self.link, j);
-            let p1 = ax * by;
-            let p2 = ay * bx;
-            let d = p1 - p2;
-            let bound =
-                conv * (ax.abs() + ay.abs() + bx.abs() + by.abs()) + rel * (p1.abs() + p2.abs());
-            let ok = d.abs().cmp_gt(bound) & real.cmp_gt(zero);
-            // den = (|a| − a_z)(|b| − b_z) + a_x b_x + a_y b_y and num = −d, both scaled by the
-            // positive s_a·s_b (no division, no cancellation).
-            let s2 = sa * sb;
-            // Term den + i·num (num carries the exact sign of −d); identity where unused.
-            let t_re = ok.blend(pa * pb + (ax * bx + ay * by) * s2, one);
-            let t_im = ok.blend((zero - d) * s2, zero);
+            let real = o.gt(lanes(&self.link, j), zero);
+            let (d, ok) = orient2d_filter_lanes!(o, [ax, ay, bx, by], real, conv, rel);
+            let dot = projected_dot!(o, ax, ay, bx, by);
+            let (t_re, t_im) = edge_term!(o, (sa, pa), (sb, pb), dot, o.sub(zero, d), ok);
             angles.push(t_re, t_im);
             if j % 8 == 4 {
                 // Terms are at most ~2^250 (grid units): two pushes stay in range.
                 angles.rescale();
             }
-            self.report_undecided(
-                j,
-                real.cmp_gt(zero).move_mask() & !ok.move_mask(),
-                undecided,
-            );
+            self.report_undecided(j, real.move_mask() & !ok.move_mask(), undecided);
         }
         angles
     }
@@ -636,32 +592,18 @@ impl BoundaryEdges {
         undecided: &mut impl FnMut(u32),
     ) -> AngleSum {
         use std::arch::x86_64::*;
+        let o = Avx2;
         let load = |v: &[f64], j: usize| -> __m256d { bytemuck::cast(lanes4(v, j)) };
-        let (qx, qy, qz) = (
-            _mm256_set1_pd(q[0]),
-            _mm256_set1_pd(q[1]),
-            _mm256_set1_pd(q[2]),
-        );
+        let [qx, qy, qz] = q.map(|c| o.splat(c));
         let (conv, rel) = self.filter_constants();
-        let (conv, rel) = (_mm256_set1_pd(conv), _mm256_set1_pd(rel));
-        let zero = _mm256_setzero_pd();
-        let one = _mm256_set1_pd(1.0);
-        let sign = _mm256_set1_pd(-0.0);
-        macro_rules! abs {
-            ($v:expr) => {
-                _mm256_andnot_pd(sign, $v)
-            };
-        }
+        let (conv, rel) = (o.splat(conv), o.splat(rel));
+        let zero = o.splat(0.0);
         macro_rules! vertices {
             ($j:expr) => {{
-                let x = _mm256_sub_pd(load(&self.xs, $j), qx);
-                let y = _mm256_sub_pd(load(&self.ys, $j), qy);
-                let z = _mm256_sub_pd(load(&self.zs, $j), qz);
-                let h = _mm256_add_pd(_mm256_mul_pd(x, x), _mm256_mul_pd(y, y));
-                let l = _mm256_sqrt_pd(_mm256_add_pd(h, _mm256_mul_pd(z, z)));
-                let s = _mm256_add_pd(l, abs!(z));
-                let up = _mm256_cmp_pd::<_CMP_GT_OQ>(z, zero);
-                let p = _mm256_blendv_pd(_mm256_mul_pd(s, s), h, up);
+                let x = o.sub(load(&self.xs, $j), qx);
+                let y = o.sub(load(&self.ys, $j), qy);
+                let z = o.sub(load(&self.zs, $j), qz);
+                let (s, p) = vertex_factors!(o, horizontal_sq!(o, x, y), z);
                 [x, y, s, p]
             }};
         }
@@ -677,13 +619,10 @@ impl BoundaryEdges {
                 shift_one_avx2(cur[3], next[3]),
             );
             cur = next;
-            let real = _mm256_cmp_pd::<_CMP_GT_OQ>(load(&self.link, j), zero);
-            let (d, ok) = orientation_filter_avx2([ax, ay, bx, by], real, conv, rel);
-            let s2 = _mm256_mul_pd(sa, sb);
-            let dot = _mm256_add_pd(_mm256_mul_pd(ax, bx), _mm256_mul_pd(ay, by));
-            let den = _mm256_add_pd(_mm256_mul_pd(pa, pb), _mm256_mul_pd(dot, s2));
-            let t_re = _mm256_blendv_pd(one, den, ok);
-            let t_im = _mm256_blendv_pd(zero, _mm256_mul_pd(_mm256_sub_pd(zero, d), s2), ok);
+            let real = o.gt(load(&self.link, j), zero);
+            let (d, ok) = orient2d_filter_lanes!(o, [ax, ay, bx, by], real, conv, rel);
+            let dot = projected_dot!(o, ax, ay, bx, by);
+            let (t_re, t_im) = edge_term!(o, (sa, pa), (sb, pb), dot, o.sub(zero, d), ok);
             angles.push(t_re, t_im);
             if j % 8 == 4 {
                 // Terms are at most ~2^250 (grid units): two pushes stay in range.

@@ -21,7 +21,7 @@ use super::boundary_multipole::{
 };
 use super::boundary_sum::{BoundaryEdges, segment_area};
 use super::predicates::{Width, orient2d_filtered};
-use super::spherical::INV_4PI;
+use super::spherical::{FOUR_PI, INV_4PI};
 use wide::f64x4;
 
 /// Slots per leaf (a multiple of the SIMD loop's 4).
@@ -41,6 +41,24 @@ const COEFFICIENT_COST: f64 = 4.5;
 const SPOKE_COST: f64 = 15.0;
 /// Fixed cost of expanding a node (distance, order choice, bound, the evaluation's set-up).
 const NODE_COST: f64 = 100.0;
+
+/// Relative rounding allowance of a node's radius: the distances from the centre are a handful
+/// of `f64` operations on normalized coordinates (relative error `≲ 4u = 4.4e-16`), and the
+/// radius only has to be an upper bound, so `1e-15` (plus 4 cells for the normalization's own
+/// rounding) covers it.
+const RADIUS_ROUNDING: f64 = 1e-15;
+
+/// Relative rounding allowance of a node's fan area (the upper bound on its fan's total triangle
+/// area that the truncation bound takes): a sum of non-negative terms, its children's areas and
+/// the triangles added at its open ends, each a few roundings. Such a sum of `n` terms errs by at
+/// most `(n + c)·u` relative (`u = 2^-53`); `1e-12` covers thousands of terms per node, far more
+/// than two children plus a cluster's open ends, and every level applies it again, so a parent's
+/// bound contains its children's.
+const AREA_ROUNDING: f64 = 1e-12;
+
+/// The reach of a node starts strictly outside its ball: a query at distance `≤ radius` could be
+/// inside the cluster, where the expansion does not converge.
+const REACH_MARGIN: f64 = 1e-9;
 
 /// One node: the slots `j0..j1`, their geometry and expansion.
 #[derive(Clone, Debug)]
@@ -167,7 +185,8 @@ impl BoundaryTree {
             ends: Vec::new(),
             tolerance,
         };
-        let per_edge = 4.0 * std::f64::consts::PI * tolerance / total as f64;
+        // The tolerance is on w = Σ/(4π): the area budget is 4π times it.
+        let per_edge = FOUR_PI * tolerance / total as f64;
         // The leaves are the LEAF_SLOTS-aligned chunks (every split is aligned): their fan moments
         // are the bulk of the work, split over scoped OS threads (`scoped_map`), like the
         // expansions below.
@@ -263,8 +282,7 @@ impl BoundaryTree {
                 .sqrt()
             })
             .fold(0.0, f64::max);
-        // Rounding of the distances above: a relative 2^-50 is far more than their error.
-        let radius = radius * (1.0 + 1e-15) + 4.0 / limit;
+        let radius = radius * (1.0 + RADIUS_ROUNDING) + 4.0 / limit;
         // Open ends: m_v = (edges leaving v) − (edges arriving), merged by position (sorted).
         // Leaves sort their edges' ends; parents merge their children's lists.
         let full_ends: Vec<([i64; 3], i32)> = if j1 - j0 <= LEAF_SLOTS {
@@ -342,7 +360,7 @@ impl BoundaryTree {
         };
         let delta: [f64; 3] = std::array::from_fn(|k| norm(apex)[k] - centre[k]);
         building.moments[index] = shifted(&m, delta);
-        self.nodes[index].area = area * (1.0 + 1e-12);
+        self.nodes[index].area = area * (1.0 + AREA_ROUNDING);
         let e0 = self.ends.len() as u32;
         self.ends.extend(
             building.full_ends[index]
@@ -621,9 +639,9 @@ fn rel(b: [i64; 3], a: [i64; 3], limit: f64) -> [f64; 3] {
 /// bisection on `r/a`).
 fn reach(area: f64, radius: f64, order: usize, budget: f64) -> f64 {
     if area == 0.0 {
-        return radius * (1.0 + 1e-9);
+        return radius * (1.0 + REACH_MARGIN);
     }
-    let (mut lo, mut hi) = (radius * (1.0 + 1e-9), radius * 2.0);
+    let (mut lo, mut hi) = (radius * (1.0 + REACH_MARGIN), radius * 2.0);
     while truncation_bound(area, radius, hi, order) > budget {
         lo = hi;
         hi *= 2.0;

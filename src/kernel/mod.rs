@@ -10,6 +10,8 @@
 //! - [`input_predicates`]: the same predicates, same perturbation, on vertices and queries that
 //!   are not on the lattice (input bits the lattice cannot hold): `f64` filters whose bounds
 //!   include every rounding, then exact dyadic arithmetic (`dyadic`);
+//! - [`exact_index`]: the exact query: a mesh quantized in one ray frame beside its ray BVH,
+//!   answering χ and the boundary sum (per-point snap and clamp, crossings, columns);
 //! - [`spherical`]: the solid-angle and spherical-triangle formulas;
 //! - [`angle_sum`]: sums of many `atan2` terms as one complex product with turn counting;
 //! - [`boundary_sum`]: the SIMD loop over the boundary edges of the Antipodal formula;
@@ -27,8 +29,10 @@ pub mod boundary_sum;
 pub mod boundary_tree;
 pub mod double_double;
 mod dyadic;
+pub mod exact_index;
 pub mod frame;
 pub mod input_predicates;
+mod lanes;
 pub mod predicates;
 pub mod quantize;
 pub mod spherical;

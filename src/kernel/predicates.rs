@@ -56,13 +56,11 @@ impl Width for W128 {
     const PRECISION: Precision = Precision::Bits60;
     #[inline]
     fn det2_sign(a0: i64, a1: i64, b0: i64, b1: i64) -> i32 {
-        // Filter: the four conversions (relative error ≤ u = 2^-53 each), two products and one
-        // difference bound the error of d by 4u·(|p1| + |p2|); we test 8u. Exact otherwise:
-        // |a|,|b| < 2^61 ⇒ each product < 2^122, the difference < 2^123.
+        // Exact fallback: |a|,|b| < 2^61 ⇒ each product < 2^122, the difference < 2^123.
         let p1 = a0 as f64 * b1 as f64;
         let p2 = a1 as f64 * b0 as f64;
         let d = p1 - p2;
-        let bound = 4.0 * f64::EPSILON * (p1.abs() + p2.abs());
+        let bound = DET2_FILTER_RELATIVE * (p1.abs() + p2.abs());
         if d > bound {
             return 1;
         }
@@ -75,10 +73,8 @@ impl Width for W128 {
     #[inline]
     fn orient3d_sign(d: [i64; 3], e1: [i64; 3], e2: [i64; 3]) -> i32 {
         // Filter in f64 straight from the differences (no i128 products, no i128 → f64
-        // conversion, which was measurable: docs/benchmarks.md, "Design measurements"). Each difference (< 2^61) is
-        // rounded once on conversion, relative error ≤ u = 2^-53 — the error model of
-        // Shewchuk's orient3d, whose first-stage bound (7 + 56u)·u·permanent therefore holds;
-        // we test 8u·permanent. Exact otherwise: i128 cross product, BigInt dot product.
+        // conversion, which was measurable: docs/benchmarks.md, "Design measurements"); see
+        // ORIENT3D_FILTER_RELATIVE. Exact otherwise: i128 cross product, BigInt dot product.
         let f = |v: [i64; 3]| v.map(|c| c as f64);
         let (x, a, b) = (f(d), f(e1), f(e2));
         let n0a = a[1] * b[2];
@@ -91,7 +87,7 @@ impl Width for W128 {
         let permanent = x[0].abs() * (n0a.abs() + n0b.abs())
             + x[1].abs() * (n1a.abs() + n1b.abs())
             + x[2].abs() * (n2a.abs() + n2b.abs());
-        let bound = 8.0 * (f64::EPSILON * 0.5) * permanent;
+        let bound = ORIENT3D_FILTER_RELATIVE * permanent;
         if v > bound {
             return 1;
         }
@@ -101,6 +97,17 @@ impl Width for W128 {
         exact_dot3_sign(d, cross_exact(e1, e2))
     }
 }
+
+/// Relative bound of the 60-bit `det2` filter on `|p1| + |p2|`: the four conversions of 61-bit
+/// integers (relative error `≤ u = 2^-53` each), the two products and the difference bound the
+/// error of `d = p1 − p2` by `4u·(|p1| + |p2|)`; the filter tests twice that, `8u`.
+pub const DET2_FILTER_RELATIVE: f64 = 8.0 * (f64::EPSILON * 0.5);
+
+/// Relative bound of the 60-bit `orient3d` filter on the permanent
+/// `Σ |d_k|·(|e1_i e2_j| + |e1_j e2_i|)`: each difference (`< 2^61`) is rounded once on
+/// conversion, relative error `≤ u = 2^-53`, which is the error model of Shewchuk's orient3d, whose
+/// first-stage bound `(7 + 56u)·u·permanent` therefore holds; the filter tests `8u·permanent`.
+pub const ORIENT3D_FILTER_RELATIVE: f64 = 8.0 * (f64::EPSILON * 0.5);
 
 /// Exact sign of `d·n` in arbitrary precision (the rare fallback of the 60-bit depth test).
 #[cold]
@@ -142,6 +149,27 @@ pub fn orient2d_filtered(ra: [f64; 2], rb: [f64; 2], limit: f64) -> Option<i32> 
         None
     }
 }
+
+/// [`orient2d_filtered`] on four edges at once, as the boundary loops evaluate it (written over the
+/// lane operations of `kernel::lanes`, so the portable and AVX2 loops share it): from the offsets
+/// `[ax, ay, bx, by]`, the mask `real` of lanes that are edges, and the splatted
+/// `conv = CONVERSION·limit` and `rel = RELATIVE`, gives `d` and the mask of the lanes where `|d|`
+/// clears the bound, i.e. where `sign(d)` is the exact sign.
+macro_rules! orient2d_filter_lanes {
+    ($o:expr, [$ax:expr, $ay:expr, $bx:expr, $by:expr], $real:expr, $conv:expr, $rel:expr) => {{
+        let (o, ax, ay, bx, by) = ($o, $ax, $ay, $bx, $by);
+        let p1 = o.mul(ax, by);
+        let p2 = o.mul(ay, bx);
+        let d = o.sub(p1, p2);
+        let sum_abs = o.add(o.add(o.add(o.abs(ax), o.abs(ay)), o.abs(bx)), o.abs(by));
+        let bound = o.add(
+            o.mul($conv, sum_abs),
+            o.mul($rel, o.add(o.abs(p1), o.abs(p2))),
+        );
+        (d, o.and(o.gt(o.abs(d), bound), $real))
+    }};
+}
+pub(crate) use orient2d_filter_lanes;
 
 /// Conversion term of [`orient2d_filtered`]'s bound, per unit of `limit`: `2·2u`.
 pub const ORIENT2D_FILTER_CONVERSION: f64 = 2.0 * 2.0 * (f64::EPSILON * 0.5);

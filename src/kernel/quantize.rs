@@ -15,7 +15,7 @@
 //! coordinates), and a query that lies on the lattice — every point whose coordinates are
 //! multiples of the cell, such as points on the faces of integer and dyadic meshes — is not moved
 //! at all. Queries outside the padded box are *not* snapped in the offending axis: the evaluator
-//! treats them by the clamp rules in `eval::antipodal`.
+//! treats them by the clamp rules of the exact query (`kernel::exact_index`, module doc).
 //!
 //! Everything above happens in *grid space*, the world scaled by a power of two that brings the
 //! mesh's extent into `[1, 2)` (exact; `w` is scale-invariant), so meshes of extent `1e-300` or
@@ -27,7 +27,7 @@
 //! than `2^-60` (see there).
 
 use super::input_predicates::{InputPoint, LatticeFrame};
-use crate::BoundingBox;
+use crate::base::bounding_box::BoundingBox;
 
 /// Width of the fixed-point grid, and with it the integer type of the predicates.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]

@@ -10,10 +10,14 @@
 
 use super::double_double::{DoubleDouble, dot3};
 
-/// `1/(4π)`: a solid angle (or a sum of spherical areas) as a winding number.
-pub const INV_4PI: f64 = 1.0 / (4.0 * std::f64::consts::PI);
 use super::quantize::decompose;
 use crate::base::vec3::{cross, dot, norm};
+
+/// `1/(4π)`: a solid angle (or a sum of spherical areas) as a winding number.
+pub const INV_4PI: f64 = 1.0 / FOUR_PI;
+
+/// `4π`, the solid angle of the whole sphere: integrals of solid angle divide by it to give `w`.
+pub const FOUR_PI: f64 = 4.0 * std::f64::consts::PI;
 
 /// `2·atan2(s·mag, den)` where the sign `s ∈ {−1, 0, 1}` of the numerator was decided exactly.
 ///
@@ -67,7 +71,7 @@ pub fn triangle_solid_angle(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
 fn solid_angle_moderate(a: [f64; 3], b: [f64; 3], c: [f64; 3], condition: f64) -> Option<f64> {
     let (la2, lb2, lc2) = (dot(a, a), dot(b, b), dot(c, c));
     let (lo, hi) = (la2.min(lb2).min(lc2), la2.max(lb2).max(lc2));
-    if !(lo > 1e-180 && hi < 1e180) {
+    if !(lo > SQUARED_NORM_LO && hi < SQUARED_NORM_HI) {
         return None;
     }
     let det = dot(a, cross(b, c));
@@ -77,7 +81,7 @@ fn solid_angle_moderate(a: [f64; 3], b: [f64; 3], c: [f64; 3], condition: f64) -
     let (la, lb, lc) = (la2.sqrt(), lb2.sqrt(), lc2.sqrt());
     let labc = la * lb * lc;
     let den = labc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
-    if det.abs() <= 1e-12 * labc {
+    if det.abs() <= ZERO_AREA_SUSPECT * labc {
         // See the zero-area test of `solid_angle_parts`.
         let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
         let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
@@ -122,7 +126,7 @@ fn solid_angle_parts(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> Option<(i32, f64,
     let (ua, ub, uc) = (unit(a), unit(b), unit(c));
     let det = dot(ua, cross(ub, uc));
     let den = 1.0 + dot(ua, ub) + dot(ub, uc) + dot(uc, ua);
-    if det.abs() <= 1e-12 {
+    if det.abs() <= ZERO_AREA_SUSPECT {
         // A zero-area triangle subtends no solid angle. Without this test, a collinear triangle
         // seen from a point close to its line gives det ≈ ±tiny against den ≤ 0 or den ≈ 0,
         // i.e. up to ±2π (found by the kernel fuzz target: the direct sum returned −1/4 next to
@@ -218,6 +222,22 @@ fn unit(v: [f64; 3]) -> [f64; 3] {
 /// Magnitudes between which products of three offset components stay normal `f64`s.
 const MODERATE_LO: f64 = 1e-90;
 const MODERATE_HI: f64 = 1e90;
+
+/// The range of `|r|²` in which the textbook solid angle ([`solid_angle_moderate`], and the fast
+/// method's lanes that copy it) runs: the squared norms of offsets in `[MODERATE_LO, MODERATE_HI]`,
+/// so that `|a||b||c|` and the triple product neither overflow nor lose bits to subnormals.
+pub(crate) const SQUARED_NORM_LO: f64 = MODERATE_LO * MODERATE_LO;
+/// Upper end of the range of [`SQUARED_NORM_LO`].
+pub(crate) const SQUARED_NORM_HI: f64 = MODERATE_HI * MODERATE_HI;
+
+/// `|det| ≤ ZERO_AREA_SUSPECT·|a||b||c|` (relative to the unit vectors' scale) sends a triangle to
+/// the exact zero-area test before its `atan2`. Why a relative threshold: a collinear triangle
+/// has `det = 0` exactly, but rounding leaves `|det| ≲ 10u·|a||b||c|` (`u = 2^-53`: three
+/// rounded products and two sums in the triple product, each relative `u` of the permanent,
+/// which is `≤ 3|a||b||c|`), i.e. `≲ 1.1e-15`; `1e-12` is a thousand times that, so every
+/// rounding-born `det` of a degenerate triangle is tested, while a genuine triangle seen at a
+/// normal angle never pays the test.
+pub(crate) const ZERO_AREA_SUSPECT: f64 = 1e-12;
 
 /// [`unit`] in double-double.
 fn unit_dd(v: [DoubleDouble; 3]) -> [DoubleDouble; 3] {

@@ -1,0 +1,151 @@
+//! The boundary part `Σ k·Area(A, B, x1)`: the exact loop (or the certified hierarchy) at a
+//! snapped query, the plain floating-point sum for queries whose ray cannot approach the mesh, the
+//! batch of a column's flat-loop queries, and the gradient's Biot–Savart sum.
+
+use super::ExactIndex;
+use crate::base::compensated::NeumaierSum;
+use crate::kernel::boundary_column::ColumnQuery;
+use crate::kernel::input_predicates::InputPoint;
+use crate::kernel::predicates::{Width, far_query_numerator_sign};
+use crate::kernel::spherical::{EdgeSigns, INV_4PI, antipodal_edge_area, segment_gradient};
+
+impl<W: Width> ExactIndex<W> {
+    /// `Σ k·Area(A, B, x1)` with exact branch signs at the query `qi + r` (lattice point and
+    /// residual), and the bound (on `w`) of its expanded far part. `z_exact` is false when the
+    /// query's frame z lies outside the grid (then `qz` is used in floating point for the
+    /// magnitudes). Queries near a boundary edge, or whose residual matters for a sign, take the
+    /// double-double path, never the hierarchy.
+    pub(super) fn boundary_sum(&self, q: &InputPoint, z_exact: bool, qz: f64) -> (f64, f64) {
+        let qz_units = self.z_in_cells(qz);
+        let (qi, r) = (q.n, q.r);
+        // A residual the grid scaling could not hold: every edge on the exact inputs.
+        if !self.boundary.is_empty()
+            && (!q.residual_exact() || self.boundary.needs_accurate_sum::<W>(qi, r, z_exact))
+        {
+            let area = self.boundary.area_sum_accurate::<W>(q, z_exact, qz_units);
+            return (area, 0.0);
+        }
+        match self.tree() {
+            Some(tree) => {
+                let sum = tree.area_sum::<W>(&self.boundary, qi, r, z_exact, qz_units);
+                (sum.area, sum.bound)
+            }
+            None => (self.boundary.area_sum::<W>(qi, r, z_exact, qz_units), 0.0),
+        }
+    }
+
+    /// Boundary sum for a query whose ray cannot approach the mesh: plain floating point (and
+    /// the hierarchy, whose every node the ray misses).
+    pub(super) fn far_boundary_sum(&self, qf: [f64; 3]) -> (f64, f64) {
+        let term = |a: [i64; 3], b: [i64; 3]| {
+            let ra = self.rel_f64(a, qf);
+            let rb = self.rel_f64(b, qf);
+            let signs = EdgeSigns {
+                numerator: far_query_numerator_sign(ra, rb),
+                query_inside_segment: false,
+            };
+            antipodal_edge_area(ra, rb, signs)
+        };
+        let limit = self.boundary.limit();
+        let q = std::array::from_fn(|k| (qf[k] - self.origin[k]) / self.cell / limit);
+        let Some(tree) = self.tree().filter(|t| t.reaches(q)) else {
+            let mut sum = 0.0;
+            for i in 0..self.boundary.len() {
+                let (a, b, weight) = self.boundary.edge(i);
+                sum += weight * term(a, b);
+            }
+            return (sum, 0.0);
+        };
+        let mut exact_sum = 0.0;
+        let mut exact = |range: std::ops::Range<usize>| {
+            for j in range {
+                if let Some(e) = self.boundary.slot_edge(j) {
+                    let (a, b, _) = self.boundary.edge(e);
+                    exact_sum += term(a, b);
+                }
+            }
+        };
+        let mut spokes = 0.0;
+        let mut spoke = |p: [i64; 3], v: [i64; 3], m: i32| spokes -= f64::from(m) * term(p, v);
+        let sum = tree.traverse(q, |_, _| true, &mut exact, &mut spoke);
+        let mut area = sum.area + exact_sum + spokes;
+        for e in self.boundary.heavy_edges() {
+            let (a, b, weight) = self.boundary.edge(e);
+            area += weight * term(a, b);
+        }
+        (area, sum.bound)
+    }
+
+    /// Offset of lattice point `p` from the frame query `qf`, in world units (floating point).
+    #[inline]
+    fn rel_f64(&self, p: [i64; 3], qf: [f64; 3]) -> [f64; 3] {
+        std::array::from_fn(|k| (p[k] as f64 * self.cell + self.origin[k]) - qf[k])
+    }
+
+    /// Gradient `∇w` at a world query: the integer part is locally constant, so only the boundary
+    /// contributes (the Biot–Savart sum of [`segment_gradient`]). NaN for a non-finite query.
+    pub fn gradient(&self, q: [f64; 3]) -> [f64; 3] {
+        if q.iter().any(|c| !c.is_finite()) {
+            return [f64::NAN; 3];
+        }
+        let qg = self.grid.to_grid_space(q);
+        if qg.iter().any(|c| !c.is_finite()) {
+            // Beyond `f64::MAX` in grid space (extent ≥ 1): the world gradient is below
+            // `1e-616 / extent`, i.e. it underflows.
+            return [0.0; 3];
+        }
+        let qf = self.ray.to_frame(qg);
+        // ∇w is homogeneous of degree −1 in lengths: evaluate on offsets scaled by an exact power
+        // of two that brings them to ~1 and scale back, so queries at 1e300 neither overflow
+        // |r|² nor turn into NaN (the true gradient there underflows to 0).
+        let half_width = self.grid.limit() as f64 * self.cell;
+        let span = (0..3).fold(half_width, |m, k| {
+            m.max((0.5 * qf[k] - 0.5 * self.origin[k]).abs())
+        });
+        let exponent = (span.to_bits() >> 52) & 0x7ff;
+        let scale = f64::from_bits((2046 - exponent) << 52);
+        let mut g = [NeumaierSum::new(); 3];
+        for i in 0..self.boundary.len() {
+            let (a, b, weight) = self.boundary.edge(i);
+            let ra = self.rel_f64(a, qf).map(|v| v * scale);
+            let rb = self.rel_f64(b, qf).map(|v| v * scale);
+            let e = segment_gradient(ra, rb);
+            for k in 0..3 {
+                g[k].add(weight * e[k]);
+            }
+        }
+        let g = self.ray.to_world(g.map(|s| s.value() * scale * INV_4PI));
+        self.grid.gradient_to_world(g)
+    }
+
+    /// The boundary sums of a column's points at lattice `x, y` whose sum is the flat loop, all in
+    /// one pass of the column loop (shared `x, y` work; each value bit-identical to its own
+    /// [`ExactIndex::boundary_sum`]).
+    pub(super) fn column_area_sums(&self, xy: [i64; 2], queries: &[ColumnQuery]) -> Vec<f64> {
+        let mut areas = vec![0.0; queries.len()];
+        self.boundary.column_area_sums::<W>(xy, queries, &mut areas);
+        areas
+    }
+
+    /// Whether the boundary sum at `qi + r` (lattice point and exact residual) is the flat loop:
+    /// no edge needs the accurate path and the hierarchy expands nothing there. Such queries of a
+    /// column are batched ([`ExactIndex::column_area_sums`]).
+    pub(super) fn boundary_sum_is_flat(
+        &self,
+        qi: [i64; 3],
+        r: [f64; 3],
+        z_exact: bool,
+        qz_units: f64,
+    ) -> bool {
+        !self.boundary.needs_accurate_sum::<W>(qi, r, z_exact)
+            && self
+                .tree()
+                .is_none_or(|t| t.is_flat_at(&self.boundary, qi, z_exact, qz_units))
+    }
+
+    /// The query's frame `z` in grid units (the magnitude of a query clamped along the ray).
+    #[inline]
+    pub(super) fn z_in_cells(&self, qz: f64) -> f64 {
+        (qz - self.origin[2]) / self.cell
+    }
+}
