@@ -276,6 +276,20 @@ impl StepWindingNumber {
     ) -> Result<StepEvaluation, Reject> {
         let frame = RayFrame::new(d);
         // Certify the boundary first (cheap), then the hits.
+        let pieces = self.certify_boundary(q, &frame, mu, strict)?;
+        let chi = self.crossings(q, &frame, margin, strict)?;
+        Ok(self.with_boundary(chi, &pieces))
+    }
+
+    /// The surface boundary in the ray frame of `q`, halved into pieces certified against the
+    /// ray with margin `mu`; `Err` (when `strict`) if some piece cannot be certified.
+    fn certify_boundary(
+        &self,
+        q: [f64; 3],
+        frame: &RayFrame,
+        mu: f64,
+        strict: bool,
+    ) -> Result<Vec<Vec<Homogeneous>>, Reject> {
         let mut pieces = Vec::new();
         for c in &self.model.boundary {
             let h: Vec<Homogeneous> = c.iter().map(|&p| frame.hom(p, q)).collect();
@@ -283,7 +297,11 @@ impl StepWindingNumber {
                 return Err(Reject::Boundary);
             }
         }
-        let chi = self.crossings(q, &frame, margin, strict)?;
+        Ok(pieces)
+    }
+
+    /// `χ` plus the boundary integral over the certified `pieces` (empty for a closed model).
+    fn with_boundary(&self, chi: i64, pieces: &[Vec<Homogeneous>]) -> StepEvaluation {
         let mut sum = NeumaierSum::new();
         let mut err = 0.0;
         let tol = self.options.tolerance * 4.0 * PI / (pieces.len().max(1) as f64);
@@ -293,7 +311,7 @@ impl StepWindingNumber {
             remaining: MAX_EVALUATIONS,
         };
         let mut capped = 0;
-        for c in &pieces {
+        for c in pieces {
             let (en, edn) = evaluation_rounding(c);
             let r = integrate(
                 |t| {
@@ -309,13 +327,118 @@ impl StepWindingNumber {
             err += r.error;
             capped += r.capped;
         }
-        Ok(StepEvaluation {
+        StepEvaluation {
             value: chi as f64 + sum.value() / (4.0 * PI),
             crossings: chi,
             error_estimate: err / (4.0 * PI),
             rays: 0,
             uncertified: capped > 0,
-        })
+        }
+    }
+
+    /// [`evaluate`](Self::evaluate) at the points `q` with coordinate `axis` replaced by each
+    /// `ts[k]` (a grid column), sharing one ray: the paper's ray reuse (Sec. 4.3.1).
+    ///
+    /// The ray of every point is the column's line in `+axis`; the line's hits on the trimmed
+    /// faces are found once, and a point's `χ` is the signed count of the inside hits above it.
+    /// A point is answered from the shared hits only when its own ray passes the tests of
+    /// [`evaluate`](Self::evaluate) (the module docs): no hit ahead of it is grazing or within
+    /// the margin of its face's loops, no hit is within the margin of the point, and, for an
+    /// open model, its surface boundary is certified against the ray. Any other point is
+    /// evaluated on its own. A closed model's values are then the same integers as
+    /// [`evaluate`](Self::evaluate)'s; an open model's differ by the quadrature error (both
+    /// within the tolerance). `axis > 2` or non-finite input evaluates point by point.
+    pub fn evaluate_column(&self, q: [f64; 3], axis: usize, ts: &[f64]) -> Vec<StepEvaluation> {
+        let point = |t: f64| {
+            let mut p = q;
+            if axis < 3 {
+                p[axis] = t;
+            }
+            p
+        };
+        let one_by_one = || ts.iter().map(|&t| self.evaluate(point(t))).collect();
+        if axis > 2 || ts.len() < 2 || q.iter().chain(ts).any(|c| !c.is_finite()) {
+            return one_by_one();
+        }
+        let mut d = [0.0; 3];
+        d[axis] = 1.0;
+        let frame = RayFrame::new(d);
+        // The line's hits as seen from a point below the model and below every `ts`: all of
+        // them are ahead of it, at heights `τ` along `+axis` from it.
+        let lowest = ts.iter().fold(self.model.lo[axis], |a, &t| a.min(t));
+        let base_height = lowest - 0.01 * self.model.diagonal() - self.margin;
+        if !base_height.is_finite() {
+            return one_by_one();
+        }
+        let hits = self.line_hits(point(base_height), &frame);
+        ts.iter()
+            .map(|&t| {
+                let p = point(t);
+                let tau = t - base_height;
+                let mut chi = 0i64;
+                for h in &hits {
+                    if (h.ambiguous && h.tau >= tau - self.margin)
+                        || (h.tau - tau).abs() <= self.margin
+                    {
+                        return self.evaluate(p);
+                    }
+                    if h.tau > tau {
+                        chi += h.sign;
+                    }
+                }
+                match self.certify_boundary(p, &frame, MU, true) {
+                    Ok(pieces) => {
+                        let mut e = self.with_boundary(chi, &pieces);
+                        e.rays = 1;
+                        e
+                    }
+                    Err(_) => self.evaluate(p),
+                }
+            })
+            .collect()
+    }
+
+    /// Every hit of the ray from `q` along `frame.d` on the trimmed faces, classified once:
+    /// sign of the crossing (0 outside the face's loops) or ambiguous (grazing, or within the
+    /// margin of the loops), at its distance `τ` from `q`.
+    fn line_hits(&self, q: [f64; 3], frame: &RayFrame) -> Vec<LineHit> {
+        let mut out = Vec::new();
+        let dedup = 1e-9 * self.model.diagonal();
+        for face in &self.model.faces {
+            let mut hits: Vec<Hit> = Vec::new();
+            for fp in &face.patches {
+                if ray_meets_box(q, frame.d, fp.lo, fp.hi, dedup) {
+                    patch_hits(fp, q, frame, &mut hits);
+                }
+            }
+            let mut kept: Vec<Hit> = Vec::new();
+            for h in hits {
+                if kept.iter().all(|k| norm(sub(k.point, h.point)) > dedup) {
+                    kept.push(h);
+                }
+            }
+            for h in kept {
+                let n = cross(h.su, h.sv);
+                let nn = norm(n);
+                let c = face.sense * dot(n, frame.d) / nn;
+                let grazing = nn.is_nan() || nn <= 0.0 || c.abs() < MIN_COSINE;
+                let side = if grazing {
+                    Side::Near
+                } else {
+                    face.trim.classify(h.uv, h.su, h.sv, self.margin)
+                };
+                out.push(LineHit {
+                    tau: h.tau,
+                    sign: match side {
+                        Side::Inside if c > 0.0 => 1,
+                        Side::Inside => -1,
+                        _ => 0,
+                    },
+                    ambiguous: side == Side::Near,
+                });
+            }
+        }
+        out
     }
 
     /// Signed count of trimmed-face crossings of the ray; `Err` if some hit is ambiguous.
@@ -436,6 +559,16 @@ fn ray_meets_box(q: [f64; 3], d: [f64; 3], lo: [f64; 3], hi: [f64; 3], pad: f64)
         }
     }
     true
+}
+
+/// A hit of a grid column's line ([`StepWindingNumber::evaluate_column`]).
+struct LineHit {
+    /// Distance along the line from its base point.
+    tau: f64,
+    /// Crossing sign if inside the face's loops, else 0.
+    sign: i64,
+    /// Grazing or within the margin of the loops: no point below it may use the line.
+    ambiguous: bool,
 }
 
 struct Hit {
@@ -661,5 +794,11 @@ impl crate::eval::Evaluator for StepWindingNumber {
     }
     fn eval_batch(&self, points: &[[f64; 3]]) -> Vec<f64> {
         StepWindingNumber::eval_batch(self, points)
+    }
+    fn eval_column(&self, q: [f64; 3], axis: usize, ts: &[f64]) -> Vec<f64> {
+        self.evaluate_column(q, axis, ts)
+            .into_iter()
+            .map(|e| e.value)
+            .collect()
     }
 }
