@@ -78,7 +78,9 @@ fn untrimmed_patches(model: &StepModel) -> Option<PatchSet> {
 
 fn reference_queries(step: &Path) -> Option<Vec<[f64; 3]>> {
     let stem = step.file_stem()?.to_str()?;
-    let q = step.with_file_name(format!("{stem}_ref")).join("queries.npy");
+    let q = step
+        .with_file_name(format!("{stem}_ref"))
+        .join("queries.npy");
     gwn::io::load_points(q).ok()
 }
 
@@ -172,9 +174,7 @@ fn main() {
             let Ok(mw) = WindingNumber::new(&mesh) else {
                 continue;
             };
-            let (ms, _) = timed(pts.len(), || {
-                pts.iter().map(|&q| mw.eval(q)).sum::<f64>()
-            });
+            let (ms, _) = timed(pts.len(), || pts.iter().map(|&q| mw.eval(q)).sum::<f64>());
             let mut errs: Vec<f64> = refq
                 .iter()
                 .zip(&exact)

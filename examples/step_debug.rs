@@ -7,7 +7,9 @@ fn main() {
         // Indexed trimming test against the scan on random points of every face.
         let mut state = 7u64;
         let mut rnd = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
         let mut bad = 0;
@@ -42,7 +44,10 @@ fn main() {
     ];
     let wn = gwn::patch::step::StepWindingNumber::new(&m);
     println!("{:?}", wn.evaluate(q));
-    println!("column along z: {:?}", wn.evaluate_column(q, 2, &[q[2], q[2]])[0]);
+    println!(
+        "column along z: {:?}",
+        wn.evaluate_column(q, 2, &[q[2], q[2]])[0]
+    );
     for h in wn.hits_along(q, [0.0, 0.0, 1.0]) {
         println!("  +z hit {h:?}");
     }

@@ -44,6 +44,15 @@ const MU_RELAXED: f64 = 0.02;
 pub const CERT_DEPTH: u32 = 5;
 /// Smallest `|cos|` between a hit's normal and the ray (grazing hits are ambiguous).
 pub const MIN_COSINE: f64 = 1e-4;
+/// Trimming margin of the hits shared by a grid column, relative to the diagonal
+/// ([`StepWindingNumber::evaluate_column`]). Far above [`HIT_MARGIN`]: a column's line is
+/// axis-aligned, and so are the edges of CAD models, so a whole row of columns can pass
+/// through a tangent junction of two faces (a fillet meeting a plane in `boxed_sphere.step`),
+/// where the two faces' loop polygons disagree by up to 1e-4 × diagonal and a hit can fall
+/// between them (the per-point rays, turned irrationally, meet such a junction only at
+/// isolated points). A point whose ray has a hit this close to its face's loops is answered
+/// by the line's other half or on its own.
+const COLUMN_HIT_MARGIN: f64 = 1e-3;
 /// Subdivision depth of a patch before Newton's method starts from the piece's centre.
 const HIT_DEPTH: u32 = 12;
 
@@ -339,13 +348,13 @@ impl StepWindingNumber {
     /// [`evaluate`](Self::evaluate) at the points `q` with coordinate `axis` replaced by each
     /// `ts[k]` (a grid column), sharing one ray: the paper's ray reuse (Sec. 4.3.1).
     ///
-    /// The ray of every point is the column's line in `+axis`; the line's hits on the trimmed
-    /// faces are found once, and a point's `χ` is the signed count of the inside hits above it.
-    /// A point is answered from the shared hits only when its own ray passes the tests of
-    /// [`evaluate`](Self::evaluate) (the module docs): no hit ahead of it is grazing or within
-    /// the margin of its face's loops, no hit is within the margin of the point, and, for an
-    /// open model, its surface boundary is certified against the ray. Any other point is
-    /// evaluated on its own. A closed model's values are then the same integers as
+    /// The ray of every point is the column's line in `+axis` (or, second choice, `−axis`); the
+    /// line's hits on the trimmed faces are found once, and a point's `χ` is the signed count
+    /// of the inside hits above (below) it. A point is answered from the shared hits only when
+    /// its own ray passes the tests of [`evaluate`](Self::evaluate) (the module docs): no hit
+    /// ahead of it is grazing or within the margin of its face's loops, no hit is within the
+    /// margin of the point, and, for an open model, its surface boundary is certified against
+    /// the ray. Any other point is evaluated on its own. A closed model's values are then the same integers as
     /// [`evaluate`](Self::evaluate)'s; an open model's differ by the quadrature error (both
     /// within the tolerance). `axis > 2` or non-finite input evaluates point by point.
     pub fn evaluate_column(&self, q: [f64; 3], axis: usize, ts: &[f64]) -> Vec<StepEvaluation> {
@@ -362,7 +371,9 @@ impl StepWindingNumber {
         }
         let mut d = [0.0; 3];
         d[axis] = 1.0;
-        let frame = RayFrame::new(d);
+        let up = RayFrame::new(d);
+        d[axis] = -1.0;
+        let down = RayFrame::new(d);
         // The line's hits as seen from a point below the model and below every `ts`: all of
         // them are ahead of it, at heights `τ` along `+axis` from it.
         let lowest = ts.iter().fold(self.model.lo[axis], |a, &t| a.min(t));
@@ -370,39 +381,53 @@ impl StepWindingNumber {
         if !base_height.is_finite() {
             return one_by_one();
         }
-        let hits = self.line_hits(point(base_height), &frame);
+        let hits = self.line_hits(point(base_height), &up);
+        // A closed model's line enters as often as it leaves: otherwise some hit was missed or
+        // counted twice (loops that disagree at a junction), and every point is on its own.
+        if self.model.boundary.is_empty()
+            && !hits.iter().any(|h| h.ambiguous)
+            && hits.iter().map(|h| h.sign).sum::<i64>() != 0
+        {
+            return one_by_one();
+        }
         ts.iter()
             .map(|&t| {
                 let p = point(t);
                 let tau = t - base_height;
-                let mut chi = 0i64;
+                // `χ` along `+axis` (hits above) and along `−axis` (hits below, crossed the
+                // other way); `None` where a hit makes that ray ambiguous.
+                let (mut chi_up, mut chi_down) = (Some(0i64), Some(0i64));
                 for h in &hits {
-                    if (h.ambiguous && h.tau >= tau - self.margin)
-                        || (h.tau - tau).abs() <= self.margin
-                    {
+                    if (h.tau - tau).abs() <= self.margin {
                         return self.evaluate(p);
                     }
                     if h.tau > tau {
-                        chi += h.sign;
+                        chi_up = chi_up.filter(|_| !h.ambiguous).map(|c| c + h.sign);
+                    } else {
+                        chi_down = chi_down.filter(|_| !h.ambiguous).map(|c| c - h.sign);
                     }
                 }
-                match self.certify_boundary(p, &frame, MU, true) {
-                    Ok(pieces) => {
+                // For an open model the boundary must be certified against the ray too; the
+                // line's other half is the second choice.
+                for (chi, frame) in [(chi_up, &up), (chi_down, &down)] {
+                    let Some(chi) = chi else { continue };
+                    if let Ok(pieces) = self.certify_boundary(p, frame, MU, true) {
                         let mut e = self.with_boundary(chi, &pieces);
                         e.rays = 1;
-                        e
+                        return e;
                     }
-                    Err(_) => self.evaluate(p),
                 }
+                self.evaluate(p)
             })
             .collect()
     }
 
     /// Every hit of the ray from `q` along `frame.d` on the trimmed faces, classified once:
-    /// sign of the crossing (0 outside the face's loops) or ambiguous (grazing, or within the
-    /// margin of the loops), at its distance `τ` from `q`.
+    /// sign of the crossing (0 outside the face's loops) or ambiguous (grazing, or within
+    /// [`COLUMN_HIT_MARGIN`] of the loops), at its distance `τ` from `q`.
     fn line_hits(&self, q: [f64; 3], frame: &RayFrame) -> Vec<LineHit> {
         let mut out = Vec::new();
+        let column_margin = COLUMN_HIT_MARGIN * self.model.diagonal();
         let dedup = 1e-9 * self.model.diagonal();
         for face in &self.model.faces {
             let mut hits: Vec<Hit> = Vec::new();
@@ -425,7 +450,7 @@ impl StepWindingNumber {
                 let side = if grazing {
                     Side::Near
                 } else {
-                    face.trim.classify(h.uv, h.su, h.sv, self.margin)
+                    face.trim.classify(h.uv, h.su, h.sv, column_margin)
                 };
                 out.push(LineHit {
                     tau: h.tau,
@@ -567,7 +592,7 @@ struct LineHit {
     tau: f64,
     /// Crossing sign if inside the face's loops, else 0.
     sign: i64,
-    /// Grazing or within the margin of the loops: no point below it may use the line.
+    /// Grazing or within the margin of the loops: no ray from a point towards it may use it.
     ambiguous: bool,
 }
 
