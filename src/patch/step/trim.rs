@@ -227,7 +227,7 @@ impl Trim {
             let det = a * c - b * b;
             let smallest = det / largest;
             // A nearly singular metric (a pole, a collapsed edge): the bound is useless.
-            if !(smallest.is_finite() && smallest > 1e-12 * largest) || !margin.is_finite() {
+            if !(smallest.is_finite() && smallest > 1e-12 * largest && margin.is_finite()) {
                 return None;
             }
             reach += 1.01 * margin.abs() / smallest.sqrt();
