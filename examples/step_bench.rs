@@ -130,6 +130,27 @@ fn main() {
                  {uncertified} uncertified",
                 rays as f64 / pts.len() as f64
             );
+            // The share of the points on the surface (within the margins; every direction is
+            // tried before the relaxed pass): timed again on their own.
+            let on_surface: Vec<[f64; 3]> = pts
+                .iter()
+                .zip(&evals)
+                .filter(|(_, e)| e.uncertified)
+                .map(|(&q, _)| q)
+                .collect();
+            if !on_surface.is_empty() {
+                let (ms_on, _) = timed(on_surface.len(), || {
+                    on_surface.iter().map(|&q| wn.eval(q)).sum::<f64>()
+                });
+                let rest = (ms * pts.len() as f64 - ms_on * on_surface.len() as f64)
+                    / (pts.len() - on_surface.len()).max(1) as f64;
+                println!(
+                    "    the {} uncertified points: {ms_on:.3} ms each ({:.0} % of the time); \
+                     the other points: {rest:.4} ms/query",
+                    on_surface.len(),
+                    100.0 * ms_on * on_surface.len() as f64 / (ms * pts.len() as f64)
+                );
+            }
             per_point = evals;
         }
         if only != "points" {
