@@ -236,3 +236,29 @@ fn grid_columns_share_a_ray_and_give_the_points_values() {
         assert!((a - b).abs() < 1e-9, "{a} {b}");
     }
 }
+
+/// A column reaching far beyond the model (1e12 and 1e300 away) keeps the values of the points
+/// near it and gives the far points' (0 for the closed cylinder, ~0 for the plate).
+#[test]
+fn far_reaching_columns_keep_their_near_values() {
+    let m = load_step(&fixture("capped_cylinder.step")).unwrap();
+    let wn = StepWindingNumber::new(&m);
+    let ts = [-1e300, -1e12, -0.5, 0.3, 1.0, 1.7, 2.5, 1e12, 1e300];
+    let want = [0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0];
+    let col = wn.evaluate_column([0.2, -0.3, 0.0], 2, &ts);
+    for ((e, &w), &t) in col.iter().zip(&want).zip(&ts) {
+        assert_eq!(e.value, w, "z = {t}: {e:?}");
+    }
+    let m = load_step(&fixture("plate_with_hole.stp")).unwrap();
+    let wn = StepWindingNumber::new(&m);
+    let ts = [-1e300, -1e12, -0.4, 0.7, 1e12, 1e300];
+    for (e, &h) in wn.evaluate_column([0.0, 0.0, 0.0], 2, &ts).iter().zip(&ts) {
+        // (The closed form itself overflows at 1e300, where w is below 1e-300.)
+        let want = if h.abs() > 1e100 {
+            0.0
+        } else {
+            plate_on_axis(h)
+        };
+        assert!((e.value - want).abs() < 1e-9, "h {h}: {e:?}");
+    }
+}

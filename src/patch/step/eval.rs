@@ -374,10 +374,11 @@ impl StepWindingNumber {
         let up = RayFrame::new(d);
         d[axis] = -1.0;
         let down = RayFrame::new(d);
-        // The line's hits as seen from a point below the model and below every `ts`: all of
-        // them are ahead of it, at heights `τ` along `+axis` from it.
-        let lowest = ts.iter().fold(self.model.lo[axis], |a, &t| a.min(t));
-        let base_height = lowest - 0.01 * self.model.diagonal() - self.margin;
+        // The line's hits as seen from a point just below the model: all of them are ahead of
+        // it, at heights `τ` along `+axis` from it. Not below every `ts`: Newton's acceptance
+        // of a hit scales with the distance from the ray's origin, so that origin stays near
+        // the model however far the column's points reach.
+        let base_height = self.model.lo[axis] - 0.01 * self.model.diagonal() - self.margin;
         if !base_height.is_finite() {
             return one_by_one();
         }
