@@ -1,5 +1,8 @@
-//! Prints, for one query, the value along every candidate direction of the STEP evaluator.
+//! Prints, for one query, the value along every candidate direction of the STEP evaluator, the
+//! grid-column value along `z` and the `+z` hits.
 //! `cargo run --release --example step_debug -- MODEL.step x y z`
+//! `cargo run --release --example step_debug -- MODEL.step index` compares the indexed trimming
+//! test with the scan on random points of every face.
 fn main() {
     let a: Vec<String> = std::env::args().collect();
     let m = gwn::patch::step::load_step(std::path::Path::new(&a[1])).unwrap();
