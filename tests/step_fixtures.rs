@@ -171,3 +171,94 @@ fn malformed_files_are_one_line_errors() {
     // Missing file.
     one_line(load_step(Path::new("/nonexistent/x.step")).unwrap_err());
 }
+
+/// Grid columns share one ray per column (`evaluate_column`, the paper's ray reuse) and give
+/// the closed-form values: the capped cylinder's integers along every axis (lines parallel to
+/// the wall, through the seam plane, across the caps), the open plate's solid angle on its
+/// axis, and `grid::evaluate` goes through the column path.
+#[test]
+fn grid_columns_share_a_ray_and_give_the_points_values() {
+    let m = load_step(&fixture("capped_cylinder.step")).unwrap();
+    let wn = StepWindingNumber::new(&m);
+    let ts: Vec<f64> = (0..23).map(|k| -1.55 + 0.17 * k as f64).collect();
+    let (mut shared, mut total) = (0, 0);
+    for axis in 0..3 {
+        for a in 0..9 {
+            for b in 0..9 {
+                let (u, v) = (-1.6 + 0.4 * a as f64 + 0.013, -1.6 + 0.4 * b as f64 + 0.007);
+                let mut q = [0.0; 3];
+                q[(axis + 1) % 3] = u;
+                q[(axis + 2) % 3] = v;
+                // Heights along the axis, shifted so that z spans the cylinder [0, 2].
+                let heights: Vec<f64> = ts.iter().map(|t| t + 1.0).collect();
+                let col = wn.evaluate_column(q, axis, &heights);
+                for (e, &t) in col.iter().zip(&heights) {
+                    let mut p = q;
+                    p[axis] = t;
+                    let r = p[0].hypot(p[1]);
+                    if (r - 1.0).abs() < 1e-3 || p[2].abs() < 1e-3 || (p[2] - 2.0).abs() < 1e-3 {
+                        continue;
+                    }
+                    let inside = r < 1.0 && p[2] > 0.0 && p[2] < 2.0;
+                    assert_eq!(e.value, if inside { 1.0 } else { 0.0 }, "{p:?} {e:?}");
+                    assert!(!e.uncertified, "{p:?}");
+                    total += 1;
+                    shared += usize::from(e.rays == 1);
+                }
+            }
+        }
+    }
+    // Most points use the column's line (the rest are evaluated on their own).
+    assert!(
+        total > 4000 && shared * 10 > total * 9,
+        "{shared} of {total}"
+    );
+
+    let m = load_step(&fixture("plate_with_hole.stp")).unwrap();
+    let wn = StepWindingNumber::new(&m);
+    let hs = [-3.0, -0.4, -1e-3, 1e-3, 0.1, 0.7, 2.0];
+    for (e, &h) in wn.evaluate_column([0.0, 0.0, 0.0], 2, &hs).iter().zip(&hs) {
+        assert!((e.value - plate_on_axis(h)).abs() < 1e-9, "h {h}: {e:?}");
+        assert_eq!(e.rays, 1, "h {h}: {e:?}");
+    }
+
+    let spec = gwn::grid::GridSpec::new(
+        gwn::BoundingBox {
+            min: [-1.5, -1.5, -0.5],
+            max: [1.5, 1.5, 0.5],
+        },
+        [6, 7, 8],
+    )
+    .unwrap();
+    let by_columns = gwn::grid::evaluate(&wn, &spec);
+    let by_points = gwn::grid::evaluate_per_point(&wn, &spec);
+    for (a, b) in by_columns.iter().zip(&by_points) {
+        assert!((a - b).abs() < 1e-9, "{a} {b}");
+    }
+}
+
+/// A column reaching far beyond the model (1e12 and 1e300 away) keeps the values of the points
+/// near it and gives the far points' (0 for the closed cylinder, ~0 for the plate).
+#[test]
+fn far_reaching_columns_keep_their_near_values() {
+    let m = load_step(&fixture("capped_cylinder.step")).unwrap();
+    let wn = StepWindingNumber::new(&m);
+    let ts = [-1e300, -1e12, -0.5, 0.3, 1.0, 1.7, 2.5, 1e12, 1e300];
+    let want = [0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0];
+    let col = wn.evaluate_column([0.2, -0.3, 0.0], 2, &ts);
+    for ((e, &w), &t) in col.iter().zip(&want).zip(&ts) {
+        assert_eq!(e.value, w, "z = {t}: {e:?}");
+    }
+    let m = load_step(&fixture("plate_with_hole.stp")).unwrap();
+    let wn = StepWindingNumber::new(&m);
+    let ts = [-1e300, -1e12, -0.4, 0.7, 1e12, 1e300];
+    for (e, &h) in wn.evaluate_column([0.0, 0.0, 0.0], 2, &ts).iter().zip(&ts) {
+        // (The closed form itself overflows at 1e300, where w is below 1e-300.)
+        let want = if h.abs() > 1e100 {
+            0.0
+        } else {
+            plate_on_axis(h)
+        };
+        assert!((e.value - want).abs() < 1e-9, "h {h}: {e:?}");
+    }
+}

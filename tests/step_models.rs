@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use gwn::patch::step::{StepWindingNumber, load_step};
+use rayon::prelude::*;
 
 fn shared() -> Option<PathBuf> {
     // `../shared` beside the clone (CI); `GWN_SHARED_DIR` points elsewhere (a worktree).
@@ -107,11 +108,31 @@ fn check(model: &str, closed: bool, stride: usize) {
     let t = std::time::Instant::now();
     let got = wn.eval_batch(&pts);
     let secs = t.elapsed().as_secs_f64();
+    // The same queries as the first point of a grid column (axes in turn) sharing its ray with
+    // the model's extreme heights and a point 1e-3 × diagonal away.
+    let (lo, hi) = m.bounding_box();
+    let step = 1e-3 * m.diagonal();
+    let by_column: Vec<f64> = pts
+        .par_iter()
+        .enumerate()
+        .map(|(j, q)| {
+            let axis = j % 3;
+            let ts = [q[axis], lo[axis], hi[axis], q[axis] + step];
+            wn.evaluate_column(*q, axis, &ts)[0].value
+        })
+        .collect();
+    let got: Vec<(f64, &str)> = got
+        .into_iter()
+        .map(|w| (w, "point"))
+        .chain(by_column.into_iter().map(|w| (w, "column")))
+        .collect();
+    let picked: Vec<usize> = picked.iter().chain(&picked).copied().collect();
     let mut worst = [(0.0f64, 0usize, 0usize); 3];
     let mut failures = Vec::new();
     for (j, &i) in picked.iter().enumerate() {
         let k = r.kind[i] as usize;
-        let e = (got[j] - r.w[i]).abs();
+        let (w, path) = got[j];
+        let e = (w - r.w[i]).abs();
         let allowed = if closed {
             1e-9
         } else {
@@ -123,8 +144,8 @@ fn check(model: &str, closed: bool, stride: usize) {
             worst[k].1 += 1;
             if failures.len() < 10 {
                 failures.push(format!(
-                    "#{i} kind {k} q {:?}: got {} ref {} err {}",
-                    r.queries[i], got[j], r.w[i], r.err[i]
+                    "#{i} kind {k} q {:?}: got {w} ({path}) ref {} err {}",
+                    r.queries[i], r.w[i], r.err[i]
                 ));
             }
         }
@@ -159,4 +180,52 @@ fn open_cylinder_matches_reference() {
 #[test]
 fn spring_matches_reference() {
     check("spring", false, 10);
+}
+
+/// The column index of the trimming test gives the scan's answer: random `(u, v)` over each
+/// face's box and a period beyond it, random surface partials and margins.
+#[test]
+fn indexed_trimming_equals_the_scan() {
+    let Some(dir) = shared() else { return };
+    for model in ["sliced_cylinder", "open_cylinder", "spring", "boxed_sphere"] {
+        let m = load_step(&dir.join(format!("{model}.step"))).unwrap();
+        let mut state = 7u64;
+        let mut rnd = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut checked = 0;
+        for f in m.faces() {
+            let b = f.trim.bbox;
+            let p = f.trim.period_u.unwrap_or(0.0);
+            let count = (20 * f.trim.segments.len()).clamp(200, 1000);
+            for k in 0..count {
+                let uv = [
+                    b[0] - p + (1.4 * rnd() - 0.2) * (b[1] - b[0] + 2.0 * p),
+                    b[2] + (1.4 * rnd() - 0.2) * (b[3] - b[2]),
+                ];
+                // Points on the loops' vertices too, where the half-open crossing rule and the
+                // topmost-segment tie-break matter.
+                let uv = if k % 4 == 0 {
+                    let s = &f.trim.segments[k / 4 % f.trim.segments.len()];
+                    [s.a[0] + p * (rnd() * 3.0 - 1.5).round(), s.a[1]]
+                } else {
+                    uv
+                };
+                let su = [1.0 + rnd(), rnd(), rnd()];
+                let sv = [rnd(), 1.0 + rnd(), rnd()];
+                let margin = [0.0, 1e-6, 1e-3][k % 3] * rnd() * (b[1] - b[0]);
+                assert_eq!(
+                    f.trim.classify(uv, su, sv, margin),
+                    f.trim.classify_by_scan(uv, su, sv, margin),
+                    "{model} face #{} at {uv:?}, margin {margin}",
+                    f.id
+                );
+                checked += 1;
+            }
+        }
+        eprintln!("{model}: {checked} classifications agree");
+    }
 }

@@ -44,6 +44,15 @@ const MU_RELAXED: f64 = 0.02;
 pub const CERT_DEPTH: u32 = 5;
 /// Smallest `|cos|` between a hit's normal and the ray (grazing hits are ambiguous).
 pub const MIN_COSINE: f64 = 1e-4;
+/// Trimming margin of the hits shared by a grid column, relative to the diagonal
+/// ([`StepWindingNumber::evaluate_column`]). Far above [`HIT_MARGIN`]: a column's line is
+/// axis-aligned, and so are the edges of CAD models, so a whole row of columns can pass
+/// through a tangent junction of two faces (a fillet meeting a plane in `boxed_sphere.step`),
+/// where the two faces' loop polygons disagree by up to 1e-4 × diagonal and a hit can fall
+/// between them (the per-point rays, turned irrationally, meet such a junction only at
+/// isolated points). A point whose ray has a hit this close to its face's loops is answered
+/// by the line's other half or on its own.
+const COLUMN_HIT_MARGIN: f64 = 1e-3;
 /// Subdivision depth of a patch before Newton's method starts from the piece's centre.
 const HIT_DEPTH: u32 = 12;
 
@@ -276,6 +285,20 @@ impl StepWindingNumber {
     ) -> Result<StepEvaluation, Reject> {
         let frame = RayFrame::new(d);
         // Certify the boundary first (cheap), then the hits.
+        let pieces = self.certify_boundary(q, &frame, mu, strict)?;
+        let chi = self.crossings(q, &frame, margin, strict)?;
+        Ok(self.with_boundary(chi, &pieces))
+    }
+
+    /// The surface boundary in the ray frame of `q`, halved into pieces certified against the
+    /// ray with margin `mu`; `Err` (when `strict`) if some piece cannot be certified.
+    fn certify_boundary(
+        &self,
+        q: [f64; 3],
+        frame: &RayFrame,
+        mu: f64,
+        strict: bool,
+    ) -> Result<Vec<Vec<Homogeneous>>, Reject> {
         let mut pieces = Vec::new();
         for c in &self.model.boundary {
             let h: Vec<Homogeneous> = c.iter().map(|&p| frame.hom(p, q)).collect();
@@ -283,7 +306,11 @@ impl StepWindingNumber {
                 return Err(Reject::Boundary);
             }
         }
-        let chi = self.crossings(q, &frame, margin, strict)?;
+        Ok(pieces)
+    }
+
+    /// `χ` plus the boundary integral over the certified `pieces` (empty for a closed model).
+    fn with_boundary(&self, chi: i64, pieces: &[Vec<Homogeneous>]) -> StepEvaluation {
         let mut sum = NeumaierSum::new();
         let mut err = 0.0;
         let tol = self.options.tolerance * 4.0 * PI / (pieces.len().max(1) as f64);
@@ -293,7 +320,7 @@ impl StepWindingNumber {
             remaining: MAX_EVALUATIONS,
         };
         let mut capped = 0;
-        for c in &pieces {
+        for c in pieces {
             let (en, edn) = evaluation_rounding(c);
             let r = integrate(
                 |t| {
@@ -309,13 +336,135 @@ impl StepWindingNumber {
             err += r.error;
             capped += r.capped;
         }
-        Ok(StepEvaluation {
+        StepEvaluation {
             value: chi as f64 + sum.value() / (4.0 * PI),
             crossings: chi,
             error_estimate: err / (4.0 * PI),
             rays: 0,
             uncertified: capped > 0,
-        })
+        }
+    }
+
+    /// [`evaluate`](Self::evaluate) at the points `q` with coordinate `axis` replaced by each
+    /// `ts[k]` (a grid column), sharing one ray: the paper's ray reuse (Sec. 4.3.1).
+    ///
+    /// The ray of every point is the column's line in `+axis` (or, second choice, `−axis`); the
+    /// line's hits on the trimmed faces are found once, and a point's `χ` is the signed count
+    /// of the inside hits above (below) it. A point is answered from the shared hits only when
+    /// its own ray passes the tests of [`evaluate`](Self::evaluate) (the module docs): no hit
+    /// ahead of it is grazing or within the margin of its face's loops, no hit is within the
+    /// margin of the point, and, for an open model, its surface boundary is certified against
+    /// the ray. Any other point is evaluated on its own. A closed model's values are then the same integers as
+    /// [`evaluate`](Self::evaluate)'s; an open model's differ by the quadrature error (both
+    /// within the tolerance). `axis > 2` or non-finite input evaluates point by point.
+    pub fn evaluate_column(&self, q: [f64; 3], axis: usize, ts: &[f64]) -> Vec<StepEvaluation> {
+        let point = |t: f64| {
+            let mut p = q;
+            if axis < 3 {
+                p[axis] = t;
+            }
+            p
+        };
+        let one_by_one = || ts.iter().map(|&t| self.evaluate(point(t))).collect();
+        if axis > 2 || ts.len() < 2 || q.iter().chain(ts).any(|c| !c.is_finite()) {
+            return one_by_one();
+        }
+        let mut d = [0.0; 3];
+        d[axis] = 1.0;
+        let up = RayFrame::new(d);
+        d[axis] = -1.0;
+        let down = RayFrame::new(d);
+        // The line's hits as seen from a point just below the model: all of them are ahead of
+        // it, at heights `τ` along `+axis` from it. Not below every `ts`: Newton's acceptance
+        // of a hit scales with the distance from the ray's origin, so that origin stays near
+        // the model however far the column's points reach.
+        let base_height = self.model.lo[axis] - 0.01 * self.model.diagonal() - self.margin;
+        if !base_height.is_finite() {
+            return one_by_one();
+        }
+        let hits = self.line_hits(point(base_height), &up);
+        // A closed model's line enters as often as it leaves: otherwise some hit was missed or
+        // counted twice (loops that disagree at a junction), and every point is on its own.
+        if self.model.boundary.is_empty()
+            && !hits.iter().any(|h| h.ambiguous)
+            && hits.iter().map(|h| h.sign).sum::<i64>() != 0
+        {
+            return one_by_one();
+        }
+        ts.iter()
+            .map(|&t| {
+                let p = point(t);
+                let tau = t - base_height;
+                // `χ` along `+axis` (hits above) and along `−axis` (hits below, crossed the
+                // other way); `None` where a hit makes that ray ambiguous.
+                let (mut chi_up, mut chi_down) = (Some(0i64), Some(0i64));
+                for h in &hits {
+                    if (h.tau - tau).abs() <= self.margin {
+                        return self.evaluate(p);
+                    }
+                    if h.tau > tau {
+                        chi_up = chi_up.filter(|_| !h.ambiguous).map(|c| c + h.sign);
+                    } else {
+                        chi_down = chi_down.filter(|_| !h.ambiguous).map(|c| c - h.sign);
+                    }
+                }
+                // For an open model the boundary must be certified against the ray too; the
+                // line's other half is the second choice.
+                for (chi, frame) in [(chi_up, &up), (chi_down, &down)] {
+                    let Some(chi) = chi else { continue };
+                    if let Ok(pieces) = self.certify_boundary(p, frame, MU, true) {
+                        let mut e = self.with_boundary(chi, &pieces);
+                        e.rays = 1;
+                        return e;
+                    }
+                }
+                self.evaluate(p)
+            })
+            .collect()
+    }
+
+    /// Every hit of the ray from `q` along `frame.d` on the trimmed faces, classified once:
+    /// sign of the crossing (0 outside the face's loops) or ambiguous (grazing, or within
+    /// [`COLUMN_HIT_MARGIN`] of the loops), at its distance `τ` from `q`.
+    fn line_hits(&self, q: [f64; 3], frame: &RayFrame) -> Vec<LineHit> {
+        let mut out = Vec::new();
+        let column_margin = COLUMN_HIT_MARGIN * self.model.diagonal();
+        let dedup = 1e-9 * self.model.diagonal();
+        for face in &self.model.faces {
+            let mut hits: Vec<Hit> = Vec::new();
+            for fp in &face.patches {
+                if ray_meets_box(q, frame.d, fp.lo, fp.hi, dedup) {
+                    patch_hits(fp, q, frame, &mut hits);
+                }
+            }
+            let mut kept: Vec<Hit> = Vec::new();
+            for h in hits {
+                if kept.iter().all(|k| norm(sub(k.point, h.point)) > dedup) {
+                    kept.push(h);
+                }
+            }
+            for h in kept {
+                let n = cross(h.su, h.sv);
+                let nn = norm(n);
+                let c = face.sense * dot(n, frame.d) / nn;
+                let grazing = nn.is_nan() || nn <= 0.0 || c.abs() < MIN_COSINE;
+                let side = if grazing {
+                    Side::Near
+                } else {
+                    face.trim.classify(h.uv, h.su, h.sv, column_margin)
+                };
+                out.push(LineHit {
+                    tau: h.tau,
+                    sign: match side {
+                        Side::Inside if c > 0.0 => 1,
+                        Side::Inside => -1,
+                        _ => 0,
+                    },
+                    ambiguous: side == Side::Near,
+                });
+            }
+        }
+        out
     }
 
     /// Signed count of trimmed-face crossings of the ray; `Err` if some hit is ambiguous.
@@ -436,6 +585,16 @@ fn ray_meets_box(q: [f64; 3], d: [f64; 3], lo: [f64; 3], hi: [f64; 3], pad: f64)
         }
     }
     true
+}
+
+/// A hit of a grid column's line ([`StepWindingNumber::evaluate_column`]).
+struct LineHit {
+    /// Distance along the line from its base point.
+    tau: f64,
+    /// Crossing sign if inside the face's loops, else 0.
+    sign: i64,
+    /// Grazing or within the margin of the loops: no ray from a point towards it may use it.
+    ambiguous: bool,
 }
 
 struct Hit {
@@ -661,5 +820,11 @@ impl crate::eval::Evaluator for StepWindingNumber {
     }
     fn eval_batch(&self, points: &[[f64; 3]]) -> Vec<f64> {
         StepWindingNumber::eval_batch(self, points)
+    }
+    fn eval_column(&self, q: [f64; 3], axis: usize, ts: &[f64]) -> Vec<f64> {
+        self.evaluate_column(q, axis, ts)
+            .into_iter()
+            .map(|e| e.value)
+            .collect()
     }
 }

@@ -34,6 +34,99 @@ pub struct Trim {
     pub sense: f64,
     /// Bounding box of the segments: `[u0, u1, v0, v1]`.
     pub bbox: [f64; 4],
+    /// Segments by `u` column, so that a classification visits only the segments that can
+    /// cross the point's vertical line or come within the margin of it.
+    index: ColumnIndex,
+}
+
+/// Fewest segments for which a face gets a [`ColumnIndex`] (below, a scan is as fast).
+const INDEX_MIN_SEGMENTS: usize = 32;
+/// Most columns of a [`ColumnIndex`].
+const INDEX_MAX_COLUMNS: usize = 4096;
+/// Most period copies of a query's `u` an indexed classification looks up; loops spanning more
+/// periods than this are scanned.
+const INDEX_MAX_COPIES: f64 = 64.0;
+
+/// The segments of a trim sorted into equal-width columns of `u` (the segments' own
+/// coordinates, before any period shift): segment `i` is listed, in increasing `i`, in every
+/// column its `u` range meets. A column lookup is a superset of the segments whose `u` range
+/// contains a given `u`, because [`ColumnIndex::column`] is monotone in `u`.
+#[derive(Clone, Debug, Default)]
+struct ColumnIndex {
+    /// `u` of the left edge of column 0.
+    u0: f64,
+    /// Columns per unit of `u`.
+    inv_width: f64,
+    /// Column count (0: no index, classifications scan every segment).
+    columns: usize,
+    /// Start of each column's entries in `entries` (`columns + 1` offsets).
+    offsets: Vec<u32>,
+    /// Segment indices, column by column.
+    entries: Vec<u32>,
+}
+
+impl ColumnIndex {
+    fn new(segments: &[Segment], bbox: [f64; 4]) -> ColumnIndex {
+        let (u0, u1) = (bbox[0], bbox[1]);
+        let span = u1 - u0;
+        if segments.len() < INDEX_MIN_SEGMENTS
+            || segments.len() > u32::MAX as usize / 4
+            || !(span.is_finite() && span > 0.0)
+        {
+            return ColumnIndex::default();
+        }
+        let columns = (segments.len() / 4).clamp(1, INDEX_MAX_COLUMNS);
+        let mut index = ColumnIndex {
+            u0,
+            inv_width: columns as f64 / span,
+            columns,
+            offsets: Vec::new(),
+            entries: Vec::new(),
+        };
+        let range = |s: &Segment| {
+            let (a, b) = (s.a[0].min(s.b[0]), s.a[0].max(s.b[0]));
+            (index.column(a), index.column(b))
+        };
+        let mut counts = vec![0u32; columns + 1];
+        for s in segments {
+            let (c0, c1) = range(s);
+            for c in &mut counts[c0..=c1] {
+                *c += 1;
+            }
+        }
+        let mut offsets = Vec::with_capacity(columns + 1);
+        let mut total = 0u32;
+        for c in &counts[..columns] {
+            offsets.push(total);
+            total += c;
+        }
+        offsets.push(total);
+        let mut fill: Vec<u32> = offsets[..columns].to_vec();
+        let mut entries = vec![0u32; total as usize];
+        for (i, s) in segments.iter().enumerate() {
+            let (c0, c1) = range(s);
+            for f in &mut fill[c0..=c1] {
+                entries[*f as usize] = i as u32;
+                *f += 1;
+            }
+        }
+        index.offsets = offsets;
+        index.entries = entries;
+        index
+    }
+
+    /// The column of `u`, clamped to the index (monotone in `u`: `fl(u − u0)` and the product
+    /// with a positive constant are monotone, and so are `floor` and the clamp).
+    fn column(&self, u: f64) -> usize {
+        let x = ((u - self.u0) * self.inv_width).floor();
+        if x >= self.columns as f64 {
+            self.columns - 1
+        } else if x >= 0.0 {
+            x as usize
+        } else {
+            0
+        }
+    }
 }
 
 /// Where a point lies relative to the loops.
@@ -65,11 +158,13 @@ impl Trim {
                 bbox[3] = bbox[3].max(p[1]);
             }
         }
+        let index = ColumnIndex::new(&segments, bbox);
         Trim {
             segments,
             period_u,
             sense,
             bbox,
+            index,
         }
     }
 
@@ -77,13 +172,23 @@ impl Trim {
     /// crossing minus the signed crossings above `v`. `None` when no segment crosses the
     /// column (the point is outside).
     pub fn indicator(&self, uv: [f64; 2]) -> i64 {
-        self.classify_with(uv, None).1
+        self.classify_with(uv, None, true).1
     }
 
     /// Inside/outside/near for a point with surface partials `su`, `sv` (to measure the
     /// distance to the loops in 3D): `Near` if some boundary segment is closer than `margin`.
     pub fn classify(&self, uv: [f64; 2], su: [f64; 3], sv: [f64; 3], margin: f64) -> Side {
-        let (near, ind) = self.classify_with(uv, Some((su, sv, margin)));
+        Self::side(self.classify_with(uv, Some((su, sv, margin)), true))
+    }
+
+    /// [`classify`](Self::classify) by a scan of every segment, without the column index: the
+    /// index's oracle in tests.
+    #[doc(hidden)]
+    pub fn classify_by_scan(&self, uv: [f64; 2], su: [f64; 3], sv: [f64; 3], margin: f64) -> Side {
+        Self::side(self.classify_with(uv, Some((su, sv, margin)), false))
+    }
+
+    fn side((near, ind): (bool, i64)) -> Side {
         if near {
             return Side::Near;
         }
@@ -94,19 +199,65 @@ impl Trim {
         }
     }
 
+    /// For an indexed trim, the period copies `k` of `uv[0]` to look up (`uv[0] + k·period`)
+    /// and the reach in `u` around each: every segment that can cross the vertical line at
+    /// `uv[0]` or lie within the metric's margin of `uv` is in a looked-up column. `None`: scan
+    /// every segment (no index, a degenerate metric, or too many copies).
+    ///
+    /// The margin test measures `|J δ|` with `J = [S_u S_v]` and `δ` the offset in `(u, v)`
+    /// to the segment, and `|J δ| ≥ σ_min |δ| ≥ σ_min |δ_u|`; so a segment whose `u` range is
+    /// farther than `margin / σ_min` from the point's `u` cannot be near. The reach is that
+    /// bound grown by 1 % (rounding of `σ_min`) plus a column width.
+    fn candidate_columns(
+        &self,
+        uv: [f64; 2],
+        metric: Option<([f64; 3], [f64; 3], f64)>,
+    ) -> Option<(std::ops::RangeInclusive<i64>, f64)> {
+        let idx = &self.index;
+        if idx.columns == 0 || !(uv[0].is_finite() && uv[1].is_finite()) {
+            return None;
+        }
+        let width = 1.0 / idx.inv_width;
+        let mut reach = width;
+        if let Some((su, sv, margin)) = metric {
+            let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+            let (a, b, c) = (dot(su, su), dot(su, sv), dot(sv, sv));
+            // Smallest eigenvalue of JᵀJ, as det / largest (no cancellation).
+            let largest = 0.5 * (a + c) + (0.25 * (a - c) * (a - c) + b * b).sqrt();
+            let det = a * c - b * b;
+            let smallest = det / largest;
+            // A nearly singular metric (a pole, a collapsed edge): the bound is useless.
+            if !(smallest.is_finite() && smallest > 1e-12 * largest && margin.is_finite()) {
+                return None;
+            }
+            reach += 1.01 * margin.abs() / smallest.sqrt();
+        }
+        let (u0, u1) = (idx.u0, idx.u0 + idx.columns as f64 * width);
+        let copies = match self.period_u {
+            None => 0..=0,
+            Some(p) => {
+                let lo = ((u0 - reach - uv[0]) / p).floor() - 1.0;
+                let hi = ((u1 + reach - uv[0]) / p).ceil() + 1.0;
+                if !(lo.is_finite() && hi.is_finite()) || hi - lo > INDEX_MAX_COPIES {
+                    return None;
+                }
+                (lo as i64)..=(hi as i64)
+            }
+        };
+        Some((copies, reach))
+    }
+
     fn classify_with(
         &self,
         uv: [f64; 2],
         metric: Option<([f64; 3], [f64; 3], f64)>,
+        indexed: bool,
     ) -> (bool, i64) {
-        let mut top: Option<(f64, i64)> = None;
+        let mut top: Option<(f64, i64, usize)> = None;
         let mut above = 0i64;
         let mut near = false;
-        for s in &self.segments {
-            let shift = match self.period_u {
-                Some(p) => p * ((0.5 * (s.a[0] + s.b[0]) - uv[0]) / p).round(),
-                None => 0.0,
-            };
+        let mut visit = |i: usize, shift: f64| {
+            let s = &self.segments[i];
             let u = uv[0] + shift;
             let (ua, ub) = (s.a[0], s.b[0]);
             if (ua <= u && u < ub) || (ub <= u && u < ua) {
@@ -115,8 +266,9 @@ impl Trim {
                 if vc > uv[1] {
                     above += sign;
                 }
-                if top.is_none_or(|(t, _)| vc > t) {
-                    top = Some((vc, sign));
+                // The first topmost segment in index order, whatever order they are visited in.
+                if top.is_none_or(|(t, _, ti)| vc > t || (vc == t && i < ti)) {
+                    top = Some((vc, sign, i));
                 }
             }
             if let (Some((su, sv, margin)), true) = (metric, s.real) {
@@ -140,10 +292,49 @@ impl Trim {
                     near = true;
                 }
             }
+        };
+        // The period copy of `uv[0]` each segment is tested at: the one nearest its midpoint.
+        let copy = |s: &Segment| match self.period_u {
+            Some(p) => ((0.5 * (s.a[0] + s.b[0]) - uv[0]) / p).round(),
+            None => 0.0,
+        };
+        let shift_of = |k: f64| self.period_u.map_or(0.0, |p| p * k);
+        let columns = if indexed {
+            self.candidate_columns(uv, metric)
+        } else {
+            None
+        };
+        match columns {
+            None => {
+                for (i, s) in self.segments.iter().enumerate() {
+                    visit(i, shift_of(copy(s)));
+                }
+            }
+            Some((copies, reach)) => {
+                let idx = &self.index;
+                for k in copies {
+                    let k = k as f64;
+                    let u = uv[0] + shift_of(k);
+                    let (c0, c1) = (idx.column(u - reach), idx.column(u + reach));
+                    for c in c0..=c1 {
+                        let (e0, e1) = (idx.offsets[c] as usize, idx.offsets[c + 1] as usize);
+                        for &i in &idx.entries[e0..e1] {
+                            let i = i as usize;
+                            let s = &self.segments[i];
+                            // Once per segment: in the first looked-up column it is listed in,
+                            // and only for its own period copy.
+                            if idx.column(s.a[0].min(s.b[0])).max(c0) != c || copy(s) != k {
+                                continue;
+                            }
+                            visit(i, shift_of(k));
+                        }
+                    }
+                }
+            }
         }
         let ind = match top {
             None => 0,
-            Some((_, sign)) => i64::from(sign > 0) - above,
+            Some((_, sign, _)) => i64::from(sign > 0) - above,
         };
         (near, ind)
     }
