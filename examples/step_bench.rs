@@ -8,7 +8,7 @@
 //! Times are the thread's CPU time (`/proc/thread-self/schedstat`, wall-clock elsewhere), so
 //! other processes on a shared machine disturb them far less than wall-clock time.
 //!
-//! `cargo run --release --example step_bench -- ../shared/parametric/step/*.step`
+//! `cargo run --release --features examples --example step_bench -- ../shared/parametric/step/*.step`
 //!
 //! Environment: `GWN_GRID` (default 32), `GWN_BENCH=points|columns` (only one of the two).
 

@@ -1,7 +1,7 @@
 //! Prints, for one query, the value along every candidate direction of the STEP evaluator, the
 //! grid-column value along `z` and the `+z` hits.
-//! `cargo run --release --example step_debug -- MODEL.step x y z`
-//! `cargo run --release --example step_debug -- MODEL.step index` compares the indexed trimming
+//! `cargo run --release --features examples --example step_debug -- MODEL.step x y z`
+//! `cargo run --release --features examples --example step_debug -- MODEL.step index` compares the indexed trimming
 //! test with the scan on random points of every face.
 fn main() {
     let a: Vec<String> = std::env::args().collect();

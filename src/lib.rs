@@ -39,10 +39,11 @@ pub mod io;
 pub mod kernel;
 pub mod mesh;
 mod one_shot;
+#[cfg(feature = "patch")]
 pub mod patch;
 #[cfg(feature = "products")]
 pub mod products;
-#[cfg(any(feature = "testing", feature = "cli"))]
+#[cfg(feature = "testing-kit")]
 pub mod testing;
 
 pub use base::bounding_box::BoundingBox;

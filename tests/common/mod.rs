@@ -13,6 +13,22 @@ pub fn open_cube() -> Mesh {
     gwn::testing::unit_cube(true)
 }
 
+/// The repository's root, the `gwn` package's directory (`tests/cli` and `tests/products` belong
+/// to the `gwn-cli` package in `cli/`, whose manifest directory is one below).
+pub fn repo() -> &'static std::path::Path {
+    let manifest = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    if env!("CARGO_PKG_NAME") == "gwn-cli" {
+        manifest.parent().expect("cli/ has a parent")
+    } else {
+        manifest
+    }
+}
+
+/// A file of `tests/fixtures/`.
+pub fn fixture(name: &str) -> std::path::PathBuf {
+    repo().join("tests/fixtures").join(name)
+}
+
 /// Reports that the running test skips its body for want of `what` (e.g. `../shared/meshes`),
 /// visibly: libtest captures the `print!`/`eprint!` output of passing tests, so a skipped test
 /// used to show as `ok` in 0.00 s. A direct write to the process's stderr is not captured, and
@@ -30,7 +46,7 @@ pub fn report_skip(what: &str) {
 
 /// `../shared/meshes` if present, else reports the skip ([`report_skip`]) and returns `None`.
 pub fn shared_meshes() -> Option<std::path::PathBuf> {
-    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes");
+    let p = repo().join("../shared/meshes");
     if p.join("manifest.csv").exists() {
         Some(p)
     } else {
@@ -42,9 +58,7 @@ pub fn shared_meshes() -> Option<std::path::PathBuf> {
 /// A file of the shared corpus (`../shared/…`, `relative` below `../shared`), or `None` after
 /// reporting the skip ([`report_skip`]).
 pub fn shared_file(relative: &str) -> Option<std::path::PathBuf> {
-    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared")
-        .join(relative);
+    let p = repo().join("../shared").join(relative);
     if p.exists() {
         Some(p)
     } else {
@@ -117,4 +131,18 @@ pub fn rational_sphere_patches() -> Vec<gwn::patch::Patch> {
         }
     }
     patches
+}
+
+/// A sphere sampled by a Fibonacci spiral: oriented points carrying equal areas.
+pub fn sphere_cloud(n: usize) -> gwn::eval::fast::PointCloud {
+    let p: Vec<[f64; 3]> = (0..n)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+            let r = (1.0 - z * z).sqrt();
+            let t = i as f64 * 2.399963229728653;
+            [r * t.cos(), r * t.sin(), z]
+        })
+        .collect();
+    let a = vec![4.0 * std::f64::consts::PI / n as f64; n];
+    gwn::eval::fast::PointCloud::new(p.clone(), p, Some(a)).unwrap()
 }

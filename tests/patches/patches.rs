@@ -1,0 +1,163 @@
+//! Curved surfaces: closed forms, oracles and ray independence for the patch evaluator
+//! (`docs/patches.md`).
+
+use crate::common;
+
+use gwn::Mesh;
+use gwn::eval::antipodal::WindingNumber;
+use gwn::kernel::frame::RayAxis;
+use gwn::patch::tessellate::tessellate;
+use gwn::patch::{Options, Patch, PatchSet, PatchWindingNumber};
+
+/// xorshift64*: deterministic points without a dependency.
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn point(&mut self, lo: f64, hi: f64) -> [f64; 3] {
+        [0, 1, 2].map(|_| lo + (hi - lo) * self.next())
+    }
+}
+
+fn with(set: &PatchSet, ray: RayAxis, tolerance: f64) -> PatchWindingNumber {
+    PatchWindingNumber::with_options(set, Options { ray, tolerance })
+}
+
+/// A planar parallelogram `o + t·a + s·b` as a patch of degrees `(m, n)` (affine control net).
+fn planar(o: [f64; 3], a: [f64; 3], b: [f64; 3], m: usize, n: usize) -> Patch {
+    let mut pts = Vec::new();
+    for i in 0..=m {
+        for j in 0..=n {
+            let (s, t) = (i as f64 / m as f64, j as f64 / n as f64);
+            pts.push([0, 1, 2].map(|c| o[c] + t * a[c] + s * b[c]));
+        }
+    }
+    Patch::polynomial(m, n, pts).unwrap()
+}
+
+/// The unit cube without its top, as five planar patches of assorted degrees and as triangles.
+fn open_box() -> (PatchSet, Mesh) {
+    let faces = [
+        ([0., 0., 0.], [0., 1., 0.], [1., 0., 0.], 3, 3), // bottom, normal −z
+        ([0., 0., 0.], [0., 0., 1.], [0., 1., 0.], 1, 1), // x = 0
+        ([1., 0., 0.], [0., 1., 0.], [0., 0., 1.], 2, 3), // x = 1
+        ([0., 0., 0.], [1., 0., 0.], [0., 0., 1.], 3, 1), // y = 0
+        ([0., 1., 0.], [0., 0., 1.], [1., 0., 0.], 3, 3), // y = 1
+    ];
+    let mut pos = Vec::new();
+    let mut tri = Vec::new();
+    let mut patches = Vec::new();
+    for (o, a, b, m, n) in faces {
+        patches.push(planar(o, a, b, m, n));
+        let base = pos.len() as u32;
+        let add = |u: [f64; 3], v: [f64; 3]| [0, 1, 2].map(|c| u[c] + v[c]);
+        pos.extend([o, add(o, a), add(add(o, a), b), add(o, b)]);
+        tri.push([base, base + 1, base + 2]);
+        tri.push([base, base + 2, base + 3]);
+    }
+    (
+        PatchSet::new(patches).unwrap(),
+        Mesh::from_slices(&pos, &tri).unwrap(),
+    )
+}
+
+#[test]
+fn planar_patches_equal_the_triangle_evaluator() {
+    let (set, mesh) = open_box();
+    let exact = WindingNumber::new(&mesh).unwrap();
+    let mut rng = Rng(7);
+    let mut worst = 0.0f64;
+    for k in 0..400 {
+        let q = rng.point(-0.5, 1.5);
+        let ray = RayAxis::ALL[k % 6];
+        let w = with(&set, ray, 1e-15).eval(q);
+        let r = exact.eval(q);
+        worst = worst.max((w - r).abs());
+    }
+    assert!(worst < 1e-12, "worst difference {worst:e}");
+    // Inside the open box, on the axis: 5/6 by symmetry.
+    let w = PatchWindingNumber::new(&set).eval([0.5, 0.5, 0.5]);
+    assert!((w - 5.0 / 6.0).abs() < 1e-12, "{w}");
+}
+
+/// The unit sphere as 8 rational biquadratic patches (quarter circles × half meridians), outward.
+fn sphere() -> PatchSet {
+    PatchSet::new(common::rational_sphere_patches()).unwrap()
+}
+
+#[test]
+fn rational_sphere_is_one_inside_and_zero_outside() {
+    let set = sphere();
+    let wn = PatchWindingNumber::new(&set);
+    // Only the collapsed pole edges are left out of the pairing: no boundary.
+    assert_eq!(wn.edge_counts(), (0, 12, 8));
+    let mut rng = Rng(11);
+    let mut checked = 0;
+    while checked < 600 {
+        let q = rng.point(-1.6, 1.6);
+        let r = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt();
+        if (r - 1.0).abs() < 1e-3 {
+            continue;
+        }
+        let expected = if r < 1.0 { 1.0 } else { 0.0 };
+        let w = with(&set, RayAxis::ALL[checked % 6], 1e-12).eval(q);
+        assert!((w - expected).abs() < 1e-12, "q = {q:?}: {w}");
+        checked += 1;
+    }
+    // Centre and poles' axis: every ray from the centre passes through a pole or an equator
+    // point shared by patches.
+    for ray in RayAxis::ALL {
+        let w = with(&set, ray, 1e-12).eval([0.0; 3]);
+        assert!((w - 1.0).abs() < 1e-12, "{ray:?}: {w}");
+    }
+}
+
+#[test]
+fn hemisphere_cap_on_its_axis_is_the_closed_form() {
+    let set = PatchSet::new(sphere().patches()[4..].to_vec()).unwrap();
+    for h in [
+        -3.0, -1.0, -0.5, -1e-3, 1e-9, 0.25, 0.5, 0.999, 1.001, 2.0, 10.0,
+    ] {
+        let disk = 0.5 * (1.0 - f64::abs(h) / (1.0 + h * h).sqrt());
+        let expected = if h > 0.0 && h < 1.0 { 1.0 } else { 0.0 } - f64::signum(h) * disk;
+        for ray in RayAxis::ALL {
+            let w = with(&set, ray, 1e-13).eval([0.0, 0.0, h]);
+            assert!(
+                (w - expected).abs() < 1e-11,
+                "h = {h}, {ray:?}: {w} vs {expected}"
+            );
+        }
+    }
+}
+
+#[test]
+fn tessellation_converges_to_the_patch_values() {
+    // The open hemisphere: tessellations at k and 2k, Richardson-extrapolated, agree with the
+    // patch evaluator within the extrapolation's own error estimate.
+    let set = PatchSet::new(sphere().patches()[4..].to_vec()).unwrap();
+    let wn = with(&set, RayAxis::PosZ, 1e-13);
+    let coarse = WindingNumber::new(&tessellate(&set, 32).unwrap()).unwrap();
+    let fine = WindingNumber::new(&tessellate(&set, 64).unwrap()).unwrap();
+    let mut rng = Rng(5);
+    let mut n = 0;
+    while n < 200 {
+        let q = rng.point(-1.5, 1.5);
+        let r = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt();
+        if (r - 1.0).abs() < 0.05 {
+            continue;
+        }
+        let (a, b) = (coarse.eval(q), fine.eval(q));
+        let reference = (4.0 * b - a) / 3.0;
+        let est = (reference - b).abs();
+        let w = wn.eval(q);
+        assert!(
+            (w - reference).abs() <= 0.5 * est + 1e-9,
+            "q = {q:?}: {w} vs {reference} (estimate {est:e})"
+        );
+        n += 1;
+    }
+}
