@@ -400,9 +400,9 @@ impl Hierarchy {
                     .pair(&self.wide_far[b])
                     .eval(r, order)
                     .to_array();
-                for l in 0..2 * WIDTH {
-                    far[l] += if mask & (1 << l) != 0 {
-                        f64::from(w[l])
+                for (l, (sum, &w)) in far.iter_mut().zip(&w).enumerate() {
+                    *sum += if mask & (1 << l) != 0 {
+                        f64::from(w)
                     } else {
                         0.0
                     };

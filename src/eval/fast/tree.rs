@@ -128,10 +128,8 @@ impl Tree {
                 }
             } else {
                 let (a, b) = (nodes[node.left as usize], nodes[node.left as usize + 1]);
-                for k in 0..3 {
-                    lo[k] = a.min[k].min(b.min[k]);
-                    hi[k] = a.max[k].max(b.max[k]);
-                }
+                lo = std::array::from_fn(|k| a.min[k].min(b.min[k]));
+                hi = std::array::from_fn(|k| a.max[k].max(b.max[k]));
             }
             nodes[id].min = lo;
             nodes[id].max = hi;
