@@ -194,10 +194,6 @@ impl Hierarchy {
     /// Numbers the leaves and collapses the binary tree into the 4-wide query tree: a binary
     /// node's lanes start as its two children, and the widest (largest radius) inner lane is
     /// replaced by its own two children until there are four lanes or only leaves.
-
-    /// Numbers the leaves and collapses the binary tree into the 4-wide query tree: a binary
-    /// node's lanes start as its two children, and the widest (largest radius) inner lane is
-    /// replaced by its own two children until there are four lanes or only leaves.
     fn build_wide(&mut self) {
         let nodes = &self.tree.nodes;
         if nodes.is_empty() {
