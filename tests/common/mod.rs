@@ -44,9 +44,18 @@ pub fn report_skip(what: &str) {
     );
 }
 
+/// The shared data folder: `$GWN_SHARED_DIR` when set (a checkout whose `../shared` is not the
+/// data, e.g. a git worktree elsewhere), else `../shared` next to the repository.
+pub fn shared_root() -> std::path::PathBuf {
+    match std::env::var_os("GWN_SHARED_DIR") {
+        Some(dir) => std::path::PathBuf::from(dir),
+        None => repo().join("../shared"),
+    }
+}
+
 /// `../shared/meshes` if present, else reports the skip ([`report_skip`]) and returns `None`.
 pub fn shared_meshes() -> Option<std::path::PathBuf> {
-    let p = repo().join("../shared/meshes");
+    let p = shared_root().join("meshes");
     if p.join("manifest.csv").exists() {
         Some(p)
     } else {
@@ -58,7 +67,7 @@ pub fn shared_meshes() -> Option<std::path::PathBuf> {
 /// A file of the shared corpus (`../shared/…`, `relative` below `../shared`), or `None` after
 /// reporting the skip ([`report_skip`]).
 pub fn shared_file(relative: &str) -> Option<std::path::PathBuf> {
-    let p = repo().join("../shared").join(relative);
+    let p = shared_root().join(relative);
     if p.exists() {
         Some(p)
     } else {

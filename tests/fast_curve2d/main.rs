@@ -10,3 +10,4 @@ mod curve2d;
 mod curve2d_open;
 mod curve2d_svg;
 mod fast;
+mod fast_vs_libigl;

@@ -10,8 +10,9 @@
 //! triangle corner or point below the node) and the [`Moments`] of order 0, 1 and 2 (exact
 //! closed forms for triangles: centroid rule and edge-midpoint rule), built bottom-up by
 //! re-centring the children's moments (parallel-axis shifts). For the queries the binary tree is
-//! collapsed into a 4-wide one, so that one `f64x4` test decides four admissibilities and one
-//! evaluation (in `f32` lanes) computes four expansions. `FASTWN(q)` (Algorithm 1) uses a node's
+//! collapsed into a 4-wide one, and a query visits two of its nodes at a time, so that one
+//! `f32x8` test decides eight admissibilities and one `f32x8` evaluation computes eight
+//! expansions (AVX2 when the CPU has it, chosen at run time; bit-identical either way). `FASTWN(q)` (Algorithm 1) uses a node's
 //! expansion when `‖q − p̃‖ > β r`, sums exact Van Oosterom–Strackee solid angles (four triangles
 //! at a time, one complex product instead of one `atan2` per triangle) or exact dipoles over a
 //! near leaf, and otherwise opens the node. Per query the cost is
@@ -41,8 +42,8 @@
 //! Barill's order 2 at `β_B = 2` reaches ≤ 1e-3 about 2.5–3× faster (it opens far fewer nodes).
 //! libigl's rule ([`Admissibility::BoxCorner`]: `size` = distance from `p̃` to the farthest corner
 //! of the node's box, `≥ r`) is Barill's with the per-node β `β·ρ/r ≥ β`. Against libigl's default
-//! (accuracy_scale 2), Barill β = 2.35 is the smallest β that was at least as accurate on all the
-//! meshes of `docs/benchmarks.md` (see `docs/fast.md`).
+//! (accuracy_scale 2), Barill β = 2.8 is the smallest β whose max error was at most libigl's on
+//! every mesh of the shared corpus libigl reads (`tests/fast_vs_libigl.rs`, `docs/fast.md`).
 //! [`FastOrExact::winding_number`](crate::eval::fossil::FastOrExact::winding_number) interprets `beta` as Barill's `β_B` (order 2); [`FastParams::fossil`] reproduces FOSSIL's rule
 //! (with the far field's sign right: FOSSIL's published dipole takes `c − q` with the wrong sign;
 //! ours is tested against the direct sum).

@@ -23,7 +23,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use crate::base::vec3::sub;
-use wide::f32x4;
+use wide::{f32x4, f32x8};
 
 use crate::base::vec3::{cross, dot};
 
@@ -314,7 +314,8 @@ impl Moments {
 /// whatever the mesh's units, so the `f32` lanes neither underflow (a mesh in metres of size
 /// 1e-2 has `M2 ≈ 1e-10`, and `M2/d⁷` runs into subnormals) nor overflow.
 ///
-/// `T` is `f64` (one node) or `f32x4` (the four lanes of a node of the 4-wide query tree): one
+/// `T` is `f64` (one node), `f32x4` (the four lanes of a node of the 4-wide query tree, as stored)
+/// or `f32x8` (two such nodes side by side, as evaluated): one
 /// generic formula serves both. `f32` halves the arithmetic and the memory of the far field; its
 /// rounding (~1e-7 relative per node) is four orders below the truncation error of the
 /// expansion (~1e-3), and the near field, which decides the β → ∞ limit, stays `f64`.
@@ -331,7 +332,7 @@ pub(crate) struct FarField<T = f64> {
     c: [T; 10],
 }
 
-/// The arithmetic [`FarField::eval`] needs, for `f64` and for four lanes of it.
+/// The arithmetic [`FarField::eval`] needs, for `f64` and for eight `f32` lanes of it.
 pub(crate) trait Lanes:
     Copy + std::ops::Add<Output = Self> + std::ops::Mul<Output = Self>
 {
@@ -346,10 +347,10 @@ impl Lanes for f64 {
     }
 }
 
-impl Lanes for f32x4 {
-    #[inline]
+impl Lanes for f32x8 {
+    #[inline(always)]
     fn rsqrt(self) -> Self {
-        f32x4::ONE / self.sqrt()
+        f32x8::ONE / self.sqrt()
     }
 }
 
@@ -365,14 +366,14 @@ impl FarField {
             m1[0][2] + m1[2][0],
             m1[1][2] + m1[2][1],
         ];
-        // Full M2ᵢⱼₖ from the stored symmetric rows.
-        let row = |i: usize, j: usize| {
-            let s = SYM_PAIRS
-                .iter()
-                .position(|&(a, b)| (a, b) == (i.min(j), i.max(j)))
-                .unwrap_or(0);
-            m.m2[s]
-        };
+        // Full M2ᵢⱼₖ from the stored symmetric rows (a table, not a search per entry: this
+        // runs once per node of the tree).
+        let mut full = [[[0.0; 3]; 3]; 3];
+        for (s, &(i, j)) in SYM_PAIRS.iter().enumerate() {
+            full[i][j] = m.m2[s];
+            full[j][i] = m.m2[s];
+        }
+        let row = |i: usize, j: usize| full[i][j];
         let mut v = [0.0; 3];
         for k in 0..3 {
             for i in 0..3 {
@@ -421,20 +422,16 @@ impl FarField {
 }
 
 impl FarField<f32x4> {
-    /// The four records side by side, one per lane, rounded to `f32`.
-    pub fn lanes(f: [&FarField; 4]) -> Self {
+    /// Up to four records side by side, one per lane, rounded to `f32` (missing lanes zero).
+    pub fn lanes(f: &[&FarField]) -> Self {
         fn pack<const N: usize>(
-            f: [&FarField; 4],
+            f: &[&FarField],
             get: impl Fn(&FarField) -> [f64; N],
         ) -> [f32x4; N] {
-            let a = f.map(get);
             std::array::from_fn(|i| {
-                f32x4::from([
-                    a[0][i] as f32,
-                    a[1][i] as f32,
-                    a[2][i] as f32,
-                    a[3][i] as f32,
-                ])
+                f32x4::from(std::array::from_fn::<f32, 4, _>(|l| {
+                    f.get(l).map_or(0.0, |x| get(x)[i] as f32)
+                }))
             })
         }
         FarField {
@@ -446,13 +443,34 @@ impl FarField<f32x4> {
             c: pack(f, |x| x.c),
         }
     }
+
+    /// Two four-lane records side by side: `self` in lanes 0–3, `other` in lanes 4–7.
+    #[inline(always)]
+    pub fn pair(&self, other: &Self) -> FarField<f32x8> {
+        #[inline(always)]
+        fn cat(a: f32x4, b: f32x4) -> f32x8 {
+            let (a, b) = (a.to_array(), b.to_array());
+            f32x8::from([a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]])
+        }
+        fn cat_n<const N: usize>(a: &[f32x4; N], b: &[f32x4; N]) -> [f32x8; N] {
+            std::array::from_fn(|i| cat(a[i], b[i]))
+        }
+        FarField {
+            inv_s: cat(self.inv_s, other.inv_s),
+            n: cat_n(&self.n, &other.n),
+            tr: cat(self.tr, other.tr),
+            q: cat_n(&self.q, &other.q),
+            v: cat_n(&self.v, &other.v),
+            c: cat_n(&self.c, &other.c),
+        }
+    }
 }
 
 impl<T: Lanes> FarField<T> {
     /// The same value as [`Moments::far_field`] at `q = p̃ − r` (per lane).
-    #[inline]
+    #[inline(always)]
     pub fn eval(&self, r: [T; 3], order: u8) -> T {
-        let r = r.map(|v| v * self.inv_s);
+        let r = [r[0] * self.inv_s, r[1] * self.inv_s, r[2] * self.inv_s];
         let d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
         let inv_d = d2.rsqrt();
         let inv_d2 = inv_d * inv_d;
@@ -609,17 +627,28 @@ mod tests {
     }
 
     #[test]
-    fn four_lanes_in_f32_equal_the_scalar_far_field() {
-        let nodes = [P, [0.2, 0.5, -0.1], [-1.0, 0.3, 0.2], [0.0, 0.0, 0.0]]
-            .map(|c| Moments::of_triangle(A, B, C, P).recentred(c));
+    fn eight_lanes_in_f32_equal_the_scalar_far_field() {
+        let centres = [
+            P,
+            [0.2, 0.5, -0.1],
+            [-1.0, 0.3, 0.2],
+            [0.0, 0.0, 0.0],
+            [0.7, -0.4, 0.9],
+            [-0.3, -0.8, 0.1],
+        ];
+        let nodes = centres.map(|c| Moments::of_triangle(A, B, C, P).recentred(c));
         let far = nodes.map(|m| FarField::new(&m));
-        let lanes = FarField::<f32x4>::lanes([&far[0], &far[1], &far[2], &far[3]]);
+        let low = FarField::<f32x4>::lanes(&[&far[0], &far[1], &far[2], &far[3]]);
+        let high = FarField::<f32x4>::lanes(&[&far[4], &far[5]]);
+        let lanes = low.pair(&high);
         let q = [3.0, -2.0, 1.5];
         let r = nodes.map(|m| sub(m.center, q));
-        let rl = [0, 1, 2].map(|k| f32x4::from(r.map(|r| r[k] as f32)));
+        // Lanes 6 and 7 are missing (zero coefficients, `1/s = 0`: NaN, never admitted).
+        let rl = [0, 1, 2]
+            .map(|k| f32x8::from(std::array::from_fn::<f32, 8, _>(|l| r[l.min(5)][k] as f32)));
         for order in 0..=2u8 {
             let got = lanes.eval(rl, order).to_array();
-            for l in 0..4 {
+            for l in 0..6 {
                 let want = nodes[l].far_field(q, order);
                 assert!(
                     (f64::from(got[l]) - want).abs() <= 1e-6 * want.abs().max(1e-3),

@@ -69,23 +69,18 @@ impl Tree {
         while let Some(id) = work.pop() {
             let (start, end) = (nodes[id].start as usize, nodes[id].end as usize);
             let slice = &mut order[start..end];
-            let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-            let (mut clo, mut chi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-            for &e in slice.iter() {
-                let (bmin, bmax) = boxes[e as usize];
-                let c = centroids[e as usize];
-                for k in 0..3 {
-                    lo[k] = lo[k].min(bmin[k]);
-                    hi[k] = hi[k].max(bmax[k]);
-                    clo[k] = clo[k].min(c[k]);
-                    chi[k] = chi[k].max(c[k]);
-                }
-            }
-            nodes[id].min = lo;
-            nodes[id].max = hi;
             let count = end - start;
             if count <= leaf_size {
                 continue;
+            }
+            // The centroids' box picks the split; the element boxes are merged bottom-up below.
+            let (mut clo, mut chi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+            for &e in slice.iter() {
+                let c = centroids[e as usize];
+                for k in 0..3 {
+                    clo[k] = clo[k].min(c[k]);
+                    chi[k] = chi[k].max(c[k]);
+                }
             }
             let ext = [0, 1, 2].map(|k| chi[k] - clo[k]);
             let axis = if ext[0] >= ext[1] && ext[0] >= ext[2] {
@@ -118,6 +113,26 @@ impl Tree {
             });
             work.push(left + 1);
             work.push(left);
+        }
+        // Children have larger ids than their parent: boxes bottom-up, each element box read once.
+        for id in (0..nodes.len()).rev() {
+            let node = nodes[id];
+            let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+            if node.is_leaf() {
+                for &e in &order[node.range()] {
+                    let (bmin, bmax) = boxes[e as usize];
+                    for k in 0..3 {
+                        lo[k] = lo[k].min(bmin[k]);
+                        hi[k] = hi[k].max(bmax[k]);
+                    }
+                }
+            } else {
+                let (a, b) = (nodes[node.left as usize], nodes[node.left as usize + 1]);
+                lo = std::array::from_fn(|k| a.min[k].min(b.min[k]));
+                hi = std::array::from_fn(|k| a.max[k].max(b.max[k]));
+            }
+            nodes[id].min = lo;
+            nodes[id].max = hi;
         }
         Tree { nodes, order }
     }
