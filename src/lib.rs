@@ -34,6 +34,7 @@ pub mod curve2d;
 pub mod error;
 pub mod eval;
 pub mod grid;
+pub mod input;
 #[cfg(feature = "io")]
 pub mod io;
 pub mod kernel;
@@ -42,10 +43,13 @@ mod one_shot;
 pub mod patch;
 #[cfg(feature = "products")]
 pub mod products;
+pub mod spec;
 #[cfg(any(feature = "testing", feature = "cli"))]
 pub mod testing;
 
 pub use base::bounding_box::BoundingBox;
+pub use kernel::frame::RayAxis;
+pub use kernel::quantize::Precision;
 pub use mesh::Mesh;
 pub use one_shot::{Position, TriangleIndices, WindingNumberError, winding_number};
 

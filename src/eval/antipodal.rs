@@ -97,6 +97,8 @@ pub enum BoundaryBy {
 pub enum BuildError {
     /// The mesh's coordinates span more than `f64` can grid.
     CoordinateRange,
+    /// [`Options::tolerance`] is NaN, infinite or negative (the value as written).
+    Tolerance(String),
 }
 
 impl std::fmt::Display for BuildError {
@@ -107,6 +109,9 @@ impl std::fmt::Display for BuildError {
                     f,
                     "mesh coordinates are too large to quantize (extent overflows f64)"
                 )
+            }
+            BuildError::Tolerance(t) => {
+                write!(f, "tolerance must be a finite number >= 0, got {t}")
             }
         }
     }
@@ -155,7 +160,11 @@ impl WindingNumber {
     }
 
     /// Builds the evaluator: quantizes the mesh, extracts the signed boundary, builds the BVH.
+    /// A NaN, infinite or negative [`Options::tolerance`] is an error.
     pub fn with_options(mesh: &Mesh, options: Options) -> Result<Self, BuildError> {
+        if !(options.tolerance.is_finite() && options.tolerance >= 0.0) {
+            return Err(BuildError::Tolerance(options.tolerance.to_string()));
+        }
         let start = Instant::now();
         let core = match options.precision {
             Precision::Bits30 => Dispatch::Narrow(FrameEvaluator::build(mesh, options)?),
@@ -260,6 +269,26 @@ impl WindingNumber {
             Dispatch::Narrow(c) => c.parts(q),
             Dispatch::Wide(c) => c.parts(q),
         }
+    }
+
+    /// The value split into its integer and fractional parts: `(χ, w − χ)`, with the crossing
+    /// count χ of [`WindingNumber::parts`] and the boundary term `Σ k·Area / 4π`, so that
+    /// `χ as f64 + fraction` is [`WindingNumber::eval`] to the bit. `(0, NaN)` for a non-finite
+    /// query.
+    ///
+    /// ```
+    /// use gwn::{Mesh, eval::antipodal::WindingNumber};
+    /// let p = [[0.,0.,0.],[1.,0.,0.],[1.,1.,0.],[0.,1.,0.],[0.,0.,1.],[1.,0.,1.],[1.,1.,1.],[0.,1.,1.]];
+    /// let t = [[0,2,1],[0,3,2],[0,1,5],[0,5,4],[1,2,6],[1,6,5],[2,3,7],[2,7,6],[3,0,4],[3,4,7]];
+    /// let w = WindingNumber::new(&Mesh::from_slices(&p, &t)?)?;
+    /// let (chi, fraction) = w.integer_and_fraction([0.5, 0.5, 0.5]);
+    /// assert_eq!(chi as f64 + fraction, w.eval([0.5, 0.5, 0.5]));
+    /// assert!((fraction - (5.0 / 6.0 - chi as f64)).abs() < 1e-14);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn integer_and_fraction(&self, q: [f64; 3]) -> (i64, f64) {
+        let (chi, area) = self.parts(q);
+        (chi, area * INV_4PI)
     }
 
     /// Winding numbers along one line parallel to the ray: at the points `q` with the world

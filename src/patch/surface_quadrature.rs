@@ -90,3 +90,30 @@ pub fn winding_number_surface_quadrature_batch(
         .map(|&q| winding_number_surface_quadrature(set, q, tol).0)
         .collect()
 }
+
+/// The surface integral as an [`Evaluator`](crate::eval::Evaluator) (the direct method on patch
+/// sets): absolute tolerance `tolerance` on `w` per patch, no gradient.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceQuadrature<'s> {
+    set: &'s PatchSet,
+    tolerance: f64,
+}
+
+impl<'s> SurfaceQuadrature<'s> {
+    /// The surface integral over `set` to `tolerance` per patch.
+    pub fn new(set: &'s PatchSet, tolerance: f64) -> Self {
+        SurfaceQuadrature { set, tolerance }
+    }
+}
+
+impl crate::eval::Evaluator for SurfaceQuadrature<'_> {
+    fn eval(&self, q: [f64; 3]) -> f64 {
+        winding_number_surface_quadrature(self.set, q, self.tolerance).0
+    }
+    fn name(&self) -> &'static str {
+        "direct (patches)"
+    }
+    fn eval_batch(&self, points: &[[f64; 3]]) -> Vec<f64> {
+        winding_number_surface_quadrature_batch(self.set, points, self.tolerance)
+    }
+}
