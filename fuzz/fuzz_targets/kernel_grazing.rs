@@ -1,5 +1,5 @@
 //! Fuzzes the exact kernel on degenerate meshes of the integer grid −4..4 (decoder
-//! `gwn::testing::soup_from_bytes`, shared with `tests/exactness.rs`): off the surface, every
+//! `gwn::testing::soup_from_bytes`, shared with `tests/exact/exactness.rs`): off the surface, every
 //! ray direction must give the same winding number; on it, the value must be finite and within
 //! 2e-3 of the direct sum at the perturbed point; a column through the query (grids) gives the
 //! query's value to the bit. Run: `cargo fuzz run --sanitizer none kernel_grazing -- -max_total_time=60`.

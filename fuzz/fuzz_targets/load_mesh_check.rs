@@ -1,4 +1,4 @@
-// Shared by the fuzz target and by `tests/fuzz_corpus_loaders.rs` (via `include!`), so the
+// Shared by the fuzz target and by `tests/inputs/fuzz_corpus_loaders.rs` (via `include!`), so the
 // stable test replays the corpus through exactly the code the fuzzer runs.
 
 /// Feeds `data` to a loader: the first byte selects the format (OBJ, STL, OFF, PLY, detect by

@@ -368,7 +368,7 @@ pub fn antipodal_edge_area_accurate(
 /// antipodal paper's Supp. Alg. 3, which differentiates `Area(A, B, x1)` and so divides by
 /// quantities that vanish when a boundary vertex is seen near the ray direction. Below an open
 /// mesh, along the ray, its x and y components were off by 2e-3 (relative) at 100 mesh sizes
-/// (`tests/gradient.rs`), and garbage from ~1e6 (−19.6 where the true value is 7.6e-27, bundled
+/// (`tests/exact/gradient.rs`), and garbage from ~1e6 (−19.6 where the true value is 7.6e-27, bundled
 /// lion head), while this form stays accurate to ~1e-9 relative.
 /// Not finite when `q` is on the segment.
 #[inline]

@@ -8,7 +8,7 @@
 //! every degeneracy survives any exact pipeline, and the exact oracle
 //! ([`super::oracle::exact_winding_number_rational`]) applies.
 //!
-//! The guarantee of each kind is stated on its variant and checked by `tests/testing_kit.rs`
+//! The guarantee of each kind is stated on its variant and checked by `tests/exact/testing_kit.rs`
 //! (with the measured frequency of each promised degeneracy).
 
 use std::collections::HashMap;

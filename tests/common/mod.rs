@@ -13,6 +13,13 @@ pub fn open_cube() -> Mesh {
     gwn::testing::unit_cube(true)
 }
 
+/// A file of `tests/fixtures/`.
+pub fn fixture(name: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures")
+        .join(name)
+}
+
 /// Reports that the running test skips its body for want of `what` (e.g. `../shared/meshes`),
 /// visibly: libtest captures the `print!`/`eprint!` output of passing tests, so a skipped test
 /// used to show as `ok` in 0.00 s. A direct write to the process's stderr is not captured, and
@@ -117,4 +124,18 @@ pub fn rational_sphere_patches() -> Vec<gwn::patch::Patch> {
         }
     }
     patches
+}
+
+/// A sphere sampled by a Fibonacci spiral: oriented points carrying equal areas.
+pub fn sphere_cloud(n: usize) -> gwn::eval::fast::PointCloud {
+    let p: Vec<[f64; 3]> = (0..n)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+            let r = (1.0 - z * z).sqrt();
+            let t = i as f64 * 2.399963229728653;
+            [r * t.cos(), r * t.sin(), z]
+        })
+        .collect();
+    let a = vec![4.0 * std::f64::consts::PI / n as f64; n];
+    gwn::eval::fast::PointCloud::new(p.clone(), p, Some(a)).unwrap()
 }

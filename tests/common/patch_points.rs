@@ -1,6 +1,6 @@
 //! Hard queries for patch sets (issue 23): points a small distance from every patch edge
 //! (seams and boundary curves), corner and collapsed pole, along the surface normal and straight
-//! below boundary curves. Shared by `tests/patches_seams.rs` and `examples/patch_seams.rs`.
+//! below boundary curves. Shared by `tests/patches/patches_seams.rs` and `examples/patch_seams.rs`.
 #![allow(dead_code)]
 
 use gwn::patch::PatchSet;

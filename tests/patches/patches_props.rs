@@ -1,11 +1,11 @@
 //! Property tests of the patch evaluator: closed patch sets split and perturbed at random stay
 //! integer-valued off the surface, for every ray; random open patches agree with tessellations.
 
+use crate::common;
 use gwn::eval::antipodal::WindingNumber;
 use gwn::kernel::frame::RayAxis;
 use gwn::patch::tessellate::tessellate;
 use gwn::patch::{Options, Patch, PatchSet, PatchWindingNumber};
-mod common;
 
 use proptest::prelude::*;
 

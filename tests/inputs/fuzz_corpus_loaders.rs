@@ -1,7 +1,7 @@
 //! Replays the fuzz corpus (`fuzz/corpus/load_mesh/`) through the fuzz target's own check on
 //! stable Rust, so CI catches regressions without cargo-fuzz.
 
-include!("../fuzz/fuzz_targets/load_mesh_check.rs");
+include!("../../fuzz/fuzz_targets/load_mesh_check.rs");
 
 #[test]
 fn fuzz_corpus_never_panics() {

@@ -2,8 +2,7 @@
 //! (or a right answer), never a stack overflow, an unbounded read, a NaN, an infinity or a zero
 //! where the evaluators are right. Each test reproduces one reported defect.
 
-#[path = "common/cli.rs"]
-mod cli;
+use crate::cli;
 
 use std::path::PathBuf;
 

@@ -3,8 +3,7 @@
 
 use std::path::PathBuf;
 
-#[path = "common/cli.rs"]
-mod cli;
+use crate::cli;
 use cli::gwn;
 
 /// The unit cube as an OBJ soup: each of the 12 triangles has its own three vertices.

@@ -2,7 +2,7 @@
 //! by snapping, meshes of any magnitude are gridded, and the fractional part stays accurate next
 //! to boundary edges. Each reproducer failed before the fix.
 
-mod common;
+use crate::common;
 
 use gwn::Mesh;
 use gwn::eval::antipodal::{Options, WindingNumber};

@@ -1,6 +1,6 @@
 //! Voxel grids with ray reuse: identical to per-point evaluation, perturbation rule on faces.
 
-mod common;
+use crate::common;
 
 use gwn::BoundingBox;
 use gwn::eval::antipodal::{Options, WindingNumber};

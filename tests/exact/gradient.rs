@@ -2,7 +2,7 @@
 //! direct Biot–Savart gradient over all triangle edges and against central finite differences of
 //! the exact value.
 
-mod common;
+use crate::common;
 
 use gwn::Mesh;
 use gwn::eval::antipodal::{Options, WindingNumber};

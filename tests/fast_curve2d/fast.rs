@@ -2,7 +2,7 @@
 //! clouds and the FOSSIL-style API.
 #![allow(clippy::needless_range_loop)] // tensor indices as in the formulas
 
-mod common;
+use crate::common;
 
 use gwn::Mesh;
 use gwn::eval::direct::winding_number_direct_batch;

@@ -2,8 +2,7 @@
 //! one-line error; `--tolerance 0` is the flat loop; far queries on a mesh with a large boundary
 //! move by at most the tolerance.
 
-#[path = "common/cli.rs"]
-mod cli;
+use crate::cli;
 use cli::gwn;
 
 /// An open wavy sheet of `n × n` quads with every seventh triangle removed: ~n²/3.5 boundary edges.

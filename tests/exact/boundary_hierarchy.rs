@@ -5,7 +5,7 @@
 //! boundary loops, chains that fold back, holes and flipped faces; queries next to boundary
 //! vertices and on the ray's line through them), for all six ray directions.
 
-mod common;
+use crate::common;
 
 use gwn::Mesh;
 use gwn::eval::antipodal::{Options, WindingNumber};

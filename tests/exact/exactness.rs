@@ -2,7 +2,7 @@
 //! closed self-intersecting shells (exact integer answers), direction independence. The byte
 //! decoders live in `gwn::testing` (shared with the `kernel_grazing` fuzz target).
 
-mod common;
+use crate::common;
 
 use gwn::eval::antipodal::{Options, WindingNumber};
 use gwn::kernel::frame::RayAxis;

@@ -1,7 +1,7 @@
 //! Agreement of the exact evaluator with the compensated direct sum, and its independence of the
 //! ray direction, on every mesh of the shared corpus (skipped with a reason when it is absent).
 
-mod common;
+use crate::common;
 
 use gwn::Mesh;
 use gwn::eval::antipodal::{BoundaryBy, Options, WindingNumber};

@@ -1,6 +1,6 @@
 //! Closed-form cases for the direct sum and the exact evaluator (foundation + kernel issues).
 
-mod common;
+use crate::common;
 
 use common::{open_cube, unit_cube};
 use gwn::eval::antipodal::{Options, WindingNumber};

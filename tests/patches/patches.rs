@@ -1,7 +1,7 @@
 //! Curved surfaces: closed forms, oracles and ray independence for the patch evaluator
 //! (`docs/patches.md`).
 
-mod common;
+use crate::common;
 
 use gwn::Mesh;
 use gwn::eval::antipodal::WindingNumber;

@@ -1,7 +1,7 @@
 //! Every mesh of the shared corpus (`../shared/meshes/manifest.csv`) loads, and its statistics
 //! match the manifest's independently computed ones.
 
-mod common;
+use crate::common;
 
 use std::path::PathBuf;
 

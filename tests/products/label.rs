@@ -2,7 +2,7 @@
 //! reproducibility (across runs, thread counts and list order), resumption, failures and time
 //! limits as manifest rows, and the `gwn label` command.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

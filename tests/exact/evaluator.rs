@@ -2,13 +2,13 @@
 //! and products accept any of them, and the fast gradients are checked against finite
 //! differences and against the exact gradient as β grows.
 
-mod common;
+use crate::common;
 
-use common::{Rng, open_cube};
+use common::{Rng, open_cube, sphere_cloud};
 use gwn::Mesh;
 use gwn::eval::antipodal::WindingNumber;
 use gwn::eval::direct::{DirectWindingNumber, winding_number_gradient_direct};
-use gwn::eval::fast::{FastParams, FastWindingNumber, PointCloud, PointCloudWindingNumber};
+use gwn::eval::fast::{FastParams, FastWindingNumber, PointCloudWindingNumber};
 use gwn::eval::{Evaluator, NoGradient};
 use gwn::grid::{self, GridSpec};
 
@@ -31,20 +31,6 @@ fn norm(v: [f64; 3]) -> f64 {
 
 fn diff(a: [f64; 3], b: [f64; 3]) -> f64 {
     norm([a[0] - b[0], a[1] - b[1], a[2] - b[2]])
-}
-
-/// A sphere sampled by a Fibonacci spiral: oriented points carrying equal areas.
-fn sphere_cloud(n: usize) -> PointCloud {
-    let p: Vec<[f64; 3]> = (0..n)
-        .map(|i| {
-            let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
-            let r = (1.0 - z * z).sqrt();
-            let t = i as f64 * 2.399963229728653;
-            [r * t.cos(), r * t.sin(), z]
-        })
-        .collect();
-    let a = vec![4.0 * std::f64::consts::PI / n as f64; n];
-    PointCloud::new(p.clone(), p, Some(a)).unwrap()
 }
 
 #[test]
@@ -269,124 +255,6 @@ fn cloud_gradient_matches_the_dipole_sum_gradient() {
         assert!(errors.windows(2).all(|w| w[1] < w[0]), "{q:?}: {errors:?}");
         assert!(errors[0] < 0.5 && errors[3] < 1e-3, "{q:?}: {errors:?}");
     }
-}
-
-// ---------------------------------------------------------------- CLI
-
-fn gwn(args: &[&str]) -> std::process::Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_gwn"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn one_line_error(args: &[&str]) -> String {
-    let out = gwn(args);
-    assert!(!out.status.success(), "{args:?} should fail");
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
-    err
-}
-
-#[test]
-fn cli_methods_apply_to_every_product_and_misuse_is_an_error() {
-    let dir = std::env::temp_dir().join(format!("gwn-evaluator-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let cloud = dir.join("sphere.xyz");
-    let c = sphere_cloud(400);
-    let text: String = c
-        .positions()
-        .iter()
-        .map(|p| format!("{} {} {} {} {} {}\n", p[0], p[1], p[2], p[0], p[1], p[2]))
-        .collect();
-    std::fs::write(&cloud, text).unwrap();
-    let queries = dir.join("q.csv");
-    std::fs::write(&queries, "0 0 0.1\n0 0 3\n").unwrap();
-    let mesh = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/cube.off");
-    let (cloud, queries) = (cloud.to_str().unwrap(), queries.to_str().unwrap());
-    let d = |name: &str| dir.join(name).to_str().unwrap().to_owned();
-
-    let out = gwn(&[
-        "eval",
-        mesh,
-        "--points",
-        queries,
-        "--method",
-        "fast",
-        "--gradient",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
-    assert_eq!(
-        stdout.lines().next().unwrap().split(',').count(),
-        4,
-        "{stdout}"
-    );
-    let out = gwn(&["eval", cloud, "--points", queries, "--gradient"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-
-    for (cmd, extra) in [
-        ("voxelize", vec!["--res", "6", "--out", &d("v.npy")]),
-        ("sdf", vec!["--res", "6", "--out", &d("s.npy")]),
-        ("slice", vec!["--res", "16", "--out", &d("s.png")]),
-    ] {
-        for input in [mesh, cloud] {
-            for method in [&["--method", "fast", "--beta", "3"][..], &[]] {
-                let mut args = vec![cmd, input];
-                args.extend(&extra);
-                args.extend(method);
-                let out = gwn(&args);
-                assert!(
-                    out.status.success(),
-                    "{args:?}: {}",
-                    String::from_utf8_lossy(&out.stderr)
-                );
-            }
-        }
-        let mut direct = vec![cmd, mesh, "--method", "direct"];
-        direct.extend(&extra);
-        assert!(gwn(&direct).status.success(), "{direct:?}");
-    }
-    let out = gwn(&["classify", mesh, cloud, "--out", &d("c.csv")]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-
-    let err = one_line_error(&["eval", cloud, "--points", queries, "--method", "exact"]);
-    assert!(
-        err.contains("--method exact does not apply to a point cloud"),
-        "{err}"
-    );
-    let err = one_line_error(&[
-        "voxelize",
-        cloud,
-        "--method",
-        "direct",
-        "--out",
-        &d("x.npy"),
-    ]);
-    assert!(err.contains("--method direct does not apply"), "{err}");
-    let err = one_line_error(&["eval", mesh, "--points", queries, "--beta", "3"]);
-    assert!(err.contains("--beta applies to --method fast"), "{err}");
-    let err = one_line_error(&[
-        "eval", mesh, "--points", queries, "--method", "fast", "--ray", "-x",
-    ]);
-    assert!(err.contains("--ray applies to --method exact"), "{err}");
-    let err = one_line_error(&["slice", cloud, "--outline", "--out", &d("o.png")]);
-    assert!(err.contains("needs a triangle mesh"), "{err}");
-    let err = one_line_error(&["classify", cloud, mesh, "--out", &d("c2.csv")]);
-    assert!(err.contains("needs a triangle mesh"), "{err}");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// `eval_batch` evaluates runs of points on one line parallel to the ray as columns (numpy grids

@@ -2,7 +2,7 @@
 //! references (Richardson-extrapolated tessellations, the direct surface quadrature) and ray
 //! independence, including rays that pass within 1e-12 of patch edges and degenerate corners.
 
-mod common;
+use crate::common;
 
 use gwn::eval::antipodal::WindingNumber;
 use gwn::kernel::frame::RayAxis;

@@ -1,6 +1,6 @@
 //! Products: slice PNGs, signed distance, tet filtering, face classification, and the CLI.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -563,15 +563,8 @@ mod apps {
     }
 }
 
-mod io_and_cli {
+mod text_io {
     use super::*;
-    use std::process::Command;
-
-    fn temp_dir(name: &str) -> std::path::PathBuf {
-        let d = std::env::temp_dir().join(format!("gwn-curve2d-{name}-{}", std::process::id()));
-        std::fs::create_dir_all(&d).unwrap();
-        d
-    }
 
     fn write_text(p: &Polygon) -> String {
         let mut s = String::from("# test polygon\n");
@@ -593,61 +586,5 @@ mod io_and_cli {
         .unwrap();
         let q = gwn::curve2d::io::parse_text(&write_text(&p), "mem").unwrap();
         assert_eq!(p, q);
-    }
-
-    #[test]
-    fn cli_smoke() {
-        let exe = env!("CARGO_BIN_EXE_gwn");
-        let dir = temp_dir("cli");
-        let input = dir.join("circle.txt");
-        std::fs::write(&input, write_text(&circle(1.0, 64, [0.0, 0.0]))).unwrap();
-        let png = dir.join("field.png");
-        let st = Command::new(exe)
-            .args(["curve", "field"])
-            .arg(&input)
-            .args(["--sigma", "0.05", "--res", "48", "--out"])
-            .arg(&png)
-            .output()
-            .unwrap();
-        assert!(
-            st.status.success(),
-            "{}",
-            String::from_utf8_lossy(&st.stderr)
-        );
-        let bytes = std::fs::read(&png).unwrap();
-        assert_eq!(&bytes[1..4], b"PNG");
-        for (sub, extra) in [("untangle", vec![]), ("offset", vec!["--distance", "0.1"])] {
-            let out = dir.join(format!("{sub}.svg"));
-            let st = Command::new(exe)
-                .args(["curve", sub])
-                .arg(&input)
-                .args(extra)
-                .arg("--out")
-                .arg(&out)
-                .output()
-                .unwrap();
-            assert!(
-                st.status.success(),
-                "{}",
-                String::from_utf8_lossy(&st.stderr)
-            );
-            let svg = gwn::curve2d::io::read_polygon(&out).unwrap();
-            assert_eq!(svg.num_loops(), 2); // input and result layers
-        }
-        // A bad input: non-zero exit and a single line naming the file and line.
-        let bad = dir.join("bad.txt");
-        std::fs::write(&bad, "0 0\n1 0\n1 oops\n").unwrap();
-        let st = Command::new(exe)
-            .args(["curve", "field"])
-            .arg(&bad)
-            .arg("--out")
-            .arg(dir.join("x.png"))
-            .output()
-            .unwrap();
-        assert!(!st.status.success());
-        let err = String::from_utf8_lossy(&st.stderr);
-        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
-        assert!(err.contains("bad.txt:3"), "{err}");
-        let _ = std::fs::remove_dir_all(&dir);
     }
 }

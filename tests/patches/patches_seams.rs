@@ -2,9 +2,8 @@
 //! boundary curves of the teapot at 1e-3 … 1e-12 × diagonal, on six rays; the on-surface rule
 //! on a closed sphere; extreme scales and weights; the tolerance bounds the total error.
 
-mod common;
-#[path = "common/patch_points.rs"]
-mod patch_points;
+use crate::common;
+use crate::patch_points;
 
 use std::path::Path;
 use std::time::{Duration, Instant};

@@ -1,0 +1,58 @@
+//! `gwn info` on fixtures, on a mesh off the 60-bit lattice, and on missing and broken files.
+
+use std::process::Command;
+
+use crate::common::fixture;
+
+#[test]
+fn cli_info_on_fixture_missing_and_broken_files() {
+    let exe = env!("CARGO_BIN_EXE_gwn");
+    let out = Command::new(exe)
+        .args(["info"])
+        .arg(fixture("cube_binary.stl"))
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    assert!(stdout.contains("STL"), "{stdout}");
+    assert!(
+        stdout
+            .lines()
+            .any(|l| l.starts_with("welded vertices") && l.split_whitespace().last() == Some("28")),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("w is an integer off the surface"),
+        "{stdout}"
+    );
+
+    // Issue 21: whether the 60-bit lattice holds the mesh. The cube's integer corners do; a
+    // triangle with a coordinate far below the extent does not, and the displacement is shown.
+    assert!(stdout.contains("60-bit snapping"), "{stdout}");
+    assert!(stdout.contains("lossless"), "{stdout}");
+    let dir = std::env::temp_dir().join(format!("gwn-info-snap-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let off = dir.join("tiny.off");
+    std::fs::write(&off, "OFF\n3 1 0\n0 0 0\n10 0 1e-20\n0 10 0.01\n3 0 1 2\n").unwrap();
+    let out = Command::new(exe).args(["info"]).arg(&off).output().unwrap();
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("60-bit snapping"))
+        .unwrap_or_else(|| panic!("{stdout}"));
+    assert!(line.contains("2 vertices off the lattice"), "{line}");
+    assert!(line.contains("largest displacement"), "{line}");
+    std::fs::remove_dir_all(&dir).ok();
+
+    for name in ["does_not_exist.off", "broken_index.off"] {
+        let out = Command::new(exe)
+            .args(["info"])
+            .arg(fixture(name))
+            .output()
+            .unwrap();
+        assert!(!out.status.success(), "{name}");
+        let stderr = String::from_utf8(out.stderr).unwrap();
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        assert!(stderr.contains(name), "{stderr}");
+    }
+}

@@ -1,0 +1,13 @@
+//! Products: slices, voxels, signed distance, tet filtering, face classification, labelling, and
+//! bounded work on hostile input (library and CLI).
+//!
+//! One test binary per area (one optimised link instead of one per file); each file is a module.
+
+#[path = "../common/cli.rs"]
+mod cli;
+#[path = "../common/mod.rs"]
+mod common;
+
+mod bounded_work;
+mod label;
+mod products;
