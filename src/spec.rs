@@ -549,6 +549,7 @@ impl EvaluatorSpec {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::patch::PatchSet;
 
     fn spec() -> EvaluatorSpec {
         EvaluatorSpec::default()
@@ -688,6 +689,83 @@ mod tests {
             direct.check(InputKind::Step).unwrap_err().to_string(),
             "the direct method does not apply to a STEP model (use exact)"
         );
+    }
+
+    fn tet() -> Mesh {
+        Mesh::from_slices(
+            &[[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]],
+            &[[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]],
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn the_exact_evaluator_refuses_a_bad_tolerance_itself() {
+        // Not only through the spec: the constructor no longer reads NaN or -1 as 0.
+        for t in [f64::NAN, -1.0, f64::INFINITY] {
+            let options = Options {
+                tolerance: t,
+                ..Options::default()
+            };
+            assert_eq!(
+                WindingNumber::with_options(&tet(), options).err(),
+                Some(BuildError::Tolerance(t.to_string()))
+            );
+        }
+        let s = EvaluatorSpec {
+            tolerance: Some(-0.5),
+            ..spec()
+        };
+        assert_eq!(
+            s.build_mesh(&tet()).err().unwrap().to_string(),
+            "tolerance must be a finite number >= 0, got -0.5"
+        );
+    }
+
+    #[test]
+    fn every_input_builds_its_evaluator() {
+        let q = [0.1, 0.1, 0.1];
+        let input = Input::Mesh(tet());
+        for (method, name) in [
+            (Method::Exact, "exact"),
+            (Method::Direct, "direct"),
+            (Method::Fast, "fast"),
+        ] {
+            let s = EvaluatorSpec {
+                method: Some(method),
+                ..spec()
+            };
+            let w = s.build(&input).unwrap();
+            assert_eq!(w.name(), name);
+            assert!((w.eval(q) - 1.0).abs() < 1e-9, "{name}");
+        }
+        let cloud = Input::Cloud(
+            crate::mesh::PointCloud::new(
+                vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]],
+                vec![[0.0, 0.0, 1.0], [0.0, 0.0, 1.0]],
+                None,
+            )
+            .unwrap(),
+        );
+        assert_eq!(spec().build(&cloud).unwrap().name(), "fast point-cloud");
+        let flat = crate::patch::Patch::polynomial(
+            1,
+            1,
+            vec![[0., 0., 0.], [0., 1., 0.], [1., 0., 0.], [1., 1., 0.]],
+        )
+        .unwrap();
+        let patches = Input::Patches(PatchSet::new(vec![flat]).unwrap());
+        assert_eq!(spec().build(&patches).unwrap().name(), "exact (patches)");
+        let direct = EvaluatorSpec {
+            method: Some(Method::Direct),
+            tolerance: Some(1e-6),
+            ..spec()
+        };
+        let (a, b) = (
+            spec().build(&patches).unwrap().eval([0.3, 0.4, 0.5]),
+            direct.build(&patches).unwrap().eval([0.3, 0.4, 0.5]),
+        );
+        assert!((a - b).abs() < 1e-5, "{a} vs {b}");
     }
 
     #[test]
