@@ -27,8 +27,8 @@
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 
-pub mod base;
-pub mod bvh;
+pub(crate) mod base;
+pub(crate) mod bvh;
 #[cfg(feature = "curve2d")]
 pub mod curve2d;
 pub mod error;
@@ -37,7 +37,7 @@ pub mod grid;
 pub mod input;
 #[cfg(feature = "io")]
 pub mod io;
-pub mod kernel;
+pub(crate) mod kernel;
 pub mod mesh;
 mod one_shot;
 pub mod patch;

@@ -5,7 +5,8 @@ use std::sync::Arc;
 
 use gwn::Mesh;
 use gwn::eval::antipodal::WindingNumber;
-use gwn::eval::fast::{FastWindingNumber, PointCloud, PointCloudWindingNumber};
+use gwn::eval::fast::{FastWindingNumber, PointCloudWindingNumber};
+use gwn::mesh::PointCloud;
 use numpy::PyArray1;
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;

@@ -3,7 +3,8 @@
 use std::sync::Arc;
 
 use gwn::Mesh;
-use gwn::eval::fast::{PointCloud, PointCloudWindingNumber};
+use gwn::eval::fast::PointCloudWindingNumber;
+use gwn::mesh::PointCloud;
 use gwn::input::InputKind;
 use gwn::spec::{EvaluatorSpec, Method};
 use numpy::PyArray1;

@@ -12,7 +12,7 @@
 //! - The crossing count χ of the ray from `q_ε` is computed with `BigInt` *polynomials in `t`*:
 //!   each predicate (2D orientation of `q_t` against a projected edge, side of `q_t` of a
 //!   triangle's plane) is expanded symbolically and its sign is the sign of the lowest-order
-//!   non-zero coefficient. Nothing is hand-expanded and `gwn::kernel::predicates` is not called.
+//!   non-zero coefficient. Nothing is hand-expanded and the exact kernel's predicates are not called.
 //! - The boundary term `Σ k·Area(A, B, −d)` is the limit `t → 0⁺` of each edge's spherical-triangle
 //!   area, evaluated in outward-rounded interval arithmetic ([`super::interval`]). Its sign is the
 //!   exact sign of the `t`-polynomial of its numerator; its magnitude is `2·atan2(|N|, D)` of the
@@ -36,8 +36,8 @@ use std::collections::{BTreeMap, HashMap};
 use num_bigint::{BigInt, Sign};
 
 use super::interval::{Iv, atan2_hull, big, pi};
-use crate::Mesh;
 use crate::kernel::frame::RayAxis;
+use crate::mesh::Mesh;
 
 /// A certified enclosure of the winding number at the perturbed query.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -99,7 +99,7 @@ impl Certified {
 ///
 /// ```
 /// use gwn::Mesh;
-/// use gwn::kernel::frame::RayAxis;
+/// use gwn::RayAxis;
 /// use gwn::testing::{exact_winding_number_rational, Decision};
 /// let tet = Mesh::from_slices(
 ///     &[[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]],

@@ -3,7 +3,8 @@
 use std::path::PathBuf;
 
 use clap::{Args as ClapArgs, ValueEnum};
-use gwn::products::classify::{Select, classify_faces, select, submesh, write_obj};
+use gwn::mesh::write_obj;
+use gwn::products::classify::{Select, classify_faces, select, submesh};
 
 use crate::common::{CliError, check_threshold, outln};
 use crate::method::{MethodArgs, need_mesh};

@@ -3,7 +3,8 @@
 use std::path::PathBuf;
 
 use clap::Args as ClapArgs;
-use gwn::products::tets::{DEFAULT_THRESHOLD, filter_tets, load_tets, save_tets};
+use gwn::io::tets::{load_tets, save_tets};
+use gwn::products::tets::{DEFAULT_THRESHOLD, filter_tets};
 
 use crate::common::{CliError, check_threshold, outln};
 use crate::method::MethodArgs;

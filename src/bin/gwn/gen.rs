@@ -80,7 +80,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 .filter(|c| c.decide(0.5) == gwn::testing::Decision::Undecided)
                 .count();
             write(&args.out, &format!("{name}.obj"), |w| {
-                export::write_obj(w, &case.mesh)
+                gwn::mesh::write_obj(w, &case.mesh)
             })?;
             write(&args.out, &format!("{name}.off"), |w| {
                 export::write_off(w, &case.mesh)

@@ -8,11 +8,12 @@ use super::moments::Moments;
 use super::tree::Tree;
 use wide::{CmpGe, CmpGt, CmpLt, f64x4};
 
+use crate::base::bounding_box::BoundingBox;
 pub(crate) use crate::base::vec3::dist2;
 use crate::base::vec3::sub;
 use crate::kernel::angle_sum::AngleSum;
 use crate::kernel::spherical::{SOLID_ANGLE_CONDITION, segment_gradient, triangle_solid_angle_at};
-use crate::{BoundingBox, Mesh};
+use crate::mesh::Mesh;
 
 use crate::kernel::spherical::INV_4PI;
 
