@@ -260,7 +260,7 @@ impl WindingNumber {
     /// The two parts of the formula: the signed crossing count χ and the boundary sum
     /// `Σ k·Area` (not yet divided by 4π). `(0, NaN)` for a non-finite query. For a query more
     /// than `2^30` box sizes away, the parts of the point pulled in to that distance
-    /// ([`crate::kernel::quantize::Grid::pull_in_far`]; same `w` to `2^-60`).
+    /// (the kernel's `Grid::pull_in_far`; same `w` to `2^-60`).
     pub fn parts(&self, q: [f64; 3]) -> (i64, f64) {
         if q.iter().any(|c| !c.is_finite()) {
             return (0, f64::NAN);
@@ -305,7 +305,7 @@ impl WindingNumber {
 
     /// Gradient `∇w(q)`: the integer part is locally constant, so only the boundary contributes:
     /// the Biot–Savart sum over the signed boundary edges
-    /// ([`crate::kernel::spherical::segment_gradient`]; better conditioned than the antipodal
+    /// (the kernel's `segment_gradient`; better conditioned than the antipodal
     /// paper's Supp. Alg. 3, see there). Not finite on the boundary curve; NaN for a non-finite
     /// query.
     pub fn gradient(&self, q: [f64; 3]) -> [f64; 3] {

@@ -616,7 +616,7 @@ fn to_frame_big(ray: RayAxis, v: &[BigInt; 3]) -> [BigInt; 3] {
 /// Richardson-extrapolated to `t → 0` (the error of each sample is `O(t)`; the extrapolation
 /// removes the linear term). Good to about 1e-5 on small integer-grid meshes; use a tolerance of
 /// 1e-3 or so. Near a degenerate face the direct sum itself is the weak link, see
-/// [`crate::kernel::spherical::triangle_solid_angle`].
+/// the exact kernel's `triangle_solid_angle_at`.
 pub fn direct_at_perturbed(
     mesh: &Mesh,
     q: [f64; 3],

@@ -167,7 +167,7 @@ impl FastWindingNumber {
     /// Gradient of the approximation [`Self::eval_with`] computes: each admissible node's
     /// expansion differentiated ([`Moments::far_field_gradient`]), and near triangles by the
     /// Biot–Savart segment sum of the direct gradient
-    /// ([`crate::kernel::spherical::segment_gradient`]). Tends to the exact gradient as β
+    /// (the exact kernel's `segment_gradient`). Tends to the exact gradient as β
     /// grows; not finite on the triangles' edges.
     pub fn gradient_with(&self, q: [f64; 3], params: FastParams) -> [f64; 3] {
         self.scale.gradient(q, |q| {
