@@ -278,10 +278,12 @@ pub enum SpecError {
         /// The method chosen (or the input's default).
         method: Method,
     },
-    /// An option given for an input whose evaluator does not use it.
+    /// An option given for an input whose evaluator (of this method) does not use it.
     OptionForInput {
         /// The option.
         option: SpecOption,
+        /// The method chosen (or the input's default).
+        method: Method,
         /// The input.
         input: InputKind,
     },
@@ -321,8 +323,15 @@ impl fmt::Display for SpecError {
                 "{option} does not apply to the {method} method (it is an option of {})",
                 option.owner()
             ),
-            SpecError::OptionForInput { option, input } => {
-                write!(f, "{option} does not apply to {input}")?;
+            SpecError::OptionForInput {
+                option,
+                method,
+                input,
+            } => {
+                write!(
+                    f,
+                    "{option} does not apply to the {method} method on {input}"
+                )?;
                 if *option == SpecOption::Ray && *input == InputKind::Step {
                     f.write_str(" (its evaluator chooses a ray per query)")?;
                 }
@@ -459,7 +468,11 @@ impl EvaluatorSpec {
                 _ => true,
             };
             if !used {
-                return Err(SpecError::OptionForInput { option, input });
+                return Err(SpecError::OptionForInput {
+                    option,
+                    method,
+                    input,
+                });
             }
         }
         let curved = matches!(input, InputKind::Patches | InputKind::Step);
@@ -652,6 +665,7 @@ mod tests {
             direct_tol.check(InputKind::Mesh),
             Err(SpecError::OptionForInput {
                 option: SpecOption::Tolerance,
+                method: Method::Direct,
                 input: InputKind::Mesh
             })
         );
@@ -662,7 +676,8 @@ mod tests {
         assert_eq!(ray.check(InputKind::Patches), Ok(Method::Exact));
         assert_eq!(
             ray.check(InputKind::Step).unwrap_err().to_string(),
-            "ray does not apply to a STEP model (its evaluator chooses a ray per query)"
+            "ray does not apply to the exact method on a STEP model (its evaluator chooses a ray \
+             per query)"
         );
         let precision = EvaluatorSpec {
             precision: Some(Precision::Bits30),
