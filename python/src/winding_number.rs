@@ -4,8 +4,8 @@ use std::sync::Arc;
 
 use gwn::Mesh;
 use gwn::eval::fast::PointCloudWindingNumber;
-use gwn::mesh::PointCloud;
 use gwn::input::InputKind;
+use gwn::mesh::PointCloud;
 use gwn::spec::{EvaluatorSpec, Method};
 use numpy::PyArray1;
 use pyo3::prelude::*;
