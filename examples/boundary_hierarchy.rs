@@ -8,8 +8,8 @@
 //! and with the hierarchy (built on first use, forced here).
 //!
 //! ```text
-//! cargo run --release --example boundary_hierarchy -- ../shared/meshes
-//! TOLS=1e-10 GROW=0.1,0.5,1,2,3 cargo run --release --example boundary_hierarchy -- MESH
+//! cargo run --release --features examples --example boundary_hierarchy -- ../shared/meshes
+//! TOLS=1e-10 GROW=0.1,0.5,1,2,3 cargo run --release --features examples --example boundary_hierarchy -- MESH
 //! ```
 //!
 //! `TOLS` and `GROW` (comma-separated) choose the tolerances and the grids (the box grown by that

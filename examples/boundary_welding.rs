@@ -5,7 +5,7 @@
 //! the values.
 //!
 //! ```text
-//! cargo run --release --example boundary_welding -- ../shared/meshes
+//! cargo run --release --features examples --example boundary_welding -- ../shared/meshes
 //! ```
 
 use gwn::eval::antipodal::{BoundaryBy, Options, WindingNumber};

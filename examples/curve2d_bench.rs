@@ -11,8 +11,8 @@
 //! back end.
 //!
 //! ```text
-//! cargo run --release --example curve2d_bench                      # 180 1800 18000, 3 reps
-//! cargo run --release --example curve2d_bench -- 500 5000 --reps 1
+//! cargo run --release --features examples --example curve2d_bench                      # 180 1800 18000, 3 reps
+//! cargo run --release --features examples --example curve2d_bench -- 500 5000 --reps 1
 //! ```
 
 use gwn::curve2d::{BvnMethod, CurveBvh, GauWn, Point, Polygon};

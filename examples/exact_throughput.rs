@@ -4,7 +4,7 @@
 //! best of several passes): the tool for A/B comparisons of kernel changes.
 //!
 //! ```text
-//! cargo run --release --example exact_throughput -- ../shared/meshes/cgal-lion-head.off ...
+//! cargo run --release --features examples --example exact_throughput -- ../shared/meshes/cgal-lion-head.off ...
 //! ```
 
 use gwn::eval::antipodal::WindingNumber;

@@ -1,7 +1,7 @@
 //! Measures the fast (Barnes–Hut) winding number against the direct sum: the error table of
 //! `docs/fast.md` (orders 0–2, β 1/2/4, FOSSIL's rule) and queries per second on a 32³ grid.
 //!
-//! `cargo run --release --example fast_table [MESH_DIR]` (default `../shared/meshes`).
+//! `cargo run --release --features examples --example fast_table [MESH_DIR]` (default `../shared/meshes`).
 
 use std::path::PathBuf;
 use std::time::Instant;

@@ -7,7 +7,7 @@
 //! bit-identical (the run fails otherwise).
 //!
 //! ```text
-//! cargo run --release --example grid_columns -- ../shared/meshes/cgal-pig.stl ...
+//! cargo run --release --features examples --example grid_columns -- ../shared/meshes/cgal-pig.stl ...
 //! ```
 
 use gwn::eval::antipodal::WindingNumber;

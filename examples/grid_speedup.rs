@@ -2,7 +2,7 @@
 //! per-voxel `eval_batch` (one ray per voxel), plus signed-distance throughput.
 //!
 //! ```text
-//! cargo run --release --example grid_speedup [-- RES... [--mesh FILE]...]
+//! cargo run --release --features examples --example grid_speedup [-- RES... [--mesh FILE]...]
 //! ```
 //! Defaults: resolutions 64 and 128 on a fixed set of shared meshes (`../shared/meshes`). Grids
 //! span the mesh's box grown by 5 %, longest side RES cells. Prints a Markdown table; every grid

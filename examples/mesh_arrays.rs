@@ -2,7 +2,7 @@
 //! (n, 3) float64 and `F` (m, 3) uint32, so peers in a benchmark label exactly the same triangles.
 //! A mesh that does not load gets no file and a line on stderr.
 //!
-//! `cargo run --release --example mesh_arrays -- OUT_DIR MESH...`
+//! `cargo run --release --features examples --example mesh_arrays -- OUT_DIR MESH...`
 
 use gwn::products::npz::NpzWriter;
 

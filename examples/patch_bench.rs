@@ -4,7 +4,7 @@
 //! accuracy against a Richardson-extrapolated tessellation reference.
 //!
 //! ```text
-//! cargo run --release --example patch_bench -- ../shared/parametric/teapot.bpt
+//! cargo run --release --features examples --example patch_bench -- ../shared/parametric/teapot.bpt
 //! ```
 //! Environment: `GRID` (default 32), `REF_K` (reference tessellation k and 2k, default 128),
 //! `SQ_STRIDE` (every n-th grid point for the slow surface quadrature, default 16).

@@ -2,7 +2,7 @@
 //! boundary curves (lid gap, tube ends), with timings.
 //!
 //! ```text
-//! cargo run --release --example patch_near -- ../shared/parametric/teapot.bpt 1e-10
+//! cargo run --release --features examples --example patch_near -- ../shared/parametric/teapot.bpt 1e-10
 //! ```
 
 use std::time::Instant;

@@ -6,7 +6,7 @@
 //! spread of the six rays' values among certified queries.
 //!
 //! ```text
-//! cargo run --release --example patch_seams -- ../shared/parametric/teapot.bpt
+//! cargo run --release --features examples --example patch_seams -- ../shared/parametric/teapot.bpt
 //! ```
 
 #[path = "../tests/common/patch_points.rs"]

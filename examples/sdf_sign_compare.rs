@@ -2,7 +2,7 @@
 //! grid points do they disagree?
 //!
 //! ```text
-//! cargo run --release --example sdf_sign_compare [-- RES]
+//! cargo run --release --features examples --example sdf_sign_compare [-- RES]
 //! ```
 //! Meshes: the unit cube, the cube without its top face (built in code), and from
 //! `../shared/meshes` the lion head (open), the mech-holes shark (open) and the armadillo

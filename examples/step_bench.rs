@@ -1,7 +1,7 @@
 //! Loads STEP models and times the trimmed-model evaluator on the paper's 32³ grid over the
 //! bounding box (one thread), printing ms per query and the load time.
 //!
-//! `cargo run --release --example step_bench -- ../shared/parametric/step/*.step`
+//! `cargo run --release --features examples --example step_bench -- ../shared/parametric/step/*.step`
 
 use std::time::Instant;
 

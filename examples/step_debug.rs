@@ -1,5 +1,5 @@
 //! Prints, for one query, the value along every candidate direction of the STEP evaluator.
-//! `cargo run --release --example step_debug -- MODEL.step x y z`
+//! `cargo run --release --features examples --example step_debug -- MODEL.step x y z`
 fn main() {
     let a: Vec<String> = std::env::args().collect();
     let m = gwn::patch::step::load_step(std::path::Path::new(&a[1])).unwrap();

@@ -13,7 +13,7 @@
 //! with net ≠ 0 (what the exact evaluator's `boundary_edge_count` reports for an indexed mesh).
 //!
 //! ```text
-//! cargo run --release --example synthetic_boundary -- OUT_DIR [FACES]
+//! cargo run --release --features examples --example synthetic_boundary -- OUT_DIR [FACES]
 //! ```
 
 use std::collections::HashMap;

@@ -1,7 +1,7 @@
 //! Throughput of the testing kit: cases per second of each generator, queries per second of the
 //! exact oracle and of the fast exact evaluator on those cases (one thread).
 //!
-//! Run: `cargo run --release --example testing_kit_rates`
+//! Run: `cargo run --release --features examples --example testing_kit_rates`
 
 use std::hint::black_box;
 use std::time::Instant;

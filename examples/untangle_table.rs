@@ -5,9 +5,9 @@
 //! (`unsmoothed`: σ fixed at 1e-6 of the size, the plain winding number's limit).
 //!
 //! ```text
-//! cargo run --release --example untangle_table            # all curves, both methods
-//! cargo run --release --example untangle_table -- 500     # only curves with ≤ 500 vertices
-//! cargo run --release --example untangle_table -- --count # the set's crossing counts only
+//! cargo run --release --features examples --example untangle_table            # all curves, both methods
+//! cargo run --release --features examples --example untangle_table -- 500     # only curves with ≤ 500 vertices
+//! cargo run --release --features examples --example untangle_table -- --count # the set's crossing counts only
 //! ```
 
 use gwn::curve2d::apps::{UntangleParams, UntangleReport, untangle};

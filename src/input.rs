@@ -19,8 +19,9 @@ use std::fmt;
 
 use crate::base::bounding_box::BoundingBox;
 use crate::mesh::{Mesh, PointCloud};
+#[cfg(feature = "patch")]
 use crate::patch::PatchSet;
-#[cfg(feature = "io")]
+#[cfg(all(feature = "patch", feature = "io"))]
 use crate::patch::step::StepModel;
 
 /// Anything the library evaluates the winding number of.
@@ -30,10 +31,12 @@ pub enum Input {
     Mesh(Mesh),
     /// An oriented point cloud.
     Cloud(PointCloud),
-    /// A set of (rational) Bézier patches (`.bpt`, `.rbpt`).
+    /// A set of (rational) Bézier patches (`.bpt`, `.rbpt`; feature `patch`).
+    #[cfg(feature = "patch")]
     Patches(PatchSet),
-    /// A trimmed B-rep model (`.step`, `.stp`); boxed, it is much larger than the others.
-    #[cfg(feature = "io")]
+    /// A trimmed B-rep model (`.step`, `.stp`; features `patch` and `io`); boxed, it is much
+    /// larger than the others.
+    #[cfg(all(feature = "patch", feature = "io"))]
     Step(Box<StepModel>),
 }
 
@@ -44,9 +47,9 @@ pub enum InputKind {
     Mesh,
     /// [`Input::Cloud`].
     Cloud,
-    /// [`Input::Patches`].
+    /// `Input::Patches` (feature `patch`).
     Patches,
-    /// `Input::Step` (feature `io`).
+    /// `Input::Step` (features `patch` and `io`).
     Step,
 }
 
@@ -68,8 +71,9 @@ impl Input {
         match self {
             Input::Mesh(_) => InputKind::Mesh,
             Input::Cloud(_) => InputKind::Cloud,
+            #[cfg(feature = "patch")]
             Input::Patches(_) => InputKind::Patches,
-            #[cfg(feature = "io")]
+            #[cfg(all(feature = "patch", feature = "io"))]
             Input::Step(_) => InputKind::Step,
         }
     }
@@ -79,11 +83,12 @@ impl Input {
         match self {
             Input::Mesh(m) => m.bounding_box(),
             Input::Cloud(c) => BoundingBox::of_points(c.positions()),
+            #[cfg(feature = "patch")]
             Input::Patches(p) => {
                 let (min, max) = p.bounding_box();
                 Some(BoundingBox { min, max })
             }
-            #[cfg(feature = "io")]
+            #[cfg(all(feature = "patch", feature = "io"))]
             Input::Step(m) => {
                 let (min, max) = m.bounding_box();
                 Some(BoundingBox { min, max })
@@ -111,8 +116,8 @@ mod loading {
     use super::Input;
     use crate::error::{LoadError, LoadWarning};
     use crate::io::{LoadOptions, MeshOrCloud};
-    use crate::patch::PatchError;
-    use crate::patch::step::StepError;
+    #[cfg(feature = "patch")]
+    use crate::patch::{PatchError, step::StepError};
 
     /// An input as loaded, with what the reader accepted but ignored.
     #[derive(Clone, Debug)]
@@ -130,8 +135,10 @@ mod loading {
         /// A mesh or point-cloud file.
         Load(LoadError),
         /// A patch file.
+        #[cfg(feature = "patch")]
         Patch(PatchError),
         /// A STEP file.
+        #[cfg(feature = "patch")]
         Step(StepError),
     }
 
@@ -139,7 +146,9 @@ mod loading {
         fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
             match self {
                 InputError::Load(e) => e.fmt(f),
+                #[cfg(feature = "patch")]
                 InputError::Patch(e) => e.fmt(f),
+                #[cfg(feature = "patch")]
                 InputError::Step(e) => e.fmt(f),
             }
         }
@@ -149,7 +158,9 @@ mod loading {
         fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
             match self {
                 InputError::Load(e) => Some(e),
+                #[cfg(feature = "patch")]
                 InputError::Patch(e) => Some(e),
+                #[cfg(feature = "patch")]
                 InputError::Step(e) => Some(e),
             }
         }
@@ -161,8 +172,8 @@ mod loading {
     }
 
     /// Loads whatever `path` holds, deciding once:
-    /// - `.bpt`, `.rbpt`: a patch set ([`crate::patch::load_patches`]);
-    /// - `.step`, `.stp`: a trimmed model ([`crate::patch::step::load_step`]);
+    /// - `.bpt`, `.rbpt`: a patch set (`gwn::patch::load_patches`; feature `patch`);
+    /// - `.step`, `.stp`: a trimmed model (`gwn::patch::step::load_step`; feature `patch`);
     /// - `.xyz`, `.xyzn`, `.csv`, `.txt`, `.pts`: an oriented point cloud (text columns);
     /// - a PLY (by extension, or by content without one): read once, a mesh when it has faces,
     ///   else an oriented point cloud (its vertices must then have normals);
@@ -190,17 +201,12 @@ mod loading {
         options: &LoadOptions,
     ) -> Result<LoadedInput, InputError> {
         let path = path.as_ref();
-        let plain = |input| LoadedInput {
-            input,
-            warnings: Vec::new(),
-        };
-        if crate::patch::is_patch_path(path) {
-            let set = crate::patch::load_patches(path).map_err(InputError::Patch)?;
-            return Ok(plain(Input::Patches(set)));
-        }
-        if crate::patch::step::is_step_path(path) {
-            let model = crate::patch::step::load_step(path).map_err(InputError::Step)?;
-            return Ok(plain(Input::Step(Box::new(model))));
+        #[cfg(feature = "patch")]
+        if let Some(curved) = load_curved(path)? {
+            return Ok(LoadedInput {
+                input: curved,
+                warnings: Vec::new(),
+            });
         }
         Ok(
             match crate::io::load_mesh_or_cloud(path, options).map_err(InputError::Load)? {
@@ -214,6 +220,20 @@ mod loading {
                 },
             },
         )
+    }
+
+    /// A patch set or STEP model, when the extension names one.
+    #[cfg(feature = "patch")]
+    fn load_curved(path: &Path) -> Result<Option<Input>, InputError> {
+        if crate::patch::is_patch_path(path) {
+            let set = crate::patch::load_patches(path).map_err(InputError::Patch)?;
+            return Ok(Some(Input::Patches(set)));
+        }
+        if crate::patch::step::is_step_path(path) {
+            let model = crate::patch::step::load_step(path).map_err(InputError::Step)?;
+            return Ok(Some(Input::Step(Box::new(model))));
+        }
+        Ok(None)
     }
 }
 
@@ -304,7 +324,10 @@ mod tests {
         assert_eq!(load_input(&off).unwrap().input.kind(), InputKind::Mesh);
         let missing = dir.0.join("missing.obj");
         assert!(matches!(load_input(&missing), Err(InputError::Load(_))));
-        let bad_patch = dir.file("bad.bpt", b"not a patch file");
-        assert!(matches!(load_input(&bad_patch), Err(InputError::Patch(_))));
+        #[cfg(feature = "patch")]
+        {
+            let bad_patch = dir.file("bad.bpt", b"not a patch file");
+            assert!(matches!(load_input(&bad_patch), Err(InputError::Patch(_))));
+        }
     }
 }

@@ -46,11 +46,12 @@ pub mod io;
 pub(crate) mod kernel;
 pub mod mesh;
 mod one_shot;
+#[cfg(feature = "patch")]
 pub mod patch;
 #[cfg(feature = "products")]
 pub mod products;
 pub mod spec;
-#[cfg(any(feature = "testing", feature = "cli"))]
+#[cfg(feature = "testing-kit")]
 pub mod testing;
 
 pub use base::bounding_box::BoundingBox;

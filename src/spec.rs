@@ -45,8 +45,8 @@ use crate::input::{Input, InputKind};
 use crate::kernel::frame::RayAxis;
 use crate::kernel::quantize::Precision;
 use crate::mesh::Mesh;
-use crate::patch::PatchWindingNumber;
-use crate::patch::surface_quadrature::SurfaceQuadrature;
+#[cfg(feature = "patch")]
+use crate::patch::{PatchWindingNumber, surface_quadrature::SurfaceQuadrature};
 
 /// An evaluation method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -502,6 +502,7 @@ impl EvaluatorSpec {
     }
 
     /// The patch evaluator's options.
+    #[cfg(feature = "patch")]
     pub fn patch_options(&self) -> crate::patch::Options {
         crate::patch::Options {
             ray: self.ray.unwrap_or_default(),
@@ -510,7 +511,7 @@ impl EvaluatorSpec {
     }
 
     /// The STEP evaluator's options.
-    #[cfg(feature = "io")]
+    #[cfg(all(feature = "patch", feature = "io"))]
     pub fn step_options(&self) -> crate::patch::step::StepOptions {
         crate::patch::step::StepOptions {
             tolerance: self.tolerance.unwrap_or(DEFAULT_TOLERANCE),
@@ -526,14 +527,16 @@ impl EvaluatorSpec {
                 cloud,
                 self.fast_params(),
             )),
+            #[cfg(feature = "patch")]
             (Input::Patches(set), Method::Exact) => {
                 Box::new(PatchWindingNumber::with_options(set, self.patch_options()))
             }
+            #[cfg(feature = "patch")]
             (Input::Patches(set), _) => Box::new(SurfaceQuadrature::new(
                 set,
                 self.tolerance.unwrap_or(DEFAULT_TOLERANCE),
             )),
-            #[cfg(feature = "io")]
+            #[cfg(all(feature = "patch", feature = "io"))]
             (Input::Step(model), _) => Box::new(
                 crate::patch::step::StepWindingNumber::with_options(model, self.step_options()),
             ),
@@ -562,7 +565,6 @@ impl EvaluatorSpec {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::patch::PatchSet;
 
     fn spec() -> EvaluatorSpec {
         EvaluatorSpec::default()
@@ -763,6 +765,12 @@ mod tests {
             .unwrap(),
         );
         assert_eq!(spec().build(&cloud).unwrap().name(), "fast point-cloud");
+    }
+
+    #[cfg(feature = "patch")]
+    #[test]
+    fn patch_sets_build_the_exact_and_direct_evaluators() {
+        use crate::patch::PatchSet;
         let flat = crate::patch::Patch::polynomial(
             1,
             1,
@@ -801,6 +809,7 @@ mod tests {
                 tolerance: 1e-4,
             }
         );
+        #[cfg(feature = "patch")]
         assert_eq!(
             s.patch_options(),
             crate::patch::Options {

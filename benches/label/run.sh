@@ -18,7 +18,7 @@ if [ ! -x "$venv/bin/python" ]; then
   "$py" -m venv "$venv"
 fi
 "$venv/bin/python" -m pip install -q --disable-pip-version-check -r "$here/requirements.txt"
-(cd "$repo" && cargo build --release --quiet --bin gwn --example mesh_arrays)
+(cd "$repo" && cargo build --release --quiet --bin gwn --features examples --example mesh_arrays)
 target="${CARGO_TARGET_DIR:-$repo/target}"
 case "$target" in /*) ;; *) target="$repo/$target" ;; esac
 args=("$@")

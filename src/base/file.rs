@@ -1,6 +1,11 @@
 //! Opening input files without blocking: a FIFO that no program writes to must not hang a
 //! reader (std has no `poll` and no `O_NONBLOCK` constant, and libc is not a dependency). Shared
 //! by the mesh loaders (`io`), the 2D module and the patch files, which do not import each other.
+//! Each reader is used by some of the features; a build with fewer of them leaves some unused.
+#![cfg_attr(
+    not(all(feature = "io", feature = "curve2d", feature = "patch")),
+    allow(dead_code)
+)]
 
 use std::path::Path;
 

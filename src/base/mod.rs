@@ -5,5 +5,6 @@
 
 pub mod bounding_box;
 pub mod compensated;
+#[cfg(any(feature = "io", feature = "curve2d"))]
 pub(crate) mod file;
 pub mod vec3;

@@ -1,8 +1,9 @@
 //! Winding numbers of curved surfaces: sets of tensor-product polynomial and rational Bézier
-//! patches (antipodal paper, Section 4.4 and Alg. 2), see `docs/patches.md`.
+//! patches (antipodal paper, Section 4.4 and Alg. 2), see `docs/patches.md`. Compiled with the
+//! `patch` feature; the file readers (`io`, `step`) also need `io`.
 //!
 //! - [`model`]: patches and patch sets;
-//! - [`io`]: the `.bpt` reader (Utah teapot format) and the rational `.rbpt` format;
+//! - `io` (feature `io`): the `.bpt` reader (Utah teapot format) and the rational `.rbpt` format;
 //! - [`boundary`]: the signed boundary (patch edges that no neighbour cancels exactly);
 //! - [`curve`]: rational Bézier curves and the two potentials of the solid-angle form;
 //! - [`quadrature`]: adaptive Gauss–Kronrod 7/15;
@@ -18,6 +19,7 @@
 pub mod boundary;
 pub mod curve;
 pub mod eval;
+#[cfg(feature = "io")]
 pub mod io;
 pub mod model;
 pub mod quadrature;
@@ -27,5 +29,6 @@ pub mod surface_quadrature;
 pub mod tessellate;
 
 pub use eval::{Evaluation, Options, PatchWindingNumber};
+#[cfg(feature = "io")]
 pub use io::{is_patch_path, load_patches};
 pub use model::{Patch, PatchError, PatchSet};

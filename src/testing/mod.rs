@@ -2,8 +2,8 @@
 //! oracle, and writers for language-neutral corpora (`gwn gen`). See `docs/testing-kit.md`.
 //!
 //! Compiled with the `testing` feature (which also enables the proptest strategies in
-//! `strategies`) or with `cli` (the default, without proptest: seeded generators and oracle
-//! only, for `gwn gen`).
+//! `strategies`) or with `testing-kit` (without proptest: seeded generators, oracle and export
+//! only; the `gwn` tool's `gwn gen` uses it).
 //!
 //! - **Generators** ([`Kind`], one [`Case`] = mesh + queries + optional closed-form truth): each
 //!   kind is a seeded function (`polycube(seed)`), a byte decoder for cargo-fuzz/arbitrary

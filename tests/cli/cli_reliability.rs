@@ -10,9 +10,7 @@ use std::process::{Command, Output, Stdio};
 const GWN: &str = env!("CARGO_BIN_EXE_gwn");
 
 fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/fixtures")
-        .join(name)
+    crate::common::repo().join("tests/fixtures").join(name)
 }
 
 /// A scratch directory, removed when dropped.

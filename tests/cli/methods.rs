@@ -32,7 +32,8 @@ fn cli_methods_apply_to_every_product_and_misuse_is_an_error() {
     std::fs::write(&cloud, text).unwrap();
     let queries = dir.join("q.csv");
     std::fs::write(&queries, "0 0 0.1\n0 0 3\n").unwrap();
-    let mesh = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/cube.off");
+    let mesh = crate::common::fixture("cube.off");
+    let mesh = mesh.to_str().unwrap();
     let (cloud, queries) = (cloud.to_str().unwrap(), queries.to_str().unwrap());
     let d = |name: &str| dir.join(name).to_str().unwrap().to_owned();
 

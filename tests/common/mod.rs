@@ -13,11 +13,20 @@ pub fn open_cube() -> Mesh {
     gwn::testing::unit_cube(true)
 }
 
+/// The repository's root, the `gwn` package's directory (`tests/cli` and `tests/products` belong
+/// to the `gwn-cli` package in `cli/`, whose manifest directory is one below).
+pub fn repo() -> &'static std::path::Path {
+    let manifest = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    if env!("CARGO_PKG_NAME") == "gwn-cli" {
+        manifest.parent().expect("cli/ has a parent")
+    } else {
+        manifest
+    }
+}
+
 /// A file of `tests/fixtures/`.
 pub fn fixture(name: &str) -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/fixtures")
-        .join(name)
+    repo().join("tests/fixtures").join(name)
 }
 
 /// Reports that the running test skips its body for want of `what` (e.g. `../shared/meshes`),
@@ -37,7 +46,7 @@ pub fn report_skip(what: &str) {
 
 /// `../shared/meshes` if present, else reports the skip ([`report_skip`]) and returns `None`.
 pub fn shared_meshes() -> Option<std::path::PathBuf> {
-    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes");
+    let p = repo().join("../shared/meshes");
     if p.join("manifest.csv").exists() {
         Some(p)
     } else {
@@ -49,9 +58,7 @@ pub fn shared_meshes() -> Option<std::path::PathBuf> {
 /// A file of the shared corpus (`../shared/…`, `relative` below `../shared`), or `None` after
 /// reporting the skip ([`report_skip`]).
 pub fn shared_file(relative: &str) -> Option<std::path::PathBuf> {
-    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared")
-        .join(relative);
+    let p = repo().join("../shared").join(relative);
     if p.exists() {
         Some(p)
     } else {

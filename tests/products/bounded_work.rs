@@ -157,7 +157,7 @@ fn an_empty_medit_file_is_an_error() {
     assert!(gwn::io::tets::parse_medit(b"MeshVersionFormatted 2\nDimension 3\nEnd\n").is_err());
     let dir = Scratch::new("medit");
     let tets = dir.file("empty.mesh", b"");
-    let mesh = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("data/lion-head.off");
+    let mesh = crate::common::repo().join("data/lion-head.off");
     let out = dir.0.join("kept").display().to_string();
     let (ok, _, err) = cli::gwn(&["filter-tets", mesh.to_str().unwrap(), &tets, "--out", &out]);
     assert!(!ok);

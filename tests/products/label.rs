@@ -14,9 +14,7 @@ use gwn::products::label::{
 };
 
 fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/fixtures")
-        .join(name)
+    crate::common::repo().join("tests/fixtures").join(name)
 }
 
 /// A fresh scratch directory for one test.

@@ -14,7 +14,7 @@ use crate::method::{MethodArgs, ToleranceArgs, need_mesh};
 
 /// The bundled example mesh (`data/lion-head.off`, CGAL demo data, CC0-1.0): an open lion head
 /// with holes, so the slice shows fractional winding numbers.
-const LION_HEAD: &[u8] = include_bytes!("../../../data/lion-head.off");
+const LION_HEAD: &[u8] = include_bytes!("../../data/lion-head.off");
 
 /// A coordinate axis.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]

@@ -37,7 +37,7 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    // SUBCOMMANDS: one variant per file in src/bin/gwn/ (keep alphabetical).
+    // SUBCOMMANDS: one variant per file in cli/src/ (keep alphabetical).
     /// Benchmark exact vs direct on meshes (queries/s on a 32³ grid, 1 and 2 threads).
     Bench(bench::Args),
     /// Classify the faces of mesh A by the winding number of mesh B (for booleans).
