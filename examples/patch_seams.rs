@@ -15,7 +15,7 @@ mod patch_points;
 use std::collections::BTreeMap;
 use std::time::Instant;
 
-use gwn::kernel::frame::RayAxis;
+use gwn::RayAxis;
 use gwn::patch::{Options, Patch, PatchSet, PatchWindingNumber, load_patches};
 use patch_points::{Query, near_feature_queries, poles};
 

@@ -6,7 +6,7 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-use gwn::kernel::frame::RayAxis;
+use gwn::RayAxis;
 use gwn::testing::{Kind, Oracle, exact_evaluator};
 
 fn main() {

@@ -28,7 +28,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use rayon::prelude::*;
 
-use crate::BoundingBox;
+use crate::base::bounding_box::BoundingBox;
 use crate::eval::Evaluator;
 #[cfg(doc)]
 use crate::eval::antipodal::WindingNumber;

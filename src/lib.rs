@@ -9,7 +9,13 @@
 //!   (ground truth, `O(F)` per query);
 //! - [`eval::antipodal`]: the exact Antipodal method: `w = χ + (1/4π) Σ_boundary area`, with the
 //!   crossing count χ of one axis-aligned ray and the atan2 branch decided by one symbolically
-//!   perturbed integer predicate ([`kernel`]), `O(B + log F)` per query.
+//!   perturbed integer predicate (the crate's exact kernel, private to it), `O(B + log F)` per
+//!   query.
+//!
+//! The front door: [`spec::EvaluatorSpec`] describes an evaluator (method, ray, precision,
+//! tolerance, β, order), checks it by the rules the CLI and the Python package share, and builds
+//! it for any [`input::Input`] (mesh, oriented point cloud, patch set, STEP model), which
+//! `input::load_input` reads from a file (feature `io`).
 //!
 //! ```
 //! use gwn::{Mesh, eval::direct::winding_number_direct};
@@ -27,26 +33,30 @@
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 
-pub mod base;
-pub mod bvh;
+pub(crate) mod base;
+pub(crate) mod bvh;
 #[cfg(feature = "curve2d")]
 pub mod curve2d;
 pub mod error;
 pub mod eval;
 pub mod grid;
+pub mod input;
 #[cfg(feature = "io")]
 pub mod io;
-pub mod kernel;
+pub(crate) mod kernel;
 pub mod mesh;
 mod one_shot;
 #[cfg(feature = "patch")]
 pub mod patch;
 #[cfg(feature = "products")]
 pub mod products;
+pub mod spec;
 #[cfg(feature = "testing-kit")]
 pub mod testing;
 
 pub use base::bounding_box::BoundingBox;
+pub use kernel::frame::RayAxis;
+pub use kernel::quantize::Precision;
 pub use mesh::Mesh;
 pub use one_shot::{Position, TriangleIndices, WindingNumberError, winding_number};
 

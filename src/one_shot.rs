@@ -1,9 +1,9 @@
 //! [`winding_number`]: the exact winding numbers of a triangle mesh given as plain slices, in one
 //! call, for users who do not want to learn the module tree.
 
-use crate::Mesh;
 use crate::error::MeshError;
 use crate::eval::antipodal::{BuildError, WindingNumber};
+use crate::mesh::Mesh;
 
 /// A point accepted by [`winding_number`]: `[f64; 3]`, `[f32; 3]`, `glam::DVec3`, `glam::Vec3`.
 pub trait Position: Copy {

@@ -10,7 +10,7 @@ use gwn::eval::direct::winding_number_direct;
 use gwn::eval::fast::{FastParams, FastWindingNumber};
 use rayon::prelude::*;
 
-use crate::common::{CliError, check_beta, checked_threads, load_mesh_for_cli, outln};
+use crate::common::{CliError, checked_threads, load_mesh_for_cli, outln};
 
 /// Benchmark the evaluators on meshes: per mesh, faces, boundary edges, precompute time of
 /// `exact` (with its boundary hierarchy, see --tolerance), tree build time of `fast`, and queries/s of `exact`, `direct` and `fast`
@@ -40,7 +40,7 @@ pub struct Args {
     #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
     pub beta: f64,
     /// Expansion order of the fast method (0, 1 or 2).
-    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(0..=2))]
+    #[arg(long, default_value_t = 2)]
     pub order: u8,
     /// Leave out the `exact` columns (for timing `fast` alone, e.g. on soups, where the exact
     /// method costs O(faces) per query).
@@ -50,7 +50,17 @@ pub struct Args {
     #[arg(long)]
     pub markdown: bool,
     #[command(flatten)]
-    pub boundary: crate::common::ToleranceArgs,
+    pub tolerance: crate::method::ToleranceArgs,
+}
+
+impl Args {
+    /// The exact method's options (`--tolerance`).
+    fn method_spec(&self) -> gwn::spec::EvaluatorSpec {
+        gwn::spec::EvaluatorSpec {
+            tolerance: self.tolerance.tolerance,
+            ..Default::default()
+        }
+    }
 }
 
 /// Largest `--grid`: the N³ query points and two value arrays take 40 bytes per point, so 256
@@ -73,8 +83,13 @@ pub fn run(mut args: Args) -> Result<(), CliError> {
             "--direct-sample 0: expected at least 1 point",
         ));
     }
-    check_beta(args.beta)?;
-    crate::common::check_boundary_tolerance(args.boundary.tolerance)?;
+    // The values' rules (bench runs both methods, so no method is named).
+    gwn::spec::EvaluatorSpec {
+        beta: Some(args.beta),
+        order: Some(args.order),
+        ..args.method_spec()
+    }
+    .validate()?;
     for t in &mut args.threads_list {
         *t = checked_threads(*t, "--threads-list")?;
     }
@@ -154,7 +169,7 @@ fn bench_mesh(mesh: &Mesh, args: &Args) -> Result<Option<String>, CliError> {
         .collect();
     let step = (points.len() / args.direct_sample).max(1);
     let sample: Vec<[f64; 3]> = points.iter().step_by(step).copied().collect();
-    let options = args.boundary.exact_options(Default::default())?;
+    let options = args.method_spec().exact_options();
     let t0 = Instant::now();
     let wn = WindingNumber::with_options(mesh, options).map_err(|e| CliError(e.to_string()))?;
     // The boundary hierarchy is built on first use: one query outside the box builds it here, so
@@ -173,7 +188,7 @@ fn bench_mesh(mesh: &Mesh, args: &Args) -> Result<Option<String>, CliError> {
     let mut ratio = 0.0;
     let mut fast_ratio = 0.0;
     let mut max_err = 0.0_f64;
-    let fallbacks_before = gwn::kernel::input_predicates::exact_fallbacks();
+    let fallbacks_before = gwn::eval::exact_fallbacks();
     let mut exact_queries = 0usize;
     for &t in &args.threads_list {
         let pool = rayon::ThreadPoolBuilder::new()
@@ -222,7 +237,7 @@ fn bench_mesh(mesh: &Mesh, args: &Args) -> Result<Option<String>, CliError> {
     }
     row += &format!(" | {fast_ratio:.1}× | {max_err:.1e}");
     if !args.skip_exact {
-        let fallbacks = gwn::kernel::input_predicates::exact_fallbacks() - fallbacks_before;
+        let fallbacks = gwn::eval::exact_fallbacks() - fallbacks_before;
         row += &format!(
             " | {} | {fallbacks} in {exact_queries} queries",
             wn.snapping().off_lattice

@@ -3,10 +3,11 @@
 use std::path::PathBuf;
 
 use clap::{Args as ClapArgs, ValueEnum};
-use gwn::products::classify::{Select, classify_faces, select, submesh, write_obj};
+use gwn::mesh::write_obj;
+use gwn::products::classify::{Select, classify_faces, select, submesh};
 
 use crate::common::{CliError, check_threshold, outln};
-use crate::method::{Input, MethodArgs};
+use crate::method::{MethodArgs, need_mesh};
 
 /// Which faces to select.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -46,18 +47,18 @@ pub struct Args {
     #[command(flatten)]
     pub weld: crate::common::WeldArgs,
     #[command(flatten)]
-    pub boundary: crate::common::ToleranceArgs,
+    pub tolerance: crate::method::ToleranceArgs,
 }
 
 /// Runs `gwn classify`.
 pub fn run(args: Args) -> Result<(), CliError> {
     check_threshold(args.threshold, "--threshold")?;
-    let a_input = Input::load(&args.a, args.weld)?;
-    let a = a_input.mesh(&args.a, "classify (its faces are classified)")?;
-    let b = Input::load(&args.b, args.weld)?;
-    let wn = args
-        .method
-        .build(&b, &args.b, args.boundary.exact_options(args.weld)?)?;
+    let method = args.method.spec(args.tolerance, args.weld);
+    method.validate()?;
+    let a_input = crate::method::load_input(&args.a, args.weld)?;
+    let a = need_mesh(&a_input, &args.a, "classify (its faces are classified)")?;
+    let b = crate::method::load_input(&args.b, args.weld)?;
+    let wn = crate::method::build(&method, &b, &args.b)?;
     let values = classify_faces(a, &wn);
     gwn::io::points::save_values(&args.out, &values)
         .map_err(|e| CliError::msg(format!("{}: cannot write: {e}", args.out.display())))?;

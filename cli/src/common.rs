@@ -78,47 +78,6 @@ impl WeldArgs {
             gwn::eval::antipodal::BoundaryBy::Position
         }
     }
-
-    /// The exact method's options for these flags.
-    pub fn exact_options(&self) -> gwn::eval::antipodal::Options {
-        gwn::eval::antipodal::Options {
-            boundary: self.boundary(),
-            ..Default::default()
-        }
-    }
-}
-
-/// `--tolerance` of the exact method's far boundary, shared by the products (`gwn eval` has its
-/// own, which also serves patch sets).
-#[derive(clap::Args, Debug, Clone, Copy)]
-pub struct ToleranceArgs {
-    /// Exact method: absolute tolerance on w for far boundary clusters, replaced by a multipole
-    /// expansion with a certified error bound (docs/boundary.md); 0 = the flat exact loop. The
-    /// integer part is always exact.
-    #[arg(long, default_value_t = gwn::eval::antipodal::DEFAULT_TOLERANCE)]
-    pub tolerance: f64,
-}
-
-impl ToleranceArgs {
-    /// The exact method's options for these flags and `weld`.
-    pub fn exact_options(&self, weld: WeldArgs) -> Result<gwn::eval::antipodal::Options, CliError> {
-        check_boundary_tolerance(self.tolerance)?;
-        Ok(gwn::eval::antipodal::Options {
-            tolerance: self.tolerance,
-            ..weld.exact_options()
-        })
-    }
-}
-
-/// A boundary tolerance must be a finite number `≥ 0`.
-pub fn check_boundary_tolerance(tolerance: f64) -> Result<(), CliError> {
-    if tolerance.is_finite() && tolerance >= 0.0 {
-        Ok(())
-    } else {
-        Err(CliError(format!(
-            "--tolerance must be a finite number >= 0, not {tolerance}"
-        )))
-    }
 }
 
 /// Loads a mesh for a subcommand, welded as `weld` says; errors name the file.
@@ -182,17 +141,6 @@ pub fn checked_threads(requested: usize, option: &str) -> Result<usize, CliError
         return Ok(cap);
     }
     Ok(requested)
-}
-
-/// Checks the fast method's accuracy parameter β: a positive finite number.
-pub fn check_beta(beta: f64) -> Result<(), CliError> {
-    if beta.is_finite() && beta > 0.0 {
-        Ok(())
-    } else {
-        Err(CliError(format!(
-            "--beta {beta}: expected a positive finite number"
-        )))
-    }
 }
 
 /// Checks a threshold on w (`--threshold`, `--occupancy`): any finite number.

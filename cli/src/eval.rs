@@ -2,49 +2,13 @@
 
 use std::path::PathBuf;
 
-use clap::{Args as ClapArgs, ValueEnum};
-use gwn::eval::antipodal::Options;
-use gwn::kernel::frame::RayAxis;
-use gwn::kernel::quantize::Precision;
+use clap::Args as ClapArgs;
+use gwn::input::Input;
+use gwn::spec::{EvaluatorSpec, Method};
+use gwn::{Precision, RayAxis};
 
-use crate::common::{CliError, check_beta, progress, stdout_error};
-use crate::method::{Input, Method, MethodArgs};
-
-/// Ray direction of the exact method.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum Ray {
-    /// +z (default)
-    #[value(name = "+z")]
-    PosZ,
-    /// -z
-    #[value(name = "-z")]
-    NegZ,
-    /// +x
-    #[value(name = "+x")]
-    PosX,
-    /// -x
-    #[value(name = "-x")]
-    NegX,
-    /// +y
-    #[value(name = "+y")]
-    PosY,
-    /// -y
-    #[value(name = "-y")]
-    NegY,
-}
-
-impl From<Ray> for RayAxis {
-    fn from(r: Ray) -> RayAxis {
-        match r {
-            Ray::PosZ => RayAxis::PosZ,
-            Ray::NegZ => RayAxis::NegZ,
-            Ray::PosX => RayAxis::PosX,
-            Ray::NegX => RayAxis::NegX,
-            Ray::PosY => RayAxis::PosY,
-            Ray::NegY => RayAxis::NegY,
-        }
-    }
-}
+use crate::common::{CliError, progress, stdout_error};
+use crate::method::{MethodArgs, ToleranceArgs, parse_option};
 
 /// Evaluate the winding number of MESH (or of an oriented point cloud) at query points.
 ///
@@ -77,12 +41,13 @@ pub struct Args {
     #[command(flatten)]
     pub method: MethodArgs,
     /// Grid bits of the exact method (30: i64 predicates; 60: i128 predicates) [default: 60].
-    #[arg(long, value_parser = parse_precision)]
-    pub precision: Option<u32>,
-    /// Ray direction of the exact method (any gives the same value off the surface; on the
-    /// surface the value is taken at the point perturbed along this ray's frame) [default: +z].
-    #[arg(long, value_enum, allow_hyphen_values = true)]
-    pub ray: Option<Ray>,
+    #[arg(long, value_parser = parse_option::<Precision>)]
+    pub precision: Option<Precision>,
+    /// Ray direction of the exact method: +x, -x, +y, -y, +z or -z (any gives the same value
+    /// off the surface; on the surface the value is taken at the point perturbed along this
+    /// ray's frame) [default: +z].
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_option::<RayAxis>)]
+    pub ray: Option<RayAxis>,
     /// Also compute the gradient ∇w (every method; for fast, the derivative of its expansion).
     #[arg(long)]
     pub gradient: bool,
@@ -95,64 +60,44 @@ pub struct Args {
     pub gradient_out: Option<PathBuf>,
     #[command(flatten)]
     pub weld: crate::common::WeldArgs,
-    /// Target absolute error of w. Meshes, exact method: far boundary clusters are replaced by a
-    /// multipole expansion with a certified bound (docs/boundary.md; 0 = the flat exact loop, the
-    /// integer part is always exact). Patch sets: boundary quadrature of the exact method, surface
-    /// quadrature of the direct method.
-    #[arg(long, default_value_t = 1e-10)]
-    pub tolerance: f64,
+    #[command(flatten)]
+    pub tolerance: ToleranceArgs,
 }
 
-fn parse_precision(s: &str) -> Result<u32, String> {
-    match s {
-        "30" => Ok(30),
-        "60" => Ok(60),
-        _ => Err(format!("precision must be 30 or 60, not {s:?}")),
+impl Args {
+    /// The library's spec of the flags.
+    fn spec(&self) -> EvaluatorSpec {
+        EvaluatorSpec {
+            precision: self.precision,
+            ray: self.ray,
+            ..self.method.spec(self.tolerance, self.weld)
+        }
     }
 }
 
 /// Runs `gwn eval`.
 pub fn run(args: Args) -> Result<(), CliError> {
-    if gwn::patch::is_patch_path(&args.mesh) {
-        return run_patches(&args);
-    }
-    if gwn::patch::step::is_step_path(&args.mesh) {
-        return run_step(&args);
-    }
-    if let Some(beta) = args.method.beta {
-        check_beta(beta)?;
-    }
+    let spec = args.spec();
+    spec.validate()?;
     if args.gradient_out.is_some() && !args.gradient {
         return Err(CliError::msg(
             "--gradient-out needs --gradient (no gradient is computed without it)",
         ));
     }
-    crate::common::check_boundary_tolerance(args.tolerance)?;
-    let input = Input::load(&args.mesh, args.weld)?;
-    let method = args.method.method(&input);
-    if method != Method::Exact {
-        for (given, flag) in [
-            (args.precision.is_some(), "--precision"),
-            (args.ray.is_some(), "--ray"),
-        ] {
-            if given {
-                return Err(CliError::msg(format!(
-                    "{flag} applies to --method exact only"
-                )));
-            }
-        }
+    let input = crate::method::load_input(&args.mesh, args.weld)?;
+    let method = crate::method::check(&spec, input.kind(), &args.mesh)?;
+    if let (Input::Patches(set), Method::Exact) = (&input, method) {
+        // The patch evaluator's own loop, for its certification flags.
+        refuse_gradient(&args, &input.kind().to_string())?;
+        let points = gwn::io::points::load_points(&args.points)?;
+        let values = eval_patches(set, &spec, &points);
+        return write_outputs(&args, &values, None);
     }
-    let options = Options {
-        precision: if args.precision == Some(30) {
-            Precision::Bits30
-        } else {
-            Precision::Bits60
-        },
-        ray: args.ray.unwrap_or(Ray::PosZ).into(),
-        tolerance: args.tolerance,
-        ..args.weld.exact_options()
-    };
-    let wn = args.method.build(&input, &args.mesh, options)?;
+    let wn = crate::method::build(&spec, &input, &args.mesh)?;
+    if args.gradient && wn.try_gradient([0.0; 3]).is_err() {
+        // Whether an evaluator has a gradient does not depend on the query: refuse up front.
+        refuse_gradient(&args, &input.kind().to_string())?;
+    }
     let points = gwn::io::points::load_points(&args.points)?;
     let pb = progress(points.len() as u64, "evaluating");
     let mut values = Vec::with_capacity(points.len());
@@ -169,100 +114,34 @@ pub fn run(args: Args) -> Result<(), CliError> {
     write_outputs(&args, &values, grads.as_deref())
 }
 
-/// The options every curved-surface input (patch sets, STEP models) refuses or needs: no
-/// gradient, a positive tolerance, no mesh-only options (`what` names the input in the errors).
-fn check_curved_surface_options(args: &Args, what: &str) -> Result<(), CliError> {
+/// `--gradient` for an input whose evaluator has none.
+fn refuse_gradient(args: &Args, what: &str) -> Result<(), CliError> {
     if args.gradient {
         return Err(CliError(format!("--gradient is not available for {what}")));
-    }
-    if !(args.tolerance.is_finite() && args.tolerance > 0.0) {
-        return Err(CliError(format!(
-            "--tolerance must be a positive number, not {}",
-            args.tolerance
-        )));
-    }
-    if args.method.beta.is_some() || args.method.order.is_some() || args.precision.is_some() {
-        return Err(CliError(format!(
-            "--beta, --order and --precision do not apply to {what}"
-        )));
     }
     Ok(())
 }
 
-/// Bézier patch sets: the boundary method (`exact`) or the surface quadrature (`direct`).
-fn run_patches(args: &Args) -> Result<(), CliError> {
-    check_curved_surface_options(args, "patch sets")?;
-    let set = gwn::patch::load_patches(&args.mesh)?;
-    let points = gwn::io::points::load_points(&args.points)?;
-    let values = match args.method.method.unwrap_or(Method::Exact) {
-        Method::Exact => {
-            let evaluations = gwn::patch::PatchWindingNumber::with_options(
-                &set,
-                gwn::patch::Options {
-                    ray: args.ray.unwrap_or(Ray::PosZ).into(),
-                    tolerance: args.tolerance,
-                },
-            )
-            .evaluate_batch(&points);
-            // The flag of docs/patches.md ("Error model"): queries on the surface (principal
-            // value), at rounding level from it, or past the work cap.
-            let uncertified = evaluations.iter().filter(|e| !e.certified).count();
-            let worst = evaluations
-                .iter()
-                .filter(|e| !e.certified)
-                .fold(0.0f64, |a, e| a.max(e.error_estimate));
-            if uncertified > 0 {
-                eprintln!(
-                    "gwn eval: warning: {uncertified} of {} values uncertified (on or within \
-                     rounding of the surface, or work cap reached; largest error estimate \
-                     {worst:.1e}); see docs/patches.md",
-                    points.len()
-                );
-            }
-            evaluations.iter().map(|e| e.value).collect()
-        }
-        Method::Direct => {
-            if args.ray.is_some() {
-                return Err(CliError::msg("--ray applies to --method exact only"));
-            }
-            gwn::patch::surface_quadrature::winding_number_surface_quadrature_batch(
-                &set,
-                &points,
-                args.tolerance,
-            )
-        }
-        Method::Fast => {
-            return Err(CliError::msg(
-                "--method fast is not available for patch sets (use exact or direct)",
-            ));
-        }
-    };
-    write_outputs(args, &values, None)
-}
-
-/// Trimmed B-rep STEP models: the crossing count plus the surface-boundary integral.
-fn run_step(args: &Args) -> Result<(), CliError> {
-    check_curved_surface_options(args, "STEP models")?;
-    if args.ray.is_some() {
-        return Err(CliError::msg(
-            "--ray does not apply to STEP models (the evaluator chooses a ray per query)",
-        ));
+/// Bézier patch sets, exact method: values, and a warning for the uncertified ones.
+fn eval_patches(set: &gwn::patch::PatchSet, spec: &EvaluatorSpec, points: &[[f64; 3]]) -> Vec<f64> {
+    let evaluations = gwn::patch::PatchWindingNumber::with_options(set, spec.patch_options())
+        .evaluate_batch(points);
+    // The flag of docs/patches.md ("Error model"): queries on the surface (principal value), at
+    // rounding level from it, or past the work cap.
+    let uncertified = evaluations.iter().filter(|e| !e.certified).count();
+    let worst = evaluations
+        .iter()
+        .filter(|e| !e.certified)
+        .fold(0.0f64, |a, e| a.max(e.error_estimate));
+    if uncertified > 0 {
+        eprintln!(
+            "gwn eval: warning: {uncertified} of {} values uncertified (on or within rounding of \
+             the surface, or work cap reached; largest error estimate {worst:.1e}); see \
+             docs/patches.md",
+            points.len()
+        );
     }
-    if !matches!(args.method.method, None | Some(Method::Exact)) {
-        return Err(CliError::msg(
-            "only --method exact is available for STEP models",
-        ));
-    }
-    let model = gwn::patch::step::load_step(&args.mesh)?;
-    let points = gwn::io::points::load_points(&args.points)?;
-    let wn = gwn::patch::step::StepWindingNumber::with_options(
-        &model,
-        gwn::patch::step::StepOptions {
-            tolerance: args.tolerance,
-        },
-    );
-    let values = wn.eval_batch(&points);
-    write_outputs(args, &values, None)
+    evaluations.iter().map(|e| e.value).collect()
 }
 
 fn write_outputs(args: &Args, values: &[f64], grads: Option<&[[f64; 3]]>) -> Result<(), CliError> {

@@ -3,10 +3,11 @@
 use std::path::PathBuf;
 
 use clap::Args as ClapArgs;
-use gwn::products::tets::{DEFAULT_THRESHOLD, filter_tets, load_tets, save_tets};
+use gwn::io::tets::{load_tets, save_tets};
+use gwn::products::tets::{DEFAULT_THRESHOLD, filter_tets};
 
 use crate::common::{CliError, check_threshold, outln};
-use crate::method::{Input, MethodArgs};
+use crate::method::MethodArgs;
 
 /// Keep the tets of TETS whose centroid has w(MESH) > threshold, and write them to OUT.
 ///
@@ -30,17 +31,17 @@ pub struct Args {
     #[command(flatten)]
     pub weld: crate::common::WeldArgs,
     #[command(flatten)]
-    pub boundary: crate::common::ToleranceArgs,
+    pub tolerance: crate::method::ToleranceArgs,
 }
 
 /// Runs `gwn filter-tets`.
 pub fn run(args: Args) -> Result<(), CliError> {
     check_threshold(args.threshold, "--threshold")?;
-    let input = Input::load(&args.mesh, args.weld)?;
+    let method = args.method.spec(args.tolerance, args.weld);
+    method.validate()?;
+    let input = crate::method::load_input(&args.mesh, args.weld)?;
     let tets = load_tets(&args.tets)?;
-    let wn = args
-        .method
-        .build(&input, &args.mesh, args.boundary.exact_options(args.weld)?)?;
+    let wn = crate::method::build(&method, &input, &args.mesh)?;
     let keep = filter_tets(&tets.points, &tets.tets, &wn, args.threshold);
     let kept = tets.select(&keep);
     // `save_tets` errors already start with the file they concern.

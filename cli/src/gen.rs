@@ -5,11 +5,11 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use gwn::kernel::frame::RayAxis;
+use gwn::RayAxis;
 use gwn::testing::{Kind, Oracle, export};
 
 use crate::common::CliError;
-use crate::eval::Ray;
+use crate::method::parse_option;
 
 /// Arguments of `gwn gen`.
 ///
@@ -38,9 +38,11 @@ pub struct Args {
     /// Output directory (created if missing).
     #[arg(long)]
     pub out: PathBuf,
-    /// Ray direction whose perturbation defines the values of on-surface queries.
-    #[arg(long, value_enum, default_value_t = Ray::PosZ, allow_hyphen_values = true)]
-    pub ray: Ray,
+    /// Ray direction (+x, -x, +y, -y, +z or -z) whose perturbation defines the values of
+    /// on-surface queries.
+    #[arg(long, default_value = "+z", allow_hyphen_values = true,
+          value_parser = parse_option::<RayAxis>)]
+    pub ray: RayAxis,
 }
 
 /// Runs `gwn gen`.
@@ -64,7 +66,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             args.out.display()
         ))
     })?;
-    let ray: RayAxis = args.ray.into();
+    let ray = args.ray;
     let mut manifest = String::from("name,kind,seed,vertices,triangles,queries,undecided\n");
     for kind in kinds {
         for i in 0..args.count {
@@ -78,7 +80,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 .filter(|c| c.decide(0.5) == gwn::testing::Decision::Undecided)
                 .count();
             write(&args.out, &format!("{name}.obj"), |w| {
-                export::write_obj(w, &case.mesh)
+                gwn::mesh::write_obj(w, &case.mesh)
             })?;
             write(&args.out, &format!("{name}.off"), |w| {
                 export::write_off(w, &case.mesh)

@@ -6,7 +6,9 @@ use clap::Args as ClapArgs;
 use gwn::products::sdf::SignedDistance;
 
 use crate::common::{CliError, progress};
-use crate::method::{Input, MethodArgs};
+use gwn::input::Input;
+
+use crate::method::MethodArgs;
 use crate::voxelize::GridArgs;
 
 /// Signed distance to the mesh on a voxel grid, signed by the winding number (`.npy`, `.vti`).
@@ -29,7 +31,7 @@ pub struct Args {
     #[command(flatten)]
     pub weld: crate::common::WeldArgs,
     #[command(flatten)]
-    pub boundary: crate::common::ToleranceArgs,
+    pub tolerance: crate::method::ToleranceArgs,
 }
 
 /// Peak bytes per cell of `gwn sdf`: the library's signed-distance grid and the `f32` copy.
@@ -38,11 +40,11 @@ const SDF_BYTES_PER_CELL: usize = gwn::products::sdf::GRID_BYTES_PER_CELL + 4;
 /// Runs `gwn sdf`.
 pub fn run(args: Args) -> Result<(), CliError> {
     args.grid.check()?;
-    let input = Input::load(&args.mesh, args.weld)?;
+    let method = args.method.spec(args.tolerance, args.weld);
+    method.validate()?;
+    let input = crate::method::load_input(&args.mesh, args.weld)?;
     let spec = args.grid.spec(&input, &args.mesh, SDF_BYTES_PER_CELL)?;
-    let wn = args
-        .method
-        .build(&input, &args.mesh, args.boundary.exact_options(args.weld)?)?;
+    let wn = crate::method::build(&method, &input, &args.mesh)?;
     let sdf = match &input {
         Input::Mesh(mesh) => SignedDistance::with_evaluator(mesh, wn),
         Input::Cloud(cloud) => SignedDistance::with_points(cloud.positions(), wn),

@@ -5,11 +5,12 @@ use std::path::{Path, PathBuf};
 
 use clap::{Args as ClapArgs, ValueEnum};
 use gwn::BoundingBox;
-use gwn::eval::antipodal::Options;
+use gwn::input::{Input, InputKind};
 use gwn::products::png::Slice;
+use gwn::spec::Method;
 
 use crate::common::{CliError, outln, progress};
-use crate::method::{Input, MethodArgs};
+use crate::method::{MethodArgs, ToleranceArgs, need_mesh};
 
 /// The bundled example mesh (`data/lion-head.off`, CGAL demo data, CC0-1.0): an open lion head
 /// with holes, so the slice shows fractional winding numbers.
@@ -74,12 +75,13 @@ pub struct Args {
     #[command(flatten)]
     pub weld: crate::common::WeldArgs,
     #[command(flatten)]
-    pub boundary: crate::common::ToleranceArgs,
+    pub tolerance: ToleranceArgs,
 }
 
 /// Runs `gwn slice`.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let input = Input::load(&args.mesh, args.weld)?;
+    args.method.spec(args.tolerance, args.weld).validate()?;
+    let input = crate::method::load_input(&args.mesh, args.weld)?;
     render(&input, &args)
 }
 
@@ -98,9 +100,7 @@ pub fn run_default() -> Result<(), CliError> {
         outline: true,
         out: PathBuf::from("slice.png"),
         weld: Default::default(),
-        boundary: crate::common::ToleranceArgs {
-            tolerance: gwn::eval::antipodal::DEFAULT_TOLERANCE,
-        },
+        tolerance: ToleranceArgs::default(),
     };
     eprintln!(
         "gwn: no subcommand given; rendering the bundled lion head (an open mesh with holes) \
@@ -120,7 +120,7 @@ fn render(input: &Input, args: &Args) -> Result<(), CliError> {
         return Err(CliError::msg("--margin must be a non-negative number"));
     }
     let outline = if args.outline {
-        Some(input.mesh(&args.mesh, "--outline")?)
+        Some(need_mesh(input, &args.mesh, "--outline")?)
     } else {
         None
     };
@@ -139,12 +139,14 @@ fn render(input: &Input, args: &Args) -> Result<(), CliError> {
     };
     let region: BoundingBox = bbox.enlarged(args.margin);
     let slice = Slice::new(&region, axis, coord, args.res);
-    // A ray in the plane: one ray serves a whole image column or row.
-    let exact = Options {
-        ray: slice.ray(),
-        ..args.boundary.exact_options(args.weld)?
-    };
-    let wn = args.method.build(input, &args.mesh, exact)?;
+    let mut spec = args.method.spec(args.tolerance, args.weld);
+    // A ray in the plane: one ray serves a whole image column or row (the exact method on
+    // meshes and patch sets; the STEP evaluator picks its own rays).
+    let method = crate::method::check(&spec, input.kind(), &args.mesh)?;
+    if method == Method::Exact && input.kind() != InputKind::Step {
+        spec.ray = Some(slice.ray());
+    }
+    let wn = crate::method::build(&spec, input, &args.mesh)?;
     let pb = progress(
         slice.grid().column_count(gwn::grid::column_axis(&wn)) as u64,
         "slice",

@@ -8,7 +8,9 @@ use gwn::grid::{GridError, GridSpec};
 use gwn::products::{npy, vti};
 
 use crate::common::{CliError, outln, progress};
-use crate::method::{Input, MethodArgs};
+use gwn::input::Input;
+
+use crate::method::{MethodArgs, ToleranceArgs};
 
 /// Element type of the `.npy` output.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -184,7 +186,7 @@ pub struct Args {
     #[command(flatten)]
     pub weld: crate::common::WeldArgs,
     #[command(flatten)]
-    pub boundary: crate::common::ToleranceArgs,
+    pub tolerance: ToleranceArgs,
 }
 
 /// Runs `gwn voxelize`.
@@ -198,13 +200,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
         ));
     }
     args.grid.check()?;
-    let input = Input::load(&args.mesh, args.weld)?;
+    let method = args.method.spec(args.tolerance, args.weld);
+    method.validate()?;
+    let input = crate::method::load_input(&args.mesh, args.weld)?;
     let spec = args
         .grid
         .spec(&input, &args.mesh, VOXELIZE_BYTES_PER_CELL)?;
-    let wn = args
-        .method
-        .build(&input, &args.mesh, args.boundary.exact_options(args.weld)?)?;
+    let wn = crate::method::build(&method, &input, &args.mesh)?;
     let pb = progress(
         spec.column_count(gwn::grid::column_axis(&wn)) as u64,
         "voxelize",

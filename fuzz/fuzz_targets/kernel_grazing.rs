@@ -6,7 +6,7 @@
 #![no_main]
 
 use gwn::eval::antipodal::{Options, WindingNumber};
-use gwn::kernel::frame::RayAxis;
+use gwn::RayAxis;
 use gwn::testing::{on_surface, soup_from_bytes};
 use libfuzzer_sys::fuzz_target;
 

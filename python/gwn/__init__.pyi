@@ -23,8 +23,10 @@ class WindingNumber:
     """Winding-number evaluator of one mesh or oriented point cloud, built once.
 
     ``method``: "exact" (Antipodal method, default), "direct" (solid-angle sum) or "fast"
-    (Barnes-Hut with accuracy ``beta`` and expansion ``order``). ``precision`` (30 or 60 bits),
-    ``ray`` and ``tolerance`` are options of the exact method: ``tolerance`` (finite, >= 0) is
+    (Barnes-Hut with accuracy ``beta``, default 2, and expansion ``order``, default 2).
+    ``precision`` (30 or 60 bits, default 60), ``ray`` (default "+z") and ``tolerance`` (default
+    1e-10) are options of the exact method; an option the method does not use is a ValueError
+    (the library's rules, shared with the ``gwn`` command line). ``tolerance`` (finite, >= 0) is
     the absolute tolerance on w for far boundary clusters, replaced by a multipole expansion with
     a certified error bound (``eval_with_bound``); the integer part is always exact, 0 is the
     flat exact loop. Calls release the GIL; one object may be used from several Python threads
@@ -36,11 +38,11 @@ class WindingNumber:
         V: _Floats,
         F: _Indices,
         method: _Method = "exact",
-        beta: float = 2.0,
-        order: int = 2,
-        precision: int = 60,
-        ray: _Ray = "+z",
-        tolerance: float = 1e-10,
+        beta: Optional[float] = None,
+        order: Optional[int] = None,
+        precision: Optional[int] = None,
+        ray: Optional[_Ray] = None,
+        tolerance: Optional[float] = None,
     ) -> None: ...
     @staticmethod
     def from_point_cloud(
@@ -135,9 +137,9 @@ def voxelize(
     bounds: Optional[Tuple[float, float, float, float, float, float]] = None,
     margin: float = 0.05,
     method: Literal["exact", "direct", "fast"] = "exact",
-    beta: float = 2.0,
-    order: int = 2,
-    tolerance: float = 1e-10,
+    beta: Optional[float] = None,
+    order: Optional[int] = None,
+    tolerance: Optional[float] = None,
     threads: Optional[int] = None,
 ) -> _Grid:
     """Winding numbers (exact by default) on a voxel grid: (values (D, H, W) indexed [z, y, x], origin, spacing)."""
@@ -176,9 +178,9 @@ def slice(
     margin: float = 0.1,
     outline: bool = False,
     method: Literal["exact", "direct", "fast"] = "exact",
-    beta: float = 2.0,
-    order: int = 2,
-    tolerance: float = 1e-10,
+    beta: Optional[float] = None,
+    order: Optional[int] = None,
+    tolerance: Optional[float] = None,
     threads: Optional[int] = None,
 ) -> Tuple[_F64, bytes]:
     """Winding numbers on an axis-aligned plane: (image (height, width), PNG bytes)."""
@@ -190,9 +192,9 @@ def classify(
     FB: _Indices,
     *,
     method: Literal["exact", "direct", "fast"] = "exact",
-    beta: float = 2.0,
-    order: int = 2,
-    tolerance: float = 1e-10,
+    beta: Optional[float] = None,
+    order: Optional[int] = None,
+    tolerance: Optional[float] = None,
     threads: Optional[int] = None,
 ) -> _F64:
     """Winding number (exact by default) of mesh B at each face centroid of mesh A."""
@@ -205,9 +207,9 @@ def filter_tets(
     threshold: float = 0.5,
     *,
     method: Literal["exact", "direct", "fast"] = "exact",
-    beta: float = 2.0,
-    order: int = 2,
-    tolerance: float = 1e-10,
+    beta: Optional[float] = None,
+    order: Optional[int] = None,
+    tolerance: Optional[float] = None,
     threads: Optional[int] = None,
 ) -> npt.NDArray[np.bool_]:
     """Mask of the tets whose centroid has winding number (exact by default) above threshold."""

@@ -4,98 +4,51 @@
 use std::sync::Arc;
 
 use gwn::Mesh;
-use gwn::eval::antipodal::{DEFAULT_TOLERANCE, Options, WindingNumber};
+use gwn::eval::antipodal::{DEFAULT_TOLERANCE, WindingNumber};
 use gwn::eval::direct::{winding_number_direct_batch, winding_number_gradient_direct};
-use gwn::eval::fast::{FastParams, FastWindingNumber, PointCloudWindingNumber};
-use gwn::kernel::frame::RayAxis;
-use gwn::kernel::quantize::Precision;
+use gwn::eval::fast::{FastWindingNumber, PointCloudWindingNumber};
+use gwn::input::InputKind;
+use gwn::spec::{EvaluatorSpec, Method, SpecError};
+use gwn::{Precision, RayAxis};
 use rayon::prelude::*;
 
-/// `1/4π` exactly as `WindingNumber::eval` multiplies the boundary sum with, so that
-/// `chi + fraction` is bit-identical to the value.
-use gwn::kernel::spherical::INV_4PI;
-
-/// The evaluation method a user asked for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Method {
-    /// The exact Antipodal method.
-    Exact,
-    /// The compensated solid-angle sum over all triangles.
-    Direct,
-    /// Barnes–Hut (Barill et al. 2018).
-    Fast,
-}
-
-impl Method {
-    /// Parses `"exact"`, `"direct"` or `"fast"`.
-    pub fn parse(s: &str) -> Result<Self, String> {
-        match s {
-            "exact" => Ok(Method::Exact),
-            "direct" => Ok(Method::Direct),
-            "fast" => Ok(Method::Fast),
-            _ => Err(format!(
-                "method must be \"exact\", \"direct\" or \"fast\", got {s:?}"
-            )),
-        }
-    }
-
-    /// The name `parse` accepts.
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Exact => "exact",
-            Method::Direct => "direct",
-            Method::Fast => "fast",
-        }
-    }
-}
-
-/// Parses a ray direction `"+z"`, `"-x"`, ... (the CLI's `--ray` values).
-pub fn parse_ray(s: &str) -> Result<RayAxis, String> {
-    Ok(match s {
-        "+z" | "z" => RayAxis::PosZ,
-        "-z" => RayAxis::NegZ,
-        "+x" | "x" => RayAxis::PosX,
-        "-x" => RayAxis::NegX,
-        "+y" | "y" => RayAxis::PosY,
-        "-y" => RayAxis::NegY,
-        _ => return Err(format!("ray must be one of +x -x +y -y +z -z, got {s:?}")),
-    })
-}
-
-/// Parses the grid precision in bits (30 or 60).
-pub fn parse_precision(bits: u32) -> Result<Precision, String> {
-    match bits {
-        30 => Ok(Precision::Bits30),
-        60 => Ok(Precision::Bits60),
-        _ => Err(format!("precision must be 30 or 60, got {bits}")),
-    }
-}
-
-/// Barill's parameters, validated: the library accepts any `β` (NaN means "exact"), but a
-/// Python user passing NaN or a negative `β` has made a mistake.
-pub fn fast_params(beta: f64, order: u8) -> Result<FastParams, String> {
-    if !(beta.is_finite() && beta > 0.0) {
-        return Err(format!("beta must be a positive finite number, got {beta}"));
-    }
-    if order > 2 {
-        return Err(format!("order must be 0, 1 or 2, got {order}"));
-    }
-    Ok(FastParams::barill(beta, order))
-}
-
-/// The Python default of `tolerance=`, written as a literal in the `#[pyo3(signature)]`s so that
-/// `help()` shows it; this pins it to the library's default.
+/// The Python default of `tolerance=`, written as a literal in the docstrings; this pins it to
+/// the library's default.
 pub const PY_DEFAULT_TOLERANCE: f64 = 1e-10;
 const _: () = assert!(PY_DEFAULT_TOLERANCE == DEFAULT_TOLERANCE);
 
-/// The exact method's boundary tolerance, validated: a finite number `>= 0` (the CLI's rule).
-pub fn check_tolerance(tolerance: f64) -> Result<f64, String> {
-    if tolerance.is_finite() && tolerance >= 0.0 {
-        Ok(tolerance)
-    } else {
-        Err(format!(
-            "tolerance must be a finite number >= 0, got {tolerance}"
-        ))
+/// The library's spec of Python's keyword arguments (`None`: not given, the library's default).
+/// Values are checked by the library ([`EvaluatorSpec::validate`]), so Python and the CLI
+/// refuse the same options with the same message.
+pub struct SpecArgs<'a> {
+    /// `method=`.
+    pub method: Option<&'a str>,
+    /// `beta=`.
+    pub beta: Option<f64>,
+    /// `order=`.
+    pub order: Option<u8>,
+    /// `precision=` (bits).
+    pub precision: Option<u32>,
+    /// `ray=`.
+    pub ray: Option<&'a str>,
+    /// `tolerance=`.
+    pub tolerance: Option<f64>,
+}
+
+impl SpecArgs<'_> {
+    /// The spec, parsed and validated (before any work, so errors come first).
+    pub fn spec(&self) -> Result<EvaluatorSpec, SpecError> {
+        let spec = EvaluatorSpec {
+            method: self.method.map(str::parse::<Method>).transpose()?,
+            beta: self.beta,
+            order: self.order,
+            precision: self.precision.map(Precision::try_from).transpose()?,
+            ray: self.ray.map(str::parse::<RayAxis>).transpose()?,
+            tolerance: self.tolerance,
+            ..Default::default()
+        };
+        spec.validate()?;
+        Ok(spec)
     }
 }
 
@@ -132,19 +85,17 @@ pub enum Evaluator {
 }
 
 impl Evaluator {
-    /// Builds the evaluator of `method` for a mesh.
-    pub fn for_mesh(
-        mesh: &Arc<Mesh>,
-        method: Method,
-        options: Options,
-        params: FastParams,
-    ) -> Result<Self, String> {
-        Ok(match method {
-            Method::Exact => Evaluator::Exact(Box::new(
-                WindingNumber::with_options(mesh, options).map_err(|e| e.to_string())?,
-            )),
+    /// Builds the evaluator `spec` describes for a mesh (checked by the library for meshes).
+    pub fn for_mesh(mesh: &Arc<Mesh>, spec: &EvaluatorSpec) -> Result<Self, SpecError> {
+        Ok(match spec.check(InputKind::Mesh)? {
+            Method::Exact => Evaluator::Exact(Box::new(WindingNumber::with_options(
+                mesh,
+                spec.exact_options(),
+            )?)),
             Method::Direct => Evaluator::Direct(mesh.clone()),
-            Method::Fast => Evaluator::FastSoup(FastWindingNumber::with_params(mesh, params)),
+            Method::Fast => {
+                Evaluator::FastSoup(FastWindingNumber::with_params(mesh, spec.fast_params()))
+            }
         })
     }
 
@@ -188,10 +139,7 @@ impl Evaluator {
         match self {
             Evaluator::Exact(wn) => Ok(points
                 .par_iter()
-                .map(|&q| {
-                    let (chi, boundary_sum) = wn.parts(q);
-                    (chi, boundary_sum * INV_4PI)
-                })
+                .map(|&q| wn.integer_and_fraction(q))
                 .unzip()),
             _ => Err(Unsupported {
                 what: "parts",

@@ -83,7 +83,7 @@ pub fn load_tets<'py>(
     Bound<'py, PyArray1<i64>>,
 )> {
     let tets = py
-        .allow_threads(|| gwn::products::tets::load_tets(&path))
+        .allow_threads(|| gwn::io::tets::load_tets(&path))
         .map_err(|e| {
             if path.exists() {
                 value_error(e)

@@ -4,10 +4,11 @@
 use std::sync::Arc;
 
 use gwn::Mesh;
-use gwn::eval::antipodal::{Options, WindingNumber};
-use gwn::eval::fast::{FastWindingNumber, PointCloud, PointCloudWindingNumber};
+use gwn::eval::antipodal::WindingNumber;
+use gwn::eval::fast::{FastWindingNumber, PointCloudWindingNumber};
+use gwn::mesh::PointCloud;
 use numpy::PyArray1;
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyFloat, PyInt, PyTuple};
 
@@ -16,7 +17,7 @@ use crate::arrays::{
     with_points,
 };
 use crate::errors::{mesh_error, value_error};
-use crate::evaluator::{check_tolerance, fast_params};
+use crate::products::exact_options;
 use crate::threads::{self, Threads};
 
 /// A validated mesh from `V`, `F` arrays.
@@ -49,10 +50,7 @@ pub fn winding_number<'py>(
     threads: Option<Threads>,
     tolerance: f64,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let options = Options {
-        tolerance: check_tolerance(tolerance).map_err(PyValueError::new_err)?,
-        ..Options::default()
-    };
+    let options = exact_options(tolerance)?;
     let mesh = mesh_from(V, F, "V", "F")?;
     let (o, single) = one_or_many::<3>(O, "O")?;
     let values = with_points(&o, "O", |q| {
@@ -109,7 +107,14 @@ pub fn fast_winding_number<'py>(
     }
     let order = order.or(expansion_order).or(positional_order).unwrap_or(2);
     let beta = beta.or(positional_beta).unwrap_or(2.0);
-    let params = fast_params(beta, order).map_err(PyValueError::new_err)?;
+    let spec = gwn::spec::EvaluatorSpec {
+        method: Some(gwn::spec::Method::Fast),
+        beta: Some(beta),
+        order: Some(order),
+        ..Default::default()
+    };
+    spec.validate().map_err(value_error)?;
+    let params = spec.fast_params();
     let values = match items.as_slice() {
         [v, f, q] if is_integer_array(f) => {
             let mesh = Arc::new(mesh_from(v, f, "V", "F")?);

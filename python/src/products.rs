@@ -4,13 +4,13 @@
 use gwn::BoundingBox;
 use gwn::Mesh;
 use gwn::eval::Evaluator;
-use gwn::eval::antipodal::{Options, WindingNumber};
-use gwn::eval::direct::DirectWindingNumber;
-use gwn::eval::fast::FastWindingNumber;
+use gwn::eval::antipodal::Options;
 use gwn::grid::GridSpec;
+use gwn::input::InputKind;
 use gwn::products::classify::classify_faces;
 use gwn::products::png::Slice;
 use gwn::products::sdf::SignedDistance;
+use gwn::spec::{EvaluatorSpec, Method};
 use numpy::PyArray1;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -18,46 +18,52 @@ use pyo3::types::PyBytes;
 
 use crate::arrays::{array_nd, array1, indices_vec, with_points};
 use crate::errors::value_error;
-use crate::evaluator::{Method, check_tolerance, fast_params};
+use crate::evaluator::SpecArgs;
 use crate::oneshot::mesh_from;
 use crate::threads::{self, Threads};
 
 /// The evaluator a product uses: any of the library's, through its `Evaluator` trait (the CLI's
-/// `--method/--beta/--order`). `beta`/`order` only apply to `"fast"`; `exact` are the exact
-/// method's options.
+/// `--method/--beta/--order/--tolerance`).
 type AnyEvaluator<'m> = Box<dyn Evaluator + 'm>;
 
-/// Checks the method arguments up front (so that errors come before any work).
-fn method_of(
+/// The spec of a product's `method`/`beta`/`order`/`tolerance`, checked up front for a mesh (so
+/// that errors come before any work) by the library's rules.
+fn spec_of(
     method: &str,
-    beta: f64,
-    order: u8,
-) -> PyResult<(Method, gwn::eval::fast::FastParams)> {
-    let m = Method::parse(method).map_err(PyValueError::new_err)?;
-    let params = fast_params(beta, order).map_err(PyValueError::new_err)?;
-    Ok((m, params))
+    beta: Option<f64>,
+    order: Option<u8>,
+    tolerance: Option<f64>,
+) -> PyResult<EvaluatorSpec> {
+    let spec = SpecArgs {
+        method: Some(method),
+        beta,
+        order,
+        precision: None,
+        ray: None,
+        tolerance,
+    }
+    .spec()
+    .map_err(value_error)?;
+    spec.check(InputKind::Mesh).map_err(value_error)?;
+    Ok(spec)
 }
 
 /// The exact method's options for `tolerance=` (the CLI's `--tolerance`), checked up front.
-fn exact_options(tolerance: f64) -> PyResult<Options> {
-    Ok(Options {
-        tolerance: check_tolerance(tolerance).map_err(PyValueError::new_err)?,
-        ..Options::default()
-    })
+pub fn exact_options(tolerance: f64) -> PyResult<Options> {
+    let spec = EvaluatorSpec {
+        tolerance: Some(tolerance),
+        ..Default::default()
+    };
+    spec.validate().map_err(value_error)?;
+    Ok(spec.exact_options())
 }
 
-/// Builds the chosen evaluator for `mesh`.
+/// Builds the evaluator `spec` describes for `mesh`.
 fn evaluator_for<'m>(
     mesh: &'m Mesh,
-    method: Method,
-    params: gwn::eval::fast::FastParams,
-    exact: Options,
+    spec: &EvaluatorSpec,
 ) -> Result<AnyEvaluator<'m>, Box<dyn std::error::Error + Send + Sync>> {
-    Ok(match method {
-        Method::Exact => Box::new(WindingNumber::with_options(mesh, exact)?),
-        Method::Direct => Box::new(DirectWindingNumber::new(mesh)),
-        Method::Fast => Box::new(FastWindingNumber::with_params(mesh, params)),
-    })
+    Ok(spec.build_mesh(mesh)?)
 }
 
 /// Largest slice side in pixels (the CLI's limit).
@@ -134,7 +140,7 @@ fn grid_result<'py>(
 /// is the exact method's boundary tolerance (``gwn voxelize --tolerance``; see
 /// :class:`WindingNumber`).
 #[pyfunction]
-#[pyo3(signature = (V, F, res = 64, *, dims = None, bounds = None, margin = 0.05, method = "exact", beta = 2.0, order = 2, tolerance = 1e-10, threads = None))]
+#[pyo3(signature = (V, F, res = 64, *, dims = None, bounds = None, margin = 0.05, method = "exact", beta = None, order = None, tolerance = None, threads = None))]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub fn voxelize<'py>(
     py: Python<'py>,
@@ -145,15 +151,14 @@ pub fn voxelize<'py>(
     bounds: Option<[f64; 6]>,
     margin: f64,
     method: &str,
-    beta: f64,
-    order: u8,
-    tolerance: f64,
+    beta: Option<f64>,
+    order: Option<u8>,
+    tolerance: Option<f64>,
     threads: Option<Threads>,
 ) -> PyResult<GridArrays<'py>> {
-    let (method, params) = method_of(method, beta, order)?;
-    let exact = exact_options(tolerance)?;
+    let method = spec_of(method, beta, order, tolerance)?;
     let mesh = mesh_from(V, F, "V", "F")?;
-    let spec = grid_spec(
+    let grid = grid_spec(
         &mesh,
         res,
         dims,
@@ -161,12 +166,11 @@ pub fn voxelize<'py>(
         margin,
         gwn::grid::EVALUATE_BYTES_PER_CELL,
     )?;
-    let wn = threads::run(py, threads, || evaluator_for(&mesh, method, params, exact))?
-        .map_err(value_error)?;
+    let wn = threads::run(py, threads, || evaluator_for(&mesh, &method))?.map_err(value_error)?;
     let values = threads::run_interruptible(py, threads, |stop| {
-        gwn::grid::evaluate_until(&wn, &spec, |_| {}, stop)
+        gwn::grid::evaluate_until(&wn, &grid, |_| {}, stop)
     })?;
-    grid_result(py, &spec, values)
+    grid_result(py, &grid, values)
 }
 
 /// Signed distance on a voxel grid: distance to the closest point of the triangles, negative
@@ -250,7 +254,7 @@ fn axis_index(axis: &str) -> PyResult<usize> {
 /// (and the mesh's cross-section in black when ``outline``). ``tolerance`` is the exact method's
 /// boundary tolerance (``gwn slice --tolerance``).
 #[pyfunction]
-#[pyo3(signature = (V, F, axis = "z", at = 0.5, *, at_coord = None, res = 1024, margin = 0.1, outline = false, method = "exact", beta = 2.0, order = 2, tolerance = 1e-10, threads = None))]
+#[pyo3(signature = (V, F, axis = "z", at = 0.5, *, at_coord = None, res = 1024, margin = 0.1, outline = false, method = "exact", beta = None, order = None, tolerance = None, threads = None))]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub fn slice<'py>(
     py: Python<'py>,
@@ -263,13 +267,12 @@ pub fn slice<'py>(
     margin: f64,
     outline: bool,
     method: &str,
-    beta: f64,
-    order: u8,
-    tolerance: f64,
+    beta: Option<f64>,
+    order: Option<u8>,
+    tolerance: Option<f64>,
     threads: Option<Threads>,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyBytes>)> {
-    let (method, params) = method_of(method, beta, order)?;
-    let exact = exact_options(tolerance)?;
+    let spec = spec_of(method, beta, order, tolerance)?;
     let axis = axis_index(axis)?;
     if res == 0 || res > MAX_SLICE_RES {
         return Err(PyValueError::new_err(format!(
@@ -301,15 +304,12 @@ pub fn slice<'py>(
     };
     let slice = Slice::new(&bbox.enlarged(margin), axis, coord, res);
     let (values, png) = threads::run(py, threads, || {
-        let wn = evaluator_for(
-            &mesh,
-            method,
-            params,
-            Options {
-                ray: slice.ray(),
-                ..exact
-            },
-        )?;
+        // A ray in the plane: one ray serves a whole image column or row (exact method).
+        let mut spec = spec;
+        if spec.method_for(InputKind::Mesh) == Method::Exact {
+            spec.ray = Some(slice.ray());
+        }
+        let wn = evaluator_for(&mesh, &spec)?;
         let values = slice.evaluate(&wn);
         let mut png = Vec::new();
         // Writing into a Vec cannot fail for I/O reasons; an encoder error is still reported.
@@ -331,7 +331,7 @@ pub fn slice<'py>(
 /// ``w > 0.5`` means inside B. ``tolerance`` is the exact method's boundary tolerance
 /// (``gwn classify --tolerance``).
 #[pyfunction]
-#[pyo3(signature = (VA, FA, VB, FB, *, method = "exact", beta = 2.0, order = 2, tolerance = 1e-10, threads = None))]
+#[pyo3(signature = (VA, FA, VB, FB, *, method = "exact", beta = None, order = None, tolerance = None, threads = None))]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub fn classify<'py>(
     py: Python<'py>,
@@ -340,17 +340,16 @@ pub fn classify<'py>(
     VB: &Bound<'py, PyAny>,
     FB: &Bound<'py, PyAny>,
     method: &str,
-    beta: f64,
-    order: u8,
-    tolerance: f64,
+    beta: Option<f64>,
+    order: Option<u8>,
+    tolerance: Option<f64>,
     threads: Option<Threads>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let (method, params) = method_of(method, beta, order)?;
-    let exact = exact_options(tolerance)?;
+    let spec = spec_of(method, beta, order, tolerance)?;
     let a = mesh_from(VA, FA, "VA", "FA")?;
     let b = mesh_from(VB, FB, "VB", "FB")?;
     let values = threads::run(py, threads, || {
-        evaluator_for(&b, method, params, exact).map(|wn| classify_faces(&a, &wn))
+        evaluator_for(&b, &spec).map(|wn| classify_faces(&a, &wn))
     })?
     .map_err(value_error)?;
     Ok(array1(py, values))
@@ -363,7 +362,7 @@ pub fn classify<'py>(
 /// (``tets[mask]`` keeps the inside tets). ``tolerance`` is the exact method's boundary
 /// tolerance (``gwn filter-tets --tolerance``).
 #[pyfunction]
-#[pyo3(signature = (V, F, points, tets, threshold = 0.5, *, method = "exact", beta = 2.0, order = 2, tolerance = 1e-10, threads = None))]
+#[pyo3(signature = (V, F, points, tets, threshold = 0.5, *, method = "exact", beta = None, order = None, tolerance = None, threads = None))]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub fn filter_tets<'py>(
     py: Python<'py>,
@@ -373,13 +372,12 @@ pub fn filter_tets<'py>(
     tets: &Bound<'py, PyAny>,
     threshold: f64,
     method: &str,
-    beta: f64,
-    order: u8,
-    tolerance: f64,
+    beta: Option<f64>,
+    order: Option<u8>,
+    tolerance: Option<f64>,
     threads: Option<Threads>,
 ) -> PyResult<Bound<'py, PyArray1<bool>>> {
-    let (method, params) = method_of(method, beta, order)?;
-    let exact = exact_options(tolerance)?;
+    let spec = spec_of(method, beta, order, tolerance)?;
     let mesh = mesh_from(V, F, "V", "F")?;
     if !threshold.is_finite() {
         return Err(PyValueError::new_err(format!(
@@ -399,7 +397,7 @@ pub fn filter_tets<'py>(
             )));
         }
         threads::run(py, threads, || {
-            evaluator_for(&mesh, method, params, exact).map(|wn| {
+            evaluator_for(&mesh, &spec).map(|wn| {
                 gwn::products::tets::filter_tets(tet_points, &tet_indices, &wn, threshold)
             })
         })?

@@ -3,10 +3,11 @@
 use std::sync::Arc;
 
 use gwn::Mesh;
-use gwn::eval::antipodal::Options;
-use gwn::eval::fast::{PointCloud, PointCloudWindingNumber};
+use gwn::eval::fast::PointCloudWindingNumber;
+use gwn::input::InputKind;
+use gwn::mesh::PointCloud;
+use gwn::spec::{EvaluatorSpec, Method};
 use numpy::PyArray1;
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
@@ -14,10 +15,7 @@ use crate::arrays::{
     array1, array2, indices_vec, one_or_many, points_vec, values_out, values_vec, with_points,
 };
 use crate::errors::{mesh_error, value_error};
-use crate::evaluator::{
-    Evaluator, Method, PY_DEFAULT_TOLERANCE, check_tolerance, fast_params, parse_precision,
-    parse_ray,
-};
+use crate::evaluator::{Evaluator, SpecArgs};
 use crate::threads::{self, Threads};
 
 /// `WindingNumber.parts`' result: crossing counts and fractional parts.
@@ -42,17 +40,18 @@ enum Source {
 
 /// Winding-number evaluator of one mesh or oriented point cloud, built once.
 ///
-/// ``WindingNumber(V, F, method="exact", beta=2.0, order=2, precision=60, ray="+z",
-/// tolerance=1e-10)``
+/// ``WindingNumber(V, F, method="exact", beta=None, order=None, precision=None, ray=None,
+/// tolerance=None)`` (``None``: the default)
 ///
 /// ``method``: ``"exact"`` (Antipodal method, the default), ``"direct"`` (solid-angle sum over
-/// all triangles) or ``"fast"`` (Barnes-Hut with accuracy ``beta`` and expansion ``order``).
-/// ``precision`` (30 or 60 bits), ``ray`` (``"+z"``, ``"-x"``, ...) and ``tolerance`` are
-/// options of the exact method. ``tolerance`` (finite, ``>= 0``) is the absolute tolerance on
-/// ``w`` for the far boundary: far boundary clusters are replaced by a multipole expansion with a
-/// certified error bound (:meth:`WindingNumber.eval_with_bound`); the integer part is always
-/// exact, ``0`` is the flat exact loop. Oriented point clouds:
-/// :meth:`WindingNumber.from_point_cloud`.
+/// all triangles) or ``"fast"`` (Barnes-Hut with accuracy ``beta``, default 2, and expansion
+/// ``order``, default 2). ``precision`` (30 or 60 bits, default 60), ``ray`` (``"+z"``,
+/// ``"-x"``, ..., default ``"+z"``) and ``tolerance`` (default 1e-10) are options of the exact
+/// method; an option the method does not use is a ``ValueError`` (the rules and messages of the
+/// ``gwn`` command line). ``tolerance`` (finite, ``>= 0``) is the absolute tolerance on ``w`` for
+/// the far boundary: far boundary clusters are replaced by a multipole expansion with a certified
+/// error bound (:meth:`WindingNumber.eval_with_bound`); the integer part is always exact, ``0``
+/// is the flat exact loop. Oriented point clouds: :meth:`WindingNumber.from_point_cloud`.
 ///
 /// Calls release the GIL; one object can be queried from several Python threads at once.
 /// Objects pickle by their arrays and are rebuilt on unpickling.
@@ -61,55 +60,60 @@ pub struct PyWindingNumber {
     evaluator: Evaluator,
     source: Source,
     method: Method,
-    beta: f64,
-    order: u8,
-    precision: u32,
-    ray: String,
-    /// The exact method's boundary tolerance as given (validated for every method).
-    tolerance: f64,
-}
-
-fn build_err(e: String) -> PyErr {
-    PyValueError::new_err(e)
+    /// The options it was built with (rebuilt from these on unpickling).
+    spec: EvaluatorSpec,
 }
 
 impl PyWindingNumber {
     /// Builds the evaluator of a mesh given as arrays.
-    #[allow(clippy::too_many_arguments)]
     fn from_mesh_arrays(
         py: Python<'_>,
         v: &Bound<'_, PyAny>,
         f: &Bound<'_, PyAny>,
-        method: &str,
-        beta: f64,
-        order: u8,
-        precision: u32,
-        ray: &str,
-        tolerance: f64,
+        args: SpecArgs<'_>,
     ) -> PyResult<Self> {
-        let method = Method::parse(method).map_err(build_err)?;
-        let options = Options {
-            precision: parse_precision(precision).map_err(build_err)?,
-            ray: parse_ray(ray).map_err(build_err)?,
-            tolerance: check_tolerance(tolerance).map_err(build_err)?,
-            ..Default::default()
-        };
-        let params = fast_params(beta, order).map_err(build_err)?;
+        let spec = args.spec().map_err(value_error)?;
         let mesh =
             Arc::new(Mesh::new(points_vec(v, "V")?, indices_vec(f, "F")?).map_err(mesh_error)?);
         let evaluator = py
-            .allow_threads(|| Evaluator::for_mesh(&mesh, method, options, params))
-            .map_err(build_err)?;
+            .allow_threads(|| Evaluator::for_mesh(&mesh, &spec))
+            .map_err(value_error)?;
         Ok(PyWindingNumber {
             evaluator,
             source: Source::Mesh(mesh),
-            method,
-            beta,
-            order,
-            precision,
-            ray: ray.to_string(),
-            tolerance,
+            method: spec.method_for(InputKind::Mesh),
+            spec,
         })
+    }
+
+    /// The options to rebuild this evaluator with, as `WindingNumber(V, F, ...)` takes them
+    /// after the arrays: the method and, resolved to their values, the options it uses (`None`
+    /// for the others).
+    #[allow(clippy::type_complexity)]
+    fn rebuild_options(
+        &self,
+    ) -> (
+        &'static str,
+        Option<f64>,
+        Option<u8>,
+        Option<u32>,
+        Option<String>,
+        Option<f64>,
+    ) {
+        let exact = self.spec.exact_options();
+        let fast = self.spec.fast_params();
+        match self.method {
+            Method::Exact => (
+                "exact",
+                None,
+                None,
+                Some(exact.precision.bits()),
+                Some(exact.ray.to_string()),
+                Some(exact.tolerance),
+            ),
+            Method::Direct => ("direct", None, None, None, None, None),
+            Method::Fast => ("fast", Some(fast.beta), Some(fast.order), None, None, None),
+        }
     }
 
     /// The exact evaluator and mesh, for products that need both.
@@ -121,20 +125,28 @@ impl PyWindingNumber {
 #[pymethods]
 impl PyWindingNumber {
     #[new]
-    #[pyo3(signature = (V, F, method = "exact", beta = 2.0, order = 2, precision = 60, ray = "+z", tolerance = 1e-10))]
+    #[pyo3(signature = (V, F, method = "exact", beta = None, order = None, precision = None, ray = None, tolerance = None))]
     #[allow(non_snake_case, clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
         V: &Bound<'_, PyAny>,
         F: &Bound<'_, PyAny>,
         method: &str,
-        beta: f64,
-        order: u8,
-        precision: u32,
-        ray: &str,
-        tolerance: f64,
+        beta: Option<f64>,
+        order: Option<u8>,
+        precision: Option<u32>,
+        ray: Option<&str>,
+        tolerance: Option<f64>,
     ) -> PyResult<Self> {
-        Self::from_mesh_arrays(py, V, F, method, beta, order, precision, ray, tolerance)
+        let args = SpecArgs {
+            method: Some(method),
+            beta,
+            order,
+            precision,
+            ray,
+            tolerance,
+        };
+        Self::from_mesh_arrays(py, V, F, args)
     }
 
     /// Barnes-Hut evaluator of an oriented point cloud: positions ``P`` (n, 3), normals ``N``
@@ -151,7 +163,13 @@ impl PyWindingNumber {
         beta: f64,
         order: u8,
     ) -> PyResult<Self> {
-        let params = fast_params(beta, order).map_err(build_err)?;
+        let spec = EvaluatorSpec {
+            beta: Some(beta),
+            order: Some(order),
+            ..Default::default()
+        };
+        spec.check(InputKind::Cloud).map_err(value_error)?;
+        let params = spec.fast_params();
         let positions = points_vec::<3>(P, "P")?;
         let normals = points_vec::<3>(N, "N")?;
         let areas = A.map(|a| values_vec(a, "A", positions.len())).transpose()?;
@@ -168,11 +186,7 @@ impl PyWindingNumber {
                 areas,
             },
             method: Method::Fast,
-            beta,
-            order,
-            precision: 60,
-            ray: "+z".to_string(),
-            tolerance: PY_DEFAULT_TOLERANCE,
+            spec,
         })
     }
 
@@ -294,7 +308,7 @@ impl PyWindingNumber {
     /// The exact method's boundary tolerance (``None`` for the other methods).
     #[getter]
     fn tolerance(&self) -> Option<f64> {
-        (self.method == Method::Exact).then_some(self.tolerance)
+        (self.method == Method::Exact).then_some(self.spec.exact_options().tolerance)
     }
 
     /// Number of boundary edges of the exact method's signed boundary (``None`` for the other
@@ -328,15 +342,16 @@ impl PyWindingNumber {
         match &self.source {
             Source::Mesh(m) => {
                 let cls = py.get_type::<PyWindingNumber>().into_any();
+                let (method, beta, order, precision, ray, tolerance) = self.rebuild_options();
                 let args = (
                     array2(py, m.positions().to_vec())?,
                     array2(py, m.triangles().to_vec())?,
-                    self.method.name(),
-                    self.beta,
-                    self.order,
-                    self.precision,
-                    self.ray.as_str(),
-                    self.tolerance,
+                    method,
+                    beta,
+                    order,
+                    precision,
+                    ray,
+                    tolerance,
                 )
                     .into_pyobject(py)?;
                 Ok((cls, args))
@@ -353,8 +368,8 @@ impl PyWindingNumber {
                     array2(py, positions.clone())?,
                     array2(py, normals.clone())?,
                     array1(py, areas.clone()),
-                    self.beta,
-                    self.order,
+                    self.spec.fast_params().beta,
+                    self.spec.fast_params().order,
                 )
                     .into_pyobject(py)?;
                 Ok((rebuild, args))

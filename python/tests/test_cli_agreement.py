@@ -171,3 +171,30 @@ def test_products_reject_bad_methods(lion):
         gwn.voxelize(v, f, 4, method="approximate")
     with pytest.raises(ValueError, match="beta"):
         gwn.classify(v, f, v, f, method="fast", beta=float("nan"))
+
+
+@pytest.mark.parametrize(
+    "cli_args, kwargs",
+    [
+        (["--method", "exact", "--beta", "2"], {"method": "exact", "beta": 2.0}),
+        (["--method", "direct", "--ray", "-x"], {"method": "direct", "ray": "-x"}),
+        (["--method", "fast", "--tolerance", "1e-3"], {"method": "fast", "tolerance": 1e-3}),
+        (["--method", "fast", "--precision", "30"], {"method": "fast", "precision": 30}),
+        (["--tolerance", "nan"], {"tolerance": float("nan")}),
+        (["--tolerance", "-1"], {"tolerance": -1.0}),
+        (["--method", "fast", "--beta", "-2"], {"method": "fast", "beta": -2.0}),
+        (["--method", "fast", "--order", "3"], {"method": "fast", "order": 3}),
+    ],
+)
+def test_same_error_for_the_same_bad_option(cli, tmp_path, cli_args, kwargs):
+    """The library's rules and messages (gwn::spec::EvaluatorSpec), from both front ends."""
+    np.save(tmp_path / "q.npy", np.zeros((1, 3)))
+    done = subprocess.run(
+        [str(cli), "eval", str(LION_HEAD), "--points", str(tmp_path / "q.npy"), *cli_args],
+        capture_output=True, text=True,
+    )
+    assert done.returncode != 0
+    cli_message = done.stderr.strip().removeprefix("gwn: ")
+    with pytest.raises(ValueError) as info:
+        gwn.WindingNumber(*gwn.load(LION_HEAD), **kwargs)
+    assert str(info.value) == cli_message

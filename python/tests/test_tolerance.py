@@ -164,8 +164,6 @@ def test_eval_with_bound_checks_queries():
 BAD_TOLERANCES = [-1.0, float("nan"), float("inf"), -float("inf")]
 CALLS = {
     "WindingNumber": lambda t: gwn.WindingNumber(CUBE_V, OPEN_BOX_F, tolerance=t),
-    "WindingNumber(direct)": lambda t: gwn.WindingNumber(CUBE_V, OPEN_BOX_F, method="direct",
-                                                         tolerance=t),
     "winding_number": lambda t: gwn.winding_number(CUBE_V, OPEN_BOX_F, [[0.5] * 3], tolerance=t),
     "voxelize": lambda t: gwn.voxelize(CUBE_V, OPEN_BOX_F, 4, tolerance=t),
     "sdf": lambda t: gwn.sdf(CUBE_V, OPEN_BOX_F, 4, tolerance=t),
@@ -184,6 +182,16 @@ def test_bad_tolerance(call, tolerance):
     with pytest.raises(ValueError, match="tolerance must be a finite number >= 0") as info:
         call(tolerance)
     assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("method", ["direct", "fast"])
+def test_tolerance_is_an_exact_option(method):
+    """The library's rule (and the CLI's): an option the method does not use is an error."""
+    with pytest.raises(ValueError, match=f"tolerance does not apply to the {method} method"):
+        gwn.WindingNumber(CUBE_V, OPEN_BOX_F, method=method, tolerance=1e-6)
+    # A bad value is reported as such first, whatever the method.
+    with pytest.raises(ValueError, match="tolerance must be a finite number >= 0"):
+        gwn.WindingNumber(CUBE_V, OPEN_BOX_F, method=method, tolerance=float("nan"))
 
 
 @pytest.mark.parametrize("call", CALLS.values(), ids=CALLS.keys())

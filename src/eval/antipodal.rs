@@ -16,12 +16,13 @@ use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 
-use crate::Mesh;
 pub use crate::kernel::exact_index::Snapping;
 use crate::kernel::exact_index::{ExactIndex, IndexedEdge, QuantizedVertices, w_of_parts};
 use crate::kernel::frame::RayAxis;
 use crate::kernel::predicates::{W64, W128, Width};
-use crate::kernel::quantize::{Grid, GridRangeError, Precision};
+use crate::kernel::quantize::{GridRangeError, Precision};
+use crate::kernel::spherical::INV_4PI;
+use crate::mesh::Mesh;
 use crate::mesh::{boundary_edges, boundary_welded_by};
 
 /// Options of the exact evaluator.
@@ -78,6 +79,8 @@ pub enum BoundaryBy {
 pub enum BuildError {
     /// The mesh's coordinates span more than `f64` can grid.
     CoordinateRange,
+    /// [`Options::tolerance`] is NaN, infinite or negative (the value as written).
+    Tolerance(String),
 }
 
 impl std::fmt::Display for BuildError {
@@ -88,6 +91,9 @@ impl std::fmt::Display for BuildError {
                     f,
                     "mesh coordinates are too large to quantize (extent overflows f64)"
                 )
+            }
+            BuildError::Tolerance(t) => {
+                write!(f, "tolerance must be a finite number >= 0, got {t}")
             }
         }
     }
@@ -136,7 +142,11 @@ impl WindingNumber {
     }
 
     /// Builds the evaluator: quantizes the mesh, extracts the signed boundary, builds the BVH.
+    /// A NaN, infinite or negative [`Options::tolerance`] is an error.
     pub fn with_options(mesh: &Mesh, options: Options) -> Result<Self, BuildError> {
+        if !(options.tolerance.is_finite() && options.tolerance >= 0.0) {
+            return Err(BuildError::Tolerance(options.tolerance.to_string()));
+        }
         let start = Instant::now();
         let core = match options.precision {
             Precision::Bits30 => Dispatch::Narrow(exact_index(mesh, options)?),
@@ -232,7 +242,7 @@ impl WindingNumber {
     /// The two parts of the formula: the signed crossing count χ and the boundary sum
     /// `Σ k·Area` (not yet divided by 4π). `(0, NaN)` for a non-finite query. For a query more
     /// than `2^30` box sizes away, the parts of the point pulled in to that distance
-    /// ([`crate::kernel::quantize::Grid::pull_in_far`]; same `w` to `2^-60`).
+    /// (the kernel's `Grid::pull_in_far`; same `w` to `2^-60`).
     pub fn parts(&self, q: [f64; 3]) -> (i64, f64) {
         if q.iter().any(|c| !c.is_finite()) {
             return (0, f64::NAN);
@@ -241,6 +251,26 @@ impl WindingNumber {
             Dispatch::Narrow(c) => c.parts(q),
             Dispatch::Wide(c) => c.parts(q),
         }
+    }
+
+    /// The value split into its integer and fractional parts: `(χ, w − χ)`, with the crossing
+    /// count χ of [`WindingNumber::parts`] and the boundary term `Σ k·Area / 4π`, so that
+    /// `χ as f64 + fraction` is [`WindingNumber::eval`] to the bit. `(0, NaN)` for a non-finite
+    /// query.
+    ///
+    /// ```
+    /// use gwn::{Mesh, eval::antipodal::WindingNumber};
+    /// let p = [[0.,0.,0.],[1.,0.,0.],[1.,1.,0.],[0.,1.,0.],[0.,0.,1.],[1.,0.,1.],[1.,1.,1.],[0.,1.,1.]];
+    /// let t = [[0,2,1],[0,3,2],[0,1,5],[0,5,4],[1,2,6],[1,6,5],[2,3,7],[2,7,6],[3,0,4],[3,4,7]];
+    /// let w = WindingNumber::new(&Mesh::from_slices(&p, &t)?)?;
+    /// let (chi, fraction) = w.integer_and_fraction([0.5, 0.5, 0.5]);
+    /// assert_eq!(chi as f64 + fraction, w.eval([0.5, 0.5, 0.5]));
+    /// assert!((fraction - (5.0 / 6.0 - chi as f64)).abs() < 1e-14);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn integer_and_fraction(&self, q: [f64; 3]) -> (i64, f64) {
+        let (chi, area) = self.parts(q);
+        (chi, area * INV_4PI)
     }
 
     /// Winding numbers along one line parallel to the ray: at the points `q` with the world
@@ -257,7 +287,7 @@ impl WindingNumber {
 
     /// Gradient `∇w(q)`: the integer part is locally constant, so only the boundary contributes:
     /// the Biot–Savart sum over the signed boundary edges
-    /// ([`crate::kernel::spherical::segment_gradient`]; better conditioned than the antipodal
+    /// (the kernel's `segment_gradient`; better conditioned than the antipodal
     /// paper's Supp. Alg. 3, see there). Not finite on the boundary curve; NaN for a non-finite
     /// query.
     pub fn gradient(&self, q: [f64; 3]) -> [f64; 3] {
@@ -298,14 +328,6 @@ impl WindingNumber {
         match &self.core {
             Dispatch::Narrow(c) => c.snapping(),
             Dispatch::Wide(c) => c.snapping(),
-        }
-    }
-
-    /// The quantization grid (world coordinates).
-    pub fn grid(&self) -> &Grid {
-        match &self.core {
-            Dispatch::Narrow(c) => c.grid(),
-            Dispatch::Wide(c) => c.grid(),
         }
     }
 }

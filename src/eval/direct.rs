@@ -14,9 +14,9 @@
 use crate::base::vec3::sub;
 use rayon::prelude::*;
 
-use crate::Mesh;
-use crate::kernel::compensated::NeumaierSum;
+use crate::base::compensated::NeumaierSum;
 use crate::kernel::spherical::{segment_gradient, triangle_solid_angle_at};
+use crate::mesh::Mesh;
 
 use crate::kernel::spherical::INV_4PI;
 

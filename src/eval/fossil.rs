@@ -4,9 +4,9 @@
 
 use std::sync::OnceLock;
 
-use crate::Mesh;
 use crate::eval::antipodal::WindingNumber;
 use crate::eval::fast::{FastParams, FastWindingNumber};
+use crate::mesh::Mesh;
 
 /// A mesh prepared for FOSSIL-style queries: `winding_number(point, beta)` evaluates with the
 /// Barnes–Hut approximation when `beta > 0` and exactly when `beta <= 0` (or NaN).

@@ -12,3 +12,10 @@ pub mod fast;
 pub mod fossil;
 
 pub use evaluator::{Evaluator, NoGradient};
+
+/// How many times, since the process started, an input predicate of the exact evaluator could
+/// not be decided by its `f64` filter and ran in exact big-integer arithmetic (`gwn bench`
+/// reports it per mesh).
+pub fn exact_fallbacks() -> u64 {
+    crate::kernel::input_predicates::exact_fallbacks()
+}

@@ -74,6 +74,14 @@ fn parse_cloud(
         CloudFormat::Text => parse_text(bytes).map(|c| (c, Vec::new())),
         CloudFormat::Ply => parse_ply(bytes),
     };
+    finish_cloud(parsed, name)
+}
+
+/// The cloud of what a reader returned (an empty one is an error).
+fn finish_cloud(
+    parsed: Result<(Columns, Vec<LoadWarning>), Fail>,
+    name: &Path,
+) -> Result<(PointCloud, Vec<LoadWarning>), LoadError> {
     let ((positions, normals, areas), warnings) =
         parsed.map_err(|(location, kind)| LoadError::new(name, location, kind))?;
     if positions.is_empty() {
@@ -154,8 +162,10 @@ fn parse_text(bytes: &[u8]) -> Result<Columns, Fail> {
     Ok((positions, normals, areas))
 }
 
+/// The vertex properties of a point-cloud PLY, in the order [`ply_columns`] reads them.
+const NAMES: [&str; 7] = ["x", "y", "z", "nx", "ny", "nz", "area"];
+
 fn parse_ply(bytes: &[u8]) -> Result<(Columns, Vec<LoadWarning>), Fail> {
-    const NAMES: [&str; 7] = ["x", "y", "z", "nx", "ny", "nz", "area"];
     let data = super::ply::read(
         bytes,
         &super::ply::Request {
@@ -163,6 +173,44 @@ fn parse_ply(bytes: &[u8]) -> Result<(Columns, Vec<LoadWarning>), Fail> {
             faces: false,
         },
     )?;
+    ply_columns(data)
+}
+
+/// What [`super::load_mesh_or_cloud`] reads from a PLY: positions (required), normals and areas
+/// (optional: a mesh needs none), and the faces.
+pub(super) const PLY_MESH_OR_CLOUD: super::ply::Request<'static> = super::ply::Request {
+    vertex: &[
+        ("x", true),
+        ("y", true),
+        ("z", true),
+        ("nx", false),
+        ("ny", false),
+        ("nz", false),
+        ("area", false),
+    ],
+    faces: true,
+};
+
+/// The point cloud of a PLY read with [`PLY_MESH_OR_CLOUD`] that turned out to have no faces.
+pub(super) fn cloud_from_ply(
+    data: super::ply::PlyData,
+    name: &Path,
+) -> Result<(PointCloud, Vec<LoadWarning>), LoadError> {
+    if let Some(k) = (3..6).find(|&k| data.columns[k].is_none()) {
+        return Err(LoadError::new(
+            name,
+            Location::File,
+            LoadErrorKind::Syntax(format!(
+                "PLY `vertex` element has no scalar property `{}`",
+                NAMES[k]
+            )),
+        ));
+    }
+    finish_cloud(ply_columns(data), name)
+}
+
+/// Checks the columns `x y z nx ny nz [area]` of a PLY read and makes them points and normals.
+fn ply_columns(data: super::ply::PlyData) -> Result<(Columns, Vec<LoadWarning>), Fail> {
     let mut columns = data.columns.into_iter();
     let mut next = || columns.next().flatten().unwrap_or_default();
     let [x, y, z, nx, ny, nz]: [Vec<f64>; 6] = std::array::from_fn(|_| next());

@@ -30,8 +30,8 @@ pub mod tets;
 use std::fmt;
 use std::path::Path;
 
-use crate::Mesh;
 use crate::error::{LoadError, LoadErrorKind, LoadWarning, Location, MeshError};
+use crate::mesh::Mesh;
 
 pub use detect::{format_from_content, format_from_extension};
 pub use points::{load_points, load_points_from_bytes};
@@ -172,6 +172,51 @@ pub fn load_mesh_with(
     )
 }
 
+/// What a mesh-or-cloud file holds ([`crate::input::load_input`]).
+#[derive(Debug)]
+pub(crate) enum MeshOrCloud {
+    /// A triangle mesh.
+    Mesh(LoadedMesh),
+    /// An oriented point cloud and the reader's warnings.
+    Cloud(crate::mesh::PointCloud, Vec<LoadWarning>),
+}
+
+/// Reads a mesh or an oriented point cloud, parsing the file once: text point formats
+/// (by extension) are clouds; a PLY (by extension, or by content without one) is a mesh when it
+/// has faces and a cloud otherwise; anything else is a mesh.
+pub(crate) fn load_mesh_or_cloud(
+    path: &Path,
+    options: &LoadOptions,
+) -> Result<MeshOrCloud, LoadError> {
+    use cloud::CloudFormat;
+    if cloud::cloud_format_from_extension(path) == Some(CloudFormat::Text) {
+        let (cloud, warnings) = cloud::load_point_cloud_with_warnings(path)?;
+        return Ok(MeshOrCloud::Cloud(cloud, warnings));
+    }
+    let bytes = read_input(path)?;
+    let format = format_from_extension(path);
+    let blank = bytes.iter().all(u8::is_ascii_whitespace);
+    if !blank && format.or_else(|| format_from_content(&bytes)) == Some(Format::Ply) {
+        let err = |(location, kind): Fail| LoadError::new(path, location, kind);
+        let data = ply::read(&bytes, &cloud::PLY_MESH_OR_CLOUD).map_err(err)?;
+        if data.triangles.is_empty() {
+            let (cloud, warnings) = cloud::cloud_from_ply(data, path)?;
+            return Ok(MeshOrCloud::Cloud(cloud, warnings));
+        }
+        let column = |k: usize| data.columns[k].as_deref().unwrap_or(&[]);
+        let (x, y, z) = (column(0), column(1), column(2));
+        let raw = RawMesh {
+            positions: (0..x.len()).map(|i| [x[i], y[i], z[i]]).collect(),
+            triangles: data.triangles,
+            polygons: data.polygons,
+            warnings: data.warnings,
+        };
+        return finish_mesh(raw, Format::Ply, path, options).map(MeshOrCloud::Mesh);
+    }
+    let base_dir = path.parent().unwrap_or(Path::new("."));
+    load_mesh_from_bytes_in(&bytes, path, format, options, Some(base_dir)).map(MeshOrCloud::Mesh)
+}
+
 /// The most bytes read from a file that is not a regular file (a pipe, a device): such a file has
 /// no size to check first, and some never end (`/dev/zero`). Regular files are read whole.
 pub const MAX_STREAM_BYTES: u64 = 1 << 28;
@@ -309,6 +354,17 @@ fn load_mesh_from_bytes_in(
         Format::Gltf => gltf_scene::parse(bytes, base_dir),
     }
     .map_err(err)?;
+    finish_mesh(raw, format, name, options)
+}
+
+/// Validates and (as `options` say) welds what a reader returned.
+fn finish_mesh(
+    raw: RawMesh,
+    format: Format,
+    name: &Path,
+    options: &LoadOptions,
+) -> Result<LoadedMesh, LoadError> {
+    let err = |(location, kind): Fail| LoadError::new(name, location, kind);
     if raw.triangles.is_empty() {
         return Err(err((Location::File, LoadErrorKind::Empty)));
     }

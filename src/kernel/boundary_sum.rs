@@ -19,7 +19,6 @@ use wide::f64x4;
 use super::angle_sum::AngleSum;
 #[cfg(target_arch = "x86_64")]
 use super::angle_sum::AngleSumAvx2;
-use super::compensated::NeumaierSum;
 use super::double_double::DoubleDouble;
 use super::input_predicates::{InputPoint, LatticeFrame, input_inside_segment, input_orient2d};
 #[cfg(target_arch = "x86_64")]
@@ -30,6 +29,7 @@ use super::predicates::{
     perturbed_orient2d, perturbed_orient2d_at, query_inside_segment, query_inside_segment_at,
 };
 use super::spherical::{EdgeSigns, antipodal_edge_area, antipodal_edge_area_accurate};
+use crate::base::compensated::NeumaierSum;
 use crate::bvh::RayBvh;
 
 /// Four consecutive values from `v[j]`.
@@ -155,7 +155,8 @@ const MAX_CHAINED_WEIGHT: f64 = 4.0;
 
 impl BoundaryEdges {
     /// Packs edges `a[i] → b[i]` with positive integer weights `weight[i]` (grid coordinates, ray
-    /// frame).
+    /// frame). The evaluator builds with [`BoundaryEdges::with_inputs`]; the unit tests use this.
+    #[cfg(test)]
     pub fn new(a: Vec<[i64; 3]>, b: Vec<[i64; 3]>, weight: Vec<f64>, bits: u32) -> Self {
         Self::build(a, b, weight, bits, None, LatticeFrame::default())
     }
@@ -282,13 +283,6 @@ impl BoundaryEdges {
             inputs,
             lattice,
         }
-    }
-
-    /// How many edges have an endpoint off the lattice.
-    pub fn off_lattice_edges(&self) -> usize {
-        self.inputs
-            .as_ref()
-            .map_or(0, |x| x.off_lattice.iter().filter(|&&o| o).count())
     }
 
     /// Number of edges.

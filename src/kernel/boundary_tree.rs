@@ -96,7 +96,6 @@ pub struct BoundaryTree {
     nodes: Vec<Node>,
     expansions: Vec<Expansion>,
     ends: Vec<([i64; 3], i32)>,
-    tolerance: f64,
 }
 
 /// Moments of the nodes while building (in node order): values and magnitudes; and the leaves'.
@@ -183,7 +182,6 @@ impl BoundaryTree {
             nodes: Vec::new(),
             expansions: Vec::new(),
             ends: Vec::new(),
-            tolerance,
         };
         // The tolerance is on w = Σ/(4π): the area budget is 4π times it.
         let per_edge = FOUR_PI * tolerance / total as f64;
@@ -221,16 +219,6 @@ impl BoundaryTree {
             tree.nodes[i].subtree_reach = own.min(below);
         }
         (tree.nodes[0].subtree_reach.is_finite()).then_some(tree)
-    }
-
-    /// The tolerance it was built for.
-    pub fn tolerance(&self) -> f64 {
-        self.tolerance
-    }
-
-    /// Number of nodes.
-    pub fn node_count(&self) -> usize {
-        self.nodes.len()
     }
 
     /// Whether a query at `q` (normalized coordinates) can expand any node: otherwise the flat

@@ -184,7 +184,7 @@ impl Grid {
     /// [`Grid::snap`] treat as "far along that axis"; an underflow only happens to coordinates
     /// far below one cell, which snap to the same integer either way).
     #[inline]
-    pub fn to_grid_space(&self, p: [f64; 3]) -> [f64; 3] {
+    pub fn in_grid_space(&self, p: [f64; 3]) -> [f64; 3] {
         self.rescale.apply(p)
     }
 
@@ -210,7 +210,7 @@ impl Grid {
     /// ties away from the origin, whatever the magnitudes of `x` and the origin. So a query moves
     /// by at most half a cell, and a query that lies on the lattice (integer and dyadic meshes'
     /// vertices, edges and faces, at any distance from the origin) does not move at all.
-    #[inline]
+    #[cfg(test)]
     pub fn snap(&self, x: f64, axis: usize) -> Snap {
         self.snap_with_residual(x, axis).0
     }
@@ -301,9 +301,10 @@ impl Grid {
     }
 
     /// Snaps a mesh vertex given in world coordinates (always inside the padded box by
-    /// construction).
+    /// construction). The evaluator snaps with residuals ([`Grid::input_vertex`]); tests use this.
+    #[cfg(test)]
     pub fn snap_vertex(&self, p: [f64; 3]) -> [i64; 3] {
-        let p = self.to_grid_space(p);
+        let p = self.in_grid_space(p);
         std::array::from_fn(|k| match self.snap(p[k], k) {
             Snap::In(v) => v,
             Snap::Low => -self.limit,
@@ -311,7 +312,7 @@ impl Grid {
         })
     }
 
-    /// Whether the grid-space coordinate `g = to_grid_space(x)` holds the world coordinate `x`
+    /// Whether the grid-space coordinate `g = in_grid_space(x)` holds the world coordinate `x`
     /// exactly. The power-of-two scaling is exact unless it shrinks a tiny coordinate of a huge
     /// mesh into the subnormal range (or to zero); then the residual of `g` is not the input's,
     /// and the exact predicates rebuild it from `x` ([`crate::kernel::input_predicates`]).
@@ -355,7 +356,7 @@ impl Grid {
 
     /// A mesh vertex (world) in the ray frame exactly: lattice point, residual, world bits.
     pub fn input_vertex(&self, p: [f64; 3], map: [(usize, bool); 3]) -> InputPoint {
-        let g = self.to_grid_space(p);
+        let g = self.in_grid_space(p);
         let one = |(axis, neg): (usize, bool)| {
             let (s, r, exact) = if self.kept_exactly(p[axis], g[axis]) {
                 let (s, r) = self.snap_with_residual(g[axis], axis);
@@ -391,6 +392,7 @@ impl Grid {
 
     /// The grid-space position of integer coordinate `v` along `axis`.
     #[inline]
+    #[cfg(test)]
     pub fn unsnap(&self, v: i64, axis: usize) -> f64 {
         v as f64 * self.cell + self.origin[axis]
     }
@@ -552,7 +554,7 @@ mod tests {
         };
         for p in [Precision::Bits30, Precision::Bits60] {
             let g = Grid::new(&b, p).unwrap();
-            let grid_x = |x: f64| g.to_grid_space([x; 3])[0];
+            let grid_x = |x: f64| g.in_grid_space([x; 3])[0];
             for x in [-4.0, -1.0, 0.0, 0.5, 3.0, 4.0] {
                 let (Snap::In(v), r) = g.snap_with_residual(grid_x(x), 0) else {
                     panic!()

@@ -17,9 +17,8 @@ pub use signed_boundary::{
 };
 pub use tet_mesh::TetMesh;
 
+use crate::base::bounding_box::BoundingBox;
 use crate::error::MeshError;
-
-pub use crate::base::bounding_box::BoundingBox;
 
 /// An indexed triangle mesh (possibly open, non-manifold, self-intersecting, a soup).
 ///

@@ -11,7 +11,8 @@
 //! - a *degenerate* face has a repeated index or an exactly zero `f64` cross product;
 //! - *duplicate* faces are the extra copies of a vertex triple, in either orientation.
 
-use super::{BoundingBox, Mesh, boundary_edges};
+use super::{Mesh, boundary_edges};
+use crate::base::bounding_box::BoundingBox;
 
 /// Statistics of a mesh; see the module documentation for the definitions.
 #[derive(Clone, Debug, PartialEq)]

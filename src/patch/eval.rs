@@ -19,7 +19,7 @@
 //! never formed as an integer, so it cannot disagree with the integral. See `docs/patches.md` for
 //! the argument and the error model.
 
-use std::f64::consts::PI;
+use crate::kernel::spherical::FOUR_PI;
 
 use rayon::prelude::*;
 
@@ -30,7 +30,7 @@ use super::curve::{
 };
 use super::model::{Patch, PatchSet};
 use super::quadrature::{Budget, GK_EVALUATIONS, integrate};
-use crate::kernel::compensated::NeumaierSum;
+use crate::base::compensated::NeumaierSum;
 use crate::kernel::frame::RayAxis;
 
 /// Separation margin `μ`: a plane certifies a net only if every control point makes an angle of
@@ -361,7 +361,7 @@ impl Accumulator {
     /// returns the evaluation.
     fn finish(mut self, tolerance: f64) -> Evaluation {
         let tasks = std::mem::take(&mut self.tasks);
-        let tol = tolerance * 4.0 * PI / tasks.len().max(1) as f64;
+        let tol = tolerance * FOUR_PI / tasks.len().max(1) as f64;
         let mut budget = Budget {
             remaining: MAX_EVALUATIONS,
         };
@@ -369,8 +369,8 @@ impl Accumulator {
             self.integrate_curve(ctrl, form, tol, &mut budget);
         }
         let mut out = self.out;
-        out.value = self.sum.value() / (4.0 * PI);
-        out.error_estimate = out.error_estimate / (4.0 * PI) + self.holes_error;
+        out.value = self.sum.value() / FOUR_PI;
+        out.error_estimate = out.error_estimate / FOUR_PI + self.holes_error;
         out.certified =
             out.uncertified_pieces == 0 && !out.capped && out.error_estimate <= tolerance;
         out

@@ -1,7 +1,7 @@
 //! Adaptive Gauss–Kronrod (7/15 points) on an interval, with an error estimate (the paper's
 //! `AdaptiveGaussKronrod15`, Alg. 2).
 
-use crate::kernel::compensated::NeumaierSum;
+use crate::base::compensated::NeumaierSum;
 
 /// Kronrod nodes on `[-1, 1]` (non-negative half; the rule is symmetric), QUADPACK `qk15`.
 const XGK: [f64; 8] = [

@@ -3,11 +3,11 @@
 //! boundary method is compared with (the paper's "surface AQ"); it needs no boundary, no ray and
 //! no classification, but `225` surface evaluations per rectangle.
 
-use std::f64::consts::PI;
+use crate::kernel::spherical::FOUR_PI;
 
 use super::model::{Patch, PatchSet};
 use super::quadrature::{XG_INDEX, gauss_kronrod_nodes};
-use crate::kernel::compensated::NeumaierSum;
+use crate::base::compensated::NeumaierSum;
 
 /// Rectangle subdivision depth limit (a `2^-24` rectangle is far below any useful tolerance).
 const MAX_DEPTH: u32 = 24;
@@ -17,11 +17,11 @@ pub fn winding_number_surface_quadrature(set: &PatchSet, q: [f64; 3], tol: f64) 
     let mut sum = NeumaierSum::new();
     let mut err = 0.0;
     for p in set.patches() {
-        let (v, e) = patch_integral(p, q, tol * 4.0 * PI);
+        let (v, e) = patch_integral(p, q, tol * FOUR_PI);
         sum.add(v);
         err += e;
     }
-    (sum.value() / (4.0 * PI), err / (4.0 * PI))
+    (sum.value() / FOUR_PI, err / FOUR_PI)
 }
 
 fn density(p: &Patch, q: [f64; 3], s: f64, t: f64) -> f64 {
@@ -89,4 +89,31 @@ pub fn winding_number_surface_quadrature_batch(
         .par_iter()
         .map(|&q| winding_number_surface_quadrature(set, q, tol).0)
         .collect()
+}
+
+/// The surface integral as an [`Evaluator`](crate::eval::Evaluator) (the direct method on patch
+/// sets): absolute tolerance `tolerance` on `w` per patch, no gradient.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceQuadrature<'s> {
+    set: &'s PatchSet,
+    tolerance: f64,
+}
+
+impl<'s> SurfaceQuadrature<'s> {
+    /// The surface integral over `set` to `tolerance` per patch.
+    pub fn new(set: &'s PatchSet, tolerance: f64) -> Self {
+        SurfaceQuadrature { set, tolerance }
+    }
+}
+
+impl crate::eval::Evaluator for SurfaceQuadrature<'_> {
+    fn eval(&self, q: [f64; 3]) -> f64 {
+        winding_number_surface_quadrature(self.set, q, self.tolerance).0
+    }
+    fn name(&self) -> &'static str {
+        "direct (patches)"
+    }
+    fn eval_batch(&self, points: &[[f64; 3]]) -> Vec<f64> {
+        winding_number_surface_quadrature_batch(self.set, points, self.tolerance)
+    }
 }

@@ -10,8 +10,8 @@
 use std::collections::HashMap;
 
 use super::model::PatchSet;
-use crate::Mesh;
 use crate::error::MeshError;
+use crate::mesh::Mesh;
 
 /// The tessellation of `set` with `k × k` quads (two triangles each) per patch, oriented like the
 /// patches (normal `∂S/∂t × ∂S/∂s`).

@@ -15,8 +15,8 @@
 
 use rayon::prelude::*;
 
-use crate::Mesh;
 use crate::eval::Evaluator;
+use crate::mesh::Mesh;
 
 /// Centroid of face `f` of `mesh`; a coordinate equal on all three corners is copied exactly.
 pub fn face_centroid(mesh: &Mesh, f: usize) -> [f64; 3] {
@@ -80,5 +80,3 @@ pub fn submesh(mesh: &Mesh, keep: &[bool]) -> Mesh {
     // Indices come from a valid mesh, so this cannot fail; fall back to an empty mesh anyway.
     Mesh::new(pos, tris).unwrap_or_default()
 }
-
-pub use crate::mesh::write_obj;

@@ -35,10 +35,10 @@ use rayon::prelude::*;
 
 use super::npz::NpzWriter;
 use super::sdf::SignedDistance;
-use crate::Mesh;
 use crate::error::{LoadError, LoadErrorKind, Location};
 use crate::eval::antipodal::BuildError;
 use crate::io::{LoadOptions, load_mesh_with, regular_file_metadata};
+use crate::mesh::Mesh;
 
 /// How points are sampled for one mesh. Distances (`padding`, `sigmas`) are fractions of the
 /// mesh's bounding-box diagonal, so the same options suit meshes of any scale.
@@ -330,7 +330,7 @@ const MAX_GAUSSIAN: f64 = 9.0;
 /// uniform points are asked for) and by `MAX_GAUSSIAN × sigma × diag` (near points) must have
 /// finite corners, extent and diagonal, so every point, distance and label stays finite.
 fn check_sample_box(
-    bb: &crate::BoundingBox,
+    bb: &crate::base::bounding_box::BoundingBox,
     diag: f64,
     opts: &SamplingOptions,
 ) -> Result<(), LabelError> {

@@ -19,10 +19,11 @@
 use std::io::{self, Write};
 use std::path::Path;
 
+use crate::base::bounding_box::BoundingBox;
 use crate::eval::Evaluator;
 use crate::grid::GridSpec;
 use crate::kernel::frame::RayAxis;
-use crate::{BoundingBox, Mesh};
+use crate::mesh::Mesh;
 
 use super::colormap;
 

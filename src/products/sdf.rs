@@ -30,10 +30,10 @@ use std::sync::atomic::{AtomicBool, Ordering as AtomicOrdering};
 use obvhs::{BvhBuildParams, aabb::Aabb, bvh2::builder::build_bvh2};
 use rayon::prelude::*;
 
-use crate::Mesh;
 use crate::eval::Evaluator;
 use crate::eval::antipodal::{BuildError, Options, WindingNumber};
 use crate::grid::GridSpec;
+use crate::mesh::Mesh;
 
 /// Where on a triangle the closest point lies (corner indices `0..3` of the triangle).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -108,7 +108,7 @@ struct Frame {
 
 impl Frame {
     fn for_triangles(tris: &[[[f64; 3]; 3]]) -> Option<Frame> {
-        let b = crate::BoundingBox::of_points(tris.iter().flatten())?;
+        let b = crate::base::bounding_box::BoundingBox::of_points(tris.iter().flatten())?;
         let center = std::array::from_fn(|i| 0.5 * b.min[i] + 0.5 * b.max[i]);
         let h = (0..3)
             .map(|k| 0.5 * b.max[k] - 0.5 * b.min[k])

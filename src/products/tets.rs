@@ -23,10 +23,6 @@ use crate::eval::Evaluator;
 /// The default inside threshold on `w`.
 pub const DEFAULT_THRESHOLD: f64 = 0.5;
 
-/// The tet mesh lives in the mesh model, its files in `io::tets`; re-exported here.
-pub use crate::io::tets::*;
-pub use crate::mesh::TetMesh;
-
 /// Marks each tet by `w` at its centroid: `true` when `w > threshold`. A tet with a corner index
 /// outside `tet_vertices` is never kept.
 pub fn filter_tets<E: Evaluator + ?Sized>(

@@ -5,9 +5,7 @@
 use std::io::{self, Write};
 
 use super::oracle::{Certified, Decision};
-use crate::Mesh;
-
-pub use crate::mesh::write_obj;
+use crate::mesh::Mesh;
 
 /// OFF: header, vertices, then `3 i j k` faces (0-based).
 pub fn write_off(mut w: impl Write, mesh: &Mesh) -> io::Result<()> {

@@ -14,7 +14,7 @@
 use std::collections::HashMap;
 
 use super::source::Source;
-use crate::Mesh;
+use crate::mesh::Mesh;
 
 /// An axis-aligned box `(lo, hi)`.
 pub type Aabb = ([f64; 3], [f64; 3]);

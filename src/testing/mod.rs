@@ -10,7 +10,7 @@
 //!   (`polycube_from_bytes(&bytes)`) and a proptest strategy (`strategies::polycube()`). Each
 //!   kind documents its guarantee on its [`Kind`] variant.
 //! - **Exact oracle** ([`exact_winding_number_rational`], [`Oracle`]): big-integer perturbed
-//!   predicates written independently of `gwn::kernel`, plus a certified interval for the
+//!   predicates written independently of the crate's exact kernel, plus a certified interval for the
 //!   boundary term. [`Certified::decide`] is never wrong when it answers; closed consistently
 //!   oriented meshes give exact integers.
 //! - **The exact evaluator** for bulk use: [`WindingNumber`] (the library's Antipodal
@@ -40,12 +40,10 @@ pub use oracle::{
 };
 pub use source::{Source, SplitMix64};
 
-/// The fast exact evaluator (re-exported from [`crate::eval::antipodal`]).
-pub use crate::eval::antipodal::{Options, WindingNumber};
-
-use crate::Mesh;
-use crate::eval::antipodal::BuildError;
+use crate::eval::antipodal::{BuildError, Options, WindingNumber};
 use crate::kernel::frame::RayAxis;
+/// The fast exact evaluator (re-exported from [`crate::eval::antipodal`]).
+use crate::mesh::Mesh;
 
 /// The library's exact evaluator for bulk use (fast next to the oracle), with the 60-bit grid and the given ray: its value is the
 /// winding number at the same perturbed point `q_ε` as the oracle's for that ray. Its integer

@@ -12,7 +12,7 @@
 //! - The crossing count χ of the ray from `q_ε` is computed with `BigInt` *polynomials in `t`*:
 //!   each predicate (2D orientation of `q_t` against a projected edge, side of `q_t` of a
 //!   triangle's plane) is expanded symbolically and its sign is the sign of the lowest-order
-//!   non-zero coefficient. Nothing is hand-expanded and `gwn::kernel::predicates` is not called.
+//!   non-zero coefficient. Nothing is hand-expanded and the exact kernel's predicates are not called.
 //! - The boundary term `Σ k·Area(A, B, −d)` is the limit `t → 0⁺` of each edge's spherical-triangle
 //!   area, evaluated in outward-rounded interval arithmetic ([`super::interval`]). Its sign is the
 //!   exact sign of the `t`-polynomial of its numerator; its magnitude is `2·atan2(|N|, D)` of the
@@ -36,8 +36,8 @@ use std::collections::{BTreeMap, HashMap};
 use num_bigint::{BigInt, Sign};
 
 use super::interval::{Iv, atan2_hull, big, pi};
-use crate::Mesh;
 use crate::kernel::frame::RayAxis;
+use crate::mesh::Mesh;
 
 /// A certified enclosure of the winding number at the perturbed query.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -99,7 +99,7 @@ impl Certified {
 ///
 /// ```
 /// use gwn::Mesh;
-/// use gwn::kernel::frame::RayAxis;
+/// use gwn::RayAxis;
 /// use gwn::testing::{exact_winding_number_rational, Decision};
 /// let tet = Mesh::from_slices(
 ///     &[[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]],
@@ -616,7 +616,7 @@ fn to_frame_big(ray: RayAxis, v: &[BigInt; 3]) -> [BigInt; 3] {
 /// Richardson-extrapolated to `t → 0` (the error of each sample is `O(t)`; the extrapolation
 /// removes the linear term). Good to about 1e-5 on small integer-grid meshes; use a tolerance of
 /// 1e-3 or so. Near a degenerate face the direct sum itself is the weak link, see
-/// [`crate::kernel::spherical::triangle_solid_angle`].
+/// the exact kernel's `triangle_solid_angle_at`.
 pub fn direct_at_perturbed(
     mesh: &Mesh,
     q: [f64; 3],

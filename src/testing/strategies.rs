@@ -6,7 +6,7 @@
 //!
 //! ```
 //! use gwn::testing::{strategies, Oracle};
-//! use gwn::kernel::frame::RayAxis;
+//! use gwn::RayAxis;
 //! use proptest::prelude::*;
 //! proptest!(ProptestConfig::with_cases(8), |(case in strategies::polycube())| {
 //!     let oracle = Oracle::new(&case.mesh, RayAxis::PosZ);

@@ -254,16 +254,17 @@ fn nonsense_option_values_are_refused() {
     for beta in ["nan", "0", "-1", "inf", "-0"] {
         let arg = format!("--beta={beta}");
         let out = run_in(&dir, &[&eval[..], &[&arg]].concat(), None);
-        assert_one_line_error(&out, &["--beta", "positive finite"]);
+        // The library's message (gwn::spec), the one Python shows.
+        assert_one_line_error(&out, &["beta must be a positive finite number"]);
         let out = run_in(&dir, &["bench", &cube, "--grid", "2", &arg], None);
-        assert_one_line_error(&out, &["--beta"]);
+        assert_one_line_error(&out, &["beta must be a positive finite number"]);
     }
     let out = run_in(
         &dir,
         &["eval", &cube, "--points", "q.csv", "--beta", "-1"],
         None,
     );
-    assert_one_line_error(&out, &["--beta -1"]);
+    assert_one_line_error(&out, &["beta must be a positive finite number, got -1"]);
     let out = run_in(
         &dir,
         &["voxelize", &cube, "--res", "4", "--occupancy", "nan"],

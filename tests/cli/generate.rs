@@ -1,7 +1,7 @@
 //! `gwn gen`: the testing kit's cases written to files reload as the same meshes, with the
 //! oracle's certified values, bit for bit across runs.
 
-use gwn::kernel::frame::RayAxis;
+use gwn::RayAxis;
 use gwn::testing::{Decision, Kind, Oracle};
 
 fn temp_dir(tag: &str) -> std::path::PathBuf {

@@ -16,3 +16,4 @@ mod curve2d_cli;
 mod generate;
 mod info;
 mod methods;
+mod patch_tolerance;

@@ -143,7 +143,7 @@ pub fn rational_sphere_patches() -> Vec<gwn::patch::Patch> {
 }
 
 /// A sphere sampled by a Fibonacci spiral: oriented points carrying equal areas.
-pub fn sphere_cloud(n: usize) -> gwn::eval::fast::PointCloud {
+pub fn sphere_cloud(n: usize) -> gwn::mesh::PointCloud {
     let p: Vec<[f64; 3]> = (0..n)
         .map(|i| {
             let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
@@ -153,5 +153,5 @@ pub fn sphere_cloud(n: usize) -> gwn::eval::fast::PointCloud {
         })
         .collect();
     let a = vec![4.0 * std::f64::consts::PI / n as f64; n];
-    gwn::eval::fast::PointCloud::new(p.clone(), p, Some(a)).unwrap()
+    gwn::mesh::PointCloud::new(p.clone(), p, Some(a)).unwrap()
 }

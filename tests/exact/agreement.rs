@@ -4,9 +4,9 @@
 use crate::common;
 
 use gwn::Mesh;
+use gwn::RayAxis;
 use gwn::eval::antipodal::{BoundaryBy, Options, WindingNumber};
 use gwn::eval::direct::winding_number_direct;
-use gwn::kernel::frame::RayAxis;
 use rayon::prelude::*;
 
 /// Each triangle's bounding sphere (centroid, radius), for a cheap rejection in [`farther_than`].

@@ -8,8 +8,8 @@
 use crate::common;
 
 use gwn::Mesh;
+use gwn::RayAxis;
 use gwn::eval::antipodal::{Options, WindingNumber};
-use gwn::kernel::frame::RayAxis;
 use proptest::prelude::*;
 use rayon::prelude::*;
 

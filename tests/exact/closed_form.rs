@@ -3,10 +3,10 @@
 use crate::common;
 
 use common::{open_cube, unit_cube};
+use gwn::Precision;
+use gwn::RayAxis;
 use gwn::eval::antipodal::{Options, WindingNumber};
 use gwn::eval::direct::winding_number_direct;
-use gwn::kernel::frame::RayAxis;
-use gwn::kernel::quantize::Precision;
 
 #[test]
 fn cube_direct_inside_outside_far_corner_face() {

@@ -263,8 +263,8 @@ fn cloud_gradient_matches_the_dipole_sum_gradient() {
 /// and points in random order (no runs).
 #[test]
 fn batches_with_grid_runs_equal_point_by_point_values() {
+    use gwn::RayAxis;
     use gwn::eval::antipodal::Options;
-    use gwn::kernel::frame::RayAxis;
     let mesh = lion_head();
     let b = mesh.bounding_box().unwrap().enlarged(0.1);
     let mut rng = Rng(77);

@@ -4,9 +4,9 @@
 
 use crate::common;
 
+use gwn::Precision;
+use gwn::RayAxis;
 use gwn::eval::antipodal::{Options, WindingNumber};
-use gwn::kernel::frame::RayAxis;
-use gwn::kernel::quantize::Precision;
 use gwn::testing::{boxes_from_bytes, on_surface, soup_from_bytes as decode};
 use proptest::prelude::*;
 

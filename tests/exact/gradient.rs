@@ -5,9 +5,9 @@
 use crate::common;
 
 use gwn::Mesh;
+use gwn::RayAxis;
 use gwn::eval::antipodal::{Options, WindingNumber};
 use gwn::eval::direct::winding_number_gradient_direct;
-use gwn::kernel::frame::RayAxis;
 
 fn check(mesh: &Mesh, queries: &[[f64; 3]], h: f64) {
     for ray in [RayAxis::PosZ, RayAxis::NegX] {

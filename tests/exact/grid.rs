@@ -3,9 +3,9 @@
 use crate::common;
 
 use gwn::BoundingBox;
+use gwn::RayAxis;
 use gwn::eval::antipodal::{Options, WindingNumber};
 use gwn::grid::{GridSpec, evaluate, evaluate_per_point};
-use gwn::kernel::frame::RayAxis;
 
 /// Grid vs per-point: every sample bit-identical (the column loop shares the `x, y` work of the
 /// boundary term and the ray of the crossings, but not a single rounding); returns the count.

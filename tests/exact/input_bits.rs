@@ -5,10 +5,10 @@
 use crate::common;
 
 use gwn::Mesh;
+use gwn::RayAxis;
 use gwn::eval::antipodal::{Options, WindingNumber};
 use gwn::eval::direct;
 use gwn::eval::fast::{FastWindingNumber, PointCloudWindingNumber};
-use gwn::kernel::frame::RayAxis;
 use gwn::testing::exact_winding_number_rational;
 use proptest::prelude::*;
 

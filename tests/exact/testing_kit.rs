@@ -5,8 +5,8 @@
 use std::collections::HashMap;
 
 use gwn::Mesh;
+use gwn::RayAxis;
 use gwn::eval::direct::winding_number_direct;
-use gwn::kernel::frame::RayAxis;
 use gwn::mesh::boundary_edges;
 use gwn::testing::{Case, Decision, Kind, Oracle, exact_evaluator, on_surface, strategies};
 use proptest::prelude::*;

@@ -7,9 +7,10 @@ use crate::common;
 use gwn::Mesh;
 use gwn::eval::direct::winding_number_direct_batch;
 use gwn::eval::fast::{
-    Admissibility, FastParams, FastWindingNumber, Moments, PointCloud, PointCloudWindingNumber,
-    SYM_PAIRS, estimate_areas,
+    Admissibility, FastParams, FastWindingNumber, Moments, PointCloudWindingNumber, SYM_PAIRS,
+    estimate_areas,
 };
+use gwn::mesh::PointCloud;
 
 // ---------------------------------------------------------------- helpers
 

@@ -283,7 +283,7 @@ fn grid_bounds_whose_extent_overflows_are_refused() {
 
 #[test]
 fn tet_file_errors_say_line() {
-    use gwn::products::tets::load_tets;
+    use gwn::io::tets::load_tets;
     let dir = std::env::temp_dir().join(format!("gwn-strict-tets-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("t.node"), "2 3 0 0\n1 0 0 0\n2 0 x 0\n").unwrap();

@@ -4,8 +4,8 @@
 use crate::common;
 
 use gwn::Mesh;
+use gwn::RayAxis;
 use gwn::eval::antipodal::WindingNumber;
-use gwn::kernel::frame::RayAxis;
 use gwn::patch::tessellate::tessellate;
 use gwn::patch::{Options, Patch, PatchSet, PatchWindingNumber};
 

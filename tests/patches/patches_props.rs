@@ -2,8 +2,8 @@
 //! integer-valued off the surface, for every ray; random open patches agree with tessellations.
 
 use crate::common;
+use gwn::RayAxis;
 use gwn::eval::antipodal::WindingNumber;
-use gwn::kernel::frame::RayAxis;
 use gwn::patch::tessellate::tessellate;
 use gwn::patch::{Options, Patch, PatchSet, PatchWindingNumber};
 

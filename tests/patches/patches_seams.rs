@@ -8,7 +8,7 @@ use crate::patch_points;
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use gwn::kernel::frame::RayAxis;
+use gwn::RayAxis;
 use gwn::patch::eval::{MAX_EVALUATIONS, MAX_PIECES};
 use gwn::patch::{Evaluation, Options, Patch, PatchSet, PatchWindingNumber, load_patches};
 

@@ -4,8 +4,8 @@
 
 use crate::common;
 
+use gwn::RayAxis;
 use gwn::eval::antipodal::WindingNumber;
-use gwn::kernel::frame::RayAxis;
 use gwn::patch::boundary::{EdgeLink, link_edges};
 use gwn::patch::surface_quadrature::winding_number_surface_quadrature;
 use gwn::patch::tessellate::tessellate;

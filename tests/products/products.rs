@@ -6,11 +6,13 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use gwn::eval::antipodal::WindingNumber;
+use gwn::io::tets::{parse_ele, parse_node, write_ele, write_node};
+use gwn::mesh::TetMesh;
 use gwn::products::classify::classify_faces;
 use gwn::products::colormap;
 use gwn::products::png::Slice;
 use gwn::products::sdf::{PseudoNormalSign, SignedDistance};
-use gwn::products::tets::{TetMesh, filter_tets, parse_ele, parse_node, write_ele, write_node};
+use gwn::products::tets::filter_tets;
 use gwn::{BoundingBox, Mesh};
 
 // ---------------------------------------------------------------- helpers

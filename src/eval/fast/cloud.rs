@@ -10,8 +10,8 @@ use super::barnes_hut::{FastParams, Hierarchy};
 use super::moments::Moments;
 use super::soup::dist2;
 use super::tree::Tree;
-use crate::BoundingBox;
-use crate::kernel::compensated::NeumaierSum;
+use crate::base::bounding_box::BoundingBox;
+use crate::base::compensated::NeumaierSum;
 use crate::mesh::PointCloud;
 
 use crate::kernel::spherical::INV_4PI;
@@ -76,14 +76,15 @@ fn dipole_gradient(p: [f64; 3], an: [f64; 3], q: [f64; 3]) -> [f64; 3] {
 /// Sections 3.1–3.2). `Send + Sync`.
 ///
 /// ```
-/// use gwn::eval::fast::{PointCloud, PointCloudWindingNumber};
+/// use gwn::eval::fast::PointCloudWindingNumber;
+/// use gwn::mesh::PointCloud;
 /// // Six points on the unit sphere, each carrying a sixth of its area.
 /// let p = vec![[1., 0., 0.], [-1., 0., 0.], [0., 1., 0.], [0., -1., 0.], [0., 0., 1.], [0., 0., -1.]];
 /// let a = vec![4.0 * std::f64::consts::PI / 6.0; 6];
 /// let cloud = PointCloud::new(p.clone(), p, Some(a))?;
 /// let fast = PointCloudWindingNumber::new(&cloud);
 /// assert!((fast.eval([0.0, 0.0, 0.0]) - 1.0).abs() < 1e-12);
-/// # Ok::<(), gwn::eval::fast::PointCloudError>(())
+/// # Ok::<(), gwn::mesh::PointCloudError>(())
 /// ```
 #[derive(Clone, Debug)]
 pub struct PointCloudWindingNumber {

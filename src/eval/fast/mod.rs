@@ -67,8 +67,6 @@ mod moments;
 mod soup;
 mod tree;
 
-/// The cloud itself lives in the mesh model; re-exported here, where it was first defined.
-pub use crate::mesh::{PointCloud, PointCloudError};
 pub use area::estimate_areas;
 pub use barnes_hut::{Admissibility, FastParams};
 pub use cloud::{
@@ -77,7 +75,7 @@ pub use cloud::{
 pub use moments::{Moments, SYM_PAIRS};
 pub use soup::{FastWindingNumber, TRIANGLE_LEAF_SIZE};
 
-use crate::BoundingBox;
+use crate::base::bounding_box::BoundingBox;
 use crate::kernel::quantize::{Rescale, pull_in};
 
 /// How the fast evaluators keep their `f64`/`f32` arithmetic in range (issue 11, section 4): the
@@ -149,8 +147,3 @@ impl InputScale {
         self.rescale.apply(gradient(s))
     }
 }
-
-/// The former name of [`FastOrExact`](crate::eval::fossil::FastOrExact), kept so that code
-/// written against it still builds.
-#[deprecated(note = "renamed to gwn::eval::fossil::FastOrExact")]
-pub type WindingNumberApi<'m> = crate::eval::fossil::FastOrExact<'m>;

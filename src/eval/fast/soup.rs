@@ -8,11 +8,12 @@ use super::moments::Moments;
 use super::tree::Tree;
 use wide::{CmpGe, CmpGt, CmpLt, f64x4};
 
+use crate::base::bounding_box::BoundingBox;
 pub(crate) use crate::base::vec3::dist2;
 use crate::base::vec3::{cross, dot, sub};
 use crate::kernel::angle_sum::AngleSum;
 use crate::kernel::spherical::{SOLID_ANGLE_CONDITION, segment_gradient, triangle_solid_angle_at};
-use crate::{BoundingBox, Mesh};
+use crate::mesh::Mesh;
 
 use crate::kernel::spherical::INV_4PI;
 
@@ -186,7 +187,7 @@ impl FastWindingNumber {
     /// Gradient of the approximation [`Self::eval_with`] computes: each admissible node's
     /// expansion differentiated ([`Moments::far_field_gradient`]), and near triangles by the
     /// Biot–Savart segment sum of the direct gradient
-    /// ([`crate::kernel::spherical::segment_gradient`]). Tends to the exact gradient as β
+    /// (the exact kernel's `segment_gradient`). Tends to the exact gradient as β
     /// grows; not finite on the triangles' edges.
     pub fn gradient_with(&self, q: [f64; 3], params: FastParams) -> [f64; 3] {
         self.scale.gradient(q, |q| {

@@ -88,7 +88,7 @@ impl<W: Width> ExactIndex<W> {
         if q.iter().any(|c| !c.is_finite()) {
             return [f64::NAN; 3];
         }
-        let qg = self.grid.to_grid_space(q);
+        let qg = self.grid.in_grid_space(q);
         if qg.iter().any(|c| !c.is_finite()) {
             // Beyond `f64::MAX` in grid space (extent ≥ 1): the world gradient is below
             // `1e-616 / extent`, i.e. it underflows.

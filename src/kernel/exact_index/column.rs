@@ -41,7 +41,7 @@ impl<W: Width> ExactIndex<W> {
             p
         };
         // Grid-space point of the column at world coordinate `t` (pulled in like `parts`).
-        let at = |t: f64| self.grid.pull_in_far(self.grid.to_grid_space(world_at(t)));
+        let at = |t: f64| self.grid.pull_in_far(self.grid.in_grid_space(world_at(t)));
         let one_by_one = || {
             ts.iter()
                 .map(|&t| {
@@ -58,7 +58,7 @@ impl<W: Width> ExactIndex<W> {
             snap,
             residual,
             exact,
-        } = self.snap_frame(self.grid.pull_in_far(self.grid.to_grid_space(q)), q);
+        } = self.snap_frame(self.grid.pull_in_far(self.grid.in_grid_space(q)), q);
         let (Snap::In(x), Snap::In(y)) = (snap[0], snap[1]) else {
             // Beyond the grid across the ray: far queries, one by one.
             return one_by_one();

@@ -262,12 +262,7 @@ impl<W: Width> ExactIndex<W> {
 
     /// The parts and the bound of the expanded boundary (on `w`) at a finite world query.
     pub fn parts_with_bound(&self, q: [f64; 3]) -> (i64, f64, f64) {
-        self.parts_in_grid_space(self.grid.pull_in_far(self.grid.to_grid_space(q)), q)
-    }
-
-    /// The quantization grid (world coordinates).
-    pub fn grid(&self) -> &Grid {
-        &self.grid
+        self.parts_in_grid_space(self.grid.pull_in_far(self.grid.in_grid_space(q)), q)
     }
 
     /// What snapping the vertices to the lattice lost.

@@ -22,7 +22,7 @@
 //! (the query is on the surface, within the margin of an edge, or surrounded by boundary
 //! curves), a relaxed second pass runs and the result is flagged `uncertified`.
 
-use std::f64::consts::PI;
+use crate::kernel::spherical::FOUR_PI;
 
 use rayon::prelude::*;
 
@@ -313,7 +313,7 @@ impl StepWindingNumber {
     fn with_boundary(&self, chi: i64, pieces: &[Vec<Homogeneous>]) -> StepEvaluation {
         let mut sum = NeumaierSum::new();
         let mut err = 0.0;
-        let tol = self.options.tolerance * 4.0 * PI / (pieces.len().max(1) as f64);
+        let tol = self.options.tolerance * FOUR_PI / (pieces.len().max(1) as f64);
         // The patch evaluator's work cap and rounding-aware integrand (docs/patches.md: a
         // bounded time per query; an integral that hits the cap is reported uncertified).
         let mut budget = Budget {
@@ -337,9 +337,9 @@ impl StepWindingNumber {
             capped += r.capped;
         }
         StepEvaluation {
-            value: chi as f64 + sum.value() / (4.0 * PI),
+            value: chi as f64 + sum.value() / FOUR_PI,
             crossings: chi,
-            error_estimate: err / (4.0 * PI),
+            error_estimate: err / FOUR_PI,
             rays: 0,
             uncertified: capped > 0,
         }
