@@ -10,6 +10,7 @@ pub mod label;
 pub mod npy;
 pub mod npz;
 pub mod png;
+pub mod remesh;
 pub mod sdf;
 pub mod tets;
 pub mod vti;
