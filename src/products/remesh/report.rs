@@ -219,3 +219,43 @@ fn nonmanifold_vertices(n: usize, triangles: &[[u32; 3]]) -> usize {
     }
     bad
 }
+
+/// Occupancy agreement: of `samples` points drawn uniformly (seeded) in `bounds`, the fraction
+/// with the same class `w > ½` under `input` and `output` (`None` when `samples` is 0). Points
+/// near the surface count too, so at cell size `h` expect a shortfall of the order of
+/// `area · h / volume`.
+pub fn occupancy_agreement<A, B>(
+    input: &A,
+    output: &B,
+    bounds: crate::BoundingBox,
+    samples: usize,
+    seed: u64,
+) -> Option<f64>
+where
+    A: crate::eval::Evaluator + ?Sized,
+    B: crate::eval::Evaluator + ?Sized,
+{
+    if samples == 0 {
+        return None;
+    }
+    let mut state = seed;
+    // SplitMix64: reproducible without a dependency.
+    let mut next = move || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let points: Vec<[f64; 3]> = (0..samples)
+        .map(|_| std::array::from_fn(|a| bounds.min[a] + next() * (bounds.max[a] - bounds.min[a])))
+        .collect();
+    let wi = input.eval_batch(&points);
+    let wo = output.eval_batch(&points);
+    let agree = wi
+        .iter()
+        .zip(&wo)
+        .filter(|(a, b)| (**a > 0.5) == (**b > 0.5))
+        .count();
+    Some(agree as f64 / samples as f64)
+}
