@@ -275,9 +275,8 @@ fn labelling_of_every_kind_gives_a_closed_manifold() {
     struct Noise;
     impl Evaluator for Noise {
         fn eval(&self, q: [f64; 3]) -> f64 {
-            let k = (q[0] * 7.3).floor() as i64 * 73_856_093
-                ^ (q[1] * 7.3).floor() as i64 * 19_349_663
-                ^ (q[2] * 7.3).floor() as i64 * 83_492_791;
+            let cell = q.map(|x| (x * 7.3).floor() as i64);
+            let k = (cell[0] * 73_856_093) ^ (cell[1] * 19_349_663) ^ (cell[2] * 83_492_791);
             if k.rem_euclid(3) == 0 { 1.0 } else { 0.0 }
         }
     }

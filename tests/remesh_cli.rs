@@ -42,10 +42,8 @@ fn remesh_writes_every_format_and_a_report() {
         }
         // STL has no shared vertices: weld when reading back (the loader does for STL).
         let back = gwn::io::load_mesh(&out).unwrap().mesh;
-        let r = gwn::products::remesh::report::TopologyReport::of(
-            back.positions(),
-            back.triangles(),
-        );
+        let r =
+            gwn::products::remesh::report::TopologyReport::of(back.positions(), back.triangles());
         assert!(r.closed && r.edge_manifold && r.oriented, "{ext}: {r}");
         assert_eq!(r.euler_characteristic, 2, "{ext}: {r}");
     }
@@ -66,9 +64,18 @@ fn remesh_errors_are_one_line() {
     let out = dir.join("o.obj");
     let out = out.to_str().unwrap();
     let cases: [(&[&str], &str); 4] = [
-        (&["remesh", input, "--out", "x.vtk"], "unknown output extension"),
-        (&["remesh", input, "--res", "0", "--out", out], "resolution 0"),
-        (&["remesh", input, "--bisect", "99", "--out", out], "bisection steps"),
+        (
+            &["remesh", input, "--out", "x.vtk"],
+            "unknown output extension",
+        ),
+        (
+            &["remesh", input, "--res", "0", "--out", out],
+            "resolution 0",
+        ),
+        (
+            &["remesh", input, "--bisect", "99", "--out", out],
+            "bisection steps",
+        ),
         (&["remesh", "/nonexistent/m.obj", "--out", out], "m.obj"),
     ];
     for (args, needle) in cases {

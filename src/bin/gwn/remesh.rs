@@ -69,28 +69,24 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let secs = start.elapsed().as_secs_f64();
     let file = std::fs::File::create(&args.out)
         .map_err(|e| CliError(format!("{}: {e}", args.out.display())))?;
-    write_surface(
-        std::io::BufWriter::new(file),
-        format,
-        &out.positions,
-        &out.triangles,
-    )
-    .map_err(|e| CliError(format!("{}: {e}", args.out.display())))?;
     let topology = TopologyReport::of(&out.positions, &out.triangles);
+    let mesh = gwn::Mesh::new(out.positions, out.triangles)?;
+    write_surface(std::io::BufWriter::new(file), format, &mesh)
+        .map_err(|e| CliError(format!("{}: {e}", args.out.display())))?;
     // The agreement compares against the written surface's own exact winding number.
-    let agreement = if args.samples > 0 && !out.triangles.is_empty() {
-        let mesh = gwn::Mesh::new(out.positions.clone(), out.triangles.clone())?;
+    let agreement = if args.samples > 0 && !mesh.is_empty() {
         let output = gwn::eval::antipodal::WindingNumber::new(&mesh)?;
         occupancy_agreement(&wn, &output, bounds, args.samples, 0x9e57)
     } else {
         None
     };
     let s = out.stats;
+    let cell_size = out.cell_size;
     outln!(
         "{}: res {} (cell {:.4e}, lattice {}x{}x{}), {:.2} s, {} points classified, {} band cells",
         args.out.display(),
         args.res,
-        out.cell_size,
+        cell_size,
         s.lattice_cells[0],
         s.lattice_cells[1],
         s.lattice_cells[2],
@@ -109,7 +105,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if let Some(path) = &args.report {
         let mut extra = vec![
             ("resolution", args.res.to_string()),
-            ("cell_size", format!("{:?}", out.cell_size)),
+            ("cell_size", format!("{:?}", cell_size)),
             ("seconds", format!("{secs:.3}")),
             ("classified_points", s.classified_points.to_string()),
             ("band_cells", s.band_cells.to_string()),

@@ -1,5 +1,5 @@
-//! Writers for the remeshed surface: OBJ, PLY (binary little-endian) and STL (binary), chosen
-//! by extension.
+//! Writers for the remeshed surface, chosen by extension: OBJ (the crate's one OBJ writer,
+//! [`crate::mesh::write_obj`]), PLY (binary little-endian) and STL (binary).
 
 use std::io::{self, Write};
 use std::path::Path;
@@ -28,22 +28,15 @@ impl SurfaceFormat {
     }
 }
 
-/// Writes the surface in `format`.
+/// Writes `mesh` in `format`.
 pub fn write_surface(
     mut w: impl Write,
     format: SurfaceFormat,
-    positions: &[[f64; 3]],
-    triangles: &[[u32; 3]],
+    mesh: &crate::Mesh,
 ) -> io::Result<()> {
+    let (positions, triangles) = (mesh.positions(), mesh.triangles());
     match format {
-        SurfaceFormat::Obj => {
-            for p in positions {
-                writeln!(w, "v {:?} {:?} {:?}", p[0], p[1], p[2])?;
-            }
-            for t in triangles {
-                writeln!(w, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)?;
-            }
-        }
+        SurfaceFormat::Obj => return crate::mesh::write_obj(w, mesh),
         SurfaceFormat::Ply => {
             write!(
                 w,
