@@ -309,3 +309,35 @@ fn bad_options_are_errors() {
         Err(RemeshError::BadBounds)
     );
 }
+
+#[test]
+fn oriented_point_cloud_remeshes_with_the_fast_evaluator() {
+    use gwn::eval::fast::{PointCloud, PointCloudWindingNumber};
+    // Fibonacci sphere of radius 1, outward normals, equal areas.
+    let n = 4000;
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    let positions: Vec<[f64; 3]> = (0..n)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+            let r = (1.0 - z * z).sqrt();
+            let t = golden * i as f64;
+            [r * t.cos(), r * t.sin(), z]
+        })
+        .collect();
+    let area = 4.0 * std::f64::consts::PI / n as f64;
+    let cloud = PointCloud::new(positions.clone(), positions, Some(vec![area; n])).unwrap();
+    let wn = PointCloudWindingNumber::new(&cloud);
+    let bounds = gwn::BoundingBox {
+        min: [-1.0; 3],
+        max: [1.0; 3],
+    };
+    let out = remesh(&wn, bounds, &RemeshOptions::with_resolution(32)).unwrap();
+    let r = TopologyReport::of(&out.positions, &out.triangles);
+    assert_closed_manifold(&r);
+    assert_eq!((r.euler_characteristic, r.components), (2, 1), "{r}");
+    let vol = signed_volume(&out, |_| true);
+    assert!(
+        (vol / (4.0 / 3.0 * std::f64::consts::PI) - 1.0).abs() < 0.05,
+        "volume {vol}"
+    );
+}
