@@ -14,7 +14,7 @@
 //! edge midpoints: its normal points from the inside corner to the outside corner of its first
 //! edge, so the surface faces outward everywhere.
 
-use super::lattice::{Corner, KeyHash, Lattice};
+use super::lattice::{Corner, KeyHash, Lattice, pack};
 use super::octree::{Classified, offset};
 
 /// The six tetrahedra of the Freudenthal split, as cube-corner bits (x: 1, y: 2, z: 4).
@@ -45,13 +45,15 @@ pub fn extract(lattice: &Lattice, classified: &Classified) -> Band {
         band_cells: classified.band.len(),
         ..Band::default()
     };
-    let mut vertex_of: std::collections::HashMap<(Corner, Corner), u32, KeyHash> =
-        Default::default();
+    // Keyed by the packed corners: hashing two u64 costs a third of hashing six u32.
+    let mut vertex_of: std::collections::HashMap<(u64, u64), u32, KeyHash> = Default::default();
     let mut vertex = |edge: (Corner, Corner), edges: &mut Vec<(Corner, Corner)>| -> u32 {
-        *vertex_of.entry(edge).or_insert_with(|| {
-            edges.push(edge);
-            (edges.len() - 1) as u32
-        })
+        *vertex_of
+            .entry((pack(edge.0), pack(edge.1)))
+            .or_insert_with(|| {
+                edges.push(edge);
+                (edges.len() - 1) as u32
+            })
     };
     for &m in &classified.band {
         let corners: [Corner; 8] = std::array::from_fn(|b| offset(m, b, 1));
