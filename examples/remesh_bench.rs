@@ -53,7 +53,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         for &r in &res {
             let lattice = Lattice::new(bounds, r).ok_or("bad bounds")?;
             let t0 = Instant::now();
-            let classified = octree::classify(&wn, &lattice);
+            let classified = octree::classify(&wn, &lattice, usize::MAX).ok_or("too large")?;
             let t1 = Instant::now();
             let band = extract::extract(&lattice, &classified);
             let t2 = Instant::now();

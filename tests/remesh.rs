@@ -300,6 +300,25 @@ fn bad_options_are_errors() {
         remesh(&wn, bb, &RemeshOptions::with_resolution(0)),
         Err(RemeshError::BadResolution { resolution: 0 })
     );
+    let budget = RemeshOptions {
+        max_classified_points: Some(5000),
+        ..RemeshOptions::with_resolution(200)
+    };
+    assert_eq!(
+        remesh(&wn, bb, &budget),
+        Err(RemeshError::OutOfMemory { max_points: 5000 })
+    );
+    // Above the coarse grid (67³ points at res 256), below the band: stops while refining.
+    let budget = RemeshOptions {
+        max_classified_points: Some(400_000),
+        ..RemeshOptions::with_resolution(256)
+    };
+    assert_eq!(
+        remesh(&wn, bb, &budget),
+        Err(RemeshError::OutOfMemory {
+            max_points: 400_000
+        })
+    );
     let bad = gwn::BoundingBox {
         min: [0.0, f64::NAN, 0.0],
         max: [1.0; 3],

@@ -62,10 +62,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let options = RemeshOptions {
         resolution: args.res,
         bisection_steps: args.bisect,
+        max_classified_points: None,
     };
     let start = std::time::Instant::now();
-    let out =
-        remesh(&wn, bounds, &options).map_err(|e| CliError(format!("--res/--bisect: {e}")))?;
+    let out = remesh(&wn, bounds, &options)
+        .map_err(|e| CliError(format!("{}: {e}", args.mesh.display())))?;
     let secs = start.elapsed().as_secs_f64();
     let file = std::fs::File::create(&args.out)
         .map_err(|e| CliError(format!("{}: {e}", args.out.display())))?;

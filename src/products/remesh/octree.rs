@@ -91,8 +91,13 @@ pub fn offset(m: Corner, b: usize, size: u32) -> Corner {
     [0, 1, 2].map(|a| m[a] + if b >> a & 1 == 1 { size } else { 0 })
 }
 
-/// Classifies the lattice (see the [module documentation](self)).
-pub fn classify<E: Evaluator + ?Sized>(evaluator: &E, lattice: &Lattice) -> Classified {
+/// Classifies the lattice (see the [module documentation](self)); `None` as soon as more than
+/// `max_points` lattice points would be classified.
+pub fn classify<E: Evaluator + ?Sized>(
+    evaluator: &E,
+    lattice: &Lattice,
+    max_points: usize,
+) -> Option<Classified> {
     let mut out = Classified::default();
     let levels = lattice.levels;
     let coarse = 1u32 << levels;
@@ -108,6 +113,9 @@ pub fn classify<E: Evaluator + ?Sized>(evaluator: &E, lattice: &Lattice) -> Clas
     // The lattice is at most MAX_RESOLUTION-ish per axis and the coarse level ~COARSE_TARGET
     // cells: always a valid, small grid.
     let spec = GridSpec { bounds, dims };
+    if spec.len() > max_points {
+        return None;
+    }
     let values = evaluate(evaluator, &spec);
     for k in 0..dims[2] {
         for j in 0..dims[1] {
@@ -131,7 +139,7 @@ pub fn classify<E: Evaluator + ?Sized>(evaluator: &E, lattice: &Lattice) -> Clas
     }
     if levels == 0 {
         out.band = coarse_mixed;
-        return out;
+        return Some(out);
     }
     let mut queue: Vec<Cell> = coarse_mixed.iter().map(|&m| (levels, pack(m))).collect();
     let mut queued_min: KeyMap<Corner> = coarse_mixed.iter().map(|&m| (pack(m), m)).collect();
@@ -157,6 +165,9 @@ pub fn classify<E: Evaluator + ?Sized>(evaluator: &E, lattice: &Lattice) -> Clas
                 }
             }
             out.split.insert((level, pack(m)));
+        }
+        if out.labels.len() + new_points.len() > max_points {
+            return None;
         }
         let interior: Vec<Corner> = new_points
             .iter()
@@ -234,7 +245,7 @@ pub fn classify<E: Evaluator + ?Sized>(evaluator: &E, lattice: &Lattice) -> Clas
     }
     band.sort_unstable_by_key(|c| (c[2], c[1], c[0]));
     out.band = band;
-    out
+    Some(out)
 }
 
 /// Inverse of [`pack`].
