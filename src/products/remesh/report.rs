@@ -2,7 +2,7 @@
 //! characteristic, components. Computed from the triangles alone (it checks the output of the
 //! remesher, and serves any other mesh as well).
 
-use std::collections::HashMap;
+use super::lattice::KeyMap;
 
 /// The topology of a triangle surface.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -45,9 +45,9 @@ impl TopologyReport {
             faces: triangles.len(),
             ..TopologyReport::default()
         };
-        // Edge table: (lo, hi) -> (triangles, triangles going lo -> hi).
-        let mut edges: HashMap<(u32, u32), (u32, u32)> =
-            HashMap::with_capacity(triangles.len() * 2);
+        // Edge table: lo << 32 | hi -> (triangles, triangles going lo -> hi).
+        let mut edges: KeyMap<(u32, u32)> = KeyMap::default();
+        edges.reserve(triangles.len() * 3 / 2);
         let mut used = vec![false; n];
         let mut parent: Vec<u32> = (0..n as u32).collect();
         for t in triangles {
@@ -57,7 +57,8 @@ impl TopologyReport {
             for k in 0..3 {
                 let (a, b) = (t[k], t[(k + 1) % 3]);
                 used[a as usize] = true;
-                let e = edges.entry((a.min(b), a.max(b))).or_insert((0, 0));
+                let key = (u64::from(a.min(b)) << 32) | u64::from(a.max(b));
+                let e = edges.entry(key).or_insert((0, 0));
                 e.0 += 1;
                 if a < b {
                     e.1 += 1;
