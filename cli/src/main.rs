@@ -15,6 +15,7 @@ mod r#gen;
 mod info;
 mod label;
 mod method;
+mod remesh;
 mod sdf;
 mod slice;
 mod voxelize;
@@ -54,6 +55,8 @@ enum Command {
     Info(info::Args),
     /// Label a dataset: sample points per mesh, write w / occupancy / SDF as .npz and a manifest.
     Label(label::Args),
+    /// A closed, manifold, oriented surface of the solid w > 1/2 (marching tetrahedra, octree).
+    Remesh(remesh::Args),
     /// Signed distance on a voxel grid, signed by the winding number (inside where w > 1/2).
     Sdf(sdf::Args),
     /// Write a PNG slice of the winding-number field (the default job when no subcommand is given).
@@ -90,6 +93,7 @@ fn run(cli: Cli) -> Result<(), common::CliError> {
         Some(Command::Gen(a)) => r#gen::run(a),
         Some(Command::Info(a)) => info::run(a),
         Some(Command::Label(a)) => label::run(a),
+        Some(Command::Remesh(a)) => remesh::run(a),
         Some(Command::Sdf(a)) => sdf::run(a),
         Some(Command::Slice(a)) => slice::run(a),
         Some(Command::Voxelize(a)) => voxelize::run(a),

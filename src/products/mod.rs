@@ -1,8 +1,8 @@
 //! What users run on whole fields: slice images ([`png`], [`colormap`]), voxel-grid files
 //! ([`npy`], [`vti`]), signed distance ([`sdf`]), inside/outside filtering of tetrahedral meshes
-//! ([`tets`]), per-face classification for booleans ([`classify`]) and dataset labelling
-//! ([`label`], [`npz`]). The grids themselves are
-//! in [`crate::grid`]. See `docs/products.md`.
+//! ([`tets`]), per-face classification for booleans ([`classify`]), dataset labelling
+//! ([`label`], [`npz`]) and remeshing at `w = ½` ([`remesh`]). The grids themselves are in
+//! [`crate::grid`]. See `docs/products.md`.
 
 pub mod classify;
 pub mod colormap;
@@ -10,6 +10,7 @@ pub mod label;
 pub mod npy;
 pub mod npz;
 pub mod png;
+pub mod remesh;
 pub mod sdf;
 pub mod tets;
 pub mod vti;

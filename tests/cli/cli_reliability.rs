@@ -79,6 +79,7 @@ fn printing_subcommands() -> Vec<Vec<String>> {
         s(&["info", &cube]),
         s(&["voxelize", &cube, "--res", "4", "--out", "v.npy"]),
         s(&["sdf", &cube, "--res", "4", "--out", "s.npy"]),
+        s(&["remesh", &cube, "--res", "4", "--out", "r.obj"]),
         s(&["slice", &cube, "--res", "8", "--out", "s.png"]),
         s(&["classify", &cube, &cube, "--out", "c.csv"]),
         s(&["filter-tets", &cube, "t.node", "--out", "k.mesh"]),
@@ -157,6 +158,16 @@ fn every_output_file_error_names_the_file() {
             &bad,
         ),
         (vec!["sdf", &cube, "--res", "4", "--out", &bad], &bad),
+        (
+            vec!["remesh", &cube, "--res", "4", "--out", &bad_obj],
+            &bad_obj,
+        ),
+        (
+            vec![
+                "remesh", &cube, "--res", "4", "--out", "r.obj", "--report", &bad,
+            ],
+            &bad,
+        ),
         (vec!["slice", &cube, "--res", "8", "--out", &bad], &bad),
         (vec!["classify", &cube, &cube, "--out", &bad], &bad),
         (

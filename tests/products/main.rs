@@ -11,3 +11,5 @@ mod common;
 mod bounded_work;
 mod label;
 mod products;
+mod remesh;
+mod remesh_cli;

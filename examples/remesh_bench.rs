@@ -1,0 +1,83 @@
+//! `gwn remesh` phases on shared meshes: time of classification (coarse grid + octree band),
+//! extraction and bisection, face count, topology, at several resolutions.
+//!
+//! ```text
+//! cargo run --release --features examples --example remesh_bench [-- RES... [--mesh FILE]...]
+//! ```
+//! Defaults: resolutions 64, 128, 256 on two shared meshes (`../shared/meshes`, or
+//! `$GWN_SHARED_DIR/meshes`); the thread count is rayon's (set `RAYON_NUM_THREADS`). Prints a
+//! Markdown table.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use gwn::eval::antipodal::WindingNumber;
+use gwn::products::remesh::lattice::Lattice;
+use gwn::products::remesh::report::TopologyReport;
+use gwn::products::remesh::{DEFAULT_BISECTION_STEPS, extract, octree, place};
+
+const DEFAULT_MESHES: [&str; 2] = ["cgal-bunny00.off", "assimp-Spider_binary.stl"];
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut res = Vec::new();
+    let mut meshes = Vec::new();
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        if a == "--mesh" {
+            meshes.push(PathBuf::from(args.next().ok_or("--mesh needs a file")?));
+        } else {
+            res.push(a.parse::<usize>()?);
+        }
+    }
+    if res.is_empty() {
+        res = vec![64, 128, 256];
+    }
+    if meshes.is_empty() {
+        let shared = std::env::var("GWN_SHARED_DIR")
+            .map(PathBuf::from)
+            .unwrap_or_else(|_| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared"));
+        meshes = DEFAULT_MESHES
+            .iter()
+            .map(|m| shared.join("meshes").join(m))
+            .collect();
+    }
+    println!(
+        "| mesh | input faces | res | classify s | extract s | bisect s | total s | points \
+         classified | band cells | output faces | closed+manifold+oriented | Euler | components |"
+    );
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|");
+    for path in &meshes {
+        let mesh = gwn::io::load_mesh(path)?.mesh;
+        let wn = WindingNumber::new(&mesh)?;
+        let bounds = mesh.bounding_box().ok_or("empty mesh")?;
+        for &r in &res {
+            let lattice = Lattice::new(bounds, r).ok_or("bad bounds")?;
+            let t0 = Instant::now();
+            let classified = octree::classify(&wn, &lattice, usize::MAX).ok_or("too large")?;
+            let t1 = Instant::now();
+            let band = extract::extract(&lattice, &classified);
+            let t2 = Instant::now();
+            let positions =
+                place::place_vertices(&wn, &lattice, &band.edges, DEFAULT_BISECTION_STEPS);
+            let t3 = Instant::now();
+            let rep = TopologyReport::of(&positions, &band.triangles);
+            let ok = rep.closed && rep.edge_manifold && rep.vertex_manifold && rep.oriented;
+            println!(
+                "| {} | {} | {r} | {:.2} | {:.2} | {:.2} | {:.2} | {} | {} | {} | {} | {} | {} |",
+                path.file_name().and_then(|n| n.to_str()).unwrap_or("?"),
+                mesh.triangles().len(),
+                (t1 - t0).as_secs_f64(),
+                (t2 - t1).as_secs_f64(),
+                (t3 - t2).as_secs_f64(),
+                (t3 - t0).as_secs_f64(),
+                classified.labels.len(),
+                classified.band.len(),
+                rep.faces,
+                if ok { "yes" } else { "NO" },
+                rep.euler_characteristic,
+                rep.components
+            );
+        }
+    }
+    Ok(())
+}

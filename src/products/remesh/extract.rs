@@ -1,0 +1,115 @@
+//! Marching tetrahedra on the Freudenthal (Kuhn) split of the band's finest cells.
+//!
+//! Every cube is cut into the six tetrahedra `0 → e_a → e_a + e_b → e_a + e_b + e_c` over the
+//! permutations `(a, b, c)` of the axes. The split is the same in every cube, so the face
+//! diagonals of neighbouring cubes match and the tetrahedra triangulate space. Give each lattice
+//! corner its class (inside `w > ½`, outside) and the value `+1` / `−1`; the zero set of the
+//! piecewise-linear interpolant is a closed 2-manifold (0 is a regular value: no vertex has value
+//! 0), made of one triangle in a tetrahedron with one corner apart from the other three, and one
+//! quadrilateral (two triangles, diagonal chosen inside the tetrahedron) in a tetrahedron with
+//! two and two. There is no ambiguous case, and no rule to keep consistent between cells.
+//!
+//! Output vertices are identified by their lattice edge (inside corner, outside corner), so
+//! neighbouring cells share them. Each triangle is oriented with exact integer arithmetic on the
+//! edge midpoints: its normal points from the inside corner to the outside corner of its first
+//! edge, so the surface faces outward everywhere.
+
+use super::lattice::{Corner, KeyHash, Lattice, pack};
+use super::octree::{Classified, offset};
+
+/// The six tetrahedra of the Freudenthal split, as cube-corner bits (x: 1, y: 2, z: 4).
+pub const FREUDENTHAL: [[usize; 4]; 6] = [
+    [0, 1, 3, 7],
+    [0, 1, 5, 7],
+    [0, 2, 3, 7],
+    [0, 2, 6, 7],
+    [0, 4, 5, 7],
+    [0, 4, 6, 7],
+];
+
+/// The extracted surface before vertex placement.
+#[derive(Debug, Default)]
+pub struct Band {
+    /// One lattice edge per output vertex: (inside corner, outside corner).
+    pub edges: Vec<(Corner, Corner)>,
+    /// Triangles over `edges`, oriented outward.
+    pub triangles: Vec<[u32; 3]>,
+    /// Finest cells in the band.
+    pub band_cells: usize,
+}
+
+/// Extracts the separating surface of the band of `classified`.
+pub fn extract(lattice: &Lattice, classified: &Classified) -> Band {
+    let _ = lattice;
+    let mut band = Band {
+        band_cells: classified.band.len(),
+        ..Band::default()
+    };
+    // Keyed by the packed corners: hashing two u64 costs a third of hashing six u32.
+    let mut vertex_of: std::collections::HashMap<(u64, u64), u32, KeyHash> = Default::default();
+    let mut vertex = |edge: (Corner, Corner), edges: &mut Vec<(Corner, Corner)>| -> u32 {
+        *vertex_of
+            .entry((pack(edge.0), pack(edge.1)))
+            .or_insert_with(|| {
+                edges.push(edge);
+                (edges.len() - 1) as u32
+            })
+    };
+    for &m in &classified.band {
+        let corners: [Corner; 8] = std::array::from_fn(|b| offset(m, b, 1));
+        let inside: [bool; 8] = std::array::from_fn(|b| classified.label(corners[b]));
+        for tet in FREUDENTHAL {
+            let v = tet.map(|b| corners[b]);
+            let ins = tet.map(|b| inside[b]);
+            let n_in = ins.iter().filter(|&&x| x).count();
+            let in_idx: Vec<usize> = (0..4).filter(|&i| ins[i]).collect();
+            let out_idx: Vec<usize> = (0..4).filter(|&i| !ins[i]).collect();
+            let tris: Vec<[(usize, usize); 3]> = match n_in {
+                1 => {
+                    let i = in_idx[0];
+                    vec![[(i, out_idx[0]), (i, out_idx[1]), (i, out_idx[2])]]
+                }
+                3 => {
+                    let o = out_idx[0];
+                    vec![[(in_idx[0], o), (in_idx[1], o), (in_idx[2], o)]]
+                }
+                2 => {
+                    let (a, b) = (in_idx[0], in_idx[1]);
+                    let (c, d) = (out_idx[0], out_idx[1]);
+                    vec![[(a, c), (a, d), (b, d)], [(a, c), (b, d), (b, c)]]
+                }
+                _ => continue,
+            };
+            for tri in tris {
+                let mut e = tri.map(|(i, o)| (v[i], v[o]));
+                if !outward(&e) {
+                    e.swap(1, 2);
+                }
+                let t = e.map(|edge| vertex(edge, &mut band.edges));
+                band.triangles.push(t);
+            }
+        }
+    }
+    band
+}
+
+/// Whether the triangle through the midpoints of `edges` (inside, outside corners) has its
+/// normal pointing from the inside corner to the outside corner of `edges[0]` (exact: twice the
+/// midpoints are integers; the product is nonzero because the midpoint plane of a tetrahedron
+/// never holds a whole edge).
+fn outward(edges: &[(Corner, Corner); 3]) -> bool {
+    let mid = |(i, o): (Corner, Corner)| -> [i64; 3] {
+        [0, 1, 2].map(|a| i64::from(i[a]) + i64::from(o[a]))
+    };
+    let [p, q, r] = edges.map(mid);
+    let u = [0, 1, 2].map(|a| q[a] - p[a]);
+    let v = [0, 1, 2].map(|a| r[a] - p[a]);
+    let n = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    let (i, o) = edges[0];
+    let d = [0, 1, 2].map(|a| i64::from(o[a]) - i64::from(i[a]));
+    n[0] * d[0] + n[1] * d[1] + n[2] * d[2] > 0
+}

@@ -1,0 +1,129 @@
+//! The finest lattice: cubic cells of edge `h`, integer corner coordinates, the coarse level and
+//! the margin whose outermost corners are declared outside.
+
+use crate::BoundingBox;
+
+/// The coarse level has about this many cells along the longest axis (inside the margin): fine
+/// enough that a thin part is rarely missed by every coarse corner, coarse enough that its
+/// `(COARSE_TARGET + 3)³` corners cost little with ray reuse.
+pub const COARSE_TARGET: usize = 64;
+
+/// A lattice corner, in finest-cell units from the lattice origin.
+pub type Corner = [u32; 3];
+
+/// The finest lattice of a remeshing run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lattice {
+    /// Position of corner `[0, 0, 0]`.
+    pub origin: [f64; 3],
+    /// Cell edge.
+    pub h: f64,
+    /// Finest cells per axis; corners run over `0..=cells[a]`.
+    pub cells: [usize; 3],
+    /// Octree levels: a coarse cell is `2^levels` finest cells wide.
+    pub levels: u32,
+}
+
+impl Lattice {
+    /// The lattice of cell edge `longest extent / res` around `bounds`, with one coarse cell of
+    /// margin on every side; `None` when `bounds` is not finite or inverted.
+    pub fn new(bounds: BoundingBox, res: usize) -> Option<Lattice> {
+        let ok = (0..3).all(|a| {
+            bounds.min[a].is_finite() && bounds.max[a].is_finite() && bounds.min[a] <= bounds.max[a]
+        });
+        if !ok || res == 0 {
+            return None;
+        }
+        let extent = [0, 1, 2].map(|a| bounds.max[a] - bounds.min[a]);
+        let longest = extent[0].max(extent[1]).max(extent[2]);
+        // A single point: any positive cell edge shows it (as nothing, w ≤ ½ everywhere).
+        let h = if longest > 0.0 {
+            longest / res as f64
+        } else {
+            1.0
+        };
+        let mut levels = 0;
+        while res >> (levels + 1) >= COARSE_TARGET {
+            levels += 1;
+        }
+        let coarse = 1usize << levels;
+        let coarse_edge = h * coarse as f64;
+        let mut cells = [0; 3];
+        let mut origin = [0.0; 3];
+        for a in 0..3 {
+            let inner = ((extent[a] / coarse_edge).ceil() as usize).max(1);
+            let c = inner + 2;
+            cells[a] = c * coarse;
+            let centre = 0.5 * (bounds.min[a] + bounds.max[a]);
+            origin[a] = centre - 0.5 * c as f64 * coarse_edge;
+        }
+        Some(Lattice {
+            origin,
+            h,
+            cells,
+            levels,
+        })
+    }
+
+    /// Coarse cells per axis.
+    pub fn coarse_cells(&self) -> [usize; 3] {
+        self.cells.map(|n| n >> self.levels)
+    }
+
+    /// Position of a point given in (possibly fractional) lattice units.
+    pub fn position(&self, p: [f64; 3]) -> [f64; 3] {
+        [0, 1, 2].map(|a| self.origin[a] + p[a] * self.h)
+    }
+
+    /// Position of a corner.
+    pub fn corner_position(&self, c: Corner) -> [f64; 3] {
+        self.position(c.map(f64::from))
+    }
+
+    /// Whether `c` lies on the outer faces of the lattice (declared outside, never evaluated).
+    pub fn is_border(&self, c: Corner) -> bool {
+        (0..3).any(|a| c[a] == 0 || c[a] as usize == self.cells[a])
+    }
+
+    /// Whether `c` is a corner of the lattice.
+    pub fn contains(&self, c: [i64; 3]) -> bool {
+        (0..3).all(|a| c[a] >= 0 && c[a] as u64 <= self.cells[a] as u64)
+    }
+}
+
+/// Packs a corner into one key (21 bits per axis; [`super::MAX_RESOLUTION`] keeps coordinates
+/// below `2^21`).
+pub fn pack(c: Corner) -> u64 {
+    u64::from(c[0]) | (u64::from(c[1]) << 21) | (u64::from(c[2]) << 42)
+}
+
+/// A multiplicative hasher for the packed integer keys of the remesher's maps (the standard
+/// SipHash costs more than the lookups it serves; the keys are not attacker-chosen hash-flooding
+/// material, and a bad distribution only costs time).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct KeyHasher(u64);
+
+impl std::hash::Hasher for KeyHasher {
+    fn finish(&self) -> u64 {
+        // Fold the high bits down: hashbrown takes its bucket index from the low bits.
+        self.0 ^ (self.0 >> 29)
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(u64::from(b));
+        }
+    }
+    fn write_u64(&mut self, v: u64) {
+        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    }
+    fn write_u32(&mut self, v: u32) {
+        self.write_u64(u64::from(v));
+    }
+}
+
+/// Builds [`KeyHasher`]s.
+pub type KeyHash = std::hash::BuildHasherDefault<KeyHasher>;
+/// A map keyed by packed lattice keys.
+pub type KeyMap<V> = std::collections::HashMap<u64, V, KeyHash>;
+/// A set of packed lattice keys.
+pub type KeySet<K> = std::collections::HashSet<K, KeyHash>;

@@ -1,0 +1,255 @@
+//! Corner classification: the coarse level with ray reuse, then an octree split only where
+//! classes differ, closed under neighbours so that the labelling of the finest lattice is well
+//! defined everywhere.
+//!
+//! # The invariant
+//! Every leaf cell above the finest level is *uniform*: all classified lattice points on its
+//! closed box have one class. A lattice point that was never classified then takes the class of
+//! any leaf whose closed box holds it; two such leaves agree, because the smaller one's corner
+//! on their common face, edge or vertex is classified and lies on both. So every finest cell
+//! whose corners differ is a finest leaf, and the band [`Classified::band`] holds all of them.
+//!
+//! The invariant is kept by splitting (1) coarse cells whose corners differ, (2) every new
+//! child whose closed box holds classified points of two classes, and (3) every leaf whose
+//! closed box holds a newly classified point of the other class. Each round classifies the new
+//! corners of all cells split in it with one parallel batch.
+
+use rayon::prelude::*;
+
+use super::lattice::{Corner, KeyMap, KeySet, Lattice, pack};
+use crate::eval::Evaluator;
+use crate::grid::{GridSpec, evaluate};
+
+/// An octree cell: level (`2^level` finest cells wide) and packed minimum corner.
+pub type Cell = (u32, u64);
+
+/// The classification of a lattice.
+#[derive(Debug, Default)]
+pub struct Classified {
+    /// `w > ½` at every classified corner (packed key); border corners are `false`.
+    pub labels: KeyMap<bool>,
+    /// The cells that were split.
+    pub split: KeySet<Cell>,
+    /// Minimum corners of the finest cells whose corners differ.
+    pub band: Vec<Corner>,
+}
+
+impl Classified {
+    /// The class of a classified corner (`false` when it was never classified; callers only ask
+    /// about classified ones).
+    pub fn label(&self, c: Corner) -> bool {
+        self.labels.get(&pack(c)).copied().unwrap_or(false)
+    }
+
+    /// The leaf holding the finest cell with minimum corner `c`.
+    fn leaf(&self, lattice: &Lattice, c: Corner) -> (u32, Corner) {
+        let mut level = lattice.levels;
+        loop {
+            let m = c.map(|x| (x >> level) << level);
+            if level > 0 && self.split.contains(&(level, pack(m))) {
+                level -= 1;
+            } else {
+                return (level, m);
+            }
+        }
+    }
+
+    /// Whether the classified points on the closed box of the cell `(level, m)` differ.
+    fn closed_box_mixed(&self, level: u32, m: Corner) -> bool {
+        let size = 1u32 << level;
+        let first = self.label(m);
+        for dz in 0..=size {
+            for dy in 0..=size {
+                let y_or_z_face = dz == 0 || dz == size || dy == 0 || dy == size;
+                for dx in 0..=size {
+                    // Interior points of an unsplit cell are never classified.
+                    if !y_or_z_face && dx != 0 && dx != size {
+                        continue;
+                    }
+                    let p = [m[0] + dx, m[1] + dy, m[2] + dz];
+                    if let Some(&l) = self.labels.get(&pack(p)) {
+                        if l != first {
+                            return true;
+                        }
+                    }
+                }
+            }
+        }
+        false
+    }
+
+    /// Whether the 8 corners of the cell `(level, m)` (all classified) differ.
+    fn corners_mixed(&self, level: u32, m: Corner) -> bool {
+        let size = 1u32 << level;
+        let first = self.label(m);
+        (1..8).any(|b| self.label(offset(m, b, size)) != first)
+    }
+}
+
+/// Corner `b` (bit 0: x, bit 1: y, bit 2: z) of the cell with minimum `m` and edge `size`.
+pub fn offset(m: Corner, b: usize, size: u32) -> Corner {
+    [0, 1, 2].map(|a| m[a] + if b >> a & 1 == 1 { size } else { 0 })
+}
+
+/// Classifies the lattice (see the [module documentation](self)); `None` as soon as more than
+/// `max_points` lattice points would be classified.
+pub fn classify<E: Evaluator + ?Sized>(
+    evaluator: &E,
+    lattice: &Lattice,
+    max_points: usize,
+) -> Option<Classified> {
+    let mut out = Classified::default();
+    let levels = lattice.levels;
+    let coarse = 1u32 << levels;
+    let cc = lattice.coarse_cells();
+    // The coarse corners as a grid of cell-centre samples: a box half a coarse cell larger on
+    // every side puts the sample centres on the corners.
+    let ch = lattice.h * f64::from(coarse);
+    let bounds = crate::BoundingBox {
+        min: [0, 1, 2].map(|a| lattice.origin[a] - 0.5 * ch),
+        max: [0, 1, 2].map(|a| lattice.origin[a] + (cc[a] as f64 + 0.5) * ch),
+    };
+    let dims = cc.map(|n| n + 1);
+    // The lattice is at most MAX_RESOLUTION-ish per axis and the coarse level ~COARSE_TARGET
+    // cells: always a valid, small grid.
+    let spec = GridSpec { bounds, dims };
+    if spec.len() > max_points {
+        return None;
+    }
+    let values = evaluate(evaluator, &spec);
+    for k in 0..dims[2] {
+        for j in 0..dims[1] {
+            for i in 0..dims[0] {
+                let c = [i, j, k].map(|x| x as u32 * coarse);
+                let inside = !lattice.is_border(c) && values[spec.index(i, j, k)] > 0.5;
+                out.labels.insert(pack(c), inside);
+            }
+        }
+    }
+    let mut coarse_mixed = Vec::new();
+    for k in 0..cc[2] {
+        for j in 0..cc[1] {
+            for i in 0..cc[0] {
+                let m = [i, j, k].map(|x| x as u32 * coarse);
+                if out.corners_mixed(levels, m) {
+                    coarse_mixed.push(m);
+                }
+            }
+        }
+    }
+    if levels == 0 {
+        out.band = coarse_mixed;
+        return Some(out);
+    }
+    let mut queue: Vec<Cell> = coarse_mixed.iter().map(|&m| (levels, pack(m))).collect();
+    let mut queued_min: KeyMap<Corner> = coarse_mixed.iter().map(|&m| (pack(m), m)).collect();
+    while !queue.is_empty() {
+        queue.sort_unstable();
+        queue.dedup();
+        queue.retain(|cell| cell.0 > 0 && !out.split.contains(cell));
+        let cells: Vec<(u32, Corner)> = queue.iter().map(|&(l, k)| (l, queued_min[&k])).collect();
+        // The new corners of the children of every cell split in this round.
+        let mut fresh = KeySet::<u64>::default();
+        let mut new_points: Vec<Corner> = Vec::new();
+        for &(level, m) in &cells {
+            let half = 1u32 << (level - 1);
+            for dz in 0..3 {
+                for dy in 0..3 {
+                    for dx in 0..3 {
+                        let p = [m[0] + dx * half, m[1] + dy * half, m[2] + dz * half];
+                        let key = pack(p);
+                        if !out.labels.contains_key(&key) && fresh.insert(key) {
+                            new_points.push(p);
+                        }
+                    }
+                }
+            }
+            out.split.insert((level, pack(m)));
+        }
+        if out.labels.len() + new_points.len() > max_points {
+            return None;
+        }
+        let interior: Vec<Corner> = new_points
+            .iter()
+            .copied()
+            .filter(|&p| !lattice.is_border(p))
+            .collect();
+        let positions: Vec<[f64; 3]> = interior
+            .par_iter()
+            .map(|&p| lattice.corner_position(p))
+            .collect();
+        let values = evaluator.eval_batch(&positions);
+        for &p in &new_points {
+            out.labels.insert(pack(p), false);
+        }
+        for (p, w) in interior.iter().zip(values) {
+            out.labels.insert(pack(*p), w > 0.5);
+        }
+        let mut next: Vec<(u32, Corner)> = Vec::new();
+        // (2) new children whose closed box is mixed.
+        for &(level, m) in &cells {
+            if level - 1 == 0 {
+                continue;
+            }
+            let half = 1u32 << (level - 1);
+            for b in 0..8 {
+                let child = offset(m, b, half);
+                if out.closed_box_mixed(level - 1, child) {
+                    next.push((level - 1, child));
+                }
+            }
+        }
+        // (3) leaves around each new point that it contradicts.
+        for &p in &new_points {
+            let lp = out.label(p);
+            for b in 0..8 {
+                let mut min = [0u32; 3];
+                let mut ok = true;
+                for a in 0..3 {
+                    let back = (b >> a & 1) as u32;
+                    if p[a] < back || (p[a] - back) as usize >= lattice.cells[a] {
+                        ok = false;
+                    } else {
+                        min[a] = p[a] - back;
+                    }
+                }
+                if !ok {
+                    continue;
+                }
+                let (level, m) = out.leaf(lattice, min);
+                if level > 0 && out.label(m) != lp {
+                    next.push((level, m));
+                }
+            }
+        }
+        queue.clear();
+        queued_min.clear();
+        for (level, m) in next {
+            queued_min.insert(pack(m), m);
+            queue.push((level, pack(m)));
+        }
+    }
+    // Every finest leaf: the children of the split level-1 cells.
+    let mut band = Vec::new();
+    for &(level, key) in &out.split {
+        if level != 1 {
+            continue;
+        }
+        let m = unpack(key);
+        for b in 0..8 {
+            let child = offset(m, b, 1);
+            if out.corners_mixed(0, child) {
+                band.push(child);
+            }
+        }
+    }
+    band.sort_unstable_by_key(|c| (c[2], c[1], c[0]));
+    out.band = band;
+    Some(out)
+}
+
+/// Inverse of [`pack`].
+pub fn unpack(key: u64) -> Corner {
+    let mask = (1u64 << 21) - 1;
+    [key & mask, (key >> 21) & mask, (key >> 42) & mask].map(|x| x as u32)
+}

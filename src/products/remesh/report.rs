@@ -1,0 +1,262 @@
+//! Topology report of a triangle surface: closed, edge- and vertex-manifold, oriented, Euler
+//! characteristic, components. Computed from the triangles alone (it checks the output of the
+//! remesher, and serves any other mesh as well).
+
+use super::lattice::KeyMap;
+
+/// The topology of a triangle surface.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TopologyReport {
+    /// Vertices used by some triangle.
+    pub vertices: usize,
+    /// Triangles.
+    pub faces: usize,
+    /// Distinct undirected edges.
+    pub edges: usize,
+    /// Edges with one triangle.
+    pub boundary_edges: usize,
+    /// Edges with more than two triangles.
+    pub nonmanifold_edges: usize,
+    /// Vertices whose link (the ring of their triangles) is not one cycle or path.
+    pub nonmanifold_vertices: usize,
+    /// Two-triangle edges traversed in the same direction by both (orientation flips).
+    pub misoriented_edges: usize,
+    /// Triangles with a repeated vertex index.
+    pub degenerate_faces: usize,
+    /// Connected components (triangles sharing a vertex are connected).
+    pub components: usize,
+    /// `V − E + F`.
+    pub euler_characteristic: i64,
+    /// No boundary edge.
+    pub closed: bool,
+    /// No edge with more than two triangles.
+    pub edge_manifold: bool,
+    /// Every vertex link is one cycle or path.
+    pub vertex_manifold: bool,
+    /// No misoriented edge.
+    pub oriented: bool,
+}
+
+impl TopologyReport {
+    /// The report of `triangles` (indices into `positions`, which only sizes the tables).
+    pub fn of(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> TopologyReport {
+        let n = positions.len();
+        let mut r = TopologyReport {
+            faces: triangles.len(),
+            ..TopologyReport::default()
+        };
+        // Edge table: lo << 32 | hi -> (triangles, triangles going lo -> hi).
+        let mut edges: KeyMap<(u32, u32)> = KeyMap::default();
+        edges.reserve(triangles.len() * 3 / 2);
+        let mut used = vec![false; n];
+        let mut parent: Vec<u32> = (0..n as u32).collect();
+        for t in triangles {
+            if t[0] == t[1] || t[1] == t[2] || t[2] == t[0] {
+                r.degenerate_faces += 1;
+            }
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                used[a as usize] = true;
+                let key = (u64::from(a.min(b)) << 32) | u64::from(a.max(b));
+                let e = edges.entry(key).or_insert((0, 0));
+                e.0 += 1;
+                if a < b {
+                    e.1 += 1;
+                }
+                union(&mut parent, a, b);
+            }
+        }
+        r.vertices = used.iter().filter(|&&u| u).count();
+        r.edges = edges.len();
+        for &(count, forward) in edges.values() {
+            match count {
+                1 => r.boundary_edges += 1,
+                2 => {
+                    if forward != 1 {
+                        r.misoriented_edges += 1
+                    }
+                }
+                _ => r.nonmanifold_edges += 1,
+            }
+        }
+        r.components = (0..n as u32)
+            .filter(|&v| used[v as usize] && find(&mut parent, v) == v)
+            .count();
+        r.nonmanifold_vertices = nonmanifold_vertices(n, triangles);
+        r.euler_characteristic = r.vertices as i64 - r.edges as i64 + r.faces as i64;
+        r.closed = r.boundary_edges == 0;
+        r.edge_manifold = r.nonmanifold_edges == 0;
+        r.vertex_manifold = r.nonmanifold_vertices == 0;
+        r.oriented = r.misoriented_edges == 0;
+        r
+    }
+
+    /// The report as one JSON object (`extra` are further `"key": value` members, already
+    /// formatted, appended as they are).
+    pub fn to_json(&self, extra: &[(&str, String)]) -> String {
+        let mut s = format!(
+            "{{\"closed\": {}, \"edge_manifold\": {}, \"vertex_manifold\": {}, \"oriented\": {}, \
+             \"euler_characteristic\": {}, \"components\": {}, \"vertices\": {}, \"faces\": {}, \
+             \"edges\": {}, \"boundary_edges\": {}, \"nonmanifold_edges\": {}, \
+             \"nonmanifold_vertices\": {}, \"misoriented_edges\": {}, \"degenerate_faces\": {}",
+            self.closed,
+            self.edge_manifold,
+            self.vertex_manifold,
+            self.oriented,
+            self.euler_characteristic,
+            self.components,
+            self.vertices,
+            self.faces,
+            self.edges,
+            self.boundary_edges,
+            self.nonmanifold_edges,
+            self.nonmanifold_vertices,
+            self.misoriented_edges,
+            self.degenerate_faces
+        );
+        for (k, v) in extra {
+            s.push_str(&format!(", \"{k}\": {v}"));
+        }
+        s.push('}');
+        s
+    }
+}
+
+impl std::fmt::Display for TopologyReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let yes = |b: bool| if b { "yes" } else { "NO" };
+        write!(
+            f,
+            "{} faces, {} vertices; closed: {} ({} boundary edges); edge-manifold: {} ({}); \
+             vertex-manifold: {} ({}); oriented: {} ({} flipped edges); Euler characteristic {}; \
+             {} component(s)",
+            self.faces,
+            self.vertices,
+            yes(self.closed),
+            self.boundary_edges,
+            yes(self.edge_manifold),
+            self.nonmanifold_edges,
+            yes(self.vertex_manifold),
+            self.nonmanifold_vertices,
+            yes(self.oriented),
+            self.misoriented_edges,
+            self.euler_characteristic,
+            self.components
+        )
+    }
+}
+
+fn find(parent: &mut [u32], mut v: u32) -> u32 {
+    while parent[v as usize] != v {
+        let p = parent[parent[v as usize] as usize];
+        parent[v as usize] = p;
+        v = p;
+    }
+    v
+}
+
+fn union(parent: &mut [u32], a: u32, b: u32) {
+    let (ra, rb) = (find(parent, a), find(parent, b));
+    if ra != rb {
+        parent[ra as usize] = rb;
+    }
+}
+
+/// Vertices whose link is not a single cycle or path: the opposite edges of the vertex's
+/// triangles must form one connected graph with every node of degree at most 2.
+fn nonmanifold_vertices(n: usize, triangles: &[[u32; 3]]) -> usize {
+    // CSR of vertex -> opposite edges.
+    let mut start = vec![0usize; n + 1];
+    for t in triangles {
+        for &v in t {
+            start[v as usize + 1] += 1;
+        }
+    }
+    for i in 0..n {
+        start[i + 1] += start[i];
+    }
+    let mut fill = start.clone();
+    let mut opposite = vec![(0u32, 0u32); start[n]];
+    for t in triangles {
+        for k in 0..3 {
+            let v = t[k] as usize;
+            opposite[fill[v]] = (t[(k + 1) % 3], t[(k + 2) % 3]);
+            fill[v] += 1;
+        }
+    }
+    let mut bad = 0;
+    let mut nodes: Vec<u32> = Vec::new();
+    let mut degree: Vec<u32> = Vec::new();
+    let mut parent: Vec<u32> = Vec::new();
+    for v in 0..n {
+        let link = &opposite[start[v]..start[v + 1]];
+        if link.is_empty() {
+            continue;
+        }
+        nodes.clear();
+        for &(a, b) in link {
+            nodes.push(a);
+            nodes.push(b);
+        }
+        nodes.sort_unstable();
+        nodes.dedup();
+        degree.clear();
+        degree.resize(nodes.len(), 0);
+        parent.clear();
+        parent.extend(0..nodes.len() as u32);
+        let local = |x: u32| nodes.binary_search(&x).unwrap_or(0) as u32;
+        for &(a, b) in link {
+            let (la, lb) = (local(a), local(b));
+            degree[la as usize] += 1;
+            degree[lb as usize] += 1;
+            union(&mut parent, la, lb);
+        }
+        let roots = (0..nodes.len() as u32)
+            .filter(|&i| find(&mut parent, i) == i)
+            .count();
+        if roots != 1 || degree.iter().any(|&d| d > 2) {
+            bad += 1;
+        }
+    }
+    bad
+}
+
+/// Occupancy agreement: of `samples` points drawn uniformly (seeded) in `bounds`, the fraction
+/// with the same class `w > ½` under `input` and `output` (`None` when `samples` is 0). Points
+/// near the surface count too, so at cell size `h` expect a shortfall of the order of
+/// `area · h / volume`.
+pub fn occupancy_agreement<A, B>(
+    input: &A,
+    output: &B,
+    bounds: crate::BoundingBox,
+    samples: usize,
+    seed: u64,
+) -> Option<f64>
+where
+    A: crate::eval::Evaluator + ?Sized,
+    B: crate::eval::Evaluator + ?Sized,
+{
+    if samples == 0 {
+        return None;
+    }
+    let mut state = seed;
+    // SplitMix64: reproducible without a dependency.
+    let mut next = move || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let points: Vec<[f64; 3]> = (0..samples)
+        .map(|_| std::array::from_fn(|a| bounds.min[a] + next() * (bounds.max[a] - bounds.min[a])))
+        .collect();
+    let wi = input.eval_batch(&points);
+    let wo = output.eval_batch(&points);
+    let agree = wi
+        .iter()
+        .zip(&wo)
+        .filter(|(a, b)| (**a > 0.5) == (**b > 0.5))
+        .count();
+    Some(agree as f64 / samples as f64)
+}

@@ -1,0 +1,369 @@
+//! `products::remesh`: closed forms (sphere, torus, nested and disjoint solids), double walls and
+//! inner faces, an open mesh, and occupancy agreement of output against input.
+
+use crate::common;
+
+use gwn::Mesh;
+use gwn::eval::Evaluator;
+use gwn::eval::antipodal::WindingNumber;
+use gwn::products::remesh::report::TopologyReport;
+use gwn::products::remesh::{RemeshError, RemeshOptions, Remeshed, remesh};
+use gwn::products::sdf::SignedDistance;
+
+/// UV sphere of radius `r` centred at `c`, outward (`flip`: inward), `n` segments.
+fn sphere(c: [f64; 3], r: f64, n: usize, flip: bool) -> Mesh {
+    let (rings, segs) = (n, 2 * n);
+    let mut v = vec![[c[0], c[1], c[2] - r], [c[0], c[1], c[2] + r]];
+    for i in 1..rings {
+        let th = std::f64::consts::PI * i as f64 / rings as f64;
+        for j in 0..segs {
+            let ph = 2.0 * std::f64::consts::PI * j as f64 / segs as f64;
+            v.push([
+                c[0] + r * th.sin() * ph.cos(),
+                c[1] + r * th.sin() * ph.sin(),
+                c[2] - r * th.cos(),
+            ]);
+        }
+    }
+    let at = |i: usize, j: usize| (2 + (i - 1) * segs + j % segs) as u32;
+    let mut f = Vec::new();
+    for j in 0..segs {
+        f.push([0, at(1, j + 1), at(1, j)]);
+        f.push([1, at(rings - 1, j), at(rings - 1, j + 1)]);
+        for i in 1..rings - 1 {
+            f.push([at(i, j), at(i, j + 1), at(i + 1, j + 1)]);
+            f.push([at(i, j), at(i + 1, j + 1), at(i + 1, j)]);
+        }
+    }
+    let m = Mesh::new(v, f).unwrap();
+    if flip { m.flipped() } else { m }
+}
+
+/// Torus around z, radii `big` and `small`, outward.
+fn torus(big: f64, small: f64, n: usize) -> Mesh {
+    let (nu, nv) = (2 * n, n);
+    let mut v = Vec::new();
+    for i in 0..nu {
+        let u = 2.0 * std::f64::consts::PI * i as f64 / nu as f64;
+        for j in 0..nv {
+            let w = 2.0 * std::f64::consts::PI * j as f64 / nv as f64;
+            let rr = big + small * w.cos();
+            v.push([rr * u.cos(), rr * u.sin(), small * w.sin()]);
+        }
+    }
+    let at = |i: usize, j: usize| ((i % nu) * nv + j % nv) as u32;
+    let mut f = Vec::new();
+    for i in 0..nu {
+        for j in 0..nv {
+            f.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+            f.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    Mesh::new(v, f).unwrap()
+}
+
+fn run(mesh: &Mesh, res: usize) -> (Remeshed, TopologyReport) {
+    let wn = WindingNumber::new(mesh).unwrap();
+    let out = remesh(
+        &wn,
+        mesh.bounding_box().unwrap(),
+        &RemeshOptions::with_resolution(res),
+    )
+    .unwrap();
+    let report = TopologyReport::of(&out.positions, &out.triangles);
+    (out, report)
+}
+
+fn assert_closed_manifold(r: &TopologyReport) {
+    assert!(r.faces > 0, "{r}");
+    assert!(
+        r.closed && r.edge_manifold && r.vertex_manifold && r.oriented,
+        "{r}"
+    );
+    assert_eq!(r.degenerate_faces, 0, "{r}");
+}
+
+/// Signed volume of the triangles selected by `keep` (outward orientation: positive).
+fn signed_volume(out: &Remeshed, keep: impl Fn([f64; 3]) -> bool) -> f64 {
+    let mut vol = 0.0;
+    for t in &out.triangles {
+        let [a, b, c] = t.map(|i| out.positions[i as usize]);
+        if !keep(a) {
+            continue;
+        }
+        vol += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+            + a[2] * (b[0] * c[1] - b[1] * c[0]))
+            / 6.0;
+    }
+    vol
+}
+
+/// Fraction of `n` random points in the input's box (grown by 10 %) farther than `cells` cells
+/// from the output surface where input and output agree on `w > ½`; also the number compared.
+fn occupancy_agreement(mesh: &Mesh, out: &Remeshed, n: usize, cells: f64) -> (f64, usize) {
+    let input = WindingNumber::new(mesh).unwrap();
+    let out_mesh = Mesh::new(out.positions.clone(), out.triangles.clone()).unwrap();
+    let output = SignedDistance::new(&out_mesh).unwrap();
+    let bb = mesh.bounding_box().unwrap();
+    let mut rng = common::Rng(0x5eed_1234);
+    let (mut agree, mut total) = (0usize, 0usize);
+    for _ in 0..n {
+        let q: [f64; 3] = std::array::from_fn(|a| {
+            let pad = 0.1 * (bb.max[a] - bb.min[a]);
+            rng.range(bb.min[a] - pad, bb.max[a] + pad)
+        });
+        let (sd, w_out) = output.eval_with_winding(q);
+        if sd.abs() <= cells * out.cell_size {
+            continue;
+        }
+        total += 1;
+        if (input.eval(q) > 0.5) == (w_out > 0.5) {
+            agree += 1;
+        }
+    }
+    (agree as f64 / total as f64, total)
+}
+
+#[test]
+fn sphere_is_a_closed_genus_zero_manifold_near_the_input() {
+    let mesh = sphere([0.1, -0.2, 0.3], 1.0, 24, false);
+    for res in [8, 32, 100] {
+        let (out, r) = run(&mesh, res);
+        assert_closed_manifold(&r);
+        assert_eq!(
+            (r.euler_characteristic, r.components),
+            (2, 1),
+            "res {res}: {r}"
+        );
+        // Every vertex is within a cell of the polyhedral sphere (bisection on the true field).
+        for p in &out.positions {
+            let d = ((p[0] - 0.1).powi(2) + (p[1] + 0.2).powi(2) + (p[2] - 0.3).powi(2)).sqrt();
+            assert!(
+                (d - 1.0).abs() < out.cell_size,
+                "res {res}: vertex at radius {d}"
+            );
+        }
+        let vol = signed_volume(&out, |_| true);
+        let ball = 4.0 / 3.0 * std::f64::consts::PI;
+        assert!((vol / ball - 1.0).abs() < 0.05, "res {res}: volume {vol}");
+    }
+}
+
+#[test]
+fn resolution_256_refines_only_the_band() {
+    let mesh = sphere([0.0; 3], 1.0, 24, false);
+    let wn = WindingNumber::new(&mesh).unwrap();
+    // Topology and memory do not depend on placement: no bisection keeps the test short.
+    let options = RemeshOptions {
+        bisection_steps: 0,
+        ..RemeshOptions::with_resolution(256)
+    };
+    let out = remesh(&wn, mesh.bounding_box().unwrap(), &options).unwrap();
+    let r = TopologyReport::of(&out.positions, &out.triangles);
+    assert_closed_manifold(&r);
+    assert_eq!((r.euler_characteristic, r.components), (2, 1), "{r}");
+    let lattice_points: usize = out.stats.lattice_cells.iter().map(|n| n + 1).product();
+    // The classified points are a thin shell: far fewer than the lattice's (~17 M).
+    assert!(
+        out.stats.classified_points * 10 < lattice_points,
+        "{:?}",
+        out.stats
+    );
+}
+
+#[test]
+fn torus_has_euler_characteristic_zero() {
+    let mesh = torus(1.0, 0.4, 24);
+    for res in [16, 48] {
+        let (_, r) = run(&mesh, res);
+        assert_closed_manifold(&r);
+        assert_eq!(
+            (r.euler_characteristic, r.components),
+            (0, 1),
+            "res {res}: {r}"
+        );
+    }
+}
+
+#[test]
+fn hollow_shell_gives_two_nested_components_oriented_apart() {
+    let outer = sphere([0.0; 3], 1.0, 24, false);
+    let inner = sphere([0.0; 3], 0.5, 16, true);
+    let shell = outer.concatenated(&inner).unwrap();
+    let (out, r) = run(&shell, 48);
+    assert_closed_manifold(&r);
+    assert_eq!((r.euler_characteristic, r.components), (4, 2), "{r}");
+    let radius = |p: [f64; 3]| (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+    let v_outer = signed_volume(&out, |p| radius(p) > 0.75);
+    let v_inner = signed_volume(&out, |p| radius(p) < 0.75);
+    assert!(v_outer > 0.0 && v_inner < 0.0, "{v_outer} {v_inner}");
+    // Both spheres outward: w = 2 inside the small one is still inside; one ball.
+    let doubled = outer
+        .concatenated(&sphere([0.0; 3], 0.5, 16, false))
+        .unwrap();
+    let (_, r) = run(&doubled, 48);
+    assert_closed_manifold(&r);
+    assert_eq!((r.euler_characteristic, r.components), (2, 1), "{r}");
+}
+
+#[test]
+fn disjoint_cubes_stay_two_solids() {
+    let a = common::unit_cube();
+    let b = a.translated([1.5, 0.2, 0.0]);
+    let (_, r) = run(&a.concatenated(&b).unwrap(), 40);
+    assert_closed_manifold(&r);
+    assert_eq!((r.euler_characteristic, r.components), (4, 2), "{r}");
+}
+
+#[test]
+fn double_walls_and_inner_faces_vanish() {
+    // Two cubes sharing the face x = 1: the double wall is inside the union (w = 1 on both sides).
+    let a = common::unit_cube();
+    let b = a.translated([1.0, 0.0, 0.0]);
+    let (out, r) = run(&a.concatenated(&b).unwrap(), 40);
+    assert_closed_manifold(&r);
+    assert_eq!((r.euler_characteristic, r.components), (2, 1), "{r}");
+    let vol = signed_volume(&out, |_| true);
+    assert!((vol - 2.0).abs() < 0.1, "volume {vol}");
+    // Inner faces listed twice, once each way (as dirty exports have them): w is 1 on both
+    // sides, so they leave no trace. (A single one-sided inner sheet would not do: w tends to ½
+    // on one side of it, and the surface may rightly follow it there.)
+    let sheet = Mesh::from_slices(
+        &[
+            [0.2, 0.2, 0.5],
+            [0.8, 0.2, 0.5],
+            [0.8, 0.8, 0.5],
+            [0.2, 0.8, 0.5],
+        ],
+        &[[0, 1, 2], [0, 2, 3]],
+    )
+    .unwrap();
+    let doubled = sheet.concatenated(&sheet.flipped()).unwrap();
+    let (_, r) = run(&a.concatenated(&doubled).unwrap(), 40);
+    assert_closed_manifold(&r);
+    assert_eq!((r.euler_characteristic, r.components), (2, 1), "{r}");
+}
+
+#[test]
+fn open_cube_is_closed_where_w_decides() {
+    let mesh = common::open_cube();
+    let (out, r) = run(&mesh, 40);
+    assert_closed_manifold(&r);
+    assert_eq!((r.euler_characteristic, r.components), (2, 1), "{r}");
+    let (agreement, compared) = occupancy_agreement(&mesh, &out, 3000, 1.0);
+    assert!(
+        compared > 2000 && agreement >= 0.99,
+        "{agreement} of {compared}"
+    );
+}
+
+#[test]
+fn occupancy_agrees_away_from_the_surface() {
+    for mesh in [
+        sphere([0.0; 3], 1.0, 24, false),
+        torus(1.0, 0.4, 24),
+        sphere([0.0; 3], 1.0, 24, false)
+            .concatenated(&sphere([0.0; 3], 0.5, 16, true))
+            .unwrap(),
+    ] {
+        let (out, _) = run(&mesh, 48);
+        let (agreement, compared) = occupancy_agreement(&mesh, &out, 3000, 1.0);
+        assert!(
+            compared > 2000 && agreement >= 0.99,
+            "{agreement} of {compared}"
+        );
+    }
+}
+
+#[test]
+fn labelling_of_every_kind_gives_a_closed_manifold() {
+    // A field that is noise at lattice scale: any labelling must still give a closed 2-manifold
+    // (the extraction's guarantee does not depend on the field being smooth).
+    struct Noise;
+    impl Evaluator for Noise {
+        fn eval(&self, q: [f64; 3]) -> f64 {
+            let cell = q.map(|x| (x * 7.3).floor() as i64);
+            let k = (cell[0] * 73_856_093) ^ (cell[1] * 19_349_663) ^ (cell[2] * 83_492_791);
+            if k.rem_euclid(3) == 0 { 1.0 } else { 0.0 }
+        }
+    }
+    let bounds = gwn::BoundingBox {
+        min: [0.0; 3],
+        max: [2.0, 1.5, 1.0],
+    };
+    for res in [7, 20, 130] {
+        let out = remesh(&Noise, bounds, &RemeshOptions::with_resolution(res)).unwrap();
+        let r = TopologyReport::of(&out.positions, &out.triangles);
+        assert_closed_manifold(&r);
+    }
+}
+
+#[test]
+fn bad_options_are_errors() {
+    let mesh = common::unit_cube();
+    let wn = WindingNumber::new(&mesh).unwrap();
+    let bb = mesh.bounding_box().unwrap();
+    assert_eq!(
+        remesh(&wn, bb, &RemeshOptions::with_resolution(0)),
+        Err(RemeshError::BadResolution { resolution: 0 })
+    );
+    let budget = RemeshOptions {
+        max_classified_points: Some(5000),
+        ..RemeshOptions::with_resolution(200)
+    };
+    assert_eq!(
+        remesh(&wn, bb, &budget),
+        Err(RemeshError::OutOfMemory { max_points: 5000 })
+    );
+    // Above the coarse grid (67³ points at res 256), below the band: stops while refining.
+    let budget = RemeshOptions {
+        max_classified_points: Some(400_000),
+        ..RemeshOptions::with_resolution(256)
+    };
+    assert_eq!(
+        remesh(&wn, bb, &budget),
+        Err(RemeshError::OutOfMemory {
+            max_points: 400_000
+        })
+    );
+    let bad = gwn::BoundingBox {
+        min: [0.0, f64::NAN, 0.0],
+        max: [1.0; 3],
+    };
+    assert_eq!(
+        remesh(&wn, bad, &RemeshOptions::with_resolution(8)),
+        Err(RemeshError::BadBounds)
+    );
+}
+
+#[test]
+fn oriented_point_cloud_remeshes_with_the_fast_evaluator() {
+    use gwn::eval::fast::{PointCloud, PointCloudWindingNumber};
+    // Fibonacci sphere of radius 1, outward normals, equal areas.
+    let n = 4000;
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    let positions: Vec<[f64; 3]> = (0..n)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+            let r = (1.0 - z * z).sqrt();
+            let t = golden * i as f64;
+            [r * t.cos(), r * t.sin(), z]
+        })
+        .collect();
+    let area = 4.0 * std::f64::consts::PI / n as f64;
+    let cloud = PointCloud::new(positions.clone(), positions, Some(vec![area; n])).unwrap();
+    let wn = PointCloudWindingNumber::new(&cloud);
+    let bounds = gwn::BoundingBox {
+        min: [-1.0; 3],
+        max: [1.0; 3],
+    };
+    let out = remesh(&wn, bounds, &RemeshOptions::with_resolution(32)).unwrap();
+    let r = TopologyReport::of(&out.positions, &out.triangles);
+    assert_closed_manifold(&r);
+    assert_eq!((r.euler_characteristic, r.components), (2, 1), "{r}");
+    let vol = signed_volume(&out, |_| true);
+    assert!(
+        (vol / (4.0 / 3.0 * std::f64::consts::PI) - 1.0).abs() < 0.05,
+        "volume {vol}"
+    );
+}

@@ -1,0 +1,86 @@
+//! `gwn remesh` through the CLI: output formats, the JSON report, and one-line errors.
+
+use crate::cli::gwn;
+
+#[test]
+fn remesh_writes_every_format_and_a_report() {
+    let dir = std::env::temp_dir().join(format!("gwn-cli-remesh-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let input = dir.join("cube.obj");
+    let cube = gwn::testing::unit_cube(false);
+    gwn::mesh::write_obj(std::fs::File::create(&input).unwrap(), &cube).unwrap();
+    for ext in ["obj", "ply", "stl"] {
+        let out = dir.join(format!("out.{ext}"));
+        let report = dir.join(format!("report-{ext}.json"));
+        let (ok, stdout, stderr) = gwn(&[
+            "remesh",
+            input.to_str().unwrap(),
+            "--res",
+            "20",
+            "--out",
+            out.to_str().unwrap(),
+            "--report",
+            report.to_str().unwrap(),
+            "--samples",
+            "2000",
+        ]);
+        assert!(ok, "{stderr}");
+        assert!(stdout.contains("closed: yes") && stdout.contains("Euler characteristic 2"));
+        let json = std::fs::read_to_string(&report).unwrap();
+        for member in [
+            "\"closed\": true",
+            "\"edge_manifold\": true",
+            "\"vertex_manifold\": true",
+            "\"oriented\": true",
+            "\"euler_characteristic\": 2",
+            "\"components\": 1",
+            "\"occupancy_agreement\": ",
+        ] {
+            assert!(json.contains(member), "{member} not in {json}");
+        }
+        // STL has no shared vertices: weld when reading back (the loader does for STL).
+        let back = gwn::io::load_mesh(&out).unwrap().mesh;
+        let r =
+            gwn::products::remesh::report::TopologyReport::of(back.positions(), back.triangles());
+        assert!(r.closed && r.edge_manifold && r.oriented, "{ext}: {r}");
+        assert_eq!(r.euler_characteristic, 2, "{ext}: {r}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn remesh_errors_are_one_line() {
+    let dir = std::env::temp_dir().join(format!("gwn-cli-remesh-err-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let input = dir.join("cube.obj");
+    gwn::mesh::write_obj(
+        std::fs::File::create(&input).unwrap(),
+        &gwn::testing::unit_cube(false),
+    )
+    .unwrap();
+    let input = input.to_str().unwrap();
+    let out = dir.join("o.obj");
+    let out = out.to_str().unwrap();
+    let cases: [(&[&str], &str); 4] = [
+        (
+            &["remesh", input, "--out", "x.vtk"],
+            "unknown output extension",
+        ),
+        (
+            &["remesh", input, "--res", "0", "--out", out],
+            "resolution 0",
+        ),
+        (
+            &["remesh", input, "--bisect", "99", "--out", out],
+            "bisection steps",
+        ),
+        (&["remesh", "/nonexistent/m.obj", "--out", out], "m.obj"),
+    ];
+    for (args, needle) in cases {
+        let (ok, _, stderr) = gwn(args);
+        assert!(!ok, "{args:?}");
+        assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+        assert!(stderr.contains(needle), "{needle}: {stderr}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
