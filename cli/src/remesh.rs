@@ -8,7 +8,7 @@ use gwn::products::remesh::write::{SurfaceFormat, write_surface};
 use gwn::products::remesh::{DEFAULT_BISECTION_STEPS, RemeshOptions, remesh};
 
 use crate::common::{CliError, outln};
-use crate::method::{Input, MethodArgs};
+use crate::method::{MethodArgs, ToleranceArgs};
 
 /// Remesh at w = 1/2: a closed, edge- and vertex-manifold, consistently oriented surface of the
 /// solid where the winding number (exact by default) is above 1/2.
@@ -41,7 +41,7 @@ pub struct Args {
     #[command(flatten)]
     pub weld: crate::common::WeldArgs,
     #[command(flatten)]
-    pub boundary: crate::common::ToleranceArgs,
+    pub tolerance: ToleranceArgs,
 }
 
 /// Runs `gwn remesh`.
@@ -52,20 +52,20 @@ pub fn run(args: Args) -> Result<(), CliError> {
             args.out.display()
         ))
     })?;
-    let input = Input::load(&args.mesh, args.weld)?;
+    let method = args.method.spec(args.tolerance, args.weld);
+    method.validate()?;
+    let input = crate::method::load_input(&args.mesh, args.weld)?;
     let bounds = input
         .bounding_box()
         .ok_or_else(|| CliError::msg(format!("{}: has no geometry", args.mesh.display())))?;
-    let wn = args
-        .method
-        .build(&input, &args.mesh, args.boundary.exact_options(args.weld)?)?;
+    let wn = crate::method::build(&method, &input, &args.mesh)?;
     let options = RemeshOptions {
         resolution: args.res,
         bisection_steps: args.bisect,
         max_classified_points: None,
     };
     let start = std::time::Instant::now();
-    let out = remesh(&wn, bounds, &options)
+    let out = remesh(&*wn, bounds, &options)
         .map_err(|e| CliError(format!("{}: {e}", args.mesh.display())))?;
     let secs = start.elapsed().as_secs_f64();
     let file = std::fs::File::create(&args.out)
@@ -77,7 +77,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     // The agreement compares against the written surface's own exact winding number.
     let agreement = if args.samples > 0 && !mesh.is_empty() {
         let output = gwn::eval::antipodal::WindingNumber::new(&mesh)?;
-        occupancy_agreement(&wn, &output, bounds, args.samples, 0x9e57)
+        occupancy_agreement(&*wn, &output, bounds, args.samples, 0x9e57)
     } else {
         None
     };

@@ -338,7 +338,8 @@ fn bad_options_are_errors() {
 
 #[test]
 fn oriented_point_cloud_remeshes_with_the_fast_evaluator() {
-    use gwn::eval::fast::{PointCloud, PointCloudWindingNumber};
+    use gwn::eval::fast::PointCloudWindingNumber;
+    use gwn::mesh::PointCloud;
     // Fibonacci sphere of radius 1, outward normals, equal areas.
     let n = 4000;
     let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());

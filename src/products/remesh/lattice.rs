@@ -1,7 +1,7 @@
 //! The finest lattice: cubic cells of edge `h`, integer corner coordinates, the coarse level and
 //! the margin whose outermost corners are declared outside.
 
-use crate::BoundingBox;
+use crate::base::bounding_box::BoundingBox;
 
 /// The coarse level has about this many cells along the longest axis (inside the margin): fine
 /// enough that a thin part is rarely missed by every coarse corner, coarse enough that its

@@ -43,7 +43,7 @@ pub mod place;
 pub mod report;
 pub mod write;
 
-use crate::BoundingBox;
+use crate::base::bounding_box::BoundingBox;
 use crate::eval::Evaluator;
 #[cfg(doc)]
 use crate::eval::antipodal::WindingNumber;

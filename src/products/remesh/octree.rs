@@ -105,7 +105,7 @@ pub fn classify<E: Evaluator + ?Sized>(
     // The coarse corners as a grid of cell-centre samples: a box half a coarse cell larger on
     // every side puts the sample centres on the corners.
     let ch = lattice.h * f64::from(coarse);
-    let bounds = crate::BoundingBox {
+    let bounds = crate::base::bounding_box::BoundingBox {
         min: [0, 1, 2].map(|a| lattice.origin[a] - 0.5 * ch),
         max: [0, 1, 2].map(|a| lattice.origin[a] + (cc[a] as f64 + 0.5) * ch),
     };

@@ -228,7 +228,7 @@ fn nonmanifold_vertices(n: usize, triangles: &[[u32; 3]]) -> usize {
 pub fn occupancy_agreement<A, B>(
     input: &A,
     output: &B,
-    bounds: crate::BoundingBox,
+    bounds: crate::base::bounding_box::BoundingBox,
     samples: usize,
     seed: u64,
 ) -> Option<f64>

@@ -32,7 +32,7 @@ impl SurfaceFormat {
 pub fn write_surface(
     mut w: impl Write,
     format: SurfaceFormat,
-    mesh: &crate::Mesh,
+    mesh: &crate::mesh::Mesh,
 ) -> io::Result<()> {
     let (positions, triangles) = (mesh.positions(), mesh.triangles());
     match format {
