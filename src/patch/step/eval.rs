@@ -31,7 +31,7 @@ use super::super::curve::{
 };
 use super::super::eval::MAX_EVALUATIONS;
 use super::super::quadrature::{Budget, integrate};
-use super::model::{FacePatch, HIT_MARGIN, StepModel};
+use super::model::{Face, FacePatch, HIT_MARGIN, StepModel};
 use super::trim::Side;
 use crate::base::compensated::NeumaierSum;
 use crate::base::vec3::{cross, dot, norm, sub};
@@ -431,19 +431,7 @@ impl StepWindingNumber {
         let column_margin = COLUMN_HIT_MARGIN * self.model.diagonal();
         let dedup = 1e-9 * self.model.diagonal();
         for face in &self.model.faces {
-            let mut hits: Vec<Hit> = Vec::new();
-            for fp in &face.patches {
-                if ray_meets_box(q, frame.d, fp.lo, fp.hi, dedup) {
-                    patch_hits(fp, q, frame, &mut hits);
-                }
-            }
-            let mut kept: Vec<Hit> = Vec::new();
-            for h in hits {
-                if kept.iter().all(|k| norm(sub(k.point, h.point)) > dedup) {
-                    kept.push(h);
-                }
-            }
-            for h in kept {
+            for h in face_hits(face, q, frame, dedup) {
                 let n = cross(h.su, h.sv);
                 let nn = norm(n);
                 let c = face.sense * dot(n, frame.d) / nn;
@@ -478,20 +466,7 @@ impl StepWindingNumber {
         let mut chi = 0i64;
         let dedup = 1e-9 * self.model.diagonal();
         for face in &self.model.faces {
-            let mut hits: Vec<Hit> = Vec::new();
-            for fp in &face.patches {
-                if !ray_meets_box(q, frame.d, fp.lo, fp.hi, dedup) {
-                    continue;
-                }
-                patch_hits(fp, q, frame, &mut hits);
-            }
-            let mut kept: Vec<Hit> = Vec::new();
-            for h in hits {
-                if kept.iter().all(|k| norm(sub(k.point, h.point)) > dedup) {
-                    kept.push(h);
-                }
-            }
-            for h in kept {
+            for h in face_hits(face, q, frame, dedup) {
                 let n = cross(h.su, h.sv);
                 let nn = norm(n);
                 let c = face.sense * dot(n, frame.d) / nn;
@@ -561,6 +536,24 @@ fn certify(h: Vec<Homogeneous>, mu: f64, depth: u32, out: &mut Vec<Vec<Homogeneo
     let ok_a = certify(a, mu, depth + 1, out);
     let ok_b = certify(b, mu, depth + 1, out);
     ok_a && ok_b
+}
+
+/// The ray's hits on the patches of `face` (patches whose box it misses are skipped), with hits
+/// closer than `dedup` to an earlier one dropped (a hit on the seam of two patches is one hit).
+fn face_hits(face: &Face, q: [f64; 3], frame: &RayFrame, dedup: f64) -> Vec<Hit> {
+    let mut hits: Vec<Hit> = Vec::new();
+    for fp in &face.patches {
+        if ray_meets_box(q, frame.d, fp.lo, fp.hi, dedup) {
+            patch_hits(fp, q, frame, &mut hits);
+        }
+    }
+    let mut kept: Vec<Hit> = Vec::new();
+    for h in hits {
+        if kept.iter().all(|k| norm(sub(k.point, h.point)) > dedup) {
+            kept.push(h);
+        }
+    }
+    kept
 }
 
 /// Slab test of the ray `q + τ d, τ ≥ 0` against a box grown by `pad`.
