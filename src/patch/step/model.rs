@@ -231,7 +231,7 @@ impl StepModel {
                 });
             }
             info.trim_segments += segments.len();
-            let trim = Trim::new(segments, period_u, sense);
+            let trim = Trim::with_periods(segments, period_u, period_v, sense);
             let [u0, mut u1, mut v0, mut v1] = trim.bbox;
             if let Some(p) = period_u {
                 u1 = u1.min(u0 + p);

@@ -30,10 +30,17 @@ pub struct Trim {
     pub segments: Vec<Segment>,
     /// Period of `u`, if any.
     pub period_u: Option<f64>,
+    /// Period of `v`, if any (tori; periodic B-spline surfaces).
+    pub period_v: Option<f64>,
     /// `+1` if the face normal is `S_u × S_v`, `−1` if opposite.
     pub sense: f64,
     /// Bounding box of the segments: `[u0, u1, v0, v1]`.
     pub bbox: [f64; 4],
+    /// Doubly periodic surfaces: the indicator of a point whose row and column meet no face
+    /// boundary (every boundary loop then closes in the plane): 1 unless the boundary loops
+    /// enclose the face (positive signed area with the face's sense): a full torus or a torus
+    /// with holes gives 1, a disk-shaped piece of a torus 0.
+    free_inside: bool,
 }
 
 /// Where a point lies relative to the loops.
@@ -49,8 +56,18 @@ pub enum Side {
 }
 
 impl Trim {
-    /// Builds the trim from segments.
+    /// Builds the trim from segments (periodic in `u` at most).
     pub fn new(segments: Vec<Segment>, period_u: Option<f64>, sense: f64) -> Trim {
+        Trim::with_periods(segments, period_u, None, sense)
+    }
+
+    /// Builds the trim from segments on a surface with the given periods.
+    pub fn with_periods(
+        segments: Vec<Segment>,
+        period_u: Option<f64>,
+        period_v: Option<f64>,
+        sense: f64,
+    ) -> Trim {
         let mut bbox = [
             f64::INFINITY,
             f64::NEG_INFINITY,
@@ -65,11 +82,20 @@ impl Trim {
                 bbox[3] = bbox[3].max(p[1]);
             }
         }
+        // Twice the signed area of the boundary loops (seams left out: a face crosses each
+        // of its seams once each way).
+        let area2: f64 = segments
+            .iter()
+            .filter(|s| s.real)
+            .map(|s| s.a[0] * s.b[1] - s.b[0] * s.a[1])
+            .sum();
         Trim {
             segments,
             period_u,
+            period_v,
             sense,
             bbox,
+            free_inside: area2 * sense <= 0.0,
         }
     }
 
@@ -102,15 +128,37 @@ impl Trim {
         let mut top: Option<(f64, i64)> = None;
         let mut above = 0i64;
         let mut near = false;
+        // With a period in v the column is a circle: crossings are read in (v, v + period]
+        // (all "above"), seams are left out (a face's seam along u is crossed once each way
+        // at the same place, which would make the topmost crossing ambiguous).
+        let v_wrap = |vc: f64| match self.period_v {
+            Some(p) => vc - p * ((vc - uv[1]) / p).ceil() + p,
+            None => vc,
+        };
         for s in &self.segments {
             let shift = match self.period_u {
                 Some(p) => p * ((0.5 * (s.a[0] + s.b[0]) - uv[0]) / p).round(),
                 None => 0.0,
             };
+            // The segment's copy nearest the point in v, for the distance test.
+            let shift_v = match self.period_v {
+                Some(p) => p * ((0.5 * (s.a[1] + s.b[1]) - uv[1]) / p).round(),
+                None => 0.0,
+            };
             let u = uv[0] + shift;
             let (ua, ub) = (s.a[0], s.b[0]);
-            if (ua <= u && u < ub) || (ub <= u && u < ua) {
-                let vc = s.a[1] + (u - ua) / (ub - ua) * (s.b[1] - s.a[1]);
+            // For the crossing, the copy of the point in [lo, lo + period) of the segment's
+            // lower end (the nearest copy misses a segment spanning a whole period at its end).
+            let uq = match self.period_u {
+                Some(p) => {
+                    let lo = ua.min(ub);
+                    uv[0] - p * ((uv[0] - lo) / p).floor()
+                }
+                None => uv[0],
+            };
+            let counted = s.real || self.period_v.is_none();
+            if counted && ((ua <= uq && uq < ub) || (ub <= uq && uq < ua)) {
+                let vc = v_wrap(s.a[1] + (uq - ua) / (ub - ua) * (s.b[1] - s.a[1]));
                 let sign = if ub > ua { 1 } else { -1 } * if self.sense < 0.0 { -1 } else { 1 };
                 if vc > uv[1] {
                     above += sign;
@@ -123,7 +171,7 @@ impl Trim {
                 // Closest point of the segment in (u, v), its offset mapped to 3D by the
                 // surface's first derivatives at the point (a local, first-order distance).
                 let d = [s.b[0] - ua, s.b[1] - s.a[1]];
-                let w = [u - ua, uv[1] - s.a[1]];
+                let w = [u - ua, uv[1] + shift_v - s.a[1]];
                 let dd = d[0] * d[0] + d[1] * d[1];
                 let t = if dd > 0.0 {
                     ((w[0] * d[0] + w[1] * d[1]) / dd).clamp(0.0, 1.0)
@@ -141,11 +189,48 @@ impl Trim {
                 }
             }
         }
-        let ind = match top {
-            None => 0,
-            Some((_, sign)) => i64::from(sign > 0) - above,
+        let ind = match (top, self.period_v) {
+            (Some((_, sign)), _) => i64::from(sign > 0) - above,
+            (None, None) => 0,
+            // A column circle meeting no boundary is all inside or all outside: the row decides.
+            (None, Some(_)) => self.row_indicator(uv),
         };
         (near, ind)
+    }
+
+    /// The indicator read along the row `v = v*` (surfaces periodic in `v`, for a column that
+    /// meets no boundary): the side of the nearest boundary crossing to the right (modulo the
+    /// period of `u`); the face lies left of its loops, so a loop running in `+v` has it at
+    /// smaller `u`. No crossing: the row is a circle meeting no boundary either, and
+    /// `free_inside` decides.
+    fn row_indicator(&self, uv: [f64; 2]) -> i64 {
+        let mut nearest: Option<(f64, i64)> = None;
+        for s in self.segments.iter().filter(|s| s.real) {
+            let (va, vb) = (s.a[1], s.b[1]);
+            // The copy of the point in [lo, lo + period) of the segment's lower end.
+            let v = match self.period_v {
+                Some(p) => uv[1] - p * ((uv[1] - va.min(vb)) / p).floor(),
+                None => uv[1],
+            };
+            if !((va <= v && v < vb) || (vb <= v && v < va)) {
+                continue;
+            }
+            let uc = s.a[0] + (v - va) / (vb - va) * (s.b[0] - s.a[0]);
+            let uc = match self.period_u {
+                Some(p) => uc - p * ((uc - uv[0]) / p).ceil() + p,
+                None if uc > uv[0] => uc,
+                None => continue,
+            };
+            let sign = if vb > va { 1 } else { -1 } * if self.sense < 0.0 { -1 } else { 1 };
+            if nearest.is_none_or(|(n, _)| uc < n) {
+                nearest = Some((uc, sign));
+            }
+        }
+        match nearest {
+            Some((_, sign)) => i64::from(sign > 0),
+            None if self.period_u.is_some() => i64::from(self.free_inside),
+            None => 0,
+        }
     }
 }
 
@@ -214,7 +299,7 @@ mod tests {
             },
         ];
         let t = Trim::new(band, Some(TAU), 1.0);
-        for u in [-7.0, 0.1, 3.0, 6.2, 20.0] {
+        for u in [-7.0, 0.0, 0.1, 3.0, 6.2, TAU, 20.0] {
             assert_eq!(t.indicator([u, 0.5]), 1, "{u}");
             assert_eq!(t.indicator([u, 1.5]), 0);
             assert_eq!(t.indicator([u, -0.5]), 0);
@@ -228,5 +313,69 @@ mod tests {
         let t = Trim::new(cap, Some(TAU), 1.0);
         assert_eq!(t.indicator([0.2, 1.0]), 1);
         assert_eq!(t.indicator([0.2, 0.0]), 0);
+    }
+
+    #[test]
+    fn doubly_periodic_domains() {
+        use std::f64::consts::TAU;
+        let seg = |a: [f64; 2], b: [f64; 2], real: bool| Segment { a, b, real };
+        // Full torus: the loop is the two seams, each once each way.
+        let full = vec![
+            seg([0., 0.], [TAU, 0.], false),
+            seg([TAU, 0.], [TAU, TAU], false),
+            seg([TAU, TAU], [0., TAU], false),
+            seg([0., TAU], [0., 0.], false),
+        ];
+        let t = Trim::with_periods(full, Some(TAU), Some(TAU), 1.0);
+        for uv in [[0.1, 0.2], [3.0, -3.0], [-7.0, 9.0], [6.2, 6.2]] {
+            assert_eq!(t.indicator(uv), 1, "{uv:?}");
+        }
+        // Band 0 < u < 1 around v: the loops are v-circles (−v at u = 0, +v at u = 1).
+        let band = vec![
+            seg([0., 0.], [0., -TAU], true),
+            seg([1., 0.], [1., TAU], true),
+        ];
+        let t = Trim::with_periods(band, Some(TAU), Some(TAU), 1.0);
+        for v in [-9.0, -1.0, 0.0, 2.0, 6.0, 13.0] {
+            assert_eq!(t.indicator([0.5, v]), 1, "{v}");
+            assert_eq!(t.indicator([0.5 + TAU, v]), 1, "{v}");
+            assert_eq!(t.indicator([2.0, v]), 0, "{v}");
+            assert_eq!(t.indicator([-0.5, v]), 0, "{v}");
+        }
+        // A square piece [1, 2]² of the torus (counter-clockwise) and the torus minus it.
+        let square = |ccw: bool| {
+            let p = [[1., 1.], [2., 1.], [2., 2.], [1., 2.]];
+            (0..4)
+                .map(|k| {
+                    let (a, b) = (p[k], p[(k + 1) % 4]);
+                    if ccw {
+                        seg(a, b, true)
+                    } else {
+                        seg(b, a, true)
+                    }
+                })
+                .collect::<Vec<_>>()
+        };
+        let piece = Trim::with_periods(square(true), Some(TAU), Some(TAU), 1.0);
+        let holed = Trim::with_periods(square(false), Some(TAU), Some(TAU), 1.0);
+        for (uv, inside) in [
+            ([1.5, 1.5], true),
+            ([1.5 + TAU, 1.5 - TAU], true),
+            ([1.5, 4.0], false),
+            ([4.0, 1.5], false),
+            ([4.0, 4.0], false),
+            ([-0.5, -3.0], false),
+        ] {
+            assert_eq!(piece.indicator(uv), i64::from(inside), "{uv:?}");
+            assert_eq!(holed.indicator(uv), i64::from(!inside), "{uv:?}");
+        }
+        // A piece across the seam v = π as the inversion unwraps it: v ∈ [2.5, 3.8].
+        let p = [[0.2, 2.5], [0.9, 2.5], [0.9, 3.8], [0.2, 3.8]];
+        let across: Vec<Segment> = (0..4).map(|k| seg(p[k], p[(k + 1) % 4], true)).collect();
+        let t = Trim::with_periods(across, Some(TAU), Some(TAU), 1.0);
+        assert_eq!(t.indicator([0.5, 3.7 - TAU]), 1);
+        assert_eq!(t.indicator([0.5, 2.6]), 1);
+        assert_eq!(t.indicator([0.5, 0.0]), 0);
+        assert_eq!(t.indicator([0.5, 2.4 - TAU]), 0);
     }
 }
