@@ -257,8 +257,8 @@ fn full_torus_is_an_exact_solid() {
     for (u, v) in [
         (0.0, 0.0),
         (0.0, 3.0),
-        (3.1, 3.1416),
-        (-1.0, -3.1416),
+        (3.1, PI + 1e-5),
+        (-1.0, -PI - 1e-5),
         (4.0, 0.0),
     ] {
         let (p, n) = (torus_point(u, v), torus_normal(u, v));
