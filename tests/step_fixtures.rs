@@ -355,3 +355,33 @@ fn torus_band_wrapping_in_v_is_trimmed() {
     // parameter plane (the row decides).
     check_torus_face("torus_band.step", [0.0, FRAC_PI_2], [-PI, PI], 2);
 }
+
+#[test]
+fn oblique_trim_on_rational_arcs() {
+    // A cylinder face cut by an ellipse that crosses its rational quarter-arc patches
+    // obliquely. A hit's u must be the cylinder's angle, not the arc's patch parameter read
+    // linearly (off by up to ~1°, which moves the top curve by up to 8e-3 here and made
+    // boxed_sphere.step count a fillet hit twice): the jump across the face is 1 just below the
+    // curve and 0 just above it, all around.
+    let m = load_step(&fixture("sliced_tube.step")).unwrap();
+    assert_eq!(m.info().boundary_edges, 2, "{:?}", m.info());
+    let wn = StepWindingNumber::new(&m);
+    for deg in [
+        7.0, 20.0, 33.0, 67.0, 110.0, 160.0, 200.0, 250.0, 290.0, 315.0, 350.0,
+    ] {
+        let u: f64 = deg * PI / 180.0;
+        let top = 1.0 + 0.5 * u.cos();
+        for (dz, expected) in [(-3e-3, 1.0), (3e-3, 0.0), (-0.3, 1.0), (0.1, 0.0)] {
+            let z = top + dz;
+            let at = |r: f64| [r * u.cos(), r * u.sin(), z];
+            // 2e-5 off the surface: beyond the hit margin, close enough that the boundary term
+            // changes by < 1e-2 between the two points. (3e-3 from the top curve no ray passes
+            // the strict boundary certificate; the relaxed pass decides the hits the same way.)
+            let jump = wn.eval(at(1.0 - 2e-5)) - wn.eval(at(1.0 + 2e-5));
+            assert!(
+                (jump - expected).abs() < 1e-2,
+                "u {deg}°, z = top {dz:+}: jump {jump}, expected {expected}"
+            );
+        }
+    }
+}
