@@ -9,6 +9,7 @@ use gwn::eval::direct::{winding_number_direct_batch, winding_number_gradient_dir
 use gwn::eval::fast::{FastParams, FastWindingNumber, PointCloudWindingNumber};
 use gwn::kernel::frame::RayAxis;
 use gwn::kernel::quantize::Precision;
+use gwn::patch::step::{StepEvaluation, StepWindingNumber};
 use rayon::prelude::*;
 
 /// `1/4π` exactly as `WindingNumber::eval` multiplies the boundary sum with, so that
@@ -129,6 +130,9 @@ pub enum Evaluator {
     FastSoup(FastWindingNumber),
     /// Barnes–Hut over an oriented point cloud.
     FastCloud(PointCloudWindingNumber),
+    /// A trimmed B-rep (STEP) model: crossings of the trimmed faces plus the surface-boundary
+    /// integral (boxed: the model is large).
+    Step(Box<StepWindingNumber>),
 }
 
 impl Evaluator {
@@ -155,6 +159,7 @@ impl Evaluator {
             Evaluator::Direct(_) => "direct",
             Evaluator::FastSoup(_) => "fast",
             Evaluator::FastCloud(_) => "fast point-cloud",
+            Evaluator::Step(_) => "trimmed B-rep (STEP)",
         }
     }
 
@@ -165,6 +170,15 @@ impl Evaluator {
             Evaluator::Direct(mesh) => winding_number_direct_batch(mesh, points),
             Evaluator::FastSoup(f) => f.eval_batch(points),
             Evaluator::FastCloud(f) => f.eval_batch(points),
+            Evaluator::Step(s) => s.eval_batch(points),
+        }
+    }
+
+    /// Evaluations with diagnostics (STEP models only), in parallel on the current rayon pool.
+    pub fn step_batch(&self, points: &[[f64; 3]]) -> Option<Vec<StepEvaluation>> {
+        match self {
+            Evaluator::Step(s) => Some(points.par_iter().map(|&q| s.evaluate(q)).collect()),
+            _ => None,
         }
     }
 
@@ -220,8 +234,12 @@ impl Evaluator {
         }
     }
 
-    /// Number of boundary edges (exact method).
+    /// Number of boundary edges (exact method; STEP models: edge uses left as the surface
+    /// boundary).
     pub fn boundary_edge_count(&self) -> Option<usize> {
-        self.exact().map(WindingNumber::boundary_edge_count)
+        match self {
+            Evaluator::Step(s) => Some(s.model().info().boundary_edges),
+            _ => self.exact().map(WindingNumber::boundary_edge_count),
+        }
     }
 }

@@ -28,27 +28,34 @@ pub fn report_skip(what: &str) {
     );
 }
 
-/// `../shared/meshes` if present, else reports the skip ([`report_skip`]) and returns `None`.
+/// The shared corpus: `$GWN_SHARED_DIR` if set (a checkout not beside it, e.g. a worktree), else
+/// `../shared` beside the clone (CI).
+pub fn shared_dir() -> std::path::PathBuf {
+    std::env::var_os("GWN_SHARED_DIR")
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|| std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared"))
+}
+
+/// `<shared>/meshes` ([`shared_dir`]) if present, else reports the skip ([`report_skip`]) and
+/// returns `None`.
 pub fn shared_meshes() -> Option<std::path::PathBuf> {
-    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes");
+    let p = shared_dir().join("meshes");
     if p.join("manifest.csv").exists() {
         Some(p)
     } else {
-        report_skip("../shared/meshes");
+        report_skip(&p.display().to_string());
         None
     }
 }
 
-/// A file of the shared corpus (`../shared/…`, `relative` below `../shared`), or `None` after
+/// A file (or folder) of the shared corpus (`relative` below [`shared_dir`]), or `None` after
 /// reporting the skip ([`report_skip`]).
 pub fn shared_file(relative: &str) -> Option<std::path::PathBuf> {
-    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared")
-        .join(relative);
+    let p = shared_dir().join(relative);
     if p.exists() {
         Some(p)
     } else {
-        report_skip(&format!("../shared/{relative}"));
+        report_skip(&p.display().to_string());
         None
     }
 }

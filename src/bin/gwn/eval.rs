@@ -261,7 +261,26 @@ fn run_step(args: &Args) -> Result<(), CliError> {
             tolerance: args.tolerance,
         },
     );
-    let values = wn.eval_batch(&points);
+    let evaluations: Vec<gwn::patch::step::StepEvaluation> = {
+        use rayon::prelude::*;
+        points.par_iter().map(|&q| wn.evaluate(q)).collect()
+    };
+    // The flag of docs/patches.md ("Trimmed B-rep models"): no ray direction passed the
+    // certificates (query on or within the margins of the surface or an edge), or the work cap.
+    let uncertified = evaluations.iter().filter(|e| e.uncertified).count();
+    if uncertified > 0 {
+        let worst = evaluations
+            .iter()
+            .filter(|e| e.uncertified)
+            .fold(0.0f64, |a, e| a.max(e.error_estimate));
+        eprintln!(
+            "gwn eval: warning: {uncertified} of {} values uncertified (on or within the margins \
+             of the surface or an edge, or work cap reached; largest error estimate {worst:.1e}); \
+             see docs/patches.md",
+            points.len()
+        );
+    }
+    let values: Vec<f64> = evaluations.iter().map(|e| e.value).collect();
     write_outputs(args, &values, None)
 }
 
