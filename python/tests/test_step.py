@@ -116,7 +116,7 @@ def test_uncertified_values_warn_and_are_flagged(cli, tmp_path):
     ({"ray": "-x"}, r"ray does not apply to the exact method on a STEP model \(its evaluator "
                     r"chooses a ray per query\)"),
     ({"precision": 30}, "precision does not apply to the exact method on a STEP model"),
-    ({"beta": 1.0}, r"beta does not apply to the exact method \(it is an option of fast\)"),
+    ({"beta": 1.0}, r"beta does not apply to the exact method \(it is an option of the fast method\)"),
     ({"F": np.zeros((1, 3), dtype=np.int64)}, "F does not apply to a STEP model"),
 ])
 def test_options_that_do_not_apply_are_refused(kwargs, message):
