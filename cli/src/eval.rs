@@ -93,6 +93,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
         let values = eval_patches(set, &spec, &points);
         return write_outputs(&args, &values, None);
     }
+    if let Input::Step(model) = &input {
+        // The STEP evaluator's own loop, for its certification flags.
+        refuse_gradient(&args, &input.kind().to_string())?;
+        let points = gwn::io::points::load_points(&args.points)?;
+        let values = eval_step(model, &spec, &points);
+        return write_outputs(&args, &values, None);
+    }
     let wn = crate::method::build(&spec, &input, &args.mesh)?;
     if args.gradient && wn.try_gradient([0.0; 3]).is_err() {
         // Whether an evaluator has a gradient does not depend on the query: refuse up front.
@@ -138,6 +145,34 @@ fn eval_patches(set: &gwn::patch::PatchSet, spec: &EvaluatorSpec, points: &[[f64
             "gwn eval: warning: {uncertified} of {} values uncertified (on or within rounding of \
              the surface, or work cap reached; largest error estimate {worst:.1e}); see \
              docs/patches.md",
+            points.len()
+        );
+    }
+    evaluations.iter().map(|e| e.value).collect()
+}
+
+/// STEP models: values, and a warning for the uncertified ones.
+fn eval_step(
+    model: &gwn::patch::step::StepModel,
+    spec: &EvaluatorSpec,
+    points: &[[f64; 3]],
+) -> Vec<f64> {
+    use rayon::prelude::*;
+    let wn = gwn::patch::step::StepWindingNumber::with_options(model, spec.step_options());
+    let evaluations: Vec<gwn::patch::step::StepEvaluation> =
+        points.par_iter().map(|&q| wn.evaluate(q)).collect();
+    // The flag of docs/patches.md ("Trimmed B-rep models"): no ray direction passed the
+    // certificates (query on or within the margins of the surface or an edge), or the work cap.
+    let uncertified = evaluations.iter().filter(|e| e.uncertified).count();
+    if uncertified > 0 {
+        let worst = evaluations
+            .iter()
+            .filter(|e| e.uncertified)
+            .fold(0.0f64, |a, e| a.max(e.error_estimate));
+        eprintln!(
+            "gwn eval: warning: {uncertified} of {} values uncertified (on or within the margins \
+             of the surface or an edge, or work cap reached; largest error estimate {worst:.1e}); \
+             see docs/patches.md",
             points.len()
         );
     }

@@ -19,8 +19,24 @@ _Method = Literal["exact", "direct", "fast"]
 _Ray = Literal["+x", "-x", "+y", "-y", "+z", "-z"]
 _Grid = Tuple[_F64, _F64, _F64]
 
+class StepModel:
+    """A trimmed B-rep model read from a STEP file by ``load("part.step")``; evaluate it with
+    ``WindingNumber(model, tolerance=1e-10)``. Pickles by its path."""
+
+    @property
+    def path(self) -> str: ...
+    @property
+    def info(self) -> dict:
+        """Counts as ``gwn info`` prints them (faces, patches, surfaces, edges, boundary_edges,
+        cancelled_exact, cancelled_matched, trim_segments, solids, shells, unit)."""
+    @property
+    def closed(self) -> bool:
+        """No surface boundary: w is an exact integer off the surface."""
+    @property
+    def bounding_box(self) -> Tuple[_F64, _F64]: ...
+
 class WindingNumber:
-    """Winding-number evaluator of one mesh or oriented point cloud, built once.
+    """Winding-number evaluator of one mesh, oriented point cloud or STEP model, built once.
 
     ``method``: "exact" (Antipodal method, default), "direct" (solid-angle sum) or "fast"
     (Barnes-Hut with accuracy ``beta``, default 2, and expansion ``order``, default 2).
@@ -31,12 +47,17 @@ class WindingNumber:
     a certified error bound (``eval_with_bound``); the integer part is always exact, 0 is the
     flat exact loop. Calls release the GIL; one object may be used from several Python threads
     at once. Picklable (rebuilt from its arrays and options).
+
+    ``WindingNumber(model, tolerance=1e-10)`` with a ``StepModel``: the trimmed B-rep evaluator
+    of ``gwn eval part.step`` (``tolerance > 0``; the other options do not apply). Uncertified
+    values (on or near the surface or an edge) raise a ``RuntimeWarning``; see
+    ``eval_with_status``.
     """
 
     def __init__(
         self,
-        V: _Floats,
-        F: _Indices,
+        V: Union[_Floats, StepModel],
+        F: Optional[_Indices] = None,
         method: _Method = "exact",
         beta: Optional[float] = None,
         order: Optional[int] = None,
@@ -63,6 +84,10 @@ class WindingNumber:
     def eval_with_bound(self, Q: _Floats, threads: Optional[int] = None) -> Tuple[_F64, _F64]:
         """``(w, bound)``, float64 (n,) each: ``w == self(Q)`` and a certified bound on
         ``|w - w_flat|`` (the flat loop, tolerance 0), ``0 <= bound <= tolerance``. Exact only."""
+    def eval_with_status(
+        self, Q: _Floats, threads: Optional[int] = None
+    ) -> Tuple[_F64, _F64, npt.NDArray[np.bool_]]:
+        """STEP models: ``(w, error_estimate, uncertified)`` at the rows of ``Q``, no warning."""
     @property
     def method(self) -> _Method:
         """The evaluation method."""
@@ -234,8 +259,12 @@ def gauwn(
 ) -> Tuple[_F64, _F64]:
     """Gaussian-smoothed winding number of a polygon at the rows of Q (k, 2) (and its gradient)."""
 
+@overload
 def load(path: _Path, weld: Optional[bool] = None) -> Tuple[_F64, _I64]:
     """Reads a mesh (OBJ, STL, OFF, PLY, glTF/GLB) as (V float64 (n, 3), F int64 (m, 3))."""
+@overload
+def load(path: _Path, weld: None = None) -> StepModel:
+    """A ``.step``/``.stp`` path gives a ``StepModel``."""
 
 def load_point_cloud(path: _Path) -> Tuple[_F64, _F64, Optional[_F64]]:
     """Reads an oriented point cloud as (P, N, A or None)."""

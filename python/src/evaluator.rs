@@ -8,6 +8,7 @@ use gwn::eval::antipodal::{DEFAULT_TOLERANCE, WindingNumber};
 use gwn::eval::direct::{winding_number_direct_batch, winding_number_gradient_direct};
 use gwn::eval::fast::{FastWindingNumber, PointCloudWindingNumber};
 use gwn::input::InputKind;
+use gwn::patch::step::{StepEvaluation, StepModel, StepWindingNumber};
 use gwn::spec::{EvaluatorSpec, Method, SpecError};
 use gwn::{Precision, RayAxis};
 use rayon::prelude::*;
@@ -82,6 +83,9 @@ pub enum Evaluator {
     FastSoup(FastWindingNumber),
     /// Barnes–Hut over an oriented point cloud.
     FastCloud(PointCloudWindingNumber),
+    /// A trimmed B-rep (STEP) model: crossings of the trimmed faces plus the surface-boundary
+    /// integral (boxed: the model is large).
+    Step(Box<StepWindingNumber>),
 }
 
 impl Evaluator {
@@ -99,6 +103,16 @@ impl Evaluator {
         })
     }
 
+    /// Builds the STEP evaluator `spec` describes (checked by the library for STEP models: only
+    /// the exact method, no `ray=`, `precision=` or fast options).
+    pub fn for_step(model: &StepModel, spec: &EvaluatorSpec) -> Result<Self, SpecError> {
+        spec.check(InputKind::Step)?;
+        Ok(Evaluator::Step(Box::new(StepWindingNumber::with_options(
+            model,
+            spec.step_options(),
+        ))))
+    }
+
     /// What `Unsupported` calls this evaluator.
     fn description(&self) -> &'static str {
         match self {
@@ -106,6 +120,7 @@ impl Evaluator {
             Evaluator::Direct(_) => "direct",
             Evaluator::FastSoup(_) => "fast",
             Evaluator::FastCloud(_) => "fast point-cloud",
+            Evaluator::Step(_) => "trimmed B-rep (STEP)",
         }
     }
 
@@ -116,6 +131,15 @@ impl Evaluator {
             Evaluator::Direct(mesh) => winding_number_direct_batch(mesh, points),
             Evaluator::FastSoup(f) => f.eval_batch(points),
             Evaluator::FastCloud(f) => f.eval_batch(points),
+            Evaluator::Step(s) => s.eval_batch(points),
+        }
+    }
+
+    /// Evaluations with diagnostics (STEP models only), in parallel on the current rayon pool.
+    pub fn step_batch(&self, points: &[[f64; 3]]) -> Option<Vec<StepEvaluation>> {
+        match self {
+            Evaluator::Step(s) => Some(points.par_iter().map(|&q| s.evaluate(q)).collect()),
+            _ => None,
         }
     }
 
@@ -168,8 +192,12 @@ impl Evaluator {
         }
     }
 
-    /// Number of boundary edges (exact method).
+    /// Number of boundary edges (exact method; STEP models: edge uses left as the surface
+    /// boundary).
     pub fn boundary_edge_count(&self) -> Option<usize> {
-        self.exact().map(WindingNumber::boundary_edge_count)
+        match self {
+            Evaluator::Step(s) => Some(s.model().info().boundary_edges),
+            _ => self.exact().map(WindingNumber::boundary_edge_count),
+        }
     }
 }

@@ -13,6 +13,7 @@ mod label;
 mod loaders;
 mod oneshot;
 mod products;
+mod step;
 mod threads;
 mod winding_number;
 
@@ -21,6 +22,7 @@ use pyo3::prelude::*;
 #[pymodule]
 fn _gwn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<winding_number::PyWindingNumber>()?;
+    m.add_class::<step::PyStepModel>()?;
     m.add_function(wrap_pyfunction!(oneshot::winding_number, m)?)?;
     m.add_function(wrap_pyfunction!(oneshot::fast_winding_number, m)?)?;
     m.add_function(wrap_pyfunction!(products::voxelize, m)?)?;

@@ -6,34 +6,45 @@ use gwn::io::LoadOptions;
 use numpy::PyArray1;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyList;
+use pyo3::types::{PyList, PyTuple};
 
 use crate::arrays::{array1, array2};
 use crate::errors::{load_error, os_error, value_error};
+use crate::step::load_step_model;
 
 fn widen<const N: usize>(rows: Vec<[u32; N]>) -> Vec<[i64; N]> {
     rows.into_iter().map(|r| r.map(i64::from)).collect()
 }
 
-/// Reads a triangle mesh (OBJ, STL ascii/binary, OFF, PLY ascii/binary; format by extension,
-/// else by content) as ``(V, F)``: float64 (n, 3) and int64 (m, 3). Polygons are
+/// Reads a triangle mesh (OBJ, STL ascii/binary, OFF, PLY ascii/binary, glTF/GLB; format by
+/// extension, else by content) as ``(V, F)``: float64 (n, 3) and int64 (m, 3). Polygons are
 /// fan-triangulated. ``weld``: merge bit-identical vertices (default: on for STL and glTF/GLB only).
+/// A STEP file (``.step``/``.stp``: trimmed B-rep, AP203/AP214/AP242) gives a
+/// :class:`StepModel` instead, for ``WindingNumber(model)``.
 /// ``OSError`` when the file (or a glTF buffer file it refers to) cannot be read:
 /// ``FileNotFoundError`` when missing, ``PermissionError`` when not readable; ``ValueError`` when
-/// it is not a valid mesh.
+/// it is not a valid mesh (or STEP model: the message names the entity and its ``#id``).
 #[pyfunction]
 #[pyo3(signature = (path, weld = None))]
 pub fn load<'py>(
     py: Python<'py>,
     path: PathBuf,
     weld: Option<bool>,
-) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+) -> PyResult<Bound<'py, PyAny>> {
+    if gwn::patch::step::is_step_path(&path) {
+        if weld.is_some() {
+            return Err(PyValueError::new_err(
+                "weld does not apply to STEP models (their faces are trimmed surfaces)",
+            ));
+        }
+        return Ok(Bound::new(py, load_step_model(py, path)?)?.into_any());
+    }
     let loaded = py
         .allow_threads(|| gwn::io::load_mesh_with(&path, &LoadOptions { weld }))
         .map_err(load_error)?;
     let positions = loaded.mesh.positions().to_vec();
     let triangles = widen(loaded.mesh.triangles().to_vec());
-    Ok((array2(py, positions)?, array2(py, triangles)?))
+    Ok(PyTuple::new(py, [array2(py, positions)?, array2(py, triangles)?])?.into_any())
 }
 
 /// Reads an oriented point cloud (text ``x y z nx ny nz [area]`` as .xyz/.csv/.txt/.pts, or a

@@ -16,6 +16,7 @@ use crate::arrays::{
 };
 use crate::errors::{mesh_error, value_error};
 use crate::evaluator::{Evaluator, SpecArgs};
+use crate::step::{PyStepModel, warn_uncertified};
 use crate::threads::{self, Threads};
 
 /// `WindingNumber.parts`' result: crossing counts and fractional parts.
@@ -23,6 +24,13 @@ type Parts<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<f64>>);
 
 /// `WindingNumber.eval_with_bound`'s result: values and their certified bounds.
 type Bounded<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
+
+/// `WindingNumber.eval_with_status`' result: values, error estimates, uncertified flags.
+type WithStatus<'py> = (
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<bool>>,
+);
 
 /// What the evaluator was built from, kept for pickling (rebuilt from these on unpickle).
 #[derive(Debug)]
@@ -36,6 +44,8 @@ enum Source {
         /// gives bit-identical values.
         areas: Vec<f64>,
     },
+    /// A STEP model (`gwn.load("part.step")`).
+    Step(Py<PyStepModel>),
 }
 
 /// Winding-number evaluator of one mesh or oriented point cloud, built once.
@@ -52,6 +62,14 @@ enum Source {
 /// the far boundary: far boundary clusters are replaced by a multipole expansion with a certified
 /// error bound (:meth:`WindingNumber.eval_with_bound`); the integer part is always exact, ``0``
 /// is the flat exact loop. Oriented point clouds: :meth:`WindingNumber.from_point_cloud`.
+///
+/// ``WindingNumber(model, tolerance=1e-10)`` with a :class:`StepModel` (``gwn.load("part.step")``)
+/// evaluates the trimmed B-rep model as ``gwn eval part.step`` does: ``tolerance`` (``> 0``) is
+/// the target error of the surface-boundary integral (closed models are exact integers off the
+/// surface); ``method``, ``beta``, ``order``, ``precision`` and ``ray`` do not apply (the
+/// evaluator chooses a ray per query) and must be left at their defaults. Values that could not
+/// be certified (query on or within the margins of the surface or an edge) raise a
+/// ``RuntimeWarning``; :meth:`WindingNumber.eval_with_status` returns the flags.
 ///
 /// Calls release the GIL; one object can be queried from several Python threads at once.
 /// Objects pickle by their arrays and are rebuilt on unpickling.
@@ -116,6 +134,46 @@ impl PyWindingNumber {
         }
     }
 
+    /// Builds the evaluator of a STEP model: the library's rules and messages for the options
+    /// (`EvaluatorSpec::check` on `InputKind::Step`), plus `F`, which only Python can pass.
+    fn from_step(
+        py: Python<'_>,
+        model: Bound<'_, PyStepModel>,
+        f: Option<&Bound<'_, PyAny>>,
+        args: SpecArgs<'_>,
+    ) -> PyResult<Self> {
+        if f.is_some_and(|f| !f.is_none()) {
+            return Err(value_error(
+                "F does not apply to a STEP model (pass the model alone)",
+            ));
+        }
+        let spec = args.spec().map_err(value_error)?;
+        let shared = model.get().model.clone();
+        let evaluator = py
+            .allow_threads(|| Evaluator::for_step(&shared, &spec))
+            .map_err(value_error)?;
+        Ok(PyWindingNumber {
+            evaluator,
+            source: Source::Step(model.unbind()),
+            method: spec.method_for(InputKind::Step),
+            spec,
+        })
+    }
+
+    /// The STEP evaluations at the rows of `q` (n, 3), interruptible.
+    fn step_evaluations(
+        &self,
+        py: Python<'_>,
+        q: &Bound<'_, PyAny>,
+        threads: Option<Threads>,
+    ) -> PyResult<Vec<gwn::patch::step::StepEvaluation>> {
+        with_points(q, "Q", |q| {
+            threads::run_batch(py, threads, q, |piece| {
+                self.evaluator.step_batch(piece).unwrap_or_default()
+            })
+        })
+    }
+
     /// The exact evaluator and mesh, for products that need both.
     pub fn evaluator(&self) -> &Evaluator {
         &self.evaluator
@@ -125,12 +183,12 @@ impl PyWindingNumber {
 #[pymethods]
 impl PyWindingNumber {
     #[new]
-    #[pyo3(signature = (V, F, method = "exact", beta = None, order = None, precision = None, ray = None, tolerance = None))]
+    #[pyo3(signature = (V, F = None, method = "exact", beta = None, order = None, precision = None, ray = None, tolerance = None))]
     #[allow(non_snake_case, clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
         V: &Bound<'_, PyAny>,
-        F: &Bound<'_, PyAny>,
+        F: Option<&Bound<'_, PyAny>>,
         method: &str,
         beta: Option<f64>,
         order: Option<u8>,
@@ -145,6 +203,14 @@ impl PyWindingNumber {
             precision,
             ray,
             tolerance,
+        };
+        if let Ok(model) = V.downcast::<PyStepModel>() {
+            return Self::from_step(py, model.clone(), F, args);
+        }
+        let Some(F) = F.filter(|f| !f.is_none()) else {
+            return Err(value_error(
+                "F (the triangles) is required unless V is a gwn.StepModel",
+            ));
         };
         Self::from_mesh_arrays(py, V, F, args)
     }
@@ -216,10 +282,43 @@ impl PyWindingNumber {
         threads: Option<Threads>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (q, single) = one_or_many::<3>(Q, "Q")?;
+        if let Evaluator::Step(_) = self.evaluator {
+            let evaluations = self.step_evaluations(py, &q, threads)?;
+            warn_uncertified(py, &evaluations)?;
+            let values = evaluations.iter().map(|e| e.value).collect();
+            return values_out(py, values, single);
+        }
         let values = with_points(&q, "Q", |q| {
             threads::run_batch(py, threads, q, |piece| self.evaluator.eval_batch(piece))
         })?;
         values_out(py, values, single)
+    }
+
+    /// STEP models: ``(w, error, uncertified)`` at the rows of ``Q`` (n, 3): float64 (n,)
+    /// values (as ``self(Q)``, without the warning), float64 (n,) error estimates of the
+    /// boundary integral, bool (n,) flags of the values that could not be certified (query on
+    /// or within the margins of the surface or an edge, or the work cap reached; see
+    /// docs/patches.md). ``ValueError`` for the mesh and point-cloud evaluators.
+    #[pyo3(signature = (Q, threads = None))]
+    #[allow(non_snake_case)]
+    fn eval_with_status<'py>(
+        &self,
+        py: Python<'py>,
+        Q: &Bound<'py, PyAny>,
+        threads: Option<Threads>,
+    ) -> PyResult<WithStatus<'py>> {
+        if !matches!(self.evaluator, Evaluator::Step(_)) {
+            return Err(value_error(crate::evaluator::Unsupported {
+                what: "eval_with_status",
+                method: "mesh or point-cloud",
+            }));
+        }
+        let evaluations = self.step_evaluations(py, Q, threads)?;
+        Ok((
+            array1(py, evaluations.iter().map(|e| e.value).collect()),
+            array1(py, evaluations.iter().map(|e| e.error_estimate).collect()),
+            PyArray1::from_vec(py, evaluations.iter().map(|e| e.uncertified).collect()),
+        ))
     }
 
     /// Gradients of the winding number at the rows of ``Q`` (n, 3): float64 array (n, 3).
@@ -296,12 +395,13 @@ impl PyWindingNumber {
         self.method.name()
     }
 
-    /// Number of triangles (0 for a point cloud).
+    /// Number of triangles (0 for a point cloud; B-rep faces for a STEP model).
     #[getter]
     fn face_count(&self) -> usize {
         match &self.source {
             Source::Mesh(m) => m.triangles().len(),
             Source::Cloud { .. } => 0,
+            Source::Step(m) => m.get().model.info().faces,
         }
     }
 
@@ -329,6 +429,12 @@ impl PyWindingNumber {
             Source::Cloud { positions, .. } => format!(
                 "gwn.WindingNumber(method=\"fast\", points={})",
                 positions.len()
+            ),
+            Source::Step(m) => format!(
+                "gwn.WindingNumber(step={:?}, faces={}, tolerance={:e})",
+                m.get().path().display().to_string(),
+                m.get().model.info().faces,
+                self.spec.step_options().tolerance
             ),
         }
     }
@@ -373,6 +479,22 @@ impl PyWindingNumber {
                 )
                     .into_pyobject(py)?;
                 Ok((rebuild, args))
+            }
+            Source::Step(m) => {
+                let cls = py.get_type::<PyWindingNumber>().into_any();
+                // Only the tolerance applies to STEP models (the spec refuses the others).
+                let args = (
+                    m.clone_ref(py),
+                    py.None(),
+                    self.method.name(),
+                    None::<f64>,
+                    None::<u8>,
+                    None::<u32>,
+                    None::<String>,
+                    self.spec.step_options().tolerance,
+                )
+                    .into_pyobject(py)?;
+                Ok((cls, args))
             }
         }
     }

@@ -59,19 +59,19 @@ pub fn shared_meshes() -> Option<std::path::PathBuf> {
     if p.join("manifest.csv").exists() {
         Some(p)
     } else {
-        report_skip("../shared/meshes");
+        report_skip(&p.display().to_string());
         None
     }
 }
 
-/// A file of the shared corpus (`../shared/…`, `relative` below `../shared`), or `None` after
+/// A file (or folder) of the shared corpus (`relative` below [`shared_root`]), or `None` after
 /// reporting the skip ([`report_skip`]).
 pub fn shared_file(relative: &str) -> Option<std::path::PathBuf> {
     let p = shared_root().join(relative);
     if p.exists() {
         Some(p)
     } else {
-        report_skip(&format!("../shared/{relative}"));
+        report_skip(&p.display().to_string());
         None
     }
 }

@@ -5,14 +5,14 @@
 use crate::common;
 use crate::patch_points;
 
-use std::path::Path;
 use std::time::{Duration, Instant};
 
 use gwn::RayAxis;
 use gwn::patch::eval::{MAX_EVALUATIONS, MAX_PIECES};
 use gwn::patch::{Evaluation, Options, Patch, PatchSet, PatchWindingNumber, load_patches};
 
-const TEAPOT: &str = "../shared/parametric/teapot.bpt";
+/// The teapot, below the shared corpus (`common::shared_root`).
+const TEAPOT: &str = "parametric/teapot.bpt";
 
 /// Work bound of one query: the evaluation cap plus one 15-point rule per boundary piece that
 /// was pending when the cap was reached (`docs/patches.md`, "Time bound").
@@ -50,13 +50,22 @@ fn evaluate_within(wn: &PatchWindingNumber, q: [f64; 3]) -> Evaluation {
 
 #[test]
 fn teapot_near_every_seam_corner_pole_and_curve_returns_and_agrees_on_six_rays() {
-    // `GWN_TEAPOT` for checkouts not beside `../shared` (worktrees).
-    let path = std::env::var("GWN_TEAPOT").unwrap_or_else(|_| TEAPOT.into());
-    if !Path::new(&path).exists() {
-        println!("skipping: {path} not found");
+    // `GWN_TEAPOT` names the file directly; otherwise the shared corpus (`GWN_SHARED_DIR` or
+    // `../shared`), skipping visibly when absent.
+    let path = match std::env::var_os("GWN_TEAPOT") {
+        Some(p) => std::path::PathBuf::from(p),
+        None => {
+            let Some(p) = common::shared_file(TEAPOT) else {
+                return;
+            };
+            p
+        }
+    };
+    if !path.exists() {
+        common::report_skip(&path.display().to_string());
         return;
     }
-    let set = load_patches(Path::new(&path)).unwrap();
+    let set = load_patches(&path).unwrap();
     let evs = evaluators(&set, 1e-10);
     let offsets = [1e-3, 1e-6, 1e-9, 1e-12];
     let mut queries = patch_points::near_feature_queries(&set, &offsets, false);

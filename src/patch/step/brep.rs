@@ -12,8 +12,8 @@ use super::StepError;
 use super::nurbs::{expand_knots, extract, hom, sub_curve};
 use super::part21::{Instance, Part, Part21, Value};
 use super::surface::{
-    Frame, Surface, UvPatch, conic_angle, conic_pieces, detect_periods, frame, invert_curve,
-    next_turn, unit,
+    Frame, ParamMap, Surface, UvPatch, conic_angle, conic_pieces, detect_periods, frame,
+    invert_curve, next_turn, unit,
 };
 use crate::base::vec3::{dot, norm, sub};
 
@@ -718,6 +718,7 @@ impl<'a> Reader<'a> {
                     patch,
                     u: [u0, u1],
                     v: [v0, v1],
+                    map: [ParamMap::Linear, ParamMap::Linear],
                 });
             }
         }
@@ -945,10 +946,13 @@ fn revolution(pieces: &Pieces, a: [f64; 3], d: [f64; 3], tol: f64) -> Result<Sur
                 }
             }
             let patch = Patch::rational(2, c.len() - 1, pts, ws).map_err(|e| e.to_string())?;
+            // The revolution's u is the patch parameter scaled linearly (the trimming loops are
+            // mapped by inverting these same patches, so the two agree).
             patches.push(UvPatch {
                 patch,
                 u: [u0, u1],
                 v: [*t0, *t1],
+                map: [ParamMap::Linear, ParamMap::Linear],
             });
         }
     }

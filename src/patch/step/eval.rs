@@ -792,11 +792,11 @@ fn newton(fp: &FacePatch, q: [f64; 3], frame: &RayFrame, piece: &Piece) -> Optio
     if (r[0] * r[0] + r[1] * r[1]).sqrt() > 1e-9 * scale {
         return None;
     }
-    let du = fp.u[1] - fp.u[0];
-    let dv = fp.v[1] - fp.v[0];
+    // The surface's own (u, v), the parameters the trimming loops are in.
+    let (uv, [du, dv]) = fp.uv_at(st);
     Some(Hit {
         point: p,
-        uv: [fp.u[0] + st[0] * du, fp.v[0] + st[1] * dv],
+        uv,
         su: [ds[0] / du, ds[1] / du, ds[2] / du],
         sv: [dt[0] / dv, dt[1] / dv, dt[2] / dv],
         tau: r[2],

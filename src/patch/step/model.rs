@@ -10,7 +10,7 @@ use super::StepError;
 use super::brep::{Reader, Topology, reverse};
 use super::nurbs::{euc, point_at};
 use super::part21::Part21;
-use super::surface::{Surface, invert_curve};
+use super::surface::{ParamMap, Surface, invert_curve};
 use super::trim::{Segment, Trim};
 use crate::base::vec3::{dot, norm, sub};
 
@@ -43,6 +43,18 @@ pub struct FacePatch {
     pub lo: [f64; 3],
     /// Upper corner.
     pub hi: [f64; 3],
+    /// How the patch parameters map to `u` and `v` (angles of elementary surfaces are not
+    /// linear in the patch parameter).
+    pub map: [ParamMap; 2],
+}
+
+impl FacePatch {
+    /// `(u, v)` of the patch parameters `(s, t)`, with `du/ds` and `dv/dt`.
+    pub fn uv_at(&self, st: [f64; 2]) -> ([f64; 2], [f64; 2]) {
+        let (u, du) = self.map[0].at(self.u, st[0]);
+        let (v, dv) = self.map[1].at(self.v, st[1]);
+        ([u, v], [du, dv])
+    }
 }
 
 /// One trimmed face.
@@ -219,7 +231,7 @@ impl StepModel {
                 });
             }
             info.trim_segments += segments.len();
-            let trim = Trim::new(segments, period_u, sense);
+            let trim = Trim::with_periods(segments, period_u, period_v, sense);
             let [u0, mut u1, mut v0, mut v1] = trim.bbox;
             if let Some(p) = period_u {
                 u1 = u1.min(u0 + p);
@@ -269,6 +281,7 @@ impl StepModel {
                         v: p.v,
                         lo: plo,
                         hi: phi,
+                        map: p.map,
                     }
                 })
                 .collect();

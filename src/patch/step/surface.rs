@@ -36,8 +36,53 @@ impl Frame {
     }
 }
 
+/// How a patch parameter in `[0, 1]` maps to its surface parameter over `[a0, a1]`.
+///
+/// B-spline pieces map linearly. The elementary surfaces' angles do not: their patches are
+/// rational quadratic arcs ([`unit_arcs`]), whose parameter `s` runs linearly in `tan` of half
+/// the angle from the arc's middle, not in the angle. A hit's `(u, v)` must be the surface's own
+/// parameter (the one [`Surface::invert`] gives the trimming loops): on a 90° arc the linear
+/// reading is off by up to 1.2° — harmless where a face's loops run along iso-lines (arc ends
+/// are exact), wrong by that much along a trimming curve that crosses the arcs obliquely
+/// (`boxed_sphere.step`'s fillet cylinders ending in corner blends).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ParamMap {
+    /// `a0 + s (a1 − a0)`.
+    Linear,
+    /// `mid + 2 atan(tan(half/2) (2s − 1))`, `mid`/`half` the middle/half-span of `[a0, a1]`.
+    Arc,
+}
+
+impl ParamMap {
+    /// The surface parameter at `s` over `[a0, a1]` and its derivative `d/ds`.
+    pub fn at(self, a: [f64; 2], s: f64) -> (f64, f64) {
+        match self {
+            ParamMap::Linear => (a[0] + s * (a[1] - a[0]), a[1] - a[0]),
+            ParamMap::Arc => {
+                let mid = 0.5 * (a[0] + a[1]);
+                let k = (0.25 * (a[1] - a[0])).tan();
+                let x = k * (2.0 * s - 1.0);
+                (mid + 2.0 * x.atan(), 4.0 * k / (1.0 + x * x))
+            }
+        }
+    }
+
+    /// The patch parameter of the surface parameter `x` over `[a0, a1]` (inverse of [`Self::at`]).
+    pub fn inverse(self, a: [f64; 2], x: f64) -> f64 {
+        match self {
+            ParamMap::Linear => (x - a[0]) / (a[1] - a[0]),
+            ParamMap::Arc => {
+                let mid = 0.5 * (a[0] + a[1]);
+                let k = (0.25 * (a[1] - a[0])).tan();
+                0.5 * (1.0 + (0.5 * (x - mid)).tan() / k)
+            }
+        }
+    }
+}
+
 /// One Bézier patch of a face with its rectangle in the surface's `(u, v)` parameters: patch
-/// row parameter `s ∈ [0, 1]` ↦ `u`, column parameter `t` ↦ `v` (both increasing).
+/// row parameter `s ∈ [0, 1]` ↦ `u`, column parameter `t` ↦ `v` (both increasing, through
+/// [`ParamMap`]s).
 #[derive(Clone, Debug)]
 pub struct UvPatch {
     /// The patch (rows along `u`).
@@ -46,21 +91,23 @@ pub struct UvPatch {
     pub u: [f64; 2],
     /// `[v0, v1]`.
     pub v: [f64; 2],
+    /// How `s` maps to `u` and `t` to `v`.
+    pub map: [ParamMap; 2],
 }
 
 impl UvPatch {
     /// The patch parameters `(s, t)` of `(u, v)`.
     pub fn local(&self, uv: [f64; 2]) -> [f64; 2] {
         [
-            (uv[0] - self.u[0]) / (self.u[1] - self.u[0]),
-            (uv[1] - self.v[0]) / (self.v[1] - self.v[0]),
+            self.map[0].inverse(self.u, uv[0]),
+            self.map[1].inverse(self.v, uv[1]),
         ]
     }
     /// `(u, v)` of patch parameters.
     pub fn global(&self, st: [f64; 2]) -> [f64; 2] {
         [
-            self.u[0] + st[0] * (self.u[1] - self.u[0]),
-            self.v[0] + st[1] * (self.v[1] - self.v[0]),
+            self.map[0].at(self.u, st[0]).0,
+            self.map[1].at(self.v, st[1]).0,
         ]
     }
 }
@@ -248,10 +295,10 @@ impl Surface {
         let mut out = Vec::new();
         // Product of a u-direction list of arcs/segments and a v-direction list; `point(a, b)`
         // maps the u-factor control value and the v-factor value to a Euclidean point.
-        type Factor = Vec<(f64, f64, Vec<([f64; 2], f64)>)>;
+        type Factor = (ParamMap, Vec<(f64, f64, Vec<([f64; 2], f64)>)>);
         let arcs = |a0: f64, a1: f64| -> Factor {
             let n = unit_arcs(a0, a1).len();
-            unit_arcs(a0, a1)
+            let pieces = unit_arcs(a0, a1)
                 .into_iter()
                 .enumerate()
                 .map(|(k, arc)| {
@@ -263,15 +310,19 @@ impl Surface {
                     };
                     (lo, hi, arc.to_vec())
                 })
-                .collect()
+                .collect();
+            (ParamMap::Arc, pieces)
         };
         let line = |a0: f64, a1: f64| -> Factor {
-            vec![(a0, a1, vec![([a0, 0.0], 1.0), ([a1, 0.0], 1.0)])]
+            (
+                ParamMap::Linear,
+                vec![(a0, a1, vec![([a0, 0.0], 1.0), ([a1, 0.0], 1.0)])],
+            )
         };
         let mut product =
             |fu: Factor, fv: Factor, point: &dyn Fn([f64; 2], [f64; 2]) -> [f64; 3]| {
-                for (u0, u1, cu) in &fu {
-                    for (v0, v1, cv) in &fv {
+                for (u0, u1, cu) in &fu.1 {
+                    for (v0, v1, cv) in &fv.1 {
                         let mut pts = Vec::new();
                         let mut ws = Vec::new();
                         for (a, wa) in cu {
@@ -286,6 +337,7 @@ impl Surface {
                             patch,
                             u: [*u0, *u1],
                             v: [*v0, *v1],
+                            map: [fu.0, fv.0],
                         });
                     }
                 }
@@ -343,6 +395,8 @@ impl Surface {
                         patch,
                         u: [*t0, *t1],
                         v,
+                        // The swept curve's own parameter (pieces and inversion agree).
+                        map: [ParamMap::Linear, ParamMap::Linear],
                     });
                 }
             }
@@ -455,10 +509,9 @@ fn invert_patches(
             .find(|up| up.u[0] <= uv[0] && uv[0] <= up.u[1] && up.v[0] <= uv[1] && uv[1] <= up.v[1])
             .unwrap_or(&patches[0]);
         let st = up.local(uv);
-        let (x, ds, dt) = up
-            .patch
-            .eval_with_partials(st[0].clamp(0.0, 1.0), st[1].clamp(0.0, 1.0));
-        let (du, dv) = (up.u[1] - up.u[0], up.v[1] - up.v[0]);
+        let st = [st[0].clamp(0.0, 1.0), st[1].clamp(0.0, 1.0)];
+        let (x, ds, dt) = up.patch.eval_with_partials(st[0], st[1]);
+        let (du, dv) = (up.map[0].at(up.u, st[0]).1, up.map[1].at(up.v, st[1]).1);
         (x, scale(ds, 1.0 / du), scale(dt, 1.0 / dv))
     };
     let newton = |start: [f64; 2]| -> (f64, [f64; 2]) {
@@ -638,6 +691,38 @@ pub fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn patch_parameters_map_to_the_surface_angles() {
+        // Every point of a torus's rational patches (arcs in u and v, spans of 1° … 90°) is at
+        // the angles `global` gives its patch parameters, as `invert` reads them; `local`
+        // inverts `global`; the derivative is the angle's.
+        let f = frame([0.1, -0.2, 0.3], Some([0.0, 0.6, 0.8]), None).unwrap();
+        let torus = Surface::Torus(f, 2.0, 0.5);
+        for (u, v) in [
+            ([0.3, 2.9], [-1.0, 0.2]),
+            ([-0.01, 0.01], [3.0, 3.1]),
+            ([0.0, TAU], [0.0, TAU]),
+        ] {
+            for up in torus.patches(u, v).unwrap() {
+                assert_eq!(up.map, [ParamMap::Arc, ParamMap::Arc]);
+                for k in 0..=8 {
+                    let st = [k as f64 / 8.0, (8 - k) as f64 / 8.0];
+                    let x = up.patch.eval(st[0], st[1]);
+                    let uv = up.global(st);
+                    let inv = torus.invert(x, Some(uv));
+                    assert!((inv[0] - uv[0]).abs() < 1e-12, "{st:?} {uv:?} {inv:?}");
+                    assert!((inv[1] - uv[1]).abs() < 1e-12, "{st:?} {uv:?} {inv:?}");
+                    let back = up.local(uv);
+                    assert!((back[0] - st[0]).abs() < 1e-12 && (back[1] - st[1]).abs() < 1e-12);
+                    let h = 1e-6;
+                    let (a, da) = up.map[0].at(up.u, st[0]);
+                    let (b, _) = up.map[0].at(up.u, st[0] + h);
+                    assert!(((b - a) / h - da).abs() < 1e-5 * da.abs().max(1.0));
+                }
+            }
+        }
+    }
 
     #[test]
     fn inversion_near_a_pole_of_a_patch_surface() {

@@ -1,0 +1,152 @@
+//! `gwn.StepModel`: a trimmed B-rep model read from a STEP file (`gwn.load("part.step")`),
+//! evaluated by `gwn.WindingNumber(model)` with the CLI's options and errors.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use gwn::patch::step::{StepError, StepModel};
+use pyo3::exceptions::PyRuntimeWarning;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
+
+use crate::arrays::array1;
+use crate::errors::os_error;
+
+/// A STEP file that cannot be read is an `OSError` (`FileNotFoundError` when missing,
+/// `PermissionError` when not readable); one that is read but is not a supported B-rep model is
+/// a `ValueError`. Both carry the CLI's one-line message. (`load_step` names the file in every
+/// error, so whether the file itself could be read is asked of the file system.)
+pub fn step_error(path: &std::path::Path, e: StepError) -> PyErr {
+    match std::fs::File::open(path) {
+        Err(io) => os_error(io.kind(), e.to_string()),
+        Ok(_) => pyo3::exceptions::PyValueError::new_err(e.to_string()),
+    }
+}
+
+/// Reads a STEP model (the body of `gwn.load` for `.step`/`.stp`).
+pub fn load_step_model(py: Python<'_>, path: PathBuf) -> PyResult<PyStepModel> {
+    let model = py
+        .allow_threads(|| gwn::patch::step::load_step(&path))
+        .map_err(|e| step_error(&path, e))?;
+    Ok(PyStepModel {
+        model: Arc::new(model),
+        path,
+    })
+}
+
+/// A trimmed B-rep model read from an ISO 10303-21 (STEP) file by :func:`gwn.load`: its faces
+/// as trimmed rational Bézier patches and its surface boundary (edges no other face shares).
+/// Evaluate it with ``gwn.WindingNumber(model, tolerance=1e-10)``. Coordinates are in the
+/// file's own length unit (:attr:`info` ``["unit"]``). Pickles by its path (the file is read
+/// again on unpickling).
+#[pyclass(module = "gwn", name = "StepModel", frozen)]
+pub struct PyStepModel {
+    pub(crate) model: Arc<StepModel>,
+    path: PathBuf,
+}
+
+#[pymethods]
+impl PyStepModel {
+    /// The path the model was read from.
+    #[getter]
+    pub fn path(&self) -> PathBuf {
+        self.path.clone()
+    }
+
+    /// Counts as ``gwn info`` prints them: ``faces``, ``patches``, ``surfaces`` (faces per
+    /// surface kind), ``edges``, ``boundary_edges`` (edge uses left as the surface boundary),
+    /// ``cancelled_exact``/``cancelled_matched`` (shared-edge pairs), ``trim_segments``,
+    /// ``solids``, ``shells``, ``unit``.
+    #[getter]
+    fn info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let i = self.model.info();
+        let d = PyDict::new(py);
+        d.set_item("faces", i.faces)?;
+        d.set_item("patches", i.patches)?;
+        let s = PyDict::new(py);
+        for (k, v) in &i.surfaces {
+            s.set_item(*k, *v)?;
+        }
+        d.set_item("surfaces", s)?;
+        d.set_item("edges", i.edges)?;
+        d.set_item("boundary_edges", i.boundary_edges)?;
+        d.set_item("cancelled_exact", i.cancelled_exact)?;
+        d.set_item("cancelled_matched", i.cancelled_matched)?;
+        d.set_item("trim_segments", i.trim_segments)?;
+        d.set_item("solids", i.topology.solids)?;
+        d.set_item("shells", i.topology.shells)?;
+        d.set_item("unit", i.topology.length_unit.clone())?;
+        Ok(d)
+    }
+
+    /// ``True`` when every edge use cancels against another (no surface boundary): the winding
+    /// number is then an exact integer off the surface.
+    #[getter]
+    fn closed(&self) -> bool {
+        self.model.boundary().is_empty()
+    }
+
+    /// ``(lo, hi)``: float64 (3,) corners of a box containing the model.
+    #[getter]
+    fn bounding_box<'py>(&self, py: Python<'py>) -> (Bound<'py, PyAny>, Bound<'py, PyAny>) {
+        let (lo, hi) = self.model.bounding_box();
+        (
+            array1(py, lo.to_vec()).into_any(),
+            array1(py, hi.to_vec()).into_any(),
+        )
+    }
+
+    fn __repr__(&self) -> String {
+        let i = self.model.info();
+        format!(
+            "gwn.StepModel({:?}, faces={}, patches={}, boundary_edges={})",
+            self.path.display().to_string(),
+            i.faces,
+            i.patches,
+            i.boundary_edges
+        )
+    }
+
+    /// Pickles by the path: unpickling reads the file again.
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        let load = py.import("gwn")?.getattr("load")?;
+        let args = (self.path.clone(),).into_pyobject(py)?;
+        Ok((load, args))
+    }
+}
+
+/// Warns (``RuntimeWarning``) when some values are uncertified, with the CLI's text.
+pub fn warn_uncertified(
+    py: Python<'_>,
+    evaluations: &[gwn::patch::step::StepEvaluation],
+) -> PyResult<()> {
+    let uncertified = evaluations.iter().filter(|e| e.uncertified).count();
+    if uncertified == 0 {
+        return Ok(());
+    }
+    let worst = evaluations
+        .iter()
+        .filter(|e| e.uncertified)
+        .fold(0.0f64, |a, e| a.max(e.error_estimate));
+    let message =
+        std::ffi::CString::new(uncertified_message(uncertified, evaluations.len(), worst))
+            .unwrap_or_default();
+    PyErr::warn(
+        py,
+        &py.get_type::<PyRuntimeWarning>(),
+        message.as_c_str(),
+        1,
+    )
+}
+
+/// The warning `gwn eval` prints for uncertified STEP values.
+pub fn uncertified_message(uncertified: usize, total: usize, worst: f64) -> String {
+    format!(
+        "{uncertified} of {total} values uncertified (on or within the margins of the \
+         surface or an edge, or work cap reached; largest error estimate {worst:.1e}); see \
+         docs/patches.md"
+    )
+}
