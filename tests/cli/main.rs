@@ -17,3 +17,4 @@ mod generate;
 mod info;
 mod methods;
 mod patch_tolerance;
+mod readme;
