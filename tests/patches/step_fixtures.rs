@@ -476,3 +476,73 @@ fn oblique_trim_on_rational_arcs() {
         }
     }
 }
+
+/// `capped_cylinder_pcurves.step`: the capped cylinder whose 3D edges lie 1e-3 outside its
+/// faces (circles of radius 1.001) while the pcurves give the true circles. Mapped from 3D,
+/// the disks overhang the side by 1e-3 and a ray from just outside the wall through that ring
+/// counts a crossing; trimmed by the pcurves, the solid is closed and every ray agrees.
+#[test]
+fn pcurves_trim_the_faces_where_the_3d_edges_stray() {
+    let text = std::fs::read_to_string(fixture("capped_cylinder_pcurves.step")).unwrap();
+    let with = parse_step(&text).unwrap();
+    let info = with.info();
+    // Top and bottom disks 1 use each, the side 4 (two circles, the seam twice).
+    assert_eq!(info.pcurve_uses, 6, "{info:?}");
+    assert_eq!((info.pcurves_rejected, info.pcurves_unreadable), (0, 0));
+    // The same file with its pcurves hidden: every use mapped from 3D.
+    let without = parse_step(&text.replace("PCURVE(", "NOT_A_PCURVE(")).unwrap();
+    assert_eq!(without.info().pcurve_uses, 0);
+    let (a, b) = (
+        StepWindingNumber::new(&with),
+        StepWindingNumber::new(&without),
+    );
+    // Just outside the wall, below the top rim's overhang and above the bottom's.
+    for q in [
+        [1.0005, 0.0, 1.9999],
+        [0.0, -1.0004, 1.9998],
+        [-0.7075, 0.7075, 1e-4],
+    ] {
+        let mut overhang = 0;
+        for &d in a.directions() {
+            let ea = a.evaluate_along(q, d).map(|e| e.value);
+            assert!(ea.is_none() || ea == Some(0.0), "{q:?} {d:?} {ea:?}");
+            overhang += usize::from(b.evaluate_along(q, d).map(|e| e.value) == Some(1.0));
+        }
+        assert!(overhang >= 4, "{q:?}: {overhang} rays through the overhang");
+        let e = a.evaluate(q);
+        assert_eq!((e.value, e.uncertified), (0.0, false), "{q:?} {e:?}");
+    }
+    // Mapped from 3D the answer at the first two points is the first ray's: through the overhang.
+    assert_eq!(b.eval([1.0005, 0.0, 1.9999]), 1.0);
+    assert_eq!(b.eval([0.0, -1.0004, 1.9998]), 1.0);
+    // Inside the wall and on a lattice, the pcurve-trimmed model is the exact solid.
+    for q in [
+        [0.9995, 0.0, 1.9999],
+        [0.0, 0.9996, 1e-4],
+        [-0.9995, 1e-9, 1.0],
+    ] {
+        assert_eq!(a.eval(q), 1.0, "{q:?}");
+    }
+    for i in 0..6 {
+        for k in 0..5 {
+            let q = [
+                -1.5 + 0.6 * i as f64 + 0.013,
+                0.011,
+                -0.45 + 0.6 * k as f64 + 0.017,
+            ];
+            let r = q[0].hypot(q[1]);
+            let inside = r < 1.0 && q[2] > 0.0 && q[2] < 2.0;
+            assert_eq!(a.eval(q), if inside { 1.0 } else { 0.0 }, "{q:?}");
+        }
+    }
+    // A pcurve in the wrong place (the disks' circle of radius 2: 1 from the 3D edge) is
+    // refused, and those uses are mapped from 3D.
+    let wrong =
+        parse_step(&text.replace("#104=CIRCLE('',#103,1.)", "#104=CIRCLE('',#103,2.)")).unwrap();
+    let info = wrong.info();
+    assert_eq!(
+        (info.pcurve_uses, info.pcurves_rejected),
+        (4, 2),
+        "{info:?}"
+    );
+}
