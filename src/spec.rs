@@ -365,6 +365,17 @@ impl From<BuildError> for SpecError {
     }
 }
 
+/// The spec's error for a tolerance a curved-surface evaluator refuses (which
+/// [`EvaluatorSpec::check`] has already refused: kept so that the two cannot drift apart).
+#[cfg(feature = "patch")]
+fn tolerance_refused(e: crate::patch::ToleranceError, input: InputKind) -> SpecError {
+    if e.0 == 0.0 {
+        SpecError::ZeroTolerance(input)
+    } else {
+        SpecError::Tolerance(e.0.to_string())
+    }
+}
+
 /// How to evaluate: the method and its options. `Default` is the exact method with its defaults
 /// (the fast method for point clouds).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -528,9 +539,10 @@ impl EvaluatorSpec {
                 self.fast_params(),
             )),
             #[cfg(feature = "patch")]
-            (Input::Patches(set), Method::Exact) => {
-                Box::new(PatchWindingNumber::with_options(set, self.patch_options()))
-            }
+            (Input::Patches(set), Method::Exact) => Box::new(
+                PatchWindingNumber::with_options(set, self.patch_options())
+                    .map_err(|e| tolerance_refused(e, InputKind::Patches))?,
+            ),
             #[cfg(feature = "patch")]
             (Input::Patches(set), _) => Box::new(SurfaceQuadrature::new(
                 set,
@@ -538,7 +550,8 @@ impl EvaluatorSpec {
             )),
             #[cfg(all(feature = "patch", feature = "io"))]
             (Input::Step(model), _) => Box::new(
-                crate::patch::step::StepWindingNumber::with_options(model, self.step_options()),
+                crate::patch::step::StepWindingNumber::with_options(model, self.step_options())
+                    .map_err(|e| tolerance_refused(e, InputKind::Step))?,
             ),
         })
     }

@@ -24,7 +24,7 @@ impl Rng {
 }
 
 fn with(set: &PatchSet, ray: RayAxis, tolerance: f64) -> PatchWindingNumber {
-    PatchWindingNumber::with_options(set, Options { ray, tolerance })
+    PatchWindingNumber::with_options(set, Options { ray, tolerance }).unwrap()
 }
 
 /// A planar parallelogram `o + t·a + s·b` as a patch of degrees `(m, n)` (affine control net).
@@ -160,4 +160,25 @@ fn tessellation_converges_to_the_patch_values() {
         );
         n += 1;
     }
+}
+
+/// A tolerance that is not a finite positive number is refused (it used to become the default
+/// silently).
+#[test]
+fn evaluator_refuses_a_bad_tolerance() {
+    let (set, _) = open_box();
+    for t in [f64::NAN, -1e-8, 0.0, f64::NEG_INFINITY, f64::INFINITY] {
+        let options = Options {
+            ray: RayAxis::PosZ,
+            tolerance: t,
+        };
+        let e = PatchWindingNumber::with_options(&set, options).unwrap_err();
+        assert_eq!(e.to_string(), gwn::patch::ToleranceError(t).to_string());
+        assert!(e.to_string().contains("finite positive"), "{e}");
+    }
+    assert!(
+        with(&set, RayAxis::PosZ, 1e-6)
+            .eval([0.5, 0.5, 0.5])
+            .is_finite()
+    );
 }

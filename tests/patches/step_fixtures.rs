@@ -546,3 +546,97 @@ fn pcurves_trim_the_faces_where_the_3d_edges_stray() {
         "{info:?}"
     );
 }
+
+/// `load_step` keeps the kind of every error (`StepError::cause`) and names the file in its one
+/// line: I/O, syntax, dangling reference, unsupported entity, invalid parameters, geometry, no
+/// faces. (`TooLarge` needs a 256 MiB file or 4·10⁶ instances: not written here.)
+#[test]
+fn load_errors_keep_their_kind_and_name_the_file() {
+    let dir = std::env::temp_dir().join(format!("gwn-step-errors-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let good = std::fs::read_to_string(fixture("capped_cylinder.step")).unwrap();
+    let load = |name: &str, text: &str| {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        let e = load_step(&path).unwrap_err();
+        let line = e.to_string();
+        assert!(!line.contains('\n'), "{line}");
+        assert!(line.starts_with(&format!("{}: ", path.display())), "{line}");
+        assert_eq!(e.path(), Some(path.as_path()));
+        e
+    };
+    let missing = dir.join("missing.step");
+    let e = load_step(&missing).unwrap_err();
+    assert!(
+        matches!(&e, StepError::Io { kind: std::io::ErrorKind::NotFound, path, .. } if path == &missing),
+        "{e:?}"
+    );
+    assert!(
+        e.to_string()
+            .starts_with(&format!("{}: ", missing.display()))
+    );
+    let e = load("truncated.step", &good[..good.len() / 2]);
+    assert!(matches!(e.cause(), StepError::Syntax { .. }), "{e:?}");
+    let e = load(
+        "dangling.step",
+        &good.replace(
+            "#12=CYLINDRICAL_SURFACE('',#10,1.);",
+            "#12=CYLINDRICAL_SURFACE('',#99,1.);",
+        ),
+    );
+    assert_eq!(e.cause(), &StepError::Dangling { id: 12, target: 99 });
+    let e = load(
+        "offset.step",
+        &good.replace("#14=PLANE('',#10);", "#14=OFFSET_SURFACE('',#12,0.1,.F.);"),
+    );
+    assert!(
+        matches!(e.cause(), StepError::Unsupported { id: 14, entity, .. } if entity == "OFFSET_SURFACE"),
+        "{e:?}"
+    );
+    assert!(
+        e.to_string()
+            .ends_with("#14 OFFSET_SURFACE: not supported as a face surface"),
+        "{e}"
+    );
+    let e = load(
+        "invalid.step",
+        &good.replace(
+            "#12=CYLINDRICAL_SURFACE('',#10,1.);",
+            "#12=CYLINDRICAL_SURFACE('',#10,-1.);",
+        ),
+    );
+    assert!(
+        matches!(e.cause(), StepError::Invalid { id: 12, .. }),
+        "{e:?}"
+    );
+    // A line edge from a vertex back to itself: well-formed parameters, no edge.
+    let e = load(
+        "geometry.step",
+        &good.replace(
+            "#42=EDGE_CURVE('',#22,#23,#32,.T.);",
+            "#42=EDGE_CURVE('',#22,#22,#32,.T.);",
+        ),
+    );
+    assert!(
+        matches!(e.cause(), StepError::Geometry { id: 42, entity, .. } if entity == "EDGE_CURVE"),
+        "{e:?}"
+    );
+    let e = load("empty.step", &minimal("#1=CARTESIAN_POINT('',(0.,0.,0.));"));
+    assert_eq!(e.cause(), &StepError::NoFaces);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A tolerance that is not a finite positive number is refused, not replaced by the default.
+#[test]
+fn evaluator_refuses_a_bad_tolerance() {
+    use gwn::patch::ToleranceError;
+    use gwn::patch::step::StepOptions;
+    let m = load_step(&fixture("capped_cylinder.step")).unwrap();
+    for t in [f64::NAN, -1e-8, 0.0, f64::INFINITY] {
+        let e = StepWindingNumber::with_options(&m, StepOptions { tolerance: t }).unwrap_err();
+        assert_eq!(e.to_string(), ToleranceError(t).to_string());
+        assert!(e.to_string().contains(&t.to_string()), "{e}");
+    }
+    let wn = StepWindingNumber::with_options(&m, StepOptions { tolerance: 1e-6 }).unwrap();
+    assert_eq!(wn.eval([0.1, 0.2, 1.0]), 1.0);
+}

@@ -2,7 +2,8 @@
 //! `SHELL_BASED_SURFACE_MODEL`, shells, `ADVANCED_FACE` → bounds → `EDGE_LOOP` →
 //! `ORIENTED_EDGE` → `EDGE_CURVE` → `VERTEX_POINT`), geometry (placements, curves, surfaces) and
 //! units. Every entity the reader does not know is an [`StepError::Unsupported`] naming it and
-//! its `#id`; wrong parameter counts or types are [`StepError::Invalid`].
+//! its `#id`; wrong parameter counts or types are [`StepError::Invalid`]; parameters that do
+//! not make an edge or surface are [`StepError::Geometry`].
 
 use std::collections::{HashMap, HashSet};
 
@@ -153,6 +154,14 @@ pub struct EdgePcurve {
 
 fn invalid(id: u64, inst: &Instance, message: impl Into<String>) -> StepError {
     StepError::Invalid {
+        id,
+        entity: inst.display_name(),
+        message: message.into(),
+    }
+}
+
+fn geometry(id: u64, inst: &Instance, message: impl Into<String>) -> StepError {
+    StepError::Geometry {
         id,
         entity: inst.display_name(),
         message: message.into(),
@@ -773,7 +782,7 @@ impl<'a> Reader<'a> {
         } else {
             self.between(&curve, v2, v1, tol).map(reverse)
         }
-        .map_err(|m| invalid(id, p.inst, m))?;
+        .map_err(|m| geometry(id, p.inst, m))?;
         let pcurves = self.read_pcurves(p.refid(3)?, &curve, [v1, v2], same_sense, tol)?;
         if !pcurves.is_empty() {
             self.pcurves.insert(id, pcurves);
@@ -846,7 +855,7 @@ impl<'a> Reader<'a> {
                     Some(r) => self.direction(ax.id, r)?,
                     None => [0.0, 0.0, 1.0],
                 };
-                revolution(&pieces, a, d, tol).map_err(|m| invalid(id, inst, m))?
+                revolution(&pieces, a, d, tol).map_err(|m| geometry(id, inst, m))?
             }
             _ => return Err(unsupported(id, inst, "as a face surface")),
         })

@@ -173,14 +173,20 @@ enum Reject {
 impl StepWindingNumber {
     /// An evaluator with default options.
     pub fn new(model: &StepModel) -> Self {
-        Self::with_options(model, StepOptions::default())
+        Self::build(model, StepOptions::default())
     }
 
-    /// An evaluator with the given options (a non-positive tolerance becomes the default).
-    pub fn with_options(model: &StepModel, mut options: StepOptions) -> Self {
-        if !(options.tolerance.is_finite() && options.tolerance > 0.0) {
-            options.tolerance = StepOptions::default().tolerance;
-        }
+    /// An evaluator with the given options; a tolerance that is not a finite positive number
+    /// is refused.
+    pub fn with_options(
+        model: &StepModel,
+        options: StepOptions,
+    ) -> Result<Self, crate::patch::ToleranceError> {
+        crate::patch::ToleranceError::check(options.tolerance)?;
+        Ok(Self::build(model, options))
+    }
+
+    fn build(model: &StepModel, options: StepOptions) -> Self {
         StepWindingNumber {
             margin: HIT_MARGIN * model.diagonal(),
             model: model.clone(),

@@ -281,7 +281,7 @@ impl StepModel {
                 }
             }
             if segments.is_empty() {
-                return Err(StepError::Invalid {
+                return Err(StepError::Geometry {
                     id: f.id,
                     entity: "ADVANCED_FACE".into(),
                     message: "no edge loop (faces bounded only by vertex loops are not supported)"
@@ -308,7 +308,7 @@ impl StepModel {
                 }
             }
             if !(u1 > u0 && v1 > v0) {
-                return Err(StepError::Invalid {
+                return Err(StepError::Geometry {
                     id: f.id,
                     entity: "ADVANCED_FACE".into(),
                     message: "its loops enclose no area in the surface's parameters".into(),
@@ -317,7 +317,7 @@ impl StepModel {
             let uvp = f
                 .surface
                 .patches([u0, u1], [v0, v1])
-                .map_err(|m| StepError::Invalid {
+                .map_err(|m| StepError::Geometry {
                     id: f.id,
                     entity: "ADVANCED_FACE".into(),
                     message: m,
