@@ -359,20 +359,22 @@ impl From<ParseError> for SpecError {
     }
 }
 
-impl From<BuildError> for SpecError {
-    fn from(e: BuildError) -> Self {
-        SpecError::Build(e)
+#[cfg(feature = "patch")]
+impl SpecError {
+    /// The spec's error for a tolerance a curved-surface evaluator refuses (which
+    /// [`EvaluatorSpec::check`] refuses first: the evaluators check again on their own).
+    pub fn refused_tolerance(e: crate::patch::ToleranceError, input: InputKind) -> SpecError {
+        if e.0 == 0.0 {
+            SpecError::ZeroTolerance(input)
+        } else {
+            SpecError::Tolerance(e.0.to_string())
+        }
     }
 }
 
-/// The spec's error for a tolerance a curved-surface evaluator refuses (which
-/// [`EvaluatorSpec::check`] has already refused: kept so that the two cannot drift apart).
-#[cfg(feature = "patch")]
-fn tolerance_refused(e: crate::patch::ToleranceError, input: InputKind) -> SpecError {
-    if e.0 == 0.0 {
-        SpecError::ZeroTolerance(input)
-    } else {
-        SpecError::Tolerance(e.0.to_string())
+impl From<BuildError> for SpecError {
+    fn from(e: BuildError) -> Self {
+        SpecError::Build(e)
     }
 }
 
@@ -541,7 +543,7 @@ impl EvaluatorSpec {
             #[cfg(feature = "patch")]
             (Input::Patches(set), Method::Exact) => Box::new(
                 PatchWindingNumber::with_options(set, self.patch_options())
-                    .map_err(|e| tolerance_refused(e, InputKind::Patches))?,
+                    .map_err(|e| SpecError::refused_tolerance(e, InputKind::Patches))?,
             ),
             #[cfg(feature = "patch")]
             (Input::Patches(set), _) => Box::new(SurfaceQuadrature::new(
@@ -551,7 +553,7 @@ impl EvaluatorSpec {
             #[cfg(all(feature = "patch", feature = "io"))]
             (Input::Step(model), _) => Box::new(
                 crate::patch::step::StepWindingNumber::with_options(model, self.step_options())
-                    .map_err(|e| tolerance_refused(e, InputKind::Step))?,
+                    .map_err(|e| SpecError::refused_tolerance(e, InputKind::Step))?,
             ),
         })
     }

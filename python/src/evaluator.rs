@@ -108,7 +108,7 @@ impl Evaluator {
     pub fn for_step(model: &StepModel, spec: &EvaluatorSpec) -> Result<Self, SpecError> {
         spec.check(InputKind::Step)?;
         let wn = StepWindingNumber::with_options(model, spec.step_options())
-            .map_err(crate::errors::value_error)?;
+            .map_err(|e| SpecError::refused_tolerance(e, InputKind::Step))?;
         Ok(Evaluator::Step(Box::new(wn)))
     }
 

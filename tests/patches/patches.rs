@@ -182,3 +182,31 @@ fn evaluator_refuses_a_bad_tolerance() {
             .is_finite()
     );
 }
+
+/// On an open boundary edge the patch evaluator's value is the principal value on every ray:
+/// the mesh direct sum's value there (triangles in whose plane the query lies contribute 0),
+/// 1/4 on the rim of the open box and 1/8 at its corners; flagged, with an estimate covering
+/// the jump of `w` around the edge.
+#[test]
+fn open_box_rim_gets_the_principal_value_on_every_ray() {
+    let (set, mesh) = open_box();
+    for q in [
+        [0.5, 0.0, 1.0],
+        [1.0, 0.3, 1.0],
+        [0.25, 1.0, 1.0],
+        [1.0, 1.0, 1.0],
+    ] {
+        let direct = gwn::eval::direct::winding_number_direct(&mesh, q);
+        for ray in RayAxis::ALL {
+            let e = with(&set, ray, 1e-10).evaluate(q);
+            assert!(
+                (e.value - direct).abs() < 1e-12,
+                "{q:?} {ray:?} {e:?} vs {direct}"
+            );
+            assert!(
+                !e.certified && e.error_estimate >= 0.5,
+                "{q:?} {ray:?} {e:?}"
+            );
+        }
+    }
+}

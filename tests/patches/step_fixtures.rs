@@ -640,3 +640,38 @@ fn evaluator_refuses_a_bad_tolerance() {
     let wn = StepWindingNumber::with_options(&m, StepOptions { tolerance: 1e-6 }).unwrap();
     assert_eq!(wn.eval([0.1, 0.2, 1.0]), 1.0);
 }
+
+/// On the plate's boundary (its outer square, corners included, and the hole's circle) the
+/// principal value is 0 exactly: the plate is flat, and a flat region seen from a point in its
+/// plane subtends no solid angle. Every qualifying ray gives it; the value is certified.
+#[test]
+fn plate_boundary_gets_the_principal_value() {
+    let m = load_step(&fixture("plate_with_hole.stp")).unwrap();
+    let wn = StepWindingNumber::new(&m);
+    let a = 1.1_f64;
+    for c in [
+        [1.0, 0.3, 0.0],
+        [-0.2, -1.0, 0.0],
+        [-1.0, 0.9, 0.0],
+        [1.0, 1.0, 0.0],
+        [-1.0, -1.0, 0.0],
+        [0.5 * a.cos(), 0.5 * a.sin(), 0.0],
+        [-0.5, 0.0, 0.0],
+    ] {
+        let e = wn.evaluate(c);
+        assert!(!e.uncertified && e.value.abs() < 1e-9, "{c:?} {e:?}");
+        let mut rays = 0;
+        for &d in wn.directions() {
+            if let Some(f) = wn.evaluate_on_boundary_along(c, d) {
+                assert!(f.value.abs() < 1e-9, "{c:?} {d:?} {f:?}");
+                rays += 1;
+            }
+        }
+        assert!(rays >= 6, "{c:?}: {rays}");
+        // Just off the boundary the rule does not apply.
+        assert!(
+            wn.evaluate_on_boundary_along([c[0], c[1], 1e-9], wn.directions()[0])
+                .is_none()
+        );
+    }
+}

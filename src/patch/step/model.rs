@@ -115,6 +115,8 @@ pub struct StepModel {
     /// Surface boundary: homogeneous Bézier curves in world coordinates, oriented as the
     /// boundary of their faces.
     pub(crate) boundary: Vec<Vec<Homogeneous>>,
+    /// The face (index into `faces`) each boundary curve bounds.
+    pub(crate) boundary_faces: Vec<usize>,
     pub(crate) lo: [f64; 3],
     pub(crate) hi: [f64; 3],
     pub(crate) info: StepInfo,
@@ -175,7 +177,7 @@ impl StepModel {
         };
         let mut faces = Vec::with_capacity(raw.len());
         // Edge uses over the whole model, for the boundary.
-        let mut uses: Vec<(u64, bool)> = Vec::new();
+        let mut uses: Vec<(u64, bool, usize)> = Vec::new();
         for f in &raw {
             *info.surfaces.entry(f.surface.kind()).or_default() += 1;
             let (period_u, period_v) = f.surface.periods();
@@ -184,7 +186,7 @@ impl StepModel {
             for l in &f.loops {
                 for u in l {
                     *count.entry(u.edge).or_default() += 1;
-                    uses.push((u.edge, u.forward));
+                    uses.push((u.edge, u.forward, faces.len()));
                 }
             }
             let mut segments = Vec::new();
@@ -363,10 +365,12 @@ impl StepModel {
                 }
             }
         }
-        let boundary = surface_boundary(&reader, &uses, EDGE_MATCH * diag, &mut info);
+        let (boundary, boundary_faces) =
+            surface_boundary(&reader, &uses, EDGE_MATCH * diag, &mut info);
         Ok(StepModel {
             faces,
             boundary,
+            boundary_faces,
             lo,
             hi,
             info,
@@ -502,33 +506,37 @@ fn pcurve_polygon(
 /// `EDGE_CURVE` used in both directions), then the geometric match of [`EDGE_MATCH`].
 fn surface_boundary(
     reader: &Reader<'_>,
-    uses: &[(u64, bool)],
+    uses: &[(u64, bool, usize)],
     tol: f64,
     info: &mut StepInfo,
-) -> Vec<Vec<Homogeneous>> {
-    let mut per_edge: HashMap<u64, (usize, usize)> = HashMap::new();
-    for &(e, fwd) in uses {
+) -> (Vec<Vec<Homogeneous>>, Vec<usize>) {
+    // Per edge, the faces using it forwards and backwards.
+    let mut per_edge: HashMap<u64, (Vec<usize>, Vec<usize>)> = HashMap::new();
+    for &(e, fwd, face) in uses {
         let c = per_edge.entry(e).or_default();
         if fwd {
-            c.0 += 1;
+            c.0.push(face);
         } else {
-            c.1 += 1;
+            c.1.push(face);
         }
     }
     info.edges = per_edge.len();
     let mut left: Vec<Vec<Vec<Homogeneous>>> = Vec::new();
+    let mut left_faces: Vec<usize> = Vec::new();
     let mut ids: Vec<u64> = per_edge.keys().copied().collect();
     ids.sort_unstable();
     for e in ids {
-        let (f, r) = per_edge[&e];
-        let pairs = f.min(r);
+        let (f, r) = &per_edge[&e];
+        let pairs = f.len().min(r.len());
         info.cancelled_exact += pairs;
         let geom = &reader.edges[&e];
-        for _ in pairs..f {
+        for &face in &f[pairs..] {
             left.push(geom.clone());
+            left_faces.push(face);
         }
-        for _ in pairs..r {
+        for &face in &r[pairs..] {
             left.push(reverse(geom.clone()));
+            left_faces.push(face);
         }
     }
     // Geometric match among the leftovers.
@@ -548,14 +556,16 @@ fn surface_boundary(
             break;
         }
     }
-    let out: Vec<Vec<Vec<Homogeneous>>> = left
-        .into_iter()
-        .zip(used)
-        .filter(|(_, u)| !u)
-        .map(|(g, _)| g)
-        .collect();
-    info.boundary_edges = out.len();
-    out.into_iter().flatten().collect()
+    let mut pieces = Vec::new();
+    let mut faces = Vec::new();
+    for ((g, face), used) in left.into_iter().zip(left_faces).zip(used) {
+        if !used {
+            info.boundary_edges += 1;
+            faces.extend(std::iter::repeat_n(face, g.len()));
+            pieces.extend(g);
+        }
+    }
+    (pieces, faces)
 }
 
 /// End points, interior points and tangents of an edge use, for the geometric match.
