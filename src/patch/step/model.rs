@@ -439,7 +439,8 @@ fn near_uv(a: [f64; 2], b: [f64; 2]) -> bool {
 
 /// The trimming polygon of one edge use from its pcurve (start and end included), in this
 /// reader's `(u, v)` (file units times `units`), or `None` if the pcurve's image on the
-/// surface strays more than [`PCURVE_TOLERANCE`] `× diag` from the use's 3D curve `geom`.
+/// surface strays more than [`PCURVE_TOLERANCE`] `× diag` from the use's 3D curve `geom` (at its
+/// ends, and at three interior points, which must also come in the curve's order).
 /// Bisection in the pcurve's parameter until the surface point of each uv chord's midpoint is
 /// within `chord` of the surface point of the curve's midpoint (the polygon's 3D image then
 /// follows the edge as closely as a polygon mapped from 3D).
@@ -463,6 +464,38 @@ fn pcurve_polygon(
     };
     let finite = |p: [f64; 3]| p.iter().all(|c| c.is_finite());
     let point = |uv: [f64; 2]| surface.point(uv).filter(|&p| finite(p));
+    // The check against the 3D curve first (a pcurve in the wrong unit is refused before it
+    // is sampled).
+    let pieces: Vec<(f64, f64, Vec<Homogeneous>)> = geom
+        .iter()
+        .enumerate()
+        .map(|(k, c)| (k as f64, k as f64 + 1.0, c.clone()))
+        .collect();
+    if pieces.is_empty() {
+        return None;
+    }
+    // Its ends at the use's ends, three interior points on the use's curve and in its order
+    // (a pcurve run backwards, or over another arc of a circle, is refused).
+    let tolerance = PCURVE_TOLERANCE * diag;
+    let ends = [
+        point_at(&geom[0], 0.0),
+        point_at(&geom[geom.len() - 1], 1.0),
+    ];
+    for (t, end) in [t0, t1].into_iter().zip(ends) {
+        if !(norm(sub(point(uv_at(t))?, end)) <= tolerance) {
+            return None;
+        }
+    }
+    let mut previous = f64::NEG_INFINITY;
+    for f in [0.25, 0.5, 0.75] {
+        let p = point(uv_at(t0 + f * (t1 - t0)))?;
+        let s = invert_curve(&pieces, p);
+        let q = super::surface::curve_point(&pieces, s);
+        if !(norm(sub(p, q)) <= tolerance && s > previous) {
+            return None;
+        }
+        previous = s;
+    }
     let (uv0, uv1) = (uv_at(t0), uv_at(t1));
     let mut out = vec![uv0];
     let mut cur = (t0, uv0);
@@ -479,24 +512,6 @@ fn pcurve_polygon(
         } else {
             out.push(wb);
             cur = (tb, wb);
-        }
-    }
-    // The check against the 3D curve.
-    let pieces: Vec<(f64, f64, Vec<Homogeneous>)> = geom
-        .iter()
-        .enumerate()
-        .map(|(k, c)| (k as f64, k as f64 + 1.0, c.clone()))
-        .collect();
-    if pieces.is_empty() {
-        return None;
-    }
-    let tolerance = PCURVE_TOLERANCE * diag;
-    for f in [0.0, 0.25, 0.5, 0.75, 1.0] {
-        let p = point(uv_at(t0 + f * (t1 - t0)))?;
-        let s = invert_curve(&pieces, p);
-        let q = super::surface::curve_point(&pieces, s);
-        if !(norm(sub(p, q)) <= tolerance) {
-            return None;
         }
     }
     Some(out)
