@@ -667,7 +667,7 @@ impl StepWindingNumber {
         let angle = (dot(t_out, inward))
             .atan2(-dot(t_out, t_in))
             .rem_euclid(std::f64::consts::TAU);
-        if !(angle > 0.0) {
+        if angle.is_nan() || angle <= 0.0 {
             return None;
         }
         let mut budget = Budget {
@@ -761,7 +761,7 @@ fn face_normal(face: &Face, c: [f64; 3], diag: f64) -> Option<[f64; 3]> {
             let r = sub(p, c);
             let (a, b, cc) = (dot(ds, ds), dot(ds, dt), dot(dt, dt));
             let det = a * cc - b * b;
-            if !(det > 0.0) {
+            if det.is_nan() || det <= 0.0 {
                 break;
             }
             let (g0, g1) = (dot(ds, r), dot(dt, r));

@@ -2,6 +2,7 @@
 //! polygon in `(u, v)`; for the whole model the surface boundary (edge uses that no other use
 //! cancels) as rational Bézier curves.
 
+use std::cmp::Ordering;
 use std::collections::{BTreeMap, HashMap};
 
 use super::super::curve::{Homogeneous, eval_with_derivative};
@@ -482,7 +483,8 @@ fn pcurve_polygon(
         point_at(&geom[geom.len() - 1], 1.0),
     ];
     for (t, end) in [t0, t1].into_iter().zip(ends) {
-        if !(norm(sub(point(uv_at(t))?, end)) <= tolerance) {
+        let off = norm(sub(point(uv_at(t))?, end));
+        if off.is_nan() || off > tolerance {
             return None;
         }
     }
@@ -491,7 +493,8 @@ fn pcurve_polygon(
         let p = point(uv_at(t0 + f * (t1 - t0)))?;
         let s = invert_curve(&pieces, p);
         let q = super::surface::curve_point(&pieces, s);
-        if !(norm(sub(p, q)) <= tolerance && s > previous) {
+        let off = norm(sub(p, q));
+        if off.is_nan() || off > tolerance || s.partial_cmp(&previous) != Some(Ordering::Greater) {
             return None;
         }
         previous = s;
