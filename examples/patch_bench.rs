@@ -115,7 +115,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 tolerance,
                 ..Options::default()
             },
-        );
+        )
+        .unwrap();
         let (ms, w) = time_per_query(&points, |q| wn.eval(q));
         let worst = good
             .iter()

@@ -25,7 +25,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             tolerance: 1e-12,
             ..Options::default()
         },
-    );
+    )
+    .unwrap();
     let mut worst = 0.0f64;
     for (p, patch) in set.patches().iter().enumerate() {
         for (e, link) in links[p].iter().enumerate() {

@@ -62,7 +62,7 @@ struct Row {
 fn run(name: &str, set: &PatchSet, queries: &[Query], tolerance: f64) {
     let evaluators: Vec<PatchWindingNumber> = RayAxis::ALL
         .iter()
-        .map(|&ray| PatchWindingNumber::with_options(set, Options { ray, tolerance }))
+        .map(|&ray| PatchWindingNumber::with_options(set, Options { ray, tolerance }).unwrap())
         .collect();
     let mut rows: BTreeMap<(String, String), Row> = BTreeMap::new();
     let total = Instant::now();
@@ -194,6 +194,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     tolerance: 1e-10,
                 },
             )
+            .unwrap()
             .eval(q.q);
             worst = worst.max((w - 0.5).abs());
         }

@@ -359,6 +359,19 @@ impl From<ParseError> for SpecError {
     }
 }
 
+#[cfg(feature = "patch")]
+impl SpecError {
+    /// The spec's error for a tolerance a curved-surface evaluator refuses (which
+    /// [`EvaluatorSpec::check`] refuses first: the evaluators check again on their own).
+    pub fn refused_tolerance(e: crate::patch::ToleranceError, input: InputKind) -> SpecError {
+        if e.0 == 0.0 {
+            SpecError::ZeroTolerance(input)
+        } else {
+            SpecError::Tolerance(e.0.to_string())
+        }
+    }
+}
+
 impl From<BuildError> for SpecError {
     fn from(e: BuildError) -> Self {
         SpecError::Build(e)
@@ -528,9 +541,10 @@ impl EvaluatorSpec {
                 self.fast_params(),
             )),
             #[cfg(feature = "patch")]
-            (Input::Patches(set), Method::Exact) => {
-                Box::new(PatchWindingNumber::with_options(set, self.patch_options()))
-            }
+            (Input::Patches(set), Method::Exact) => Box::new(
+                PatchWindingNumber::with_options(set, self.patch_options())
+                    .map_err(|e| SpecError::refused_tolerance(e, InputKind::Patches))?,
+            ),
             #[cfg(feature = "patch")]
             (Input::Patches(set), _) => Box::new(SurfaceQuadrature::new(
                 set,
@@ -538,7 +552,8 @@ impl EvaluatorSpec {
             )),
             #[cfg(all(feature = "patch", feature = "io"))]
             (Input::Step(model), _) => Box::new(
-                crate::patch::step::StepWindingNumber::with_options(model, self.step_options()),
+                crate::patch::step::StepWindingNumber::with_options(model, self.step_options())
+                    .map_err(|e| SpecError::refused_tolerance(e, InputKind::Step))?,
             ),
         })
     }

@@ -90,14 +90,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
         // The patch evaluator's own loop, for its certification flags.
         refuse_gradient(&args, &input.kind().to_string())?;
         let points = gwn::io::points::load_points(&args.points)?;
-        let values = eval_patches(set, &spec, &points);
+        let values = eval_patches(set, &spec, &points)?;
         return write_outputs(&args, &values, None);
     }
     if let Input::Step(model) = &input {
         // The STEP evaluator's own loop, for its certification flags.
         refuse_gradient(&args, &input.kind().to_string())?;
         let points = gwn::io::points::load_points(&args.points)?;
-        let values = eval_step(model, &spec, &points);
+        let values = eval_step(model, &spec, &points)?;
         return write_outputs(&args, &values, None);
     }
     let wn = crate::method::build(&spec, &input, &args.mesh)?;
@@ -130,8 +130,13 @@ fn refuse_gradient(args: &Args, what: &str) -> Result<(), CliError> {
 }
 
 /// Bézier patch sets, exact method: values, and a warning for the uncertified ones.
-fn eval_patches(set: &gwn::patch::PatchSet, spec: &EvaluatorSpec, points: &[[f64; 3]]) -> Vec<f64> {
+fn eval_patches(
+    set: &gwn::patch::PatchSet,
+    spec: &EvaluatorSpec,
+    points: &[[f64; 3]],
+) -> Result<Vec<f64>, CliError> {
     let evaluations = gwn::patch::PatchWindingNumber::with_options(set, spec.patch_options())
+        .map_err(|e| CliError(e.to_string()))?
         .evaluate_batch(points);
     // The flag of docs/patches.md ("Error model"): queries on the surface (principal value), at
     // rounding level from it, or past the work cap.
@@ -148,7 +153,7 @@ fn eval_patches(set: &gwn::patch::PatchSet, spec: &EvaluatorSpec, points: &[[f64
             points.len()
         );
     }
-    evaluations.iter().map(|e| e.value).collect()
+    Ok(evaluations.iter().map(|e| e.value).collect())
 }
 
 /// STEP models: values, and a warning for the uncertified ones.
@@ -156,9 +161,10 @@ fn eval_step(
     model: &gwn::patch::step::StepModel,
     spec: &EvaluatorSpec,
     points: &[[f64; 3]],
-) -> Vec<f64> {
+) -> Result<Vec<f64>, CliError> {
     use rayon::prelude::*;
-    let wn = gwn::patch::step::StepWindingNumber::with_options(model, spec.step_options());
+    let wn = gwn::patch::step::StepWindingNumber::with_options(model, spec.step_options())
+        .map_err(|e| CliError(e.to_string()))?;
     let evaluations: Vec<gwn::patch::step::StepEvaluation> =
         points.par_iter().map(|&q| wn.evaluate(q)).collect();
     // The flag of docs/patches.md ("Trimmed B-rep models"): no ray direction passed the
@@ -176,7 +182,7 @@ fn eval_step(
             points.len()
         );
     }
-    evaluations.iter().map(|e| e.value).collect()
+    Ok(evaluations.iter().map(|e| e.value).collect())
 }
 
 fn write_outputs(args: &Args, values: &[f64], grads: Option<&[[f64; 3]]>) -> Result<(), CliError> {

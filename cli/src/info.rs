@@ -59,6 +59,13 @@ fn step_report(path: &std::path::Path, model: &gwn::patch::step::StepModel) -> S
         ("surfaces", surfaces),
         ("Bézier patches", i.patches.to_string()),
         ("trim polygon segments", i.trim_segments.to_string()),
+        (
+            "edge uses trimmed by pcurves",
+            format!(
+                "{} ({} pcurves off their 3D edge, {} unreadable: mapped from 3D)",
+                i.pcurve_uses, i.pcurves_rejected, i.pcurves_unreadable
+            ),
+        ),
         ("edges", i.edges.to_string()),
         ("edge pairs cancelled", i.cancelled_exact.to_string()),
         ("edge pairs matched", i.cancelled_matched.to_string()),

@@ -107,10 +107,9 @@ impl Evaluator {
     /// the exact method, no `ray=`, `precision=` or fast options).
     pub fn for_step(model: &StepModel, spec: &EvaluatorSpec) -> Result<Self, SpecError> {
         spec.check(InputKind::Step)?;
-        Ok(Evaluator::Step(Box::new(StepWindingNumber::with_options(
-            model,
-            spec.step_options(),
-        ))))
+        let wn = StepWindingNumber::with_options(model, spec.step_options())
+            .map_err(|e| SpecError::refused_tolerance(e, InputKind::Step))?;
+        Ok(Evaluator::Step(Box::new(wn)))
     }
 
     /// What `Unsupported` calls this evaluator.

@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
+use gwn::input::{Input, InputError};
 use gwn::patch::step::{StepError, StepModel};
 use pyo3::exceptions::PyRuntimeWarning;
 use pyo3::prelude::*;
@@ -14,24 +15,34 @@ use crate::errors::os_error;
 
 /// A STEP file that cannot be read is an `OSError` (`FileNotFoundError` when missing,
 /// `PermissionError` when not readable); one that is read but is not a supported B-rep model is
-/// a `ValueError`. Both carry the CLI's one-line message. (`load_step` names the file in every
-/// error, so whether the file itself could be read is asked of the file system.)
-pub fn step_error(path: &std::path::Path, e: StepError) -> PyErr {
-    match std::fs::File::open(path) {
-        Err(io) => os_error(io.kind(), e.to_string()),
-        Ok(_) => pyo3::exceptions::PyValueError::new_err(e.to_string()),
+/// a `ValueError`. Both carry the CLI's one-line message, which names the file.
+pub fn step_error(e: StepError) -> PyErr {
+    match &e {
+        StepError::Io { kind, .. } => os_error(*kind, e.to_string()),
+        _ => pyo3::exceptions::PyValueError::new_err(e.to_string()),
     }
 }
 
-/// Reads a STEP model (the body of `gwn.load` for `.step`/`.stp`).
+/// Reads a STEP model (the body of `gwn.load` for `.step`/`.stp`) through the library's front
+/// door, `gwn::input::load_input`, as the CLI does.
 pub fn load_step_model(py: Python<'_>, path: PathBuf) -> PyResult<PyStepModel> {
-    let model = py
-        .allow_threads(|| gwn::patch::step::load_step(&path))
-        .map_err(|e| step_error(&path, e))?;
-    Ok(PyStepModel {
-        model: Arc::new(model),
-        path,
-    })
+    let loaded = py
+        .allow_threads(|| gwn::input::load_input(&path))
+        .map_err(|e| match e {
+            InputError::Step(e) => step_error(e),
+            other => pyo3::exceptions::PyValueError::new_err(other.to_string()),
+        })?;
+    match loaded.input {
+        Input::Step(model) => Ok(PyStepModel {
+            model: Arc::new(*model),
+            path,
+        }),
+        other => Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "{}: read as {}, not a STEP model",
+            path.display(),
+            other.kind()
+        ))),
+    }
 }
 
 /// A trimmed B-rep model read from an ISO 10303-21 (STEP) file by :func:`gwn.load`: its faces
@@ -56,6 +67,8 @@ impl PyStepModel {
     /// Counts as ``gwn info`` prints them: ``faces``, ``patches``, ``surfaces`` (faces per
     /// surface kind), ``edges``, ``boundary_edges`` (edge uses left as the surface boundary),
     /// ``cancelled_exact``/``cancelled_matched`` (shared-edge pairs), ``trim_segments``,
+    /// ``pcurve_uses`` (edge uses trimmed by the file's pcurve), ``pcurves_rejected`` (pcurves
+    /// straying from their 3D edge, mapped from 3D instead), ``pcurves_unreadable``,
     /// ``solids``, ``shells``, ``unit``.
     #[getter]
     fn info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
@@ -73,6 +86,9 @@ impl PyStepModel {
         d.set_item("cancelled_exact", i.cancelled_exact)?;
         d.set_item("cancelled_matched", i.cancelled_matched)?;
         d.set_item("trim_segments", i.trim_segments)?;
+        d.set_item("pcurve_uses", i.pcurve_uses)?;
+        d.set_item("pcurves_rejected", i.pcurves_rejected)?;
+        d.set_item("pcurves_unreadable", i.pcurves_unreadable)?;
         d.set_item("solids", i.topology.solids)?;
         d.set_item("shells", i.topology.shells)?;
         d.set_item("unit", i.topology.length_unit.clone())?;

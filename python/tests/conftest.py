@@ -8,7 +8,10 @@ import numpy as np
 import pytest
 
 REPO = pathlib.Path(__file__).resolve().parents[2]
-SHARED_MESHES = REPO.parent / "shared" / "meshes"
+# The shared data folder: $GWN_SHARED_DIR when set (a checkout whose ../shared is not the data,
+# e.g. a git worktree elsewhere), else ../shared next to the repository (as tests/common does).
+SHARED = pathlib.Path(os.environ.get("GWN_SHARED_DIR") or REPO.parent / "shared")
+SHARED_MESHES = SHARED / "meshes"
 FIXTURES = REPO / "tests" / "fixtures"
 LION_HEAD = REPO / "data" / "lion-head.off"
 

@@ -4,8 +4,6 @@ the shared reference models (``../shared/parametric/step``, or ``$GWN_SHARED_DIR
 visibly when absent."""
 
 import math
-import os
-import pathlib
 import pickle
 import subprocess
 import warnings
@@ -15,10 +13,10 @@ import pytest
 
 import gwn
 
-from conftest import FIXTURES, REPO
+from conftest import FIXTURES, REPO, SHARED
 
 STEP = FIXTURES / "step"
-SHARED_STEP = pathlib.Path(os.environ.get("GWN_SHARED_DIR", REPO.parent / "shared")) / "parametric" / "step"
+SHARED_STEP = SHARED / "parametric" / "step"
 
 
 def plate_on_axis(h):
@@ -153,6 +151,17 @@ def test_load_errors(tmp_path):
     truncated.write_text("ISO-10303-21;\nHEADER;\nENDSEC;\nDATA;\n#1=CARTESIAN_POINT('',(0.,")
     with pytest.raises(ValueError, match="line"):
         gwn.load(truncated)
+
+
+def test_pcurves_trim_the_faces():
+    # The 3D edges of this fixture lie 1e-3 outside the faces; the pcurves give the true circles
+    # (tests/patches/step_fixtures.rs has the details).
+    model = gwn.load(STEP / "capped_cylinder_pcurves.step")
+    info = model.info
+    assert (info["pcurve_uses"], info["pcurves_rejected"], info["pcurves_unreadable"]) == (6, 0, 0)
+    wn = gwn.WindingNumber(model)
+    values = wn(np.array([[1.0005, 0.0, 1.9999], [0.9995, 0.0, 1.9999]]))
+    np.testing.assert_array_equal(values, [0.0, 1.0])
 
 
 def test_pickling_reads_the_file_again():

@@ -151,15 +151,17 @@ struct Net {
 impl PatchWindingNumber {
     /// An evaluator with the default options.
     pub fn new(set: &PatchSet) -> Self {
-        Self::with_options(set, Options::default())
+        Self::build(set, Options::default())
     }
 
-    /// An evaluator with the given options. A non-positive or non-finite tolerance is replaced
-    /// by the default.
-    pub fn with_options(set: &PatchSet, mut options: Options) -> Self {
-        if !(options.tolerance.is_finite() && options.tolerance > 0.0) {
-            options.tolerance = Options::default().tolerance;
-        }
+    /// An evaluator with the given options; a tolerance that is not a finite positive number
+    /// is refused.
+    pub fn with_options(set: &PatchSet, options: Options) -> Result<Self, super::ToleranceError> {
+        super::ToleranceError::check(options.tolerance)?;
+        Ok(Self::build(set, options))
+    }
+
+    fn build(set: &PatchSet, options: Options) -> Self {
         let links = link_edges(set);
         let (scaled, coord_exp) = rescaled(set);
         let edges = set

@@ -29,6 +29,35 @@ pub mod surface_quadrature;
 pub mod tessellate;
 
 pub use eval::{Evaluation, Options, PatchWindingNumber};
+
+/// A tolerance the patch and STEP evaluators refuse: not a finite positive number (their
+/// quadratures cannot meet a tolerance of 0, and NaN or a negative value is a mistake). Before,
+/// they silently replaced it by the default.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ToleranceError(pub f64);
+
+impl std::fmt::Display for ToleranceError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "tolerance must be a finite positive number for curved surfaces, got {}",
+            self.0
+        )
+    }
+}
+
+impl std::error::Error for ToleranceError {}
+
+impl ToleranceError {
+    /// `Ok` for a finite positive tolerance.
+    pub fn check(tolerance: f64) -> Result<(), ToleranceError> {
+        if tolerance.is_finite() && tolerance > 0.0 {
+            Ok(())
+        } else {
+            Err(ToleranceError(tolerance))
+        }
+    }
+}
 #[cfg(feature = "io")]
 pub use io::{is_patch_path, load_patches};
 pub use model::{Patch, PatchError, PatchSet};

@@ -56,3 +56,48 @@ fn cli_info_on_fixture_missing_and_broken_files() {
         assert!(stderr.contains(name), "{stderr}");
     }
 }
+
+/// A broken STEP file is one line on stderr naming the file and the entity with its `#id`, for
+/// `gwn info` and `gwn eval` alike; `gwn info` counts the edge uses trimmed by pcurves.
+#[test]
+fn cli_step_errors_are_one_line_naming_the_file() {
+    let dir = std::env::temp_dir().join(format!("gwn-cli-step-errors-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let good = std::fs::read_to_string(fixture("step/capped_cylinder.step")).unwrap();
+    let bad = dir.join("offset.step");
+    std::fs::write(
+        &bad,
+        good.replace("#14=PLANE('',#10);", "#14=OFFSET_SURFACE('',#12,0.1,.F.);"),
+    )
+    .unwrap();
+    let points = dir.join("q.csv");
+    std::fs::write(&points, "0 0 1\n").unwrap();
+    let bad_s = bad.to_str().unwrap();
+    for args in [
+        vec!["info", bad_s],
+        vec!["eval", bad_s, "--points", points.to_str().unwrap()],
+    ] {
+        let (ok, _, err) = crate::cli::gwn(&args);
+        assert!(!ok, "{args:?}");
+        let lines: Vec<&str> = err.lines().collect();
+        assert_eq!(lines.len(), 1, "{err}");
+        assert!(
+            lines[0].contains(bad_s) && lines[0].contains("#14 OFFSET_SURFACE: not supported"),
+            "{err}"
+        );
+    }
+    let (ok, out, err) = crate::cli::gwn(&[
+        "info",
+        fixture("step/capped_cylinder_pcurves.step")
+            .to_str()
+            .unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        out.lines()
+            .any(|l| l.starts_with("edge uses trimmed by pcurves")
+                && l.contains(" 6 (0 pcurves off")),
+        "{out}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -86,7 +86,8 @@ fn voxelize_and_slice_pass_the_tolerance_to_patch_sets() {
                 tolerance,
                 ..Options::default()
             },
-        );
+        )
+        .unwrap();
         gwn::grid::evaluate(&wn, &spec)
     };
     let coarse = voxelize("1e-2");

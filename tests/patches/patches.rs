@@ -24,7 +24,7 @@ impl Rng {
 }
 
 fn with(set: &PatchSet, ray: RayAxis, tolerance: f64) -> PatchWindingNumber {
-    PatchWindingNumber::with_options(set, Options { ray, tolerance })
+    PatchWindingNumber::with_options(set, Options { ray, tolerance }).unwrap()
 }
 
 /// A planar parallelogram `o + t·a + s·b` as a patch of degrees `(m, n)` (affine control net).
@@ -159,5 +159,54 @@ fn tessellation_converges_to_the_patch_values() {
             "q = {q:?}: {w} vs {reference} (estimate {est:e})"
         );
         n += 1;
+    }
+}
+
+/// A tolerance that is not a finite positive number is refused (it used to become the default
+/// silently).
+#[test]
+fn evaluator_refuses_a_bad_tolerance() {
+    let (set, _) = open_box();
+    for t in [f64::NAN, -1e-8, 0.0, f64::NEG_INFINITY, f64::INFINITY] {
+        let options = Options {
+            ray: RayAxis::PosZ,
+            tolerance: t,
+        };
+        let e = PatchWindingNumber::with_options(&set, options).unwrap_err();
+        assert_eq!(e.to_string(), gwn::patch::ToleranceError(t).to_string());
+        assert!(e.to_string().contains("finite positive"), "{e}");
+    }
+    assert!(
+        with(&set, RayAxis::PosZ, 1e-6)
+            .eval([0.5, 0.5, 0.5])
+            .is_finite()
+    );
+}
+
+/// On an open boundary edge the patch evaluator's value is the principal value on every ray:
+/// the mesh direct sum's value there (triangles in whose plane the query lies contribute 0),
+/// 1/4 on the rim of the open box and 1/8 at its corners; flagged, with an estimate covering
+/// the jump of `w` around the edge.
+#[test]
+fn open_box_rim_gets_the_principal_value_on_every_ray() {
+    let (set, mesh) = open_box();
+    for q in [
+        [0.5, 0.0, 1.0],
+        [1.0, 0.3, 1.0],
+        [0.25, 1.0, 1.0],
+        [1.0, 1.0, 1.0],
+    ] {
+        let direct = gwn::eval::direct::winding_number_direct(&mesh, q);
+        for ray in RayAxis::ALL {
+            let e = with(&set, ray, 1e-10).evaluate(q);
+            assert!(
+                (e.value - direct).abs() < 1e-12,
+                "{q:?} {ray:?} {e:?} vs {direct}"
+            );
+            assert!(
+                !e.certified && e.error_estimate >= 0.5,
+                "{q:?} {ray:?} {e:?}"
+            );
+        }
     }
 }

@@ -108,7 +108,7 @@ proptest! {
                 continue;
             }
             let ray = RayAxis::ALL[i % 6];
-            let wn = PatchWindingNumber::with_options(&set, Options { ray, tolerance: 1e-11 });
+            let wn = PatchWindingNumber::with_options(&set, Options { ray, tolerance: 1e-11 }).unwrap();
             let w = wn.eval(q);
             prop_assert!((w - w.round()).abs() < 1e-9, "q = {:?}, {:?}: {}", q, ray, w);
         }
@@ -132,7 +132,7 @@ proptest! {
             }
             let reference = (4.0 * b - a) / 3.0;
             let ray = RayAxis::ALL[i % 6];
-            let wn = PatchWindingNumber::with_options(&set, Options { ray, tolerance: 1e-11 });
+            let wn = PatchWindingNumber::with_options(&set, Options { ray, tolerance: 1e-11 }).unwrap();
             let w = wn.eval(q);
             prop_assert!((w - reference).abs() <= 2.0 * est + 1e-9,
                 "q = {:?}: {} vs {} (estimate {:e})", q, w, reference, est);

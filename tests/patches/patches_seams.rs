@@ -23,7 +23,7 @@ const QUERY_DEADLINE: Duration = Duration::from_secs(2);
 fn evaluators(set: &PatchSet, tolerance: f64) -> Vec<PatchWindingNumber> {
     RayAxis::ALL
         .iter()
-        .map(|&ray| PatchWindingNumber::with_options(set, Options { ray, tolerance }))
+        .map(|&ray| PatchWindingNumber::with_options(set, Options { ray, tolerance }).unwrap())
         .collect()
 }
 
@@ -212,7 +212,8 @@ fn extreme_scales_and_weights_give_the_unscaled_value() {
                     ray,
                     tolerance: 1e-12,
                 },
-            );
+            )
+            .unwrap();
             let r = wn.evaluate([0.5 * s, 0.5 * s, 0.5 * s]);
             assert!(
                 (r.value - reference).abs() < 1e-12 && r.certified,
@@ -248,6 +249,7 @@ fn tolerance_bounds_the_total_error_estimate() {
         for h in [-0.5, 0.25, 0.999, 2.0] {
             for ray in RayAxis::ALL {
                 let r = PatchWindingNumber::with_options(&set, Options { ray, tolerance })
+                    .unwrap()
                     .evaluate([0.01, -0.02, h]);
                 assert!(r.certified, "{r:?}");
                 assert!(
@@ -264,6 +266,7 @@ fn tolerance_bounds_the_total_error_estimate() {
             let expected = if h > 0.0 && h < 1.0 { 1.0 } else { 0.0 } - f64::signum(h) * disk;
             for ray in RayAxis::ALL {
                 let r = PatchWindingNumber::with_options(&set, Options { ray, tolerance })
+                    .unwrap()
                     .evaluate([0.0, 0.0, h]);
                 assert!(
                     r.error_estimate <= tolerance,

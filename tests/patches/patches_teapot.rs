@@ -35,7 +35,7 @@ fn random_points(set: &PatchSet, count: usize, seed: u64) -> Vec<[f64; 3]> {
 }
 
 fn evaluator(set: &PatchSet, ray: RayAxis, tolerance: f64) -> PatchWindingNumber {
-    PatchWindingNumber::with_options(set, Options { ray, tolerance })
+    PatchWindingNumber::with_options(set, Options { ray, tolerance }).unwrap()
 }
 
 /// Points on the boundary curves (lid gap, tube ends), pushed off by `offset` in each axis

@@ -476,3 +476,202 @@ fn oblique_trim_on_rational_arcs() {
         }
     }
 }
+
+/// `capped_cylinder_pcurves.step`: the capped cylinder whose 3D edges lie 1e-3 outside its
+/// faces (circles of radius 1.001) while the pcurves give the true circles. Mapped from 3D,
+/// the disks overhang the side by 1e-3 and a ray from just outside the wall through that ring
+/// counts a crossing; trimmed by the pcurves, the solid is closed and every ray agrees.
+#[test]
+fn pcurves_trim_the_faces_where_the_3d_edges_stray() {
+    let text = std::fs::read_to_string(fixture("capped_cylinder_pcurves.step")).unwrap();
+    let with = parse_step(&text).unwrap();
+    let info = with.info();
+    // Top and bottom disks 1 use each, the side 4 (two circles, the seam twice).
+    assert_eq!(info.pcurve_uses, 6, "{info:?}");
+    assert_eq!((info.pcurves_rejected, info.pcurves_unreadable), (0, 0));
+    // The same file with its pcurves hidden: every use mapped from 3D.
+    let without = parse_step(&text.replace("PCURVE(", "NOT_A_PCURVE(")).unwrap();
+    assert_eq!(without.info().pcurve_uses, 0);
+    let (a, b) = (
+        StepWindingNumber::new(&with),
+        StepWindingNumber::new(&without),
+    );
+    // Just outside the wall, below the top rim's overhang and above the bottom's.
+    for q in [
+        [1.0005, 0.0, 1.9999],
+        [0.0, -1.0004, 1.9998],
+        [-0.7075, 0.7075, 1e-4],
+    ] {
+        let mut overhang = 0;
+        for &d in a.directions() {
+            let ea = a.evaluate_along(q, d).map(|e| e.value);
+            assert!(ea.is_none() || ea == Some(0.0), "{q:?} {d:?} {ea:?}");
+            overhang += usize::from(b.evaluate_along(q, d).map(|e| e.value) == Some(1.0));
+        }
+        assert!(overhang >= 4, "{q:?}: {overhang} rays through the overhang");
+        let e = a.evaluate(q);
+        assert_eq!((e.value, e.uncertified), (0.0, false), "{q:?} {e:?}");
+    }
+    // Mapped from 3D the answer at the first two points is the first ray's: through the overhang.
+    assert_eq!(b.eval([1.0005, 0.0, 1.9999]), 1.0);
+    assert_eq!(b.eval([0.0, -1.0004, 1.9998]), 1.0);
+    // Inside the wall and on a lattice, the pcurve-trimmed model is the exact solid.
+    for q in [
+        [0.9995, 0.0, 1.9999],
+        [0.0, 0.9996, 1e-4],
+        [-0.9995, 1e-9, 1.0],
+    ] {
+        assert_eq!(a.eval(q), 1.0, "{q:?}");
+    }
+    for i in 0..6 {
+        for k in 0..5 {
+            let q = [
+                -1.5 + 0.6 * i as f64 + 0.013,
+                0.011,
+                -0.45 + 0.6 * k as f64 + 0.017,
+            ];
+            let r = q[0].hypot(q[1]);
+            let inside = r < 1.0 && q[2] > 0.0 && q[2] < 2.0;
+            assert_eq!(a.eval(q), if inside { 1.0 } else { 0.0 }, "{q:?}");
+        }
+    }
+    // A pcurve in the wrong place (the disks' circle of radius 2: 1 from the 3D edge) is
+    // refused, and those uses are mapped from 3D.
+    let wrong =
+        parse_step(&text.replace("#104=CIRCLE('',#103,1.)", "#104=CIRCLE('',#103,2.)")).unwrap();
+    let info = wrong.info();
+    assert_eq!(
+        (info.pcurve_uses, info.pcurves_rejected),
+        (4, 2),
+        "{info:?}"
+    );
+}
+
+/// `load_step` keeps the kind of every error (`StepError::cause`) and names the file in its one
+/// line: I/O, syntax, dangling reference, unsupported entity, invalid parameters, geometry, no
+/// faces. (`TooLarge` needs a 256 MiB file or 4·10⁶ instances: not written here.)
+#[test]
+fn load_errors_keep_their_kind_and_name_the_file() {
+    let dir = std::env::temp_dir().join(format!("gwn-step-errors-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let good = std::fs::read_to_string(fixture("capped_cylinder.step")).unwrap();
+    let load = |name: &str, text: &str| {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        let e = load_step(&path).unwrap_err();
+        let line = e.to_string();
+        assert!(!line.contains('\n'), "{line}");
+        assert!(line.starts_with(&format!("{}: ", path.display())), "{line}");
+        assert_eq!(e.path(), Some(path.as_path()));
+        e
+    };
+    let missing = dir.join("missing.step");
+    let e = load_step(&missing).unwrap_err();
+    assert!(
+        matches!(&e, StepError::Io { kind: std::io::ErrorKind::NotFound, path, .. } if path == &missing),
+        "{e:?}"
+    );
+    assert!(
+        e.to_string()
+            .starts_with(&format!("{}: ", missing.display()))
+    );
+    let e = load("truncated.step", &good[..good.len() / 2]);
+    assert!(matches!(e.cause(), StepError::Syntax { .. }), "{e:?}");
+    let e = load(
+        "dangling.step",
+        &good.replace(
+            "#12=CYLINDRICAL_SURFACE('',#10,1.);",
+            "#12=CYLINDRICAL_SURFACE('',#99,1.);",
+        ),
+    );
+    assert_eq!(e.cause(), &StepError::Dangling { id: 12, target: 99 });
+    let e = load(
+        "offset.step",
+        &good.replace("#14=PLANE('',#10);", "#14=OFFSET_SURFACE('',#12,0.1,.F.);"),
+    );
+    assert!(
+        matches!(e.cause(), StepError::Unsupported { id: 14, entity, .. } if entity == "OFFSET_SURFACE"),
+        "{e:?}"
+    );
+    assert!(
+        e.to_string()
+            .ends_with("#14 OFFSET_SURFACE: not supported as a face surface"),
+        "{e}"
+    );
+    let e = load(
+        "invalid.step",
+        &good.replace(
+            "#12=CYLINDRICAL_SURFACE('',#10,1.);",
+            "#12=CYLINDRICAL_SURFACE('',#10,-1.);",
+        ),
+    );
+    assert!(
+        matches!(e.cause(), StepError::Invalid { id: 12, .. }),
+        "{e:?}"
+    );
+    // A line edge from a vertex back to itself: well-formed parameters, no edge.
+    let e = load(
+        "geometry.step",
+        &good.replace(
+            "#42=EDGE_CURVE('',#22,#23,#32,.T.);",
+            "#42=EDGE_CURVE('',#22,#22,#32,.T.);",
+        ),
+    );
+    assert!(
+        matches!(e.cause(), StepError::Geometry { id: 42, entity, .. } if entity == "EDGE_CURVE"),
+        "{e:?}"
+    );
+    let e = load("empty.step", &minimal("#1=CARTESIAN_POINT('',(0.,0.,0.));"));
+    assert_eq!(e.cause(), &StepError::NoFaces);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A tolerance that is not a finite positive number is refused, not replaced by the default.
+#[test]
+fn evaluator_refuses_a_bad_tolerance() {
+    use gwn::patch::ToleranceError;
+    use gwn::patch::step::StepOptions;
+    let m = load_step(&fixture("capped_cylinder.step")).unwrap();
+    for t in [f64::NAN, -1e-8, 0.0, f64::INFINITY] {
+        let e = StepWindingNumber::with_options(&m, StepOptions { tolerance: t }).unwrap_err();
+        assert_eq!(e.to_string(), ToleranceError(t).to_string());
+        assert!(e.to_string().contains(&t.to_string()), "{e}");
+    }
+    let wn = StepWindingNumber::with_options(&m, StepOptions { tolerance: 1e-6 }).unwrap();
+    assert_eq!(wn.eval([0.1, 0.2, 1.0]), 1.0);
+}
+
+/// On the plate's boundary (its outer square, corners included, and the hole's circle) the
+/// principal value is 0 exactly: the plate is flat, and a flat region seen from a point in its
+/// plane subtends no solid angle. Every qualifying ray gives it; the value is certified.
+#[test]
+fn plate_boundary_gets_the_principal_value() {
+    let m = load_step(&fixture("plate_with_hole.stp")).unwrap();
+    let wn = StepWindingNumber::new(&m);
+    let a = 1.1_f64;
+    for c in [
+        [1.0, 0.3, 0.0],
+        [-0.2, -1.0, 0.0],
+        [-1.0, 0.9, 0.0],
+        [1.0, 1.0, 0.0],
+        [-1.0, -1.0, 0.0],
+        [0.5 * a.cos(), 0.5 * a.sin(), 0.0],
+        [-0.5, 0.0, 0.0],
+    ] {
+        let e = wn.evaluate(c);
+        assert!(!e.uncertified && e.value.abs() < 1e-9, "{c:?} {e:?}");
+        let mut rays = 0;
+        for &d in wn.directions() {
+            if let Some(f) = wn.evaluate_on_boundary_along(c, d) {
+                assert!(f.value.abs() < 1e-9, "{c:?} {d:?} {f:?}");
+                rays += 1;
+            }
+        }
+        assert!(rays >= 6, "{c:?}: {rays}");
+        // Just off the boundary the rule does not apply.
+        assert!(
+            wn.evaluate_on_boundary_along([c[0], c[1], 1e-9], wn.directions()[0])
+                .is_none()
+        );
+    }
+}

@@ -209,3 +209,49 @@ fn indexed_trimming_equals_the_scan() {
         eprintln!("{model}: {checked} classifications agree");
     }
 }
+
+/// Queries exactly on the open rim of `open_cylinder` (the slanted top's loop, on the cylinder
+/// faces) follow the on-boundary rule: the principal value, the same along every ray that
+/// qualifies, and the mean of the two values just off the surface on either side of it (the
+/// limits from the two sides of the surface, whose mean is the mean over all directions).
+#[test]
+fn open_cylinder_rim_gets_the_principal_value() {
+    let Some(dir) = shared() else { return };
+    let m = load_step(&dir.join("open_cylinder.step")).unwrap();
+    let wn = StepWindingNumber::new(&m);
+    let mut checked = 0;
+    for piece in m.boundary() {
+        // Inside the pieces: the rim's corners (where the slanted ellipse meets the straight
+        // edge) are no smooth-curve points, and two sides do not average to the mean there.
+        for t in [0.37, 0.81] {
+            let c = gwn::patch::step::nurbs::point_at(piece, t);
+            let r = c[0].hypot(c[1]);
+            if (r - 10.0).abs() > 1e-3 {
+                continue; // on the straight edge (a plane face)
+            }
+            let e = wn.evaluate(c);
+            assert!(!e.uncertified, "{c:?} {e:?}");
+            let mut rays = 0;
+            for &d in wn.directions() {
+                if let Some(f) = wn.evaluate_on_boundary_along(c, d) {
+                    // Not to 1e-9: the rim lies up to 2.7e-5 off the faces' cylinders (radius
+                    // 9.99997 and 10.0000038 against edge curves of radius 10).
+                    assert!((f.value - e.value).abs() < 1e-7, "{c:?} {d:?} {f:?} {e:?}");
+                    rays += 1;
+                }
+            }
+            assert!(rays >= 6, "{c:?}: {rays} rays");
+            // The axis is z to 3.4e-6; the normal is radial.
+            let n = [c[0] / r, c[1] / r, 0.0];
+            let side = |s: f64| wn.eval([c[0] + s * n[0], c[1] + s * n[1], c[2]]);
+            let mean = 0.5 * (side(1e-3) + side(-1e-3));
+            assert!(
+                (e.value - mean).abs() < 1e-6,
+                "{c:?}: {} vs {mean}",
+                e.value
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked >= 4);
+}

@@ -2,7 +2,8 @@
 //! `SHELL_BASED_SURFACE_MODEL`, shells, `ADVANCED_FACE` → bounds → `EDGE_LOOP` →
 //! `ORIENTED_EDGE` → `EDGE_CURVE` → `VERTEX_POINT`), geometry (placements, curves, surfaces) and
 //! units. Every entity the reader does not know is an [`StepError::Unsupported`] naming it and
-//! its `#id`; wrong parameter counts or types are [`StepError::Invalid`].
+//! its `#id`; wrong parameter counts or types are [`StepError::Invalid`]; parameters that do
+//! not make an edge or surface are [`StepError::Geometry`].
 
 use std::collections::{HashMap, HashSet};
 
@@ -51,6 +52,13 @@ pub struct RawFace {
     pub surface: Surface,
     /// `same_sense`.
     pub same_sense: bool,
+    /// `#id` of the surface (pcurves name it as their basis surface).
+    pub surface_id: u64,
+    /// Radians per file unit of the surface's `u` and `v` as pcurves give them (the file's
+    /// plane-angle unit for angles, 1 for lengths and B-spline parameters); `None` where this
+    /// reader's `(u, v)` is not the file's (surfaces of revolution and extrusion), so pcurves
+    /// cannot be used.
+    pub pcurve_units: Option<[f64; 2]>,
     /// Loops of edge uses, oriented as the face boundary (face on the left seen from the
     /// face normal).
     pub loops: Vec<Vec<EdgeUse>>,
@@ -73,10 +81,87 @@ pub(crate) struct Reader<'a> {
     curves: HashMap<u64, Curve>,
     /// Edge geometry from start to end vertex, by `EDGE_CURVE` id.
     pub edges: HashMap<u64, Vec<Vec<Homogeneous>>>,
+    /// The pcurves of each `EDGE_CURVE` that the reader can use, by edge id.
+    pub pcurves: HashMap<u64, Vec<EdgePcurve>>,
+    /// Pcurves the file gives that the reader cannot use (their 2D curve or the edge's 3D curve
+    /// is of a kind without a parameter range here): those edge uses are mapped from 3D.
+    pub pcurves_unreadable: usize,
+}
+
+/// A 2D curve of a pcurve, in the file's `(u, v)` units.
+#[derive(Clone, Debug)]
+pub enum Curve2 {
+    /// `p + t d`.
+    Line([f64; 2], [f64; 2]),
+    /// `o + a cos θ x + b sin θ y`, `θ = t ×` the plane-angle factor (circle: `a = b`).
+    Conic {
+        /// Centre.
+        o: [f64; 2],
+        /// First axis (unit).
+        x: [f64; 2],
+        /// Second axis (unit, `x` turned by +90°).
+        y: [f64; 2],
+        /// Semi-axes.
+        a: f64,
+        /// Second semi-axis.
+        b: f64,
+        /// Radians per unit of `t`.
+        angle: f64,
+    },
+    /// A B-spline as Bézier pieces (the third coordinate 0).
+    Pieces(Pieces),
+}
+
+impl Curve2 {
+    /// The point at the curve's own parameter `t` (B-splines clamped to their domain).
+    pub fn at(&self, t: f64) -> [f64; 2] {
+        match self {
+            Curve2::Line(p, d) => [p[0] + t * d[0], p[1] + t * d[1]],
+            Curve2::Conic {
+                o,
+                x,
+                y,
+                a,
+                b,
+                angle,
+            } => {
+                let (s, c) = (t * angle).sin_cos();
+                [
+                    o[0] + a * c * x[0] + b * s * y[0],
+                    o[1] + a * c * x[1] + b * s * y[1],
+                ]
+            }
+            Curve2::Pieces(p) => {
+                let q = super::surface::curve_point(p, t);
+                [q[0], q[1]]
+            }
+        }
+    }
+}
+
+/// A pcurve of an edge: its 2D curve on the surface `#surface` and the parameter range of the
+/// edge, from its start vertex to its end vertex (the 3D curve's parameters, which a
+/// `SURFACE_CURVE`'s pcurves share, ISO 10303-42).
+#[derive(Clone, Debug)]
+pub struct EdgePcurve {
+    /// `#id` of the basis surface.
+    pub surface: u64,
+    /// The 2D curve.
+    pub curve: Curve2,
+    /// Parameter at the edge's start and end vertex.
+    pub range: [f64; 2],
 }
 
 fn invalid(id: u64, inst: &Instance, message: impl Into<String>) -> StepError {
     StepError::Invalid {
+        id,
+        entity: inst.display_name(),
+        message: message.into(),
+    }
+}
+
+fn geometry(id: u64, inst: &Instance, message: impl Into<String>) -> StepError {
+    StepError::Geometry {
         id,
         entity: inst.display_name(),
         message: message.into(),
@@ -192,6 +277,8 @@ impl<'a> Reader<'a> {
             angle_factor: 1.0,
             curves: HashMap::new(),
             edges: HashMap::new(),
+            pcurves: HashMap::new(),
+            pcurves_unreadable: 0,
         };
         r.angle_factor = r.find_angle_factor();
         r
@@ -298,6 +385,167 @@ impl<'a> Reader<'a> {
         Ok([c[0], c[1], c[2]])
     }
 
+    fn point2(&self, from: u64, id: u64) -> Result<[f64; 2], StepError> {
+        let p = self.simple(from, id, &["CARTESIAN_POINT"], "as a 2D point")?;
+        let c = p.reals(1)?;
+        if c.len() != 2 {
+            return Err(invalid(id, p.inst, "a 2D point needs two coordinates"));
+        }
+        Ok([c[0], c[1]])
+    }
+
+    fn direction2(&self, from: u64, id: u64) -> Result<[f64; 2], StepError> {
+        let p = self.simple(from, id, &["DIRECTION"], "as a 2D direction")?;
+        let c = p.reals(1)?;
+        let n = if c.len() == 2 { c[0].hypot(c[1]) } else { 0.0 };
+        if !(n > 0.0 && n.is_finite()) {
+            return Err(invalid(
+                id,
+                p.inst,
+                "a 2D direction needs two components, not both 0",
+            ));
+        }
+        Ok([c[0] / n, c[1] / n])
+    }
+
+    /// The 2D curve of a pcurve: `LINE`, `CIRCLE`, `ELLIPSE` (on an `AXIS2_PLACEMENT_2D`) or a
+    /// (rational) B-spline, in the file's parameter units.
+    fn curve2(&self, from: u64, id: u64) -> Result<Curve2, StepError> {
+        let inst = self.inst(from, id)?;
+        if inst.parts.len() > 1 {
+            return match self.bspline_curve_in(id, inst, 2)? {
+                Curve::Pieces(p, _) => Ok(Curve2::Pieces(p)),
+                _ => Err(unsupported(id, inst, "as a 2D curve")),
+            };
+        }
+        let p = Params {
+            id,
+            inst,
+            part: &inst.parts[0],
+        };
+        Ok(match p.part.name.as_str() {
+            "LINE" => {
+                let o = self.point2(id, p.refid(1)?)?;
+                let v = self.simple(id, p.refid(2)?, &["VECTOR"], "as a line direction")?;
+                let d = self.direction2(v.id, v.refid(1)?)?;
+                let m = v.real(2)?;
+                Curve2::Line(o, [d[0] * m, d[1] * m])
+            }
+            "CIRCLE" | "ELLIPSE" => {
+                let pl = self.simple(
+                    id,
+                    p.refid(1)?,
+                    &["AXIS2_PLACEMENT_2D"],
+                    "as a 2D placement",
+                )?;
+                let o = self.point2(pl.id, pl.refid(1)?)?;
+                let x = match pl.opt_ref(2)? {
+                    Some(r) => self.direction2(pl.id, r)?,
+                    None => [1.0, 0.0],
+                };
+                let a = p.real(2)?;
+                let b = if p.part.name == "CIRCLE" {
+                    a
+                } else {
+                    p.real(3)?
+                };
+                if !(a > 0.0 && b > 0.0) {
+                    return Err(invalid(id, inst, "radii must be positive"));
+                }
+                Curve2::Conic {
+                    o,
+                    x,
+                    y: [-x[1], x[0]],
+                    a,
+                    b,
+                    angle: self.angle_factor,
+                }
+            }
+            "B_SPLINE_CURVE_WITH_KNOTS" => match self.bspline_curve_in(id, inst, 2)? {
+                Curve::Pieces(p, _) => Curve2::Pieces(p),
+                _ => return Err(unsupported(id, inst, "as a 2D curve")),
+            },
+            _ => return Err(unsupported(id, inst, "as a 2D curve")),
+        })
+    }
+
+    /// The pcurves of an edge whose geometry is a `SURFACE_CURVE` / `SEAM_CURVE`, with the
+    /// edge's parameter range on its 3D curve `curve` (from start to end vertex). Pcurves this
+    /// reader cannot use are counted in `pcurves_unreadable` (their edge uses are mapped from 3D).
+    fn read_pcurves(
+        &mut self,
+        geometry: u64,
+        curve: &Curve,
+        ends: [[f64; 3]; 2],
+        same_sense: bool,
+        tol: f64,
+    ) -> Result<Vec<EdgePcurve>, StepError> {
+        let inst = self.inst(geometry, geometry)?;
+        let [part] = inst.parts.as_slice() else {
+            return Ok(Vec::new());
+        };
+        if !matches!(part.name.as_str(), "SURFACE_CURVE" | "SEAM_CURVE") {
+            return Ok(Vec::new());
+        }
+        let p = Params {
+            id: geometry,
+            inst,
+            part,
+        };
+        let mut out = Vec::new();
+        let mut candidates = Vec::new();
+        for r in p.refs(2)? {
+            let a = self.inst(geometry, r)?;
+            // A SURFACE in the list names a surface without a pcurve: nothing to use.
+            if let [pp] = a.parts.as_slice() {
+                if pp.name == "PCURVE" {
+                    let pc = Params {
+                        id: r,
+                        inst: a,
+                        part: pp,
+                    };
+                    candidates.push((pc.refid(1)?, pc.refid(2)?, r));
+                }
+            }
+        }
+        if candidates.is_empty() {
+            return Ok(out);
+        }
+        let range = if same_sense {
+            param_range(curve, ends[0], ends[1], self.angle_factor, tol)
+        } else {
+            param_range(curve, ends[1], ends[0], self.angle_factor, tol).map(|[a, b]| [b, a])
+        };
+        for (surface, rep, pid) in candidates {
+            let Some(range) = range else {
+                self.pcurves_unreadable += 1;
+                continue;
+            };
+            let items = match self.simple(
+                pid,
+                rep,
+                &["DEFINITIONAL_REPRESENTATION"],
+                "as a pcurve's representation",
+            ) {
+                Ok(dr) => dr.refs(1).unwrap_or_default(),
+                Err(e @ StepError::Dangling { .. }) => return Err(e),
+                Err(_) => Vec::new(),
+            };
+            match items.first().map(|&c| self.curve2(rep, c)) {
+                Some(Ok(c)) => out.push(EdgePcurve {
+                    surface,
+                    curve: c,
+                    range,
+                }),
+                Some(Err(StepError::Dangling { id, target })) => {
+                    return Err(StepError::Dangling { id, target });
+                }
+                _ => self.pcurves_unreadable += 1,
+            }
+        }
+        Ok(out)
+    }
+
     fn direction(&self, from: u64, id: u64) -> Result<[f64; 3], StepError> {
         let p = self.simple(from, id, &["DIRECTION"], "as a direction")?;
         let c = p.reals(1)?;
@@ -379,6 +627,17 @@ impl<'a> Reader<'a> {
 
     /// `B_SPLINE_CURVE_WITH_KNOTS` (simple) or the complex form with `RATIONAL_B_SPLINE_CURVE`.
     fn bspline_curve(&self, id: u64, inst: &'a Instance) -> Result<Curve, StepError> {
+        self.bspline_curve_in(id, inst, 3)
+    }
+
+    /// A B-spline curve with `dim`-dimensional control points (2 for a pcurve's curve; the
+    /// third coordinate is then 0).
+    fn bspline_curve_in(
+        &self,
+        id: u64,
+        inst: &'a Instance,
+        dim: usize,
+    ) -> Result<Curve, StepError> {
         let (head, off, knots_part, koff, weights) = if inst.parts.len() == 1 {
             let part = &inst.parts[0];
             (part, 1, part, 6, None)
@@ -423,7 +682,13 @@ impl<'a> Reader<'a> {
             expand_knots(&mults, &knots, ctrl_ids.len(), p).map_err(|m| invalid(id, inst, m))?;
         let mut ctrl = Vec::with_capacity(ctrl_ids.len());
         for (&c, &w) in ctrl_ids.iter().zip(&ws) {
-            ctrl.push(vec![hom(self.point(id, c)?, w)]);
+            let point = if dim == 2 {
+                let [x, y] = self.point2(id, c)?;
+                [x, y, 0.0]
+            } else {
+                self.point(id, c)?
+            };
+            ctrl.push(vec![hom(point, w)]);
         }
         let pieces: Pieces = extract(p, &u, &ctrl)
             .into_iter()
@@ -517,7 +782,11 @@ impl<'a> Reader<'a> {
         } else {
             self.between(&curve, v2, v1, tol).map(reverse)
         }
-        .map_err(|m| invalid(id, p.inst, m))?;
+        .map_err(|m| geometry(id, p.inst, m))?;
+        let pcurves = self.read_pcurves(p.refid(3)?, &curve, [v1, v2], same_sense, tol)?;
+        if !pcurves.is_empty() {
+            self.pcurves.insert(id, pcurves);
+        }
         self.edges.insert(id, pieces.clone());
         Ok(pieces)
     }
@@ -586,7 +855,7 @@ impl<'a> Reader<'a> {
                     Some(r) => self.direction(ax.id, r)?,
                     None => [0.0, 0.0, 1.0],
                 };
-                revolution(&pieces, a, d, tol).map_err(|m| invalid(id, inst, m))?
+                revolution(&pieces, a, d, tol).map_err(|m| geometry(id, inst, m))?
             }
             _ => return Err(unsupported(id, inst, "as a face surface")),
         })
@@ -729,7 +998,21 @@ impl<'a> Reader<'a> {
     /// A face: `ADVANCED_FACE` / `FACE_SURFACE`.
     pub(crate) fn face(&mut self, from: u64, id: u64, tol: f64) -> Result<RawFace, StepError> {
         let p = self.simple(from, id, &["ADVANCED_FACE", "FACE_SURFACE"], "as a face")?;
-        let surface = self.surface(id, p.refid(2)?, tol)?;
+        let surface_id = p.refid(2)?;
+        let surface = self.surface(id, surface_id, tol)?;
+        let a = self.angle_factor;
+        let surface_inst = self.inst(id, surface_id)?;
+        let pcurve_units = match surface {
+            Surface::Plane(_) => Some([1.0, 1.0]),
+            Surface::Cylinder(..) | Surface::Cone(..) => Some([a, 1.0]),
+            Surface::Sphere(..) | Surface::Torus(..) => Some([a, a]),
+            // B-spline surfaces keep their knot parameters; surfaces of revolution (also
+            // patches here) run linearly in the rational arcs' parameter, not in the angle.
+            Surface::Patches { .. } => (surface_inst.parts.len() > 1
+                || surface_inst.parts[0].name == "B_SPLINE_SURFACE_WITH_KNOTS")
+                .then_some([1.0, 1.0]),
+            Surface::Extrusion(..) => None,
+        };
         let same_sense = p.boolean(3)?;
         let mut loops = Vec::new();
         for b in p.refs(1)? {
@@ -770,6 +1053,8 @@ impl<'a> Reader<'a> {
             id,
             surface,
             same_sense,
+            surface_id,
+            pcurve_units,
             loops,
         })
     }
@@ -892,6 +1177,45 @@ impl<'a> Reader<'a> {
         } else {
             1e-12
         }
+    }
+}
+
+/// The parameters of `curve` at the points `a` and `b`, running in the curve's direction from
+/// `a` to `b`, in the file's units (angles divided by `angle_factor`, radians per unit): the
+/// range a pcurve of this curve shares. `None` where the reader has no such range: trimmed
+/// curves, and a closed B-spline run across its closing point.
+fn param_range(
+    curve: &Curve,
+    a: [f64; 3],
+    b: [f64; 3],
+    angle_factor: f64,
+    tol: f64,
+) -> Option<[f64; 2]> {
+    let same = norm(sub(a, b)) <= tol;
+    match curve {
+        Curve::Line(o, d) => {
+            let dd = dot(*d, *d);
+            let t = |p: [f64; 3]| dot(sub(p, *o), *d) / dd;
+            (!same).then(|| [t(a), t(b)])
+        }
+        Curve::Conic(f, ra, rb) => {
+            let t0 = conic_angle(f, *ra, *rb, a);
+            let t1 = if same {
+                t0 + std::f64::consts::TAU
+            } else {
+                next_turn(t0, conic_angle(f, *ra, *rb, b))
+            };
+            Some([t0 / angle_factor, t1 / angle_factor])
+        }
+        Curve::Pieces(pieces, closed) => {
+            let (lo, hi) = (pieces[0].0, pieces[pieces.len() - 1].1);
+            if same && *closed {
+                return Some([lo, hi]);
+            }
+            let (ta, tb) = (invert_curve(pieces, a), invert_curve(pieces, b));
+            (tb > ta).then_some([ta, tb])
+        }
+        Curve::Trimmed(..) => None,
     }
 }
 

@@ -55,6 +55,22 @@ pub const MIN_COSINE: f64 = 1e-4;
 const COLUMN_HIT_MARGIN: f64 = 1e-3;
 /// Subdivision depth of a patch before Newton's method starts from the piece's centre.
 const HIT_DEPTH: u32 = 12;
+/// A query this close to a surface-boundary curve (relative to the diagonal) is *on* it and
+/// gets the principal value ([`StepWindingNumber::evaluate`], docs/patches.md "On an open
+/// boundary curve"). Chosen far below the distances at which values are certified (a query
+/// 1e-9 × diagonal from a rim is certified, and its `w` differs from the principal value by up
+/// to 1/2) and far above the rounding of a point computed on a curve (~1e-16).
+pub const ON_BOUNDARY: f64 = 1e-12;
+/// Smallest `|cos|` between the ray and the face's normal at a boundary point for the
+/// on-boundary rule: the ray leaves the face at an angle, and the tangent-plane arc of the rule
+/// stays `asin 0.2 ≈ 11.5°` from the ray.
+const ON_BOUNDARY_COSINE: f64 = 0.2;
+/// Edge curves lie off their faces by the modelling tolerance (up to 2.7·10⁻⁵ in
+/// `open_cylinder.step`, whose rim has radius 10 and its cylinders 9.99997 and 10.0000038): for
+/// the on-boundary rule the face's normal is taken at its point nearest the query, and the
+/// ray's crossing of the surface next to the query is left out, within this distance relative
+/// to the diagonal.
+const ON_BOUNDARY_GAP: f64 = 1e-4;
 
 /// Options of the trimmed-model evaluator.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -173,14 +189,20 @@ enum Reject {
 impl StepWindingNumber {
     /// An evaluator with default options.
     pub fn new(model: &StepModel) -> Self {
-        Self::with_options(model, StepOptions::default())
+        Self::build(model, StepOptions::default())
     }
 
-    /// An evaluator with the given options (a non-positive tolerance becomes the default).
-    pub fn with_options(model: &StepModel, mut options: StepOptions) -> Self {
-        if !(options.tolerance.is_finite() && options.tolerance > 0.0) {
-            options.tolerance = StepOptions::default().tolerance;
-        }
+    /// An evaluator with the given options; a tolerance that is not a finite positive number
+    /// is refused.
+    pub fn with_options(
+        model: &StepModel,
+        options: StepOptions,
+    ) -> Result<Self, crate::patch::ToleranceError> {
+        crate::patch::ToleranceError::check(options.tolerance)?;
+        Ok(Self::build(model, options))
+    }
+
+    fn build(model: &StepModel, options: StepOptions) -> Self {
         StepWindingNumber {
             margin: HIT_MARGIN * model.diagonal(),
             model: model.clone(),
@@ -214,6 +236,19 @@ impl StepWindingNumber {
         }
         let mut rays = 0;
         for (mu, margin, strict) in [(MU, self.margin, true), (MU_RELAXED, 0.0, false)] {
+            if !strict {
+                // No ray passed: on the surface, near an edge, or on a boundary curve, which
+                // has its own rule.
+                if let Some(point) = self.boundary_point(q) {
+                    for &d in &self.dirs {
+                        rays += 1;
+                        if let Some(mut e) = self.on_boundary_along(&point, d) {
+                            e.rays = rays;
+                            return e;
+                        }
+                    }
+                }
+            }
             for &d in &self.dirs {
                 rays += 1;
                 match self.try_ray(q, d, mu, margin, strict) {
@@ -239,6 +274,14 @@ impl StepWindingNumber {
     /// direction fails the certificates. For diagnostics and tests of direction independence.
     pub fn evaluate_along(&self, q: [f64; 3], d: [f64; 3]) -> Option<StepEvaluation> {
         self.try_ray(q, d, MU, self.margin, true).ok()
+    }
+
+    /// The on-boundary rule at `q` along the ray `d`, if `q` is on a surface-boundary curve (within
+    /// [`ON_BOUNDARY`] `×` diagonal) and `d` qualifies (see [`evaluate`](Self::evaluate)):
+    /// `None` otherwise. For tests of direction independence.
+    pub fn evaluate_on_boundary_along(&self, q: [f64; 3], d: [f64; 3]) -> Option<StepEvaluation> {
+        let point = self.boundary_point(q)?;
+        self.on_boundary_along(&point, d)
     }
 
     /// Every hit of the ray from `q` along `d` on every face's patches: `(face #id, point,
@@ -302,7 +345,7 @@ impl StepWindingNumber {
         let mut pieces = Vec::new();
         for c in &self.model.boundary {
             let h: Vec<Homogeneous> = c.iter().map(|&p| frame.hom(p, q)).collect();
-            if !certify(h, mu, 0, &mut pieces) && strict {
+            if !certify(h, mu, 0, false, &mut pieces) && strict {
                 return Err(Reject::Boundary);
             }
         }
@@ -494,13 +537,274 @@ impl StepWindingNumber {
     }
 }
 
+/// A query on the surface boundary, prepared for the on-boundary rule: the boundary curves
+/// with the ones through the point split there and their end points at the point set to it
+/// exactly, the tangents in and out, and the face's unit normal there.
+struct BoundaryPoint {
+    /// The point (the query moved onto the curve, by at most [`ON_BOUNDARY`] `×` diagonal).
+    c: [f64; 3],
+    /// Curves not through `c`.
+    others: Vec<Vec<Homogeneous>>,
+    /// The curve ending at `c` and the one starting there.
+    incident: [Vec<Homogeneous>; 2],
+    /// Unit tangents of the boundary arriving at and leaving `c`.
+    tangent_in: [f64; 3],
+    tangent_out: [f64; 3],
+    /// Unit normal of the face at `c`.
+    normal: [f64; 3],
+}
+
+impl StepWindingNumber {
+    /// `q` as a [`BoundaryPoint`] if it lies within [`ON_BOUNDARY`] `×` diagonal of exactly one
+    /// surface-boundary curve's point (one curve through it, or one ending and one starting
+    /// there), on a face with a normal there; `None` otherwise.
+    fn boundary_point(&self, q: [f64; 3]) -> Option<BoundaryPoint> {
+        let boundary = &self.model.boundary;
+        if boundary.is_empty() {
+            return None;
+        }
+        let tol = ON_BOUNDARY * self.model.diagonal();
+        let mut near: Vec<(usize, f64, [f64; 3])> = Vec::new();
+        for (i, c) in boundary.iter().enumerate() {
+            let t = super::surface::invert_curve(&[(0.0, 1.0, c.clone())], q);
+            let p = super::nurbs::point_at(c, t);
+            if norm(sub(p, q)) <= tol {
+                near.push((i, t, p));
+            }
+        }
+        let &(first, _, c) = near.first()?;
+        let snap = |h: Homogeneous| [h[3] * c[0], h[3] * c[1], h[3] * c[2], h[3]];
+        let end_tol = 1e-9;
+        let (mut arriving, mut leaving) = (Vec::new(), Vec::new());
+        for &(i, t, _) in &near {
+            let curve = &boundary[i];
+            if t >= 1.0 - end_tol || norm(sub(super::nurbs::point_at(curve, 1.0), c)) <= tol {
+                let mut a = curve.clone();
+                let last = a.len() - 1;
+                a[last] = snap(a[last]);
+                arriving.push((i, a));
+            } else if t <= end_tol || norm(sub(super::nurbs::point_at(curve, 0.0), c)) <= tol {
+                let mut b = curve.clone();
+                b[0] = snap(b[0]);
+                leaving.push((i, b));
+            } else {
+                let (mut a, mut b) = super::nurbs::split_at(curve, t);
+                let last = a.len() - 1;
+                a[last] = snap(a[last]);
+                b[0] = snap(b[0]);
+                arriving.push((i, a));
+                leaving.push((i, b));
+            }
+        }
+        if arriving.len() != 1 || leaving.len() != 1 {
+            return None;
+        }
+        let (ia, a) = arriving.pop()?;
+        let (ib, b) = leaving.pop()?;
+        // The tangent from the control polygon at the end (the Bézier end tangent's direction).
+        let euc = |h: &Homogeneous| [h[0] / h[3], h[1] / h[3], h[2] / h[3]];
+        let tangent_in = a
+            .iter()
+            .rev()
+            .map(|h| sub(c, euc(h)))
+            .find(|d| norm(*d) > tol)?;
+        let tangent_out = b.iter().map(|h| sub(euc(h), c)).find(|d| norm(*d) > tol)?;
+        let unit = |v: [f64; 3]| {
+            let n = norm(v);
+            [v[0] / n, v[1] / n, v[2] / n]
+        };
+        let face = &self.model.faces[self.model.boundary_faces[first]];
+        let normal = face_normal(face, c, self.model.diagonal())?;
+        let others = boundary
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| *i != ia && *i != ib)
+            .map(|(_, c)| c.clone())
+            .collect();
+        Some(BoundaryPoint {
+            c,
+            others,
+            incident: [a, b],
+            tangent_in: unit(tangent_in),
+            tangent_out: unit(tangent_out),
+            normal,
+        })
+    }
+
+    /// The principal value at a boundary point along the ray `d`:
+    /// `χ + (1/4π) (∮_{∂S} α↓ + ∫_arc α↓)`, where `χ` counts the ray's crossings other than at
+    /// `c`, the boundary integral runs through `c` (its integrand is bounded there), and `arc`
+    /// is the arc of directions in the face's tangent plane from `−tangent_in` through the face
+    /// to `tangent_out` (a half circle on a smooth curve). This is the formula for the surface
+    /// with a small disk around `c` cut out, in the limit: the solid angle of the rest, i.e. the
+    /// mean of `w` over the directions of approach. `None` if `d` is within `asin 0.2` of the
+    /// tangent plane, or a boundary curve or hit fails the certificates of a regular query.
+    fn on_boundary_along(&self, point: &BoundaryPoint, d: [f64; 3]) -> Option<StepEvaluation> {
+        if dot(point.normal, d).abs() < ON_BOUNDARY_COSINE {
+            return None;
+        }
+        let c = point.c;
+        let frame = RayFrame::new(d);
+        let mut pieces = Vec::new();
+        for (curves, through) in [(&point.others[..], false), (&point.incident[..], true)] {
+            for curve in curves {
+                let h: Vec<Homogeneous> = curve.iter().map(|&p| frame.hom(p, c)).collect();
+                if !certify(h, MU, 0, through, &mut pieces) {
+                    return None;
+                }
+            }
+        }
+        let chi = self.crossings_from_boundary(c, &frame)?;
+        let mut e = self.with_boundary(chi, &pieces);
+        // The arc, in the ray frame: γ(ψ) = cos ψ a + sin ψ b, a = −tangent_in, b the inward
+        // direction in the tangent plane, ψ from 0 to the face's angle at c.
+        let n = point.normal;
+        let t_in = point.tangent_in;
+        let inward = cross(n, t_in);
+        let a = frame.map([-t_in[0], -t_in[1], -t_in[2]]);
+        let b = frame.map(inward);
+        let t_out = point.tangent_out;
+        let angle = (dot(t_out, inward))
+            .atan2(-dot(t_out, t_in))
+            .rem_euclid(std::f64::consts::TAU);
+        if angle.is_nan() || angle <= 0.0 {
+            return None;
+        }
+        let mut budget = Budget {
+            remaining: MAX_EVALUATIONS,
+        };
+        let arc = integrate(
+            |psi| {
+                let (s, co) = psi.sin_cos();
+                let r = [
+                    co * a[0] + s * b[0],
+                    co * a[1] + s * b[1],
+                    co * a[2] + s * b[2],
+                ];
+                let dr = [
+                    -s * a[0] + co * b[0],
+                    -s * a[1] + co * b[1],
+                    -s * a[2] + co * b[2],
+                ];
+                // α↓ = −(r × r')_z / (ρ (ρ − r_z)) with ρ = 1; the arc keeps the margin angle from
+                // the ray, so 1 − r_z ≥ 1 − cos(asin 0.2).
+                let f = -(r[0] * dr[1] - r[1] * dr[0]) / (1.0 - r[2]);
+                (f, 8.0 * f64::EPSILON * f.abs())
+            },
+            0.0,
+            angle,
+            self.options.tolerance * FOUR_PI,
+            &mut budget,
+        );
+        e.value += arc.value / FOUR_PI;
+        e.error_estimate += arc.error / FOUR_PI;
+        e.uncertified = e.uncertified || arc.capped > 0;
+        Some(e)
+    }
+
+    /// Signed count of trimmed-face crossings of the ray from a boundary point `c`, leaving out
+    /// the hits within [`ON_BOUNDARY_GAP`] `× diagonal` of `c` (the surface at the point itself);
+    /// `None` if another hit is grazing or within the margin of its face's loops.
+    fn crossings_from_boundary(&self, c: [f64; 3], frame: &RayFrame) -> Option<i64> {
+        let mut chi = 0i64;
+        let dedup = 1e-9 * self.model.diagonal();
+        let gap = ON_BOUNDARY_GAP * self.model.diagonal();
+        for face in &self.model.faces {
+            for h in face_hits(face, c, frame, dedup) {
+                if h.tau.abs() <= gap {
+                    continue;
+                }
+                let n = cross(h.su, h.sv);
+                let nn = norm(n);
+                let cosine = face.sense * dot(n, frame.d) / nn;
+                if nn.is_nan() || nn <= 0.0 || cosine.abs() < MIN_COSINE {
+                    return None;
+                }
+                if h.tau < 0.0 {
+                    continue;
+                }
+                match face.trim.classify(h.uv, h.su, h.sv, self.margin) {
+                    Side::Inside => chi += if cosine > 0.0 { 1 } else { -1 },
+                    Side::Outside => {}
+                    Side::Near => return None,
+                }
+            }
+        }
+        Some(chi)
+    }
+}
+
+/// The unit normal (`sense × S_u × S_v`) of `face` at its point `c`: Gauss–Newton for the
+/// closest point on each patch whose box holds `c`, from the nearest of 9 × 9 samples; `None`
+/// if no patch comes within [`ON_BOUNDARY_GAP`] `× diag` (the normal at the closest point is off
+/// by about that distance over the radius of curvature) or the normal degenerates there (a pole).
+fn face_normal(face: &Face, c: [f64; 3], diag: f64) -> Option<[f64; 3]> {
+    let pad = ON_BOUNDARY_GAP * diag;
+    let mut best: Option<(f64, [f64; 3])> = None;
+    for fp in &face.patches {
+        if (0..3).any(|k| c[k] < fp.lo[k] - pad || c[k] > fp.hi[k] + pad) {
+            continue;
+        }
+        let mut st = [0.5, 0.5];
+        let mut nearest = f64::INFINITY;
+        for i in 0..=8 {
+            for j in 0..=8 {
+                let x = [i as f64 / 8.0, j as f64 / 8.0];
+                let dist = norm(sub(fp.patch.eval(x[0], x[1]), c));
+                if dist < nearest {
+                    (nearest, st) = (dist, x);
+                }
+            }
+        }
+        for _ in 0..30 {
+            let (p, ds, dt) = fp.patch.eval_with_partials(st[0], st[1]);
+            let r = sub(p, c);
+            let (a, b, cc) = (dot(ds, ds), dot(ds, dt), dot(dt, dt));
+            let det = a * cc - b * b;
+            if det.is_nan() || det <= 0.0 {
+                break;
+            }
+            let (g0, g1) = (dot(ds, r), dot(dt, r));
+            let next = [
+                (st[0] - (cc * g0 - b * g1) / det).clamp(0.0, 1.0),
+                (st[1] - (a * g1 - b * g0) / det).clamp(0.0, 1.0),
+            ];
+            let moved = (next[0] - st[0]).abs() + (next[1] - st[1]).abs();
+            st = next;
+            if moved < 1e-15 {
+                break;
+            }
+        }
+        let (p, ds, dt) = fp.patch.eval_with_partials(st[0], st[1]);
+        let dist = norm(sub(p, c));
+        let n = cross(ds, dt);
+        let len = norm(n);
+        if dist <= pad && len > 1e-12 * norm(ds) * norm(dt) && best.is_none_or(|(bd, _)| dist < bd)
+        {
+            let s = face.sense / len;
+            best = Some((dist, [n[0] * s, n[1] * s, n[2] * s]));
+        }
+    }
+    best.map(|(_, n)| n)
+}
+
 /// Certifies a boundary piece (homogeneous, ray frame) against the ray `+z` with margin `mu`,
 /// halving it up to [`CERT_DEPTH`] times; certified pieces go to `out`. Returns `false` (and
 /// still pushes the pieces) if some part could not be certified.
-fn certify(h: Vec<Homogeneous>, mu: f64, depth: u32, out: &mut Vec<Vec<Homogeneous>>) -> bool {
+fn certify(
+    h: Vec<Homogeneous>,
+    mu: f64,
+    depth: u32,
+    through_query: bool,
+    out: &mut Vec<Vec<Homogeneous>>,
+) -> bool {
+    // `through_query`: control points exactly at the query (a boundary curve through a
+    // boundary query's own point, `BoundaryPoint`) are left out: the hull of the origin and the
+    // other points lies in the cone of the others, which each test below certifies.
     let pts: Vec<[f64; 3]> = h
         .iter()
         .map(|p| [p[0] / p[3], p[1] / p[3], p[2] / p[3]])
+        .filter(|p| !(through_query && *p == [0.0; 3]))
         .collect();
     if pts.iter().all(|p| p[2] < 0.0) {
         out.push(h);
@@ -533,8 +837,8 @@ fn certify(h: Vec<Homogeneous>, mu: f64, depth: u32, out: &mut Vec<Vec<Homogeneo
         return false;
     }
     let (a, b) = split_half(&h);
-    let ok_a = certify(a, mu, depth + 1, out);
-    let ok_b = certify(b, mu, depth + 1, out);
+    let ok_a = certify(a, mu, depth + 1, through_query, out);
+    let ok_b = certify(b, mu, depth + 1, through_query, out);
     ok_a && ok_b
 }
 

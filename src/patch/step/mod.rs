@@ -18,16 +18,31 @@ pub mod surface;
 pub mod trim;
 
 use std::fmt;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 pub use eval::{StepEvaluation, StepOptions, StepWindingNumber};
 pub use model::{StepInfo, StepModel};
 
 /// A STEP file that cannot be read or turned into a model. Displays as one line.
+///
+/// The kinds: [`Io`](StepError::Io) (the file cannot be read), parse errors
+/// ([`TooLarge`](StepError::TooLarge), [`Syntax`](StepError::Syntax),
+/// [`Dangling`](StepError::Dangling)), [`Unsupported`](StepError::Unsupported) (an entity the
+/// reader does not know, with its name and `#id`), [`Invalid`](StepError::Invalid) (wrong
+/// parameters), [`Geometry`](StepError::Geometry) (parameters that do not make a face or edge)
+/// and [`NoFaces`](StepError::NoFaces). [`load_step`] wraps every one but `Io` (which has its
+/// own path) in [`InFile`](StepError::InFile); [`StepError::cause`] unwraps it.
 #[derive(Clone, Debug, PartialEq)]
 pub enum StepError {
     /// The file could not be read.
-    Io(String),
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The operating system's error kind (`NotFound`, `PermissionDenied`, …).
+        kind: std::io::ErrorKind,
+        /// Its message.
+        message: String,
+    },
     /// Over the byte or entity cap ([`part21::MAX_BYTES`], [`part21::MAX_ENTITIES`]).
     TooLarge(String),
     /// Not Part 21 syntax.
@@ -53,8 +68,19 @@ pub enum StepError {
         /// Where it occurs, e.g. "as a face surface".
         context: String,
     },
-    /// A supported entity with wrong or inconsistent parameters.
+    /// A supported entity with wrong parameters (types, counts, non-positive radii or
+    /// weights, knots).
     Invalid {
+        /// Its `#id`.
+        id: u64,
+        /// Its name.
+        entity: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A supported entity whose parameters are well formed but do not make geometry: an edge's
+    /// vertices running against its open curve, a face whose loops enclose no area.
+    Geometry {
         /// Its `#id`.
         id: u64,
         /// Its name.
@@ -64,12 +90,38 @@ pub enum StepError {
     },
     /// No face to evaluate.
     NoFaces,
+    /// One of the errors above in the file `path` (from [`load_step`]).
+    InFile {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it (never `InFile` or `Io`).
+        error: Box<StepError>,
+    },
+}
+
+impl StepError {
+    /// The error without the file it occurred in ([`StepError::InFile`] unwrapped).
+    pub fn cause(&self) -> &StepError {
+        match self {
+            StepError::InFile { error, .. } => error,
+            e => e,
+        }
+    }
+
+    /// The file named by the error, if any.
+    pub fn path(&self) -> Option<&Path> {
+        match self {
+            StepError::Io { path, .. } | StepError::InFile { path, .. } => Some(path),
+            _ => None,
+        }
+    }
 }
 
 impl fmt::Display for StepError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            StepError::Io(m) | StepError::TooLarge(m) => write!(f, "{m}"),
+            StepError::Io { path, message, .. } => write!(f, "{}: {message}", path.display()),
+            StepError::TooLarge(m) => write!(f, "{m}"),
             StepError::Syntax { line, message } => write!(f, "line {line}: {message}"),
             StepError::Dangling { id, target } => {
                 write!(
@@ -86,8 +138,14 @@ impl fmt::Display for StepError {
                 id,
                 entity,
                 message,
+            }
+            | StepError::Geometry {
+                id,
+                entity,
+                message,
             } => write!(f, "#{id} {entity}: {message}"),
             StepError::NoFaces => write!(f, "no B-rep face found (ADVANCED_FACE in shells)"),
+            StepError::InFile { path, error } => write!(f, "{}: {error}", path.display()),
         }
     }
 }
@@ -101,24 +159,31 @@ pub fn is_step_path(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("step") || e.eq_ignore_ascii_case("stp"))
 }
 
-/// Reads a STEP file into a trimmed model. Errors are one line naming the file.
+/// Reads a STEP file into a trimmed model. Errors are one line naming the file:
+/// [`StepError::Io`] if it cannot be read, else [`StepError::InFile`] around the reason.
 pub fn load_step(path: &Path) -> Result<StepModel, StepError> {
-    let named = |e: StepError| StepError::Io(format!("{}: {e}", path.display()));
-    let meta =
-        std::fs::metadata(path).map_err(|e| StepError::Io(format!("{}: {e}", path.display())))?;
+    let io = |e: std::io::Error| StepError::Io {
+        path: path.to_path_buf(),
+        kind: e.kind(),
+        message: e.to_string(),
+    };
+    let in_file = |e: StepError| StepError::InFile {
+        path: path.to_path_buf(),
+        error: Box::new(e),
+    };
+    let meta = std::fs::metadata(path).map_err(io)?;
     if meta.len() > part21::MAX_BYTES as u64 {
-        return Err(named(StepError::TooLarge(format!(
+        return Err(in_file(StepError::TooLarge(format!(
             "{} bytes, more than the {} accepted",
             meta.len(),
             part21::MAX_BYTES
         ))));
     }
-    let bytes =
-        std::fs::read(path).map_err(|e| StepError::Io(format!("{}: {e}", path.display())))?;
+    let bytes = std::fs::read(path).map_err(io)?;
     // Part 21 is ISO 8859-1 / ASCII with escapes; non-UTF-8 bytes only occur inside strings,
     // which the reader does not interpret.
     let text = String::from_utf8_lossy(&bytes);
-    parse_step(&text).map_err(named)
+    parse_step(&text).map_err(in_file)
 }
 
 /// Parses STEP text into a trimmed model.

@@ -2,12 +2,13 @@
 //! polygon in `(u, v)`; for the whole model the surface boundary (edge uses that no other use
 //! cancels) as rational Bézier curves.
 
+use std::cmp::Ordering;
 use std::collections::{BTreeMap, HashMap};
 
 use super::super::curve::{Homogeneous, eval_with_derivative};
 use super::super::model::Patch;
 use super::StepError;
-use super::brep::{Reader, Topology, reverse};
+use super::brep::{EdgePcurve, Reader, Topology, reverse};
 use super::nurbs::{euc, point_at};
 use super::part21::Part21;
 use super::surface::{ParamMap, Surface, invert_curve};
@@ -29,6 +30,12 @@ pub const HIT_MARGIN: f64 = 2e-6;
 /// tangents are opposite. For files that store each face in its own shell with its own copy
 /// of every edge (`open_cylinder`, `spring`).
 pub const EDGE_MATCH: f64 = 1e-6;
+/// A pcurve is used for a face's trimming loop only if its image on the surface stays this
+/// close (relative to the diagonal) to the edge's 3D curve at its ends and three interior
+/// points; otherwise the edge use is mapped from 3D. Loose enough for CAD files whose edges
+/// lie off their faces by the modelling tolerance, tight enough to catch a pcurve in the wrong
+/// unit, on the wrong side of a seam's surface copy or of another edge.
+pub const PCURVE_TOLERANCE: f64 = 1e-3;
 
 /// One patch of a face with its parameter rectangle and control-point box.
 #[derive(Clone, Debug)]
@@ -91,6 +98,15 @@ pub struct StepInfo {
     pub topology: Topology,
     /// Segments of all trimming polygons.
     pub trim_segments: usize,
+    /// Edge uses whose trimming polygon comes from the file's pcurve.
+    pub pcurve_uses: usize,
+    /// Edge uses mapped from their 3D curve although the file gives a pcurve on the face's
+    /// surface: the pcurve strays more than [`PCURVE_TOLERANCE`] from the 3D curve, or the
+    /// surface's parameters are not the file's (revolution, extrusion).
+    pub pcurves_rejected: usize,
+    /// Pcurves of a kind the reader does not evaluate (2D curve other than line, conic or
+    /// B-spline; 3D curve trimmed or a closed B-spline run across its start).
+    pub pcurves_unreadable: usize,
 }
 
 /// A trimmed B-rep model read from a STEP file.
@@ -100,6 +116,8 @@ pub struct StepModel {
     /// Surface boundary: homogeneous Bézier curves in world coordinates, oriented as the
     /// boundary of their faces.
     pub(crate) boundary: Vec<Vec<Homogeneous>>,
+    /// The face (index into `faces`) each boundary curve bounds.
+    pub(crate) boundary_faces: Vec<usize>,
     pub(crate) lo: [f64; 3],
     pub(crate) hi: [f64; 3],
     pub(crate) info: StepInfo,
@@ -160,7 +178,7 @@ impl StepModel {
         };
         let mut faces = Vec::with_capacity(raw.len());
         // Edge uses over the whole model, for the boundary.
-        let mut uses: Vec<(u64, bool)> = Vec::new();
+        let mut uses: Vec<(u64, bool, usize)> = Vec::new();
         for f in &raw {
             *info.surfaces.entry(f.surface.kind()).or_default() += 1;
             let (period_u, period_v) = f.surface.periods();
@@ -169,7 +187,7 @@ impl StepModel {
             for l in &f.loops {
                 for u in l {
                     *count.entry(u.edge).or_default() += 1;
-                    uses.push((u.edge, u.forward));
+                    uses.push((u.edge, u.forward, faces.len()));
                 }
             }
             let mut segments = Vec::new();
@@ -181,6 +199,49 @@ impl StepModel {
                     let geom = reader.edges[&u.edge].clone();
                     let geom = if u.forward { geom } else { reverse(geom) };
                     let seam = count[&u.edge] > 1;
+                    let on_face: Vec<&EdgePcurve> = reader
+                        .pcurves
+                        .get(&u.edge)
+                        .map(|v| v.iter().filter(|p| p.surface == f.surface_id).collect())
+                        .unwrap_or_default();
+                    let from_pcurve = f.pcurve_units.and_then(|units| {
+                        on_face.iter().find_map(|pc| {
+                            pcurve_polygon(pc, u.forward, units, &f.surface, &geom, chord, diag)
+                        })
+                    });
+                    if let Some(mut pts) = from_pcurve {
+                        info.pcurve_uses += 1;
+                        // Continue where the loop is (a pcurve may be written in another
+                        // period copy; a seam's two pcurves differ by one period).
+                        if let Some(prev) = poly.last().copied() {
+                            let mut shift = [0.0; 2];
+                            for (k, period) in [period_u, period_v].into_iter().enumerate() {
+                                if let Some(p) = period {
+                                    shift[k] = p * ((prev[k] - pts[0][k]) / p).round();
+                                }
+                            }
+                            for q in &mut pts {
+                                q[0] += shift[0];
+                                q[1] += shift[1];
+                            }
+                        }
+                        for (k, uv) in pts.into_iter().enumerate() {
+                            if let Some(&last) = poly.last() {
+                                if k == 0 && near_uv(last, uv) {
+                                    continue;
+                                }
+                                // A gap between two uses' pcurves (at a pole, where every
+                                // `u` is one point) is closed by a segment of the loop.
+                                real.push(k == 0 || !seam);
+                            }
+                            poly.push(uv);
+                        }
+                        hint = poly.last().copied();
+                        continue;
+                    }
+                    if !on_face.is_empty() {
+                        info.pcurves_rejected += 1;
+                    }
                     for c in &geom {
                         let pts = sample(c, &f.surface, &mut hint, chord);
                         for (k, uv) in pts.into_iter().enumerate() {
@@ -223,7 +284,7 @@ impl StepModel {
                 }
             }
             if segments.is_empty() {
-                return Err(StepError::Invalid {
+                return Err(StepError::Geometry {
                     id: f.id,
                     entity: "ADVANCED_FACE".into(),
                     message: "no edge loop (faces bounded only by vertex loops are not supported)"
@@ -250,7 +311,7 @@ impl StepModel {
                 }
             }
             if !(u1 > u0 && v1 > v0) {
-                return Err(StepError::Invalid {
+                return Err(StepError::Geometry {
                     id: f.id,
                     entity: "ADVANCED_FACE".into(),
                     message: "its loops enclose no area in the surface's parameters".into(),
@@ -259,7 +320,7 @@ impl StepModel {
             let uvp = f
                 .surface
                 .patches([u0, u1], [v0, v1])
-                .map_err(|m| StepError::Invalid {
+                .map_err(|m| StepError::Geometry {
                     id: f.id,
                     entity: "ADVANCED_FACE".into(),
                     message: m,
@@ -294,6 +355,7 @@ impl StepModel {
             });
         }
         info.faces = faces.len();
+        info.pcurves_unreadable = reader.pcurves_unreadable;
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
         for f in &faces {
@@ -304,10 +366,12 @@ impl StepModel {
                 }
             }
         }
-        let boundary = surface_boundary(&reader, &uses, EDGE_MATCH * diag, &mut info);
+        let (boundary, boundary_faces) =
+            surface_boundary(&reader, &uses, EDGE_MATCH * diag, &mut info);
         Ok(StepModel {
             faces,
             boundary,
+            boundary_faces,
             lo,
             hi,
             info,
@@ -368,37 +432,129 @@ fn sample(
     out
 }
 
+/// Whether two loop points are the same up to rounding.
+fn near_uv(a: [f64; 2], b: [f64; 2]) -> bool {
+    let scale = 1.0 + a[0].abs().max(a[1].abs());
+    (a[0] - b[0]).abs().max((a[1] - b[1]).abs()) <= 1e-12 * scale
+}
+
+/// The trimming polygon of one edge use from its pcurve (start and end included), in this
+/// reader's `(u, v)` (file units times `units`), or `None` if the pcurve's image on the
+/// surface strays more than [`PCURVE_TOLERANCE`] `× diag` from the use's 3D curve `geom` (at its
+/// ends, and at three interior points, which must also come in the curve's order).
+/// Bisection in the pcurve's parameter until the surface point of each uv chord's midpoint is
+/// within `chord` of the surface point of the curve's midpoint (the polygon's 3D image then
+/// follows the edge as closely as a polygon mapped from 3D).
+fn pcurve_polygon(
+    pc: &EdgePcurve,
+    forward: bool,
+    units: [f64; 2],
+    surface: &Surface,
+    geom: &[Vec<Homogeneous>],
+    chord: f64,
+    diag: f64,
+) -> Option<Vec<[f64; 2]>> {
+    let [t0, t1] = if forward {
+        pc.range
+    } else {
+        [pc.range[1], pc.range[0]]
+    };
+    let uv_at = |t: f64| {
+        let p = pc.curve.at(t);
+        [p[0] * units[0], p[1] * units[1]]
+    };
+    let finite = |p: [f64; 3]| p.iter().all(|c| c.is_finite());
+    let point = |uv: [f64; 2]| surface.point(uv).filter(|&p| finite(p));
+    // The check against the 3D curve first (a pcurve in the wrong unit is refused before it
+    // is sampled).
+    let pieces: Vec<(f64, f64, Vec<Homogeneous>)> = geom
+        .iter()
+        .enumerate()
+        .map(|(k, c)| (k as f64, k as f64 + 1.0, c.clone()))
+        .collect();
+    if pieces.is_empty() {
+        return None;
+    }
+    // Its ends at the use's ends, three interior points on the use's curve and in its order
+    // (a pcurve run backwards, or over another arc of a circle, is refused).
+    let tolerance = PCURVE_TOLERANCE * diag;
+    let ends = [
+        point_at(&geom[0], 0.0),
+        point_at(&geom[geom.len() - 1], 1.0),
+    ];
+    for (t, end) in [t0, t1].into_iter().zip(ends) {
+        let off = norm(sub(point(uv_at(t))?, end));
+        if off.is_nan() || off > tolerance {
+            return None;
+        }
+    }
+    let mut previous = f64::NEG_INFINITY;
+    for f in [0.25, 0.5, 0.75] {
+        let p = point(uv_at(t0 + f * (t1 - t0)))?;
+        let s = invert_curve(&pieces, p);
+        let q = super::surface::curve_point(&pieces, s);
+        let off = norm(sub(p, q));
+        if off.is_nan() || off > tolerance || s.partial_cmp(&previous) != Some(Ordering::Greater) {
+            return None;
+        }
+        previous = s;
+    }
+    let (uv0, uv1) = (uv_at(t0), uv_at(t1));
+    let mut out = vec![uv0];
+    let mut cur = (t0, uv0);
+    let mut stack = vec![(t1, uv1, 0u32)];
+    while let Some((tb, wb, depth)) = stack.pop() {
+        let (ta, wa) = cur;
+        let tm = 0.5 * (ta + tb);
+        let wm = uv_at(tm);
+        let on_curve = point(wm)?;
+        let on_chord = point([0.5 * (wa[0] + wb[0]), 0.5 * (wa[1] + wb[1])])?;
+        if depth < 22 && (depth < 2 || norm(sub(on_curve, on_chord)) > chord) {
+            stack.push((tb, wb, depth + 1));
+            stack.push((tm, wm, depth + 1));
+        } else {
+            out.push(wb);
+            cur = (tb, wb);
+        }
+    }
+    Some(out)
+}
+
 /// The edge uses that no other use cancels, as Bézier pieces. Exact cancellation first (one
 /// `EDGE_CURVE` used in both directions), then the geometric match of [`EDGE_MATCH`].
 fn surface_boundary(
     reader: &Reader<'_>,
-    uses: &[(u64, bool)],
+    uses: &[(u64, bool, usize)],
     tol: f64,
     info: &mut StepInfo,
-) -> Vec<Vec<Homogeneous>> {
-    let mut per_edge: HashMap<u64, (usize, usize)> = HashMap::new();
-    for &(e, fwd) in uses {
+) -> (Vec<Vec<Homogeneous>>, Vec<usize>) {
+    // Per edge, the faces using it forwards and backwards.
+    let mut per_edge: HashMap<u64, (Vec<usize>, Vec<usize>)> = HashMap::new();
+    for &(e, fwd, face) in uses {
         let c = per_edge.entry(e).or_default();
         if fwd {
-            c.0 += 1;
+            c.0.push(face);
         } else {
-            c.1 += 1;
+            c.1.push(face);
         }
     }
     info.edges = per_edge.len();
     let mut left: Vec<Vec<Vec<Homogeneous>>> = Vec::new();
+    let mut left_faces: Vec<usize> = Vec::new();
     let mut ids: Vec<u64> = per_edge.keys().copied().collect();
     ids.sort_unstable();
     for e in ids {
-        let (f, r) = per_edge[&e];
-        let pairs = f.min(r);
+        let (f, r) = &per_edge[&e];
+        let pairs = f.len().min(r.len());
         info.cancelled_exact += pairs;
         let geom = &reader.edges[&e];
-        for _ in pairs..f {
+        for &face in &f[pairs..] {
             left.push(geom.clone());
+            left_faces.push(face);
         }
-        for _ in pairs..r {
+        for &face in &r[pairs..] {
             left.push(reverse(geom.clone()));
+            left_faces.push(face);
         }
     }
     // Geometric match among the leftovers.
@@ -418,14 +574,16 @@ fn surface_boundary(
             break;
         }
     }
-    let out: Vec<Vec<Vec<Homogeneous>>> = left
-        .into_iter()
-        .zip(used)
-        .filter(|(_, u)| !u)
-        .map(|(g, _)| g)
-        .collect();
-    info.boundary_edges = out.len();
-    out.into_iter().flatten().collect()
+    let mut pieces = Vec::new();
+    let mut faces = Vec::new();
+    for ((g, face), used) in left.into_iter().zip(left_faces).zip(used) {
+        if !used {
+            info.boundary_edges += 1;
+            faces.extend(std::iter::repeat_n(face, g.len()));
+            pieces.extend(g);
+        }
+    }
+    (pieces, faces)
 }
 
 /// End points, interior points and tangents of an edge use, for the geometric match.

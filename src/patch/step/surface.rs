@@ -268,6 +268,59 @@ impl Surface {
         uv
     }
 
+    /// The point at `(u, v)` (`None` for an extrusion, and outside a non-periodic patch
+    /// surface's domain).
+    pub fn point(&self, uv: [f64; 2]) -> Option<[f64; 3]> {
+        let [u, v] = uv;
+        Some(match self {
+            Surface::Plane(f) => f.world(u, v, 0.0),
+            Surface::Cylinder(f, r) => f.world(r * u.cos(), r * u.sin(), v),
+            Surface::Cone(f, r, tan) => {
+                let rr = r + v * tan;
+                f.world(rr * u.cos(), rr * u.sin(), v)
+            }
+            Surface::Sphere(f, r) => {
+                f.world(r * v.cos() * u.cos(), r * v.cos() * u.sin(), r * v.sin())
+            }
+            Surface::Torus(f, big, r) => {
+                let rr = big + r * v.cos();
+                f.world(rr * u.cos(), rr * u.sin(), r * v.sin())
+            }
+            Surface::Extrusion(..) => return None,
+            Surface::Patches {
+                patches,
+                period_u,
+                period_v,
+                ..
+            } => {
+                let mut dom = [
+                    f64::INFINITY,
+                    f64::NEG_INFINITY,
+                    f64::INFINITY,
+                    f64::NEG_INFINITY,
+                ];
+                for p in patches {
+                    dom = [
+                        dom[0].min(p.u[0]),
+                        dom[1].max(p.u[1]),
+                        dom[2].min(p.v[0]),
+                        dom[3].max(p.v[1]),
+                    ];
+                }
+                // Periodic parameters wrap; the others are clamped to the domain (a pcurve
+                // ending a rounding error outside it).
+                let wrap = |x: f64, lo: f64, hi: f64, period: Option<f64>| match period {
+                    Some(p) => (lo + (x - lo).rem_euclid(p)).min(hi),
+                    None => x.clamp(lo, hi),
+                };
+                return self.patch_point([
+                    wrap(u, dom[0], dom[1], *period_u),
+                    wrap(v, dom[2], dom[3], *period_v),
+                ]);
+            }
+        })
+    }
+
     /// The point at `(u, v)` of a patch-set surface (`None` for the others, whose inversion is
     /// in closed form, and outside the domain).
     pub fn patch_point(&self, uv: [f64; 2]) -> Option<[f64; 3]> {
