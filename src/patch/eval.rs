@@ -29,7 +29,8 @@ use super::curve::{
     integrand_with_rounding, split_half,
 };
 use super::model::{Patch, PatchSet};
-use super::quadrature::{Budget, GK_EVALUATIONS, integrate};
+use super::quadrature::{Budget, GK_EVALUATIONS, integrate, integrate_dyadic};
+use super::samples::{CACHE_LEVELS, CurveSamples};
 use crate::base::compensated::NeumaierSum;
 use crate::kernel::frame::RayAxis;
 
@@ -137,6 +138,9 @@ pub struct PatchWindingNumber {
     edges: Vec<[Vec<usize>; 4]>,
     /// World bounding box of each patch's control points.
     boxes: Vec<([f64; 3], [f64; 3])>,
+    /// Precomputed quadrature samples of the surface-boundary edges (`links` = `Boundary`), in
+    /// the ray frame of `options.ray`: the query-independent part of their integrals.
+    samples: Vec<[Option<CurveSamples>; 4]>,
     options: Options,
 }
 
@@ -185,6 +189,25 @@ impl PatchWindingNumber {
                 (lo, hi)
             })
             .collect();
+        let samples = scaled
+            .patches()
+            .iter()
+            .enumerate()
+            .map(|(p, patch)| {
+                std::array::from_fn(|e| {
+                    if links[p][e] != EdgeLink::Boundary {
+                        return None;
+                    }
+                    let ctrl = edges_of(patch, e)
+                        .map(|(pt, w)| {
+                            let f = options.ray.to_frame(pt);
+                            [w * f[0], w * f[1], w * f[2], w]
+                        })
+                        .collect();
+                    Some(CurveSamples::new(ctrl))
+                })
+            })
+            .collect();
         PatchWindingNumber {
             set: set.clone(),
             scaled,
@@ -192,6 +215,7 @@ impl PatchWindingNumber {
             links,
             edges,
             boxes,
+            samples,
             options,
         }
     }
@@ -284,7 +308,7 @@ impl PatchWindingNumber {
             for e in 0..4 {
                 match self.links[p][e] {
                     EdgeLink::Degenerate => {}
-                    EdgeLink::Boundary => acc.integrate(edge_ctrl(p, e), form),
+                    EdgeLink::Boundary => acc.tasks.push(Task::Edge(p, e, form)),
                     EdgeLink::Shared { patch: o, .. } => match forms[o] {
                         None => acc.integrate(edge_ctrl(p, e), form),
                         Some(g) if g == form => {}
@@ -315,7 +339,14 @@ impl PatchWindingNumber {
             }
         }
         acc.leaf_edges(leaf_edges);
-        acc.finish(self.options.tolerance)
+        let q_frame = ray.to_frame(q);
+        acc.finish(self.options.tolerance, |task, acc, tol, budget| {
+            let (p, e, form) = task;
+            match &self.samples[p][e] {
+                Some(s) => acc.integrate_sampled(s, || edge_ctrl(p, e), form, q_frame, tol, budget),
+                None => acc.integrate_curve(edge_ctrl(p, e), form, tol, budget),
+            }
+        })
     }
 
     /// `(min, max, scale)` of the frame `z` of patch `p`'s control points relative to `q`, from
@@ -343,7 +374,7 @@ struct Accumulator {
     out: Evaluation,
     /// Boundary curves to integrate (with their piece's form), deferred so that the tolerance
     /// can be shared among them.
-    tasks: Vec<(Vec<Homogeneous>, Form)>,
+    tasks: Vec<Task>,
     /// Mixed pieces subdivided so far (capped by [`MAX_PIECES`]).
     pieces: usize,
     /// Error charged per hole piece of the patch being refined ([`HOLE_ERROR`] or
@@ -354,19 +385,26 @@ struct Accumulator {
 
 impl Accumulator {
     fn integrate(&mut self, ctrl: Vec<Homogeneous>, form: Form) {
-        self.tasks.push((ctrl, form));
+        self.tasks.push(Task::Curve(ctrl, form));
     }
 
     /// Integrates the deferred curves, each with `tolerance / count` (in units of `w`), and
-    /// returns the evaluation.
-    fn finish(mut self, tolerance: f64) -> Evaluation {
+    /// returns the evaluation. `edge` integrates a [`Task::Edge`] (patch, edge, form).
+    fn finish(
+        mut self,
+        tolerance: f64,
+        edge: impl Fn((usize, usize, Form), &mut Accumulator, f64, &mut Budget),
+    ) -> Evaluation {
         let tasks = std::mem::take(&mut self.tasks);
         let tol = tolerance * FOUR_PI / tasks.len().max(1) as f64;
         let mut budget = Budget {
             remaining: MAX_EVALUATIONS,
         };
-        for (ctrl, form) in tasks {
-            self.integrate_curve(ctrl, form, tol, &mut budget);
+        for task in tasks {
+            match task {
+                Task::Curve(ctrl, form) => self.integrate_curve(ctrl, form, tol, &mut budget),
+                Task::Edge(p, e, form) => edge((p, e, form), &mut self, tol, &mut budget),
+            }
         }
         let mut out = self.out;
         out.value = self.sum.value() / FOUR_PI;
@@ -388,7 +426,90 @@ impl Accumulator {
         budget: &mut Budget,
     ) {
         self.out.integrals += 1;
-        let mut stack = vec![(ctrl, 1.0f64, 0u32)];
+        self.integrate_pieces(vec![(ctrl, 1.0, 0)], form, tol, budget);
+    }
+
+    /// [`integrate_curve`](Self::integrate_curve) for a surface-boundary edge with
+    /// precomputed samples `s` (`super::samples`): the same splitting of the curve where it is
+    /// large compared with its distance from the query (`q_frame`: the query in the ray frame),
+    /// but pieces down to [`CACHE_LEVELS`] are dyadic intervals of the curve's own parameter,
+    /// integrated from the samples. A piece that must be split deeper, or that lies too close
+    /// to the query for the centred samples' rounding ([`CurveSamples::usable_at`]), takes
+    /// the uncached path on its control points relative to the query (`relative()`: the
+    /// whole edge, halved as that path halves it).
+    fn integrate_sampled(
+        &mut self,
+        s: &CurveSamples,
+        relative: impl Fn() -> Vec<Homogeneous>,
+        form: Form,
+        q_frame: [f64; 3],
+        tol: f64,
+        budget: &mut Budget,
+    ) {
+        self.out.integrals += 1;
+        let delta = s.offset(q_frame);
+        let (en, edn) = s.rounding(delta);
+        let mut stack = vec![(0u32, 0u64)];
+        let mut uncached = Vec::new();
+        while let Some((level, index)) = stack.pop() {
+            let (distance, size) = s.piece_distance_and_size(level, index, delta);
+            let split = size > CURVE_SPLIT_RATIO * distance
+                && level < CURVE_MAX_DEPTH
+                && budget.remaining > GK_EVALUATIONS;
+            if split && level < CACHE_LEVELS {
+                stack.push((level + 1, 2 * index + 1));
+                stack.push((level + 1, 2 * index));
+                continue;
+            }
+            if !split && s.usable_at(distance) {
+                let r = integrate_dyadic(
+                    |l, i| s.rule(form, l, i, delta, en, edn),
+                    level,
+                    index,
+                    tol * 0.5f64.powi(level as i32),
+                    budget,
+                );
+                self.sum.add(r.value);
+                self.out.error_estimate += r.error;
+                self.out.evaluations += r.evaluations;
+                self.out.capped |= r.capped > 0;
+            } else {
+                uncached.push((level, index));
+            }
+        }
+        if uncached.is_empty() {
+            if budget.remaining <= GK_EVALUATIONS {
+                self.out.capped = true;
+            }
+            return;
+        }
+        // The uncached pieces, cut from the query-relative edge by exact halving (the same
+        // bits as the uncached path's own splitting), in the stack's order.
+        let whole = relative();
+        let pieces = uncached
+            .into_iter()
+            .rev()
+            .map(|(level, index)| {
+                let mut ctrl = whole.clone();
+                for bit in (0..level).rev() {
+                    let (a, b) = split_half(&ctrl);
+                    ctrl = if (index >> bit) & 1 == 0 { a } else { b };
+                }
+                (ctrl, 0.5f64.powi(level as i32), level)
+            })
+            .collect();
+        self.integrate_pieces(pieces, form, tol, budget);
+    }
+
+    /// The splitting and quadrature loop of [`integrate_curve`](Self::integrate_curve), from
+    /// the pieces `stack` (control points, tolerance share, depth).
+    fn integrate_pieces(
+        &mut self,
+        mut stack: Vec<(Vec<Homogeneous>, f64, u32)>,
+        form: Form,
+        tol: f64,
+        budget: &mut Budget,
+    ) {
         while let Some((ctrl, share, depth)) = stack.pop() {
             let (distance, size) = distance_and_size(&ctrl);
             if size > CURVE_SPLIT_RATIO * distance
@@ -537,6 +658,14 @@ impl Accumulator {
     }
 }
 
+/// A deferred boundary integral.
+enum Task {
+    /// A curve by its control points (query-relative, ray frame) with its piece's form.
+    Curve(Vec<Homogeneous>, Form),
+    /// Edge `e` of patch `p`, a surface-boundary edge (it may have precomputed samples).
+    Edge(usize, usize, Form),
+}
+
 /// An edge of a classified piece of a mixed patch.
 struct LeafEdge {
     /// Bits of the control points in canonical direction.
@@ -566,6 +695,14 @@ impl LeafEdge {
             ctrl,
         }
     }
+}
+
+/// The control points and weights of edge `e` of `patch`, in loop order.
+fn edges_of(patch: &Patch, e: usize) -> impl Iterator<Item = ([f64; 3], f64)> + '_ {
+    let (m, n) = patch.degree();
+    edge_indices(m, n, e)
+        .into_iter()
+        .map(move |k| (patch.points()[k], patch.weights()[k]))
 }
 
 /// The eight axis and diagonal directions of the `xy` plane.
