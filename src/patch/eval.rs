@@ -21,6 +21,8 @@
 
 use crate::kernel::spherical::FOUR_PI;
 
+use std::collections::HashMap;
+
 use rayon::prelude::*;
 
 use super::boundary::{EdgeLink, edge_counts, edge_indices, link_edges};
@@ -303,6 +305,11 @@ impl PatchWindingNumber {
                 })
                 .collect()
         };
+        // Edges of classified patches next to a mixed one join the mixed patch's leaf edges:
+        // the leaves along the shared edge are its dyadic pieces, bit for bit (de Casteljau
+        // halving of the net halves its boundary rows as `split_half` halves the edge), so
+        // `leaf_edges` can cancel them piece by piece instead of integrating both sides.
+        let mut leaf_edges = Vec::new();
         for (p, form) in forms.iter().enumerate() {
             let Some(form) = *form else { continue };
             for e in 0..4 {
@@ -310,7 +317,7 @@ impl PatchWindingNumber {
                     EdgeLink::Degenerate => {}
                     EdgeLink::Boundary => acc.tasks.push(Task::Edge(p, e, form)),
                     EdgeLink::Shared { patch: o, .. } => match forms[o] {
-                        None => acc.integrate(edge_ctrl(p, e), form),
+                        None => leaf_edges.push(LeafEdge::new(edge_ctrl(p, e), form)),
                         Some(g) if g == form => {}
                         Some(_) if p < o => acc.interface(&edge_ctrl(p, e), form, None),
                         Some(_) => {}
@@ -318,7 +325,6 @@ impl PatchWindingNumber {
                 }
             }
         }
-        let mut leaf_edges = Vec::new();
         for (p, patch) in patches.iter().enumerate() {
             if forms[p].is_none() {
                 acc.out.mixed_patches += 1;
@@ -619,6 +625,7 @@ impl Accumulator {
     /// Cancels leaf edges against each other and integrates the rest.
     fn leaf_edges(&mut self, mut edges: Vec<LeafEdge>) {
         edges.sort_by(|a, b| a.key.cmp(&b.key).then(a.form.cmp(&b.form)));
+        let mut unpaired = Vec::new();
         let mut start = 0;
         while start < edges.len() {
             let mut end = start + 1;
@@ -648,13 +655,109 @@ impl Accumulator {
                     }
                 }
             }
-            for (i, e) in group.iter().enumerate() {
-                if !used[i] {
-                    self.integrate(e.ctrl.clone(), e.form);
+            for (i, &used) in used.iter().enumerate() {
+                if !used {
+                    unpaired.push(i + start);
                 }
             }
             start = end;
         }
+        self.match_halves(&edges, unpaired);
+    }
+
+    /// The leaf edges that found no partner of the same extent: an edge of a piece next to
+    /// two or more smaller pieces (or a patch edge next to a subdivided neighbour) is halved
+    /// (exact de Casteljau) as long as a half is some other unpaired edge traversed the other
+    /// way; matched halves cancel or become interfaces as in [`leaf_edges`](Self::leaf_edges),
+    /// the rest is integrated. Longer edges first, so that an edge is cut to the pieces of its
+    /// finer neighbours rather than the reverse.
+    fn match_halves(&mut self, edges: &[LeafEdge], mut unpaired: Vec<usize>) {
+        if unpaired.is_empty() {
+            return;
+        }
+        let mut by_key: HashMap<&[u64], Vec<usize>> = HashMap::new();
+        for &i in &unpaired {
+            by_key.entry(edges[i].key.as_slice()).or_default().push(i);
+        }
+        let extent = |e: &LeafEdge| {
+            let (a, b) = (e.ctrl[0], e.ctrl[e.ctrl.len() - 1]);
+            (0..3)
+                .map(|k| (a[k] / a[3] - b[k] / b[3]).powi(2))
+                .sum::<f64>()
+        };
+        unpaired.sort_by(|&a, &b| {
+            extent(&edges[b])
+                .total_cmp(&extent(&edges[a]))
+                .then(a.cmp(&b))
+        });
+        let mut consumed = vec![false; edges.len()];
+        for &i in &unpaired {
+            if consumed[i] {
+                continue;
+            }
+            consumed[i] = true;
+            let e = &edges[i];
+            self.resolve_piece(e.ctrl.clone(), e.form, 0, edges, &by_key, &mut consumed);
+        }
+    }
+
+    /// One piece of an unpaired leaf edge (see [`match_halves`](Self::match_halves)).
+    fn resolve_piece(
+        &mut self,
+        ctrl: Vec<Homogeneous>,
+        form: Form,
+        depth: u32,
+        edges: &[LeafEdge],
+        by_key: &HashMap<&[u64], Vec<usize>>,
+        consumed: &mut [bool],
+    ) {
+        let partner = |piece: &LeafEdge, consumed: &[bool]| {
+            by_key.get(piece.key.as_slice()).and_then(|c| {
+                c.iter()
+                    .copied()
+                    .find(|&j| !consumed[j] && edges[j].forward != piece.forward)
+            })
+        };
+        if depth > 0 {
+            let piece = LeafEdge::new(ctrl, form);
+            if let Some(j) = partner(&piece, consumed) {
+                consumed[j] = true;
+                if edges[j].form != form {
+                    self.interface(&piece.ctrl, form, Some(&edges[j].ctrl));
+                }
+                return;
+            }
+            return self.resolve_or_integrate(piece.ctrl, form, depth, edges, by_key, consumed);
+        }
+        self.resolve_or_integrate(ctrl, form, depth, edges, by_key, consumed)
+    }
+
+    /// Halves `ctrl` if a half has an unpaired partner, else integrates it.
+    fn resolve_or_integrate(
+        &mut self,
+        ctrl: Vec<Homogeneous>,
+        form: Form,
+        depth: u32,
+        edges: &[LeafEdge],
+        by_key: &HashMap<&[u64], Vec<usize>>,
+        consumed: &mut [bool],
+    ) {
+        if depth < MAX_DEPTH {
+            let (a, b) = split_half(&ctrl);
+            let has_partner = |half: &Vec<Homogeneous>| {
+                let piece = LeafEdge::new(half.clone(), form);
+                by_key.get(piece.key.as_slice()).is_some_and(|c| {
+                    c.iter()
+                        .any(|&j| !consumed[j] && edges[j].forward != piece.forward)
+                })
+            };
+            if has_partner(&a) || has_partner(&b) {
+                self.resolve_piece(a, form, depth + 1, edges, by_key, consumed);
+                self.resolve_piece(b, form, depth + 1, edges, by_key, consumed);
+                return;
+            }
+        }
+        self.integrate(ctrl, form);
     }
 }
 
