@@ -28,7 +28,7 @@ use rayon::prelude::*;
 use super::boundary::{EdgeLink, edge_counts, edge_indices, link_edges};
 use super::curve::{
     Form, Homogeneous, azimuth_change, eval_with_derivative, evaluation_rounding,
-    integrand_with_rounding, split_half,
+    integrand_with_rounding, split_half, split_half_with,
 };
 use super::model::{Patch, PatchSet};
 use super::quadrature::{Budget, GK_EVALUATIONS, integrate, integrate_dyadic};
@@ -781,15 +781,18 @@ struct LeafEdge {
 
 impl LeafEdge {
     fn new(ctrl: Vec<Homogeneous>, form: Form) -> LeafEdge {
-        let bits = |it: &mut dyn Iterator<Item = &Homogeneous>| -> Vec<u64> {
-            it.flat_map(|h| h.map(|c| (c + 0.0).to_bits())).collect()
-        };
-        let fwd = bits(&mut ctrl.iter());
-        let rev = bits(&mut ctrl.iter().rev());
-        let (key, forward) = if fwd <= rev {
-            (fwd, true)
+        // `+ 0.0` turns −0.0 into +0.0, so the two zeros compare equal as in f64.
+        let bits = |h: &Homogeneous| h.map(|c| (c + 0.0).to_bits());
+        // The key is the lexicographically smaller of the two traversals' bits.
+        let forward = ctrl
+            .iter()
+            .map(bits)
+            .cmp(ctrl.iter().rev().map(bits))
+            .is_le();
+        let key: Vec<u64> = if forward {
+            ctrl.iter().flat_map(bits).collect()
         } else {
-            (rev, false)
+            ctrl.iter().rev().flat_map(bits).collect()
         };
         LeafEdge {
             key,
@@ -975,10 +978,9 @@ fn split_net(net: Net) -> Vec<Net> {
     let mut out = Vec::with_capacity(4);
     for h in halves_s {
         if split_t {
-            let t = transpose(&h);
-            let (a, b) = split_rows(&t);
-            out.push(transpose(&a));
-            out.push(transpose(&b));
+            let (a, b) = split_columns(&h);
+            out.push(a);
+            out.push(b);
         } else {
             out.push(h);
         }
@@ -986,31 +988,41 @@ fn split_net(net: Net) -> Vec<Net> {
     out
 }
 
-/// Halves a net in `s` (along its columns).
+/// Halves a net in `s` (each column halved by [`split_half_with`], bit for bit as
+/// [`split_half`] would).
 fn split_rows(net: &Net) -> (Net, Net) {
     let (m, n) = (net.m, net.n);
     let mut a = vec![[0.0; 4]; net.h.len()];
     let mut b = vec![[0.0; 4]; net.h.len()];
     for j in 0..=n {
-        let col: Vec<Homogeneous> = (0..=m).map(|i| net.h[i * (n + 1) + j]).collect();
-        let (l, r) = split_half(&col);
-        for i in 0..=m {
-            a[i * (n + 1) + j] = l[i];
-            b[i * (n + 1) + j] = r[i];
-        }
+        split_half_with(
+            m,
+            |i| net.h[i * (n + 1) + j],
+            |i, l, r| {
+                a[i * (n + 1) + j] = l;
+                b[i * (n + 1) + j] = r;
+            },
+        );
     }
     (Net { m, n, h: a }, Net { m, n, h: b })
 }
 
-fn transpose(net: &Net) -> Net {
+/// Halves a net in `t` (each row halved likewise).
+fn split_columns(net: &Net) -> (Net, Net) {
     let (m, n) = (net.m, net.n);
-    let mut h = vec![[0.0; 4]; net.h.len()];
+    let mut a = vec![[0.0; 4]; net.h.len()];
+    let mut b = vec![[0.0; 4]; net.h.len()];
     for i in 0..=m {
-        for j in 0..=n {
-            h[j * (m + 1) + i] = net.h[i * (n + 1) + j];
-        }
+        split_half_with(
+            n,
+            |j| net.h[i * (n + 1) + j],
+            |j, l, r| {
+                a[i * (n + 1) + j] = l;
+                b[i * (n + 1) + j] = r;
+            },
+        );
     }
-    Net { m: n, n: m, h }
+    (Net { m, n, h: a }, Net { m, n, h: b })
 }
 
 /// Distance from the origin (the query) to the box of a curve's Euclidean control points (a
