@@ -21,8 +21,6 @@
 
 use crate::kernel::spherical::FOUR_PI;
 
-use std::collections::HashMap;
-
 use rayon::prelude::*;
 
 use super::boundary::{EdgeLink, edge_counts, edge_indices, link_edges};
@@ -665,99 +663,98 @@ impl Accumulator {
         self.match_halves(&edges, unpaired);
     }
 
+
     /// The leaf edges that found no partner of the same extent: an edge of a piece next to
     /// two or more smaller pieces (or a patch edge next to a subdivided neighbour) is halved
     /// (exact de Casteljau) as long as a half is some other unpaired edge traversed the other
     /// way; matched halves cancel or become interfaces as in [`leaf_edges`](Self::leaf_edges),
     /// the rest is integrated. Longer edges first, so that an edge is cut to the pieces of its
     /// finer neighbours rather than the reverse.
-    fn match_halves(&mut self, edges: &[LeafEdge], mut unpaired: Vec<usize>) {
+    fn match_halves(&mut self, edges: &[LeafEdge], unpaired: Vec<usize>) {
         if unpaired.is_empty() {
             return;
         }
-        let mut by_key: HashMap<&[u64], Vec<usize>> = HashMap::new();
-        for &i in &unpaired {
-            by_key.entry(edges[i].key.as_slice()).or_default().push(i);
-        }
+        // `unpaired` is in key order (`edges` is sorted): lookups are binary searches.
+        let lookup = Lookup {
+            edges,
+            sorted: unpaired.clone(),
+        };
         let extent = |e: &LeafEdge| {
             let (a, b) = (e.ctrl[0], e.ctrl[e.ctrl.len() - 1]);
             (0..3)
                 .map(|k| (a[k] / a[3] - b[k] / b[3]).powi(2))
                 .sum::<f64>()
         };
-        unpaired.sort_by(|&a, &b| {
+        let mut order = unpaired;
+        order.sort_by(|&a, &b| {
             extent(&edges[b])
                 .total_cmp(&extent(&edges[a]))
                 .then(a.cmp(&b))
         });
         let mut consumed = vec![false; edges.len()];
-        for &i in &unpaired {
+        for &i in &order {
             if consumed[i] {
                 continue;
             }
             consumed[i] = true;
             let e = &edges[i];
-            self.resolve_piece(e.ctrl.clone(), e.form, 0, edges, &by_key, &mut consumed);
+            self.resolve_or_integrate(e.ctrl.clone(), e.form, 0, &lookup, &mut consumed);
         }
     }
 
-    /// One piece of an unpaired leaf edge (see [`match_halves`](Self::match_halves)).
-    fn resolve_piece(
-        &mut self,
-        ctrl: Vec<Homogeneous>,
-        form: Form,
-        depth: u32,
-        edges: &[LeafEdge],
-        by_key: &HashMap<&[u64], Vec<usize>>,
-        consumed: &mut [bool],
-    ) {
-        let partner = |piece: &LeafEdge, consumed: &[bool]| {
-            by_key.get(piece.key.as_slice()).and_then(|c| {
-                c.iter()
-                    .copied()
-                    .find(|&j| !consumed[j] && edges[j].forward != piece.forward)
-            })
-        };
-        if depth > 0 {
-            let piece = LeafEdge::new(ctrl, form);
-            if let Some(j) = partner(&piece, consumed) {
-                consumed[j] = true;
-                if edges[j].form != form {
-                    self.interface(&piece.ctrl, form, Some(&edges[j].ctrl));
-                }
-                return;
-            }
-            return self.resolve_or_integrate(piece.ctrl, form, depth, edges, by_key, consumed);
-        }
-        self.resolve_or_integrate(ctrl, form, depth, edges, by_key, consumed)
-    }
-
-    /// Halves `ctrl` if a half has an unpaired partner, else integrates it.
+    /// Halves `ctrl` if a half has an unconsumed partner (see
+    /// [`match_halves`](Self::match_halves)), pairing each matched half, else integrates it.
     fn resolve_or_integrate(
         &mut self,
         ctrl: Vec<Homogeneous>,
         form: Form,
         depth: u32,
-        edges: &[LeafEdge],
-        by_key: &HashMap<&[u64], Vec<usize>>,
+        lookup: &Lookup,
         consumed: &mut [bool],
     ) {
         if depth < MAX_DEPTH {
             let (a, b) = split_half(&ctrl);
-            let has_partner = |half: &Vec<Homogeneous>| {
-                let piece = LeafEdge::new(half.clone(), form);
-                by_key.get(piece.key.as_slice()).is_some_and(|c| {
-                    c.iter()
-                        .any(|&j| !consumed[j] && edges[j].forward != piece.forward)
-                })
-            };
-            if has_partner(&a) || has_partner(&b) {
-                self.resolve_piece(a, form, depth + 1, edges, by_key, consumed);
-                self.resolve_piece(b, form, depth + 1, edges, by_key, consumed);
+            let (ka, fa) = canonical_key(&a);
+            let (kb, fb) = canonical_key(&b);
+            let pa = lookup.partner(&ka, fa, consumed);
+            let pb = lookup.partner(&kb, fb, consumed);
+            if pa.is_some() || pb.is_some() {
+                for (half, partner) in [(a, pa), (b, pb)] {
+                    match partner {
+                        Some(j) => {
+                            consumed[j] = true;
+                            let other = &lookup.edges[j];
+                            if other.form != form {
+                                self.interface(&half, form, Some(&other.ctrl));
+                            }
+                        }
+                        None => self.resolve_or_integrate(half, form, depth + 1, lookup, consumed),
+                    }
+                }
                 return;
             }
         }
         self.integrate(ctrl, form);
+    }
+}
+
+/// The unpaired leaf edges of [`Accumulator::match_halves`], sorted by key.
+struct Lookup<'a> {
+    edges: &'a [LeafEdge],
+    sorted: Vec<usize>,
+}
+
+impl Lookup<'_> {
+    /// An unconsumed edge with key `key` traversed against `forward`.
+    fn partner(&self, key: &[u64], forward: bool, consumed: &[bool]) -> Option<usize> {
+        let start = self
+            .sorted
+            .partition_point(|&i| self.edges[i].key.as_slice() < key);
+        self.sorted[start..]
+            .iter()
+            .copied()
+            .take_while(|&i| self.edges[i].key.as_slice() == key)
+            .find(|&i| !consumed[i] && self.edges[i].forward != forward)
     }
 }
 
@@ -781,19 +778,7 @@ struct LeafEdge {
 
 impl LeafEdge {
     fn new(ctrl: Vec<Homogeneous>, form: Form) -> LeafEdge {
-        // `+ 0.0` turns −0.0 into +0.0, so the two zeros compare equal as in f64.
-        let bits = |h: &Homogeneous| h.map(|c| (c + 0.0).to_bits());
-        // The key is the lexicographically smaller of the two traversals' bits.
-        let forward = ctrl
-            .iter()
-            .map(bits)
-            .cmp(ctrl.iter().rev().map(bits))
-            .is_le();
-        let key: Vec<u64> = if forward {
-            ctrl.iter().flat_map(bits).collect()
-        } else {
-            ctrl.iter().rev().flat_map(bits).collect()
-        };
+        let (key, forward) = canonical_key(&ctrl);
         LeafEdge {
             key,
             forward,
@@ -801,6 +786,24 @@ impl LeafEdge {
             ctrl,
         }
     }
+}
+
+/// The bits of a curve's control points in its canonical direction (the lexicographically
+/// smaller of the two traversals), and whether that is `ctrl`'s own direction.
+fn canonical_key(ctrl: &[Homogeneous]) -> (Vec<u64>, bool) {
+    // `+ 0.0` turns −0.0 into +0.0, so the two zeros compare equal as in f64.
+    let bits = |h: &Homogeneous| h.map(|c| (c + 0.0).to_bits());
+    let forward = ctrl
+        .iter()
+        .map(bits)
+        .cmp(ctrl.iter().rev().map(bits))
+        .is_le();
+    let key = if forward {
+        ctrl.iter().flat_map(bits).collect()
+    } else {
+        ctrl.iter().rev().flat_map(bits).collect()
+    };
+    (key, forward)
 }
 
 /// The control points and weights of edge `e` of `patch`, in loop order.
