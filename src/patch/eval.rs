@@ -453,16 +453,23 @@ impl Accumulator {
         self.out.integrals += 1;
         let delta = s.offset(q_frame);
         let (en, edn) = s.rounding(delta);
-        let mut stack = vec![(0u32, 0u64)];
-        let mut uncached = Vec::new();
-        while let Some((level, index)) = stack.pop() {
+        // Depth first over the levels `0..=CACHE_LEVELS` (at most one pending piece per level
+        // plus the root); pieces for the uncached path, in order (at most `2^CACHE_LEVELS`).
+        let mut stack = [(0u32, 0u64); CACHE_LEVELS as usize + 2];
+        let mut pending = 1;
+        let mut uncached = [(0u32, 0u64); 1 << CACHE_LEVELS];
+        let mut uncached_count = 0;
+        while pending > 0 {
+            pending -= 1;
+            let (level, index) = stack[pending];
             let (distance, size) = s.piece_distance_and_size(level, index, delta);
             let split = size > CURVE_SPLIT_RATIO * distance
                 && level < CURVE_MAX_DEPTH
                 && budget.remaining > GK_EVALUATIONS;
             if split && level < CACHE_LEVELS {
-                stack.push((level + 1, 2 * index + 1));
-                stack.push((level + 1, 2 * index));
+                stack[pending] = (level + 1, 2 * index + 1);
+                stack[pending + 1] = (level + 1, 2 * index);
+                pending += 2;
                 continue;
             }
             if !split && s.usable_at(distance) {
@@ -478,10 +485,11 @@ impl Accumulator {
                 self.out.evaluations += r.evaluations;
                 self.out.capped |= r.capped > 0;
             } else {
-                uncached.push((level, index));
+                uncached[uncached_count] = (level, index);
+                uncached_count += 1;
             }
         }
-        if uncached.is_empty() {
+        if uncached_count == 0 {
             if budget.remaining <= GK_EVALUATIONS {
                 self.out.capped = true;
             }
@@ -490,10 +498,10 @@ impl Accumulator {
         // The uncached pieces, cut from the query-relative edge by exact halving (the same
         // bits as the uncached path's own splitting), in the stack's order.
         let whole = relative();
-        let pieces = uncached
-            .into_iter()
+        let pieces = uncached[..uncached_count]
+            .iter()
             .rev()
-            .map(|(level, index)| {
+            .map(|&(level, index)| {
                 let mut ctrl = whole.clone();
                 for bit in (0..level).rev() {
                     let (a, b) = split_half(&ctrl);
@@ -552,10 +560,15 @@ impl Accumulator {
     fn refine(&mut self, net: Net, depth: u32, leaves: &mut Vec<LeafEdge>) -> bool {
         if let Some(form) = classify(&net) {
             for e in 0..4 {
-                let ctrl: Vec<Homogeneous> = edge_indices(net.m, net.n, e)
-                    .into_iter()
-                    .map(|k| net.h[k])
-                    .collect();
+                let (m, n) = (net.m, net.n);
+                let at = |i: usize, j: usize| net.h[i * (n + 1) + j];
+                // Loop order of `edge_indices`, without its index vector.
+                let ctrl: Vec<Homogeneous> = match e {
+                    0 => (0..=n).map(|j| at(0, j)).collect(),
+                    1 => (0..=m).map(|i| at(i, n)).collect(),
+                    2 => (0..=n).rev().map(|j| at(m, j)).collect(),
+                    _ => (0..=m).rev().map(|i| at(i, 0)).collect(),
+                };
                 if ctrl.iter().all(|c| *c == ctrl[0]) {
                     continue;
                 }
@@ -662,7 +675,6 @@ impl Accumulator {
         }
         self.match_halves(&edges, unpaired);
     }
-
 
     /// The leaf edges that found no partner of the same extent: an edge of a piece next to
     /// two or more smaller pieces (or a patch edge next to a subdivided neighbour) is halved

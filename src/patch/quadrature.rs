@@ -221,8 +221,13 @@ pub fn integrate_dyadic(
     let mut error = 0.0;
     let mut evaluations = 0;
     let mut capped = 0;
-    let mut stack = vec![(level, index)];
-    while let Some((l, i)) = stack.pop() {
+    // Depth first: at most one pending interval per level below the root, plus the root.
+    let mut stack = [(0u32, 0u64); MAX_DEPTH as usize + 2];
+    stack[0] = (level, index);
+    let mut pending = 1;
+    while pending > 0 {
+        pending -= 1;
+        let (l, i) = stack[pending];
         let (k, g, kabs, noise) = rule(l, i);
         evaluations += GK_EVALUATIONS;
         budget.remaining = budget.remaining.saturating_sub(GK_EVALUATIONS);
@@ -239,8 +244,9 @@ pub fn integrate_dyadic(
             value.add(k);
             error += err.max(rounding);
         } else {
-            stack.push((l + 1, 2 * i + 1));
-            stack.push((l + 1, 2 * i));
+            stack[pending] = (l + 1, 2 * i + 1);
+            stack[pending + 1] = (l + 1, 2 * i);
+            pending += 2;
         }
     }
     Integral {
