@@ -93,6 +93,9 @@ pub struct StepWindingNumber {
     options: StepOptions,
     dirs: Vec<[f64; 3]>,
     margin: f64,
+    /// Per face, the union of its patches' boxes: a ray that misses it (with the same padding)
+    /// misses every patch box of the face, so the face's patches are not visited.
+    face_boxes: Vec<([f64; 3], [f64; 3])>,
 }
 
 /// A ray frame: `e1`, `e2`, `d` right-handed.
@@ -181,8 +184,24 @@ impl StepWindingNumber {
         if !(options.tolerance.is_finite() && options.tolerance > 0.0) {
             options.tolerance = StepOptions::default().tolerance;
         }
+        let face_boxes = model
+            .faces
+            .iter()
+            .map(|face| {
+                let mut lo = [f64::INFINITY; 3];
+                let mut hi = [f64::NEG_INFINITY; 3];
+                for fp in &face.patches {
+                    for k in 0..3 {
+                        lo[k] = lo[k].min(fp.lo[k]);
+                        hi[k] = hi[k].max(fp.hi[k]);
+                    }
+                }
+                (lo, hi)
+            })
+            .collect();
         StepWindingNumber {
             margin: HIT_MARGIN * model.diagonal(),
+            face_boxes,
             model: model.clone(),
             options,
             dirs: directions(),
@@ -430,7 +449,12 @@ impl StepWindingNumber {
         let mut out = Vec::new();
         let column_margin = COLUMN_HIT_MARGIN * self.model.diagonal();
         let dedup = 1e-9 * self.model.diagonal();
-        for face in &self.model.faces {
+        for (face, (lo, hi)) in self.model.faces.iter().zip(&self.face_boxes) {
+            // Conservative: the slab test is monotone in the box, so a ray meeting a patch's
+            // padded box meets the face's.
+            if !ray_meets_box(q, frame.d, *lo, *hi, dedup) {
+                continue;
+            }
             for h in face_hits(face, q, frame, dedup) {
                 let n = cross(h.su, h.sv);
                 let nn = norm(n);
@@ -465,7 +489,10 @@ impl StepWindingNumber {
     ) -> Result<i64, Reject> {
         let mut chi = 0i64;
         let dedup = 1e-9 * self.model.diagonal();
-        for face in &self.model.faces {
+        for (face, (lo, hi)) in self.model.faces.iter().zip(&self.face_boxes) {
+            if !ray_meets_box(q, frame.d, *lo, *hi, dedup) {
+                continue;
+            }
             for h in face_hits(face, q, frame, dedup) {
                 let n = cross(h.su, h.sv);
                 let nn = norm(n);
