@@ -388,9 +388,10 @@ mod tests {
                         "{cached:?} {direct:?}"
                     );
                     assert!((cached.2 - direct.2).abs() <= 1e-13 * scale);
-                    // The rounding bound covers the difference and stays at rounding level.
+                    // The rounding bound covers the difference and stays at the rounding level
+                    // of the uncached path (both are worst-case bounds).
                     assert!((cached.0 - direct.0).abs() <= cached.3 + direct.3);
-                    assert!(cached.3 <= 1e-13 * scale, "{cached:?}");
+                    assert!(cached.3 <= 16.0 * direct.3, "{cached:?} {direct:?}");
                 }
             }
         }
