@@ -36,7 +36,7 @@ pub const MAX_SIZE_OVER_DISTANCE: f64 = 8.0;
 const LANES: usize = 16;
 
 /// Samples of one interval, structure of arrays over its 15 nodes (increasing `t`):
-/// `N_c` (x, y, z), `N_w`, and the derivative's `x`, `y`, `w` (the integrand needs no `z'`).
+/// `N_c` (x, y, z), `N_w`, and the derivative (the integrand needs no `z'` in its frame).
 #[derive(Clone, Debug)]
 struct IntervalSamples {
     x: [f64; LANES],
@@ -45,10 +45,40 @@ struct IntervalSamples {
     w: [f64; LANES],
     dx: [f64; LANES],
     dy: [f64; LANES],
+    /// `z'`: used only by [`IntervalSamples::rotated`] (the frame's `x'`, `y'` mix all three).
+    dz: [f64; LANES],
     dw: [f64; LANES],
 }
 
 impl IntervalSamples {
+    /// The samples relative to the query at offset `delta`, rotated into the frame whose rows
+    /// are `rotation` (the weights are unchanged; `z'` is not kept).
+    fn rotated(&self, delta: [f64; 3], rotation: &[[f64; 3]; 3]) -> IntervalSamples {
+        let mut out = self.clone();
+        let [e1, e2, e3] = rotation;
+        for i in 0..LANES {
+            let w = self.w[i];
+            let r = [
+                self.x[i] - w * delta[0],
+                self.y[i] - w * delta[1],
+                self.z[i] - w * delta[2],
+            ];
+            let dw = self.dw[i];
+            let dr = [
+                self.dx[i] - dw * delta[0],
+                self.dy[i] - dw * delta[1],
+                self.dz[i] - dw * delta[2],
+            ];
+            let dot = |e: &[f64; 3], v: [f64; 3]| e[0] * v[0] + e[1] * v[1] + e[2] * v[2];
+            out.x[i] = dot(e1, r);
+            out.y[i] = dot(e2, r);
+            out.z[i] = dot(e3, r);
+            out.dx[i] = dot(e1, dr);
+            out.dy[i] = dot(e2, dr);
+        }
+        out
+    }
+
     /// The centred curve at the 15 nodes of the interval with centre `c` and half-length `h`.
     fn at_nodes(centred: &[Homogeneous], c: f64, h: f64) -> IntervalSamples {
         let (nodes, _, _) = gauss_kronrod_nodes();
@@ -59,12 +89,13 @@ impl IntervalSamples {
             w: [0.0; LANES],
             dx: [0.0; LANES],
             dy: [0.0; LANES],
+            dz: [0.0; LANES],
             dw: [0.0; LANES],
         };
         for i in 0..LANES {
             let (p, dp) = eval_with_derivative(centred, c + h * nodes[i.min(14)]);
             (s.x[i], s.y[i], s.z[i], s.w[i]) = (p[0], p[1], p[2], p[3]);
-            (s.dx[i], s.dy[i], s.dw[i]) = (dp[0], dp[1], dp[3]);
+            (s.dx[i], s.dy[i], s.dz[i], s.dw[i]) = (dp[0], dp[1], dp[2], dp[3]);
         }
         s
     }
@@ -231,6 +262,42 @@ impl CurveSamples {
         (en, edn)
     }
 
+    /// [`rounding`](Self::rounding) after the rotation into an orthonormal ray frame (as
+    /// [`rule_rotated`](Self::rule_rotated) applies it): each frame component is a dot product
+    /// of three, `√3` times a component's bound plus three roundings of `|r|`.
+    #[inline]
+    pub fn rounding_rotated(&self, delta: [f64; 3]) -> (f64, f64) {
+        let (en, edn) = self.rounding(delta);
+        let eps = f64::EPSILON;
+        let dmax = delta[0].abs().max(delta[1].abs()).max(delta[2].abs());
+        let r = 1.8 * (self.size + self.w_max * dmax);
+        let dr = 1.8 * (2.0 * self.degree.max(1.0) * self.size + self.dw_max * dmax);
+        (1.8 * en + 4.0 * eps * r, 1.8 * edn + 4.0 * eps * dr)
+    }
+
+    /// [`rule`](Self::rule) for samples stored in world coordinates and a ray frame given by
+    /// the rows of `rotation` (orthonormal: `e1`, `e2`, ray direction), with rounding bounds
+    /// from [`rounding_rotated`](Self::rounding_rotated).
+    pub fn rule_rotated(
+        &self,
+        form: Form,
+        level: u32,
+        index: u64,
+        delta: [f64; 3],
+        rotation: &[[f64; 3]; 3],
+        en: f64,
+        edn: f64,
+    ) -> (f64, f64, f64, f64) {
+        let h = 0.5f64.powi(level as i32 + 1);
+        if level <= CACHE_LEVELS {
+            let s = &self.samples[(1usize << level) - 1 + index as usize];
+            return interval_sums(&s.rotated(delta, rotation), form, [0.0; 3], en, edn, h);
+        }
+        let c = (2 * index + 1) as f64 * h;
+        let s = IntervalSamples::at_nodes(&self.centred, c, h);
+        interval_sums(&s.rotated(delta, rotation), form, [0.0; 3], en, edn, h)
+    }
+
     /// The rule sums ([`gk15_sums`]) of `α_form` on the dyadic interval `(level, index)` of
     /// `[0, 1]` for the query at offset `delta`, with rounding bounds `(en, edn)` from
     /// [`rounding`](Self::rounding).
@@ -343,6 +410,49 @@ mod tests {
         pts.iter()
             .map(|&(p, w)| [w * p[0], w * p[1], w * p[2], w])
             .collect()
+    }
+
+    #[test]
+    fn rotated_rule_matches_the_direct_rule_in_the_rotated_frame() {
+        let ctrl = curve();
+        let samples = CurveSamples::new(ctrl.clone());
+        // An orthonormal frame (rows), as `step::eval::RayFrame` builds them.
+        let (c, s) = (0.6f64, 0.8f64);
+        let rotation = [[c, 0.0, -s], [0.0, 1.0, 0.0], [s, 0.0, c]];
+        let q = [1.5, -0.7, 2.0];
+        let rel: Vec<Homogeneous> = ctrl
+            .iter()
+            .map(|h| {
+                let r = [h[0] - h[3] * q[0], h[1] - h[3] * q[1], h[2] - h[3] * q[2]];
+                let f = rotation.map(|e| e[0] * r[0] + e[1] * r[1] + e[2] * r[2]);
+                [f[0], f[1], f[2], h[3]]
+            })
+            .collect();
+        let delta = samples.offset(q);
+        let (en, edn) = samples.rounding_rotated(delta);
+        let (en_direct, edn_direct) = evaluation_rounding(&rel);
+        for (level, index) in [(0u32, 0u64), (2, 3), (4, 9)] {
+            let n = (1u64 << level) as f64;
+            let direct = gk15(
+                &mut |t| {
+                    let (p, dp) = eval_with_derivative(&rel, t);
+                    integrand_with_rounding(Form::Down, p, dp, en_direct, edn_direct)
+                },
+                index as f64 / n,
+                (index + 1) as f64 / n,
+            );
+            let cached = samples.rule_rotated(Form::Down, level, index, delta, &rotation, en, edn);
+            assert!(
+                (cached.0 - direct.0).abs() <= 1e-13 * direct.2,
+                "{cached:?} {direct:?}"
+            );
+            assert!(
+                (cached.1 - direct.1).abs() <= 1e-13 * direct.2,
+                "{cached:?} {direct:?}"
+            );
+            assert!((cached.0 - direct.0).abs() <= cached.3 + direct.3);
+            assert!(cached.3 <= 16.0 * direct.3, "{cached:?} {direct:?}");
+        }
     }
 
     #[test]

@@ -30,7 +30,8 @@ use super::super::curve::{
     Form, Homogeneous, evaluation_rounding, integrand_with_rounding, split_half,
 };
 use super::super::eval::MAX_EVALUATIONS;
-use super::super::quadrature::{Budget, integrate};
+use super::super::quadrature::{Budget, integrate, integrate_dyadic};
+use super::super::samples::CurveSamples;
 use super::model::{Face, FacePatch, HIT_MARGIN, StepModel};
 use super::trim::Side;
 use crate::base::compensated::NeumaierSum;
@@ -96,6 +97,9 @@ pub struct StepWindingNumber {
     /// Per face, the union of its patches' boxes: a ray that misses it (with the same padding)
     /// misses every patch box of the face, so the face's patches are not visited.
     face_boxes: Vec<([f64; 3], [f64; 3])>,
+    /// Precomputed quadrature samples of the surface-boundary curves (world coordinates,
+    /// `super::super::samples`), rotated into each ray's frame per query.
+    boundary_samples: Vec<CurveSamples>,
 }
 
 /// A ray frame: `e1`, `e2`, `d` right-handed.
@@ -199,9 +203,15 @@ impl StepWindingNumber {
                 (lo, hi)
             })
             .collect();
+        let boundary_samples = model
+            .boundary
+            .iter()
+            .map(|c| CurveSamples::new(c.clone()))
+            .collect();
         StepWindingNumber {
             margin: HIT_MARGIN * model.diagonal(),
             face_boxes,
+            boundary_samples,
             model: model.clone(),
             options,
             dirs: directions(),
@@ -306,7 +316,7 @@ impl StepWindingNumber {
         // Certify the boundary first (cheap), then the hits.
         let pieces = self.certify_boundary(q, &frame, mu, strict)?;
         let chi = self.crossings(q, &frame, margin, strict)?;
-        Ok(self.with_boundary(chi, &pieces))
+        Ok(self.with_boundary(chi, &pieces, q, &frame))
     }
 
     /// The surface boundary in the ray frame of `q`, halved into pieces certified against the
@@ -317,19 +327,35 @@ impl StepWindingNumber {
         frame: &RayFrame,
         mu: f64,
         strict: bool,
-    ) -> Result<Vec<Vec<Homogeneous>>, Reject> {
+    ) -> Result<Vec<BoundaryPiece>, Reject> {
         let mut pieces = Vec::new();
-        for c in &self.model.boundary {
+        for (curve, c) in self.model.boundary.iter().enumerate() {
             let h: Vec<Homogeneous> = c.iter().map(|&p| frame.hom(p, q)).collect();
-            if !certify(h, mu, 0, &mut pieces) && strict {
+            let mut out = Vec::new();
+            let ok = certify(h, mu, 0, 0, &mut out);
+            if !ok && strict {
                 return Err(Reject::Boundary);
             }
+            pieces.extend(out.into_iter().map(|(ctrl, level, index)| BoundaryPiece {
+                curve,
+                level,
+                index,
+                ctrl,
+            }));
         }
         Ok(pieces)
     }
 
     /// `χ` plus the boundary integral over the certified `pieces` (empty for a closed model).
-    fn with_boundary(&self, chi: i64, pieces: &[Vec<Homogeneous>]) -> StepEvaluation {
+    /// A piece far enough from `q` for the centred samples (`CurveSamples::usable_at`) is
+    /// integrated from them, rotated into `frame`; a nearer one from its control points.
+    fn with_boundary(
+        &self,
+        chi: i64,
+        pieces: &[BoundaryPiece],
+        q: [f64; 3],
+        frame: &RayFrame,
+    ) -> StepEvaluation {
         let mut sum = NeumaierSum::new();
         let mut err = 0.0;
         let tol = self.options.tolerance * FOUR_PI / (pieces.len().max(1) as f64);
@@ -339,7 +365,25 @@ impl StepWindingNumber {
             remaining: MAX_EVALUATIONS,
         };
         let mut capped = 0;
-        for c in pieces {
+        let rotation = [frame.e1, frame.e2, frame.d];
+        for piece in pieces {
+            let c = &piece.ctrl;
+            let samples = &self.boundary_samples[piece.curve];
+            if samples.usable_at(distance_to_box(c)) {
+                let delta = samples.offset(q);
+                let (en, edn) = samples.rounding_rotated(delta);
+                let r = integrate_dyadic(
+                    |l, i| samples.rule_rotated(Form::Down, l, i, delta, &rotation, en, edn),
+                    piece.level,
+                    piece.index,
+                    tol,
+                    &mut budget,
+                );
+                sum.add(r.value);
+                err += r.error;
+                capped += r.capped;
+                continue;
+            }
             let (en, edn) = evaluation_rounding(c);
             let r = integrate(
                 |t| {
@@ -432,7 +476,7 @@ impl StepWindingNumber {
                 for (chi, frame) in [(chi_up, &up), (chi_down, &down)] {
                     let Some(chi) = chi else { continue };
                     if let Ok(pieces) = self.certify_boundary(p, frame, MU, true) {
-                        let mut e = self.with_boundary(chi, &pieces);
+                        let mut e = self.with_boundary(chi, &pieces, p, frame);
                         e.rays = 1;
                         return e;
                     }
@@ -524,13 +568,20 @@ impl StepWindingNumber {
 /// Certifies a boundary piece (homogeneous, ray frame) against the ray `+z` with margin `mu`,
 /// halving it up to [`CERT_DEPTH`] times; certified pieces go to `out`. Returns `false` (and
 /// still pushes the pieces) if some part could not be certified.
-fn certify(h: Vec<Homogeneous>, mu: f64, depth: u32, out: &mut Vec<Vec<Homogeneous>>) -> bool {
+/// Each piece is recorded with its dyadic `(level, index)` in the curve's parameter.
+fn certify(
+    h: Vec<Homogeneous>,
+    mu: f64,
+    depth: u32,
+    index: u64,
+    out: &mut Vec<(Vec<Homogeneous>, u32, u64)>,
+) -> bool {
     let pts: Vec<[f64; 3]> = h
         .iter()
         .map(|p| [p[0] / p[3], p[1] / p[3], p[2] / p[3]])
         .collect();
     if pts.iter().all(|p| p[2] < 0.0) {
-        out.push(h);
+        out.push((h, depth, index));
         return true;
     }
     let (mut mx, mut my) = (0.0, 0.0);
@@ -550,18 +601,18 @@ fn certify(h: Vec<Homogeneous>, mu: f64, depth: u32, out: &mut Vec<Vec<Homogeneo
                 .iter()
                 .all(|p| dot(n, *p) >= mu * norm(*p) && dot(n, *p) > 0.0)
             {
-                out.push(h);
+                out.push((h, depth, index));
                 return true;
             }
         }
     }
     if depth >= CERT_DEPTH {
-        out.push(h);
+        out.push((h, depth, index));
         return false;
     }
     let (a, b) = split_half(&h);
-    let ok_a = certify(a, mu, depth + 1, out);
-    let ok_b = certify(b, mu, depth + 1, out);
+    let ok_a = certify(a, mu, depth + 1, 2 * index, out);
+    let ok_b = certify(b, mu, depth + 1, 2 * index + 1, out);
     ok_a && ok_b
 }
 
@@ -605,6 +656,31 @@ fn ray_meets_box(q: [f64; 3], d: [f64; 3], lo: [f64; 3], hi: [f64; 3], pad: f64)
         }
     }
     true
+}
+
+/// A certified piece of a surface-boundary curve: curve, dyadic `(level, index)` in its
+/// parameter, control points in the ray frame relative to the query.
+struct BoundaryPiece {
+    curve: usize,
+    level: u32,
+    index: u64,
+    ctrl: Vec<Homogeneous>,
+}
+
+/// Distance from the origin (the query) to the box of a curve's Euclidean control points.
+fn distance_to_box(ctrl: &[Homogeneous]) -> f64 {
+    let mut d2 = 0.0;
+    for a in 0..3 {
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for h in ctrl {
+            let x = h[a] / h[3];
+            lo = lo.min(x);
+            hi = hi.max(x);
+        }
+        let gap = lo.max(-hi).max(0.0);
+        d2 += gap * gap;
+    }
+    d2.sqrt()
 }
 
 /// A hit of a grid column's line ([`StepWindingNumber::evaluate_column`]).
