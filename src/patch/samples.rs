@@ -277,7 +277,7 @@ impl CurveSamples {
 
     /// [`rule`](Self::rule) for samples stored in world coordinates and a ray frame given by
     /// the rows of `rotation` (orthonormal: `e1`, `e2`, ray direction), with rounding bounds
-    /// from [`rounding_rotated`](Self::rounding_rotated).
+    /// from [`rounding_rotated`](Self::rounding_rotated) as `(en, edn)`.
     pub fn rule_rotated(
         &self,
         form: Form,
@@ -285,8 +285,7 @@ impl CurveSamples {
         index: u64,
         delta: [f64; 3],
         rotation: &[[f64; 3]; 3],
-        en: f64,
-        edn: f64,
+        (en, edn): (f64, f64),
     ) -> (f64, f64, f64, f64) {
         let h = 0.5f64.powi(level as i32 + 1);
         if level <= CACHE_LEVELS {
@@ -441,7 +440,8 @@ mod tests {
                 index as f64 / n,
                 (index + 1) as f64 / n,
             );
-            let cached = samples.rule_rotated(Form::Down, level, index, delta, &rotation, en, edn);
+            let cached =
+                samples.rule_rotated(Form::Down, level, index, delta, &rotation, (en, edn));
             assert!(
                 (cached.0 - direct.0).abs() <= 1e-13 * direct.2,
                 "{cached:?} {direct:?}"

@@ -371,9 +371,9 @@ impl StepWindingNumber {
             let samples = &self.boundary_samples[piece.curve];
             if samples.usable_at(distance_to_box(c)) {
                 let delta = samples.offset(q);
-                let (en, edn) = samples.rounding_rotated(delta);
+                let rounding = samples.rounding_rotated(delta);
                 let r = integrate_dyadic(
-                    |l, i| samples.rule_rotated(Form::Down, l, i, delta, &rotation, en, edn),
+                    |l, i| samples.rule_rotated(Form::Down, l, i, delta, &rotation, rounding),
                     piece.level,
                     piece.index,
                     tol,
