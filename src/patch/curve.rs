@@ -134,6 +134,37 @@ pub fn split_half(ctrl: &[Homogeneous]) -> (Vec<Homogeneous>, Vec<Homogeneous>) 
     (left, right)
 }
 
+/// [`split_half`] of the `d + 1` points `get(0..=d)` without allocating: `put(i, left_i,
+/// right_i)` receives the halves' control points, bit for bit those of [`split_half`] (the same
+/// operations in the same order). For halving the rows and columns of a net in place.
+#[inline]
+pub fn split_half_with(
+    d: usize,
+    get: impl Fn(usize) -> Homogeneous,
+    mut put: impl FnMut(usize, Homogeneous, Homogeneous),
+) {
+    let mut work = [[0.0f64; 4]; super::model::MAX_DEGREE + 1];
+    let mut left = [[0.0f64; 4]; super::model::MAX_DEGREE + 1];
+    let mut right = [[0.0f64; 4]; super::model::MAX_DEGREE + 1];
+    for (i, w) in work[..=d].iter_mut().enumerate() {
+        *w = get(i);
+    }
+    left[0] = work[0];
+    right[d] = work[d];
+    for level in 1..=d {
+        for i in 0..=(d - level) {
+            for c in 0..4 {
+                work[i][c] = 0.5 * (work[i][c] + work[i + 1][c]);
+            }
+        }
+        left[level] = work[0];
+        right[d - level] = work[d - level];
+    }
+    for i in 0..=d {
+        put(i, left[i], right[i]);
+    }
+}
+
 /// The eight axis and diagonal directions tried as half-plane centres.
 const HALF_PLANES: [[f64; 2]; 8] = [
     [1.0, 0.0],
@@ -259,6 +290,28 @@ mod tests {
         assert!((up - 2.0 * PI * (1.0 - cos)).abs() < 1e-12, "{up}");
         assert!((up - down - 2.0 * turn).abs() < 1e-12);
         assert!((azimuth_change(&quarter(0.0)).unwrap() - FRAC_PI_2).abs() < 1e-15);
+    }
+
+    #[test]
+    fn split_half_with_is_split_half_bit_for_bit() {
+        let c: Vec<Homogeneous> = (0..5)
+            .map(|i| {
+                let x = i as f64;
+                [0.1 * x.sin(), 0.3 + x.cos() / 7.0, x / 3.0, 1.0 + 0.1 * x]
+            })
+            .collect();
+        let (l, r) = split_half(&c);
+        let mut l2 = vec![[0.0; 4]; 5];
+        let mut r2 = vec![[0.0; 4]; 5];
+        split_half_with(
+            4,
+            |i| c[i],
+            |i, a, b| {
+                l2[i] = a;
+                r2[i] = b;
+            },
+        );
+        assert_eq!((l, r), (l2, r2));
     }
 
     #[test]

@@ -26,10 +26,11 @@ use rayon::prelude::*;
 use super::boundary::{EdgeLink, edge_counts, edge_indices, link_edges};
 use super::curve::{
     Form, Homogeneous, azimuth_change, eval_with_derivative, evaluation_rounding,
-    integrand_with_rounding, split_half,
+    integrand_with_rounding, split_half, split_half_with,
 };
 use super::model::{Patch, PatchSet};
-use super::quadrature::{Budget, GK_EVALUATIONS, integrate};
+use super::quadrature::{Budget, GK_EVALUATIONS, integrate, integrate_dyadic};
+use super::samples::{CACHE_LEVELS, CurveSamples};
 use crate::base::compensated::NeumaierSum;
 use crate::kernel::frame::RayAxis;
 
@@ -137,6 +138,9 @@ pub struct PatchWindingNumber {
     edges: Vec<[Vec<usize>; 4]>,
     /// World bounding box of each patch's control points.
     boxes: Vec<([f64; 3], [f64; 3])>,
+    /// Precomputed quadrature samples of the surface-boundary edges (`links` = `Boundary`), in
+    /// the ray frame of `options.ray`: the query-independent part of their integrals.
+    samples: Vec<[Option<CurveSamples>; 4]>,
     options: Options,
 }
 
@@ -187,6 +191,25 @@ impl PatchWindingNumber {
                 (lo, hi)
             })
             .collect();
+        let samples = scaled
+            .patches()
+            .iter()
+            .enumerate()
+            .map(|(p, patch)| {
+                std::array::from_fn(|e| {
+                    if links[p][e] != EdgeLink::Boundary {
+                        return None;
+                    }
+                    let ctrl = edges_of(patch, e)
+                        .map(|(pt, w)| {
+                            let f = options.ray.to_frame(pt);
+                            [w * f[0], w * f[1], w * f[2], w]
+                        })
+                        .collect();
+                    Some(CurveSamples::new(ctrl))
+                })
+            })
+            .collect();
         PatchWindingNumber {
             set: set.clone(),
             scaled,
@@ -194,6 +217,7 @@ impl PatchWindingNumber {
             links,
             edges,
             boxes,
+            samples,
             options,
         }
     }
@@ -281,14 +305,19 @@ impl PatchWindingNumber {
                 })
                 .collect()
         };
+        // Edges of classified patches next to a mixed one join the mixed patch's leaf edges:
+        // the leaves along the shared edge are its dyadic pieces, bit for bit (de Casteljau
+        // halving of the net halves its boundary rows as `split_half` halves the edge), so
+        // `leaf_edges` can cancel them piece by piece instead of integrating both sides.
+        let mut leaf_edges = Vec::new();
         for (p, form) in forms.iter().enumerate() {
             let Some(form) = *form else { continue };
             for e in 0..4 {
                 match self.links[p][e] {
                     EdgeLink::Degenerate => {}
-                    EdgeLink::Boundary => acc.integrate(edge_ctrl(p, e), form),
+                    EdgeLink::Boundary => acc.tasks.push(Task::Edge(p, e, form)),
                     EdgeLink::Shared { patch: o, .. } => match forms[o] {
-                        None => acc.integrate(edge_ctrl(p, e), form),
+                        None => leaf_edges.push(LeafEdge::new(edge_ctrl(p, e), form)),
                         Some(g) if g == form => {}
                         Some(_) if p < o => acc.interface(&edge_ctrl(p, e), form, None),
                         Some(_) => {}
@@ -296,7 +325,6 @@ impl PatchWindingNumber {
                 }
             }
         }
-        let mut leaf_edges = Vec::new();
         for (p, patch) in patches.iter().enumerate() {
             if forms[p].is_none() {
                 acc.out.mixed_patches += 1;
@@ -317,7 +345,14 @@ impl PatchWindingNumber {
             }
         }
         acc.leaf_edges(leaf_edges);
-        acc.finish(self.options.tolerance)
+        let q_frame = ray.to_frame(q);
+        acc.finish(self.options.tolerance, |task, acc, tol, budget| {
+            let (p, e, form) = task;
+            match &self.samples[p][e] {
+                Some(s) => acc.integrate_sampled(s, || edge_ctrl(p, e), form, q_frame, tol, budget),
+                None => acc.integrate_curve(edge_ctrl(p, e), form, tol, budget),
+            }
+        })
     }
 
     /// `(min, max, scale)` of the frame `z` of patch `p`'s control points relative to `q`, from
@@ -345,7 +380,7 @@ struct Accumulator {
     out: Evaluation,
     /// Boundary curves to integrate (with their piece's form), deferred so that the tolerance
     /// can be shared among them.
-    tasks: Vec<(Vec<Homogeneous>, Form)>,
+    tasks: Vec<Task>,
     /// Mixed pieces subdivided so far (capped by [`MAX_PIECES`]).
     pieces: usize,
     /// Error charged per hole piece of the patch being refined ([`HOLE_ERROR`] or
@@ -356,19 +391,26 @@ struct Accumulator {
 
 impl Accumulator {
     fn integrate(&mut self, ctrl: Vec<Homogeneous>, form: Form) {
-        self.tasks.push((ctrl, form));
+        self.tasks.push(Task::Curve(ctrl, form));
     }
 
     /// Integrates the deferred curves, each with `tolerance / count` (in units of `w`), and
-    /// returns the evaluation.
-    fn finish(mut self, tolerance: f64) -> Evaluation {
+    /// returns the evaluation. `edge` integrates a [`Task::Edge`] (patch, edge, form).
+    fn finish(
+        mut self,
+        tolerance: f64,
+        edge: impl Fn((usize, usize, Form), &mut Accumulator, f64, &mut Budget),
+    ) -> Evaluation {
         let tasks = std::mem::take(&mut self.tasks);
         let tol = tolerance * FOUR_PI / tasks.len().max(1) as f64;
         let mut budget = Budget {
             remaining: MAX_EVALUATIONS,
         };
-        for (ctrl, form) in tasks {
-            self.integrate_curve(ctrl, form, tol, &mut budget);
+        for task in tasks {
+            match task {
+                Task::Curve(ctrl, form) => self.integrate_curve(ctrl, form, tol, &mut budget),
+                Task::Edge(p, e, form) => edge((p, e, form), &mut self, tol, &mut budget),
+            }
         }
         let mut out = self.out;
         out.value = self.sum.value() / FOUR_PI;
@@ -390,7 +432,98 @@ impl Accumulator {
         budget: &mut Budget,
     ) {
         self.out.integrals += 1;
-        let mut stack = vec![(ctrl, 1.0f64, 0u32)];
+        self.integrate_pieces(vec![(ctrl, 1.0, 0)], form, tol, budget);
+    }
+
+    /// [`integrate_curve`](Self::integrate_curve) for a surface-boundary edge with
+    /// precomputed samples `s` (`super::samples`): the same splitting of the curve where it is
+    /// large compared with its distance from the query (`q_frame`: the query in the ray frame),
+    /// but pieces down to [`CACHE_LEVELS`] are dyadic intervals of the curve's own parameter,
+    /// integrated from the samples. A piece that must be split deeper, or that lies too close
+    /// to the query for the centred samples' rounding ([`CurveSamples::usable_at`]), takes
+    /// the uncached path on its control points relative to the query (`relative()`: the
+    /// whole edge, halved as that path halves it).
+    fn integrate_sampled(
+        &mut self,
+        s: &CurveSamples,
+        relative: impl Fn() -> Vec<Homogeneous>,
+        form: Form,
+        q_frame: [f64; 3],
+        tol: f64,
+        budget: &mut Budget,
+    ) {
+        self.out.integrals += 1;
+        let delta = s.offset(q_frame);
+        let (en, edn) = s.rounding(delta);
+        // Depth first over the levels `0..=CACHE_LEVELS` (at most one pending piece per level
+        // plus the root); pieces for the uncached path, in order (at most `2^CACHE_LEVELS`).
+        let mut stack = [(0u32, 0u64); CACHE_LEVELS as usize + 2];
+        let mut pending = 1;
+        let mut uncached = [(0u32, 0u64); 1 << CACHE_LEVELS];
+        let mut uncached_count = 0;
+        while pending > 0 {
+            pending -= 1;
+            let (level, index) = stack[pending];
+            let (distance, size) = s.piece_distance_and_size(level, index, delta);
+            let split = size > CURVE_SPLIT_RATIO * distance
+                && level < CURVE_MAX_DEPTH
+                && budget.remaining > GK_EVALUATIONS;
+            if split && level < CACHE_LEVELS {
+                stack[pending] = (level + 1, 2 * index + 1);
+                stack[pending + 1] = (level + 1, 2 * index);
+                pending += 2;
+                continue;
+            }
+            if !split && s.usable_at(distance) {
+                let r = integrate_dyadic(
+                    |l, i| s.rule(form, l, i, delta, en, edn),
+                    level,
+                    index,
+                    tol * 0.5f64.powi(level as i32),
+                    budget,
+                );
+                self.sum.add(r.value);
+                self.out.error_estimate += r.error;
+                self.out.evaluations += r.evaluations;
+                self.out.capped |= r.capped > 0;
+            } else {
+                uncached[uncached_count] = (level, index);
+                uncached_count += 1;
+            }
+        }
+        if uncached_count == 0 {
+            if budget.remaining <= GK_EVALUATIONS {
+                self.out.capped = true;
+            }
+            return;
+        }
+        // The uncached pieces, cut from the query-relative edge by exact halving (the same
+        // bits as the uncached path's own splitting), in the stack's order.
+        let whole = relative();
+        let pieces = uncached[..uncached_count]
+            .iter()
+            .rev()
+            .map(|&(level, index)| {
+                let mut ctrl = whole.clone();
+                for bit in (0..level).rev() {
+                    let (a, b) = split_half(&ctrl);
+                    ctrl = if (index >> bit) & 1 == 0 { a } else { b };
+                }
+                (ctrl, 0.5f64.powi(level as i32), level)
+            })
+            .collect();
+        self.integrate_pieces(pieces, form, tol, budget);
+    }
+
+    /// The splitting and quadrature loop of [`integrate_curve`](Self::integrate_curve), from
+    /// the pieces `stack` (control points, tolerance share, depth).
+    fn integrate_pieces(
+        &mut self,
+        mut stack: Vec<(Vec<Homogeneous>, f64, u32)>,
+        form: Form,
+        tol: f64,
+        budget: &mut Budget,
+    ) {
         while let Some((ctrl, share, depth)) = stack.pop() {
             let (distance, size) = distance_and_size(&ctrl);
             if size > CURVE_SPLIT_RATIO * distance
@@ -429,10 +562,15 @@ impl Accumulator {
     fn refine(&mut self, net: Net, depth: u32, leaves: &mut Vec<LeafEdge>) -> bool {
         if let Some(form) = classify(&net) {
             for e in 0..4 {
-                let ctrl: Vec<Homogeneous> = edge_indices(net.m, net.n, e)
-                    .into_iter()
-                    .map(|k| net.h[k])
-                    .collect();
+                let (m, n) = (net.m, net.n);
+                let at = |i: usize, j: usize| net.h[i * (n + 1) + j];
+                // Loop order of `edge_indices`, without its index vector.
+                let ctrl: Vec<Homogeneous> = match e {
+                    0 => (0..=n).map(|j| at(0, j)).collect(),
+                    1 => (0..=m).map(|i| at(i, n)).collect(),
+                    2 => (0..=n).rev().map(|j| at(m, j)).collect(),
+                    _ => (0..=m).rev().map(|i| at(i, 0)).collect(),
+                };
                 if ctrl.iter().all(|c| *c == ctrl[0]) {
                     continue;
                 }
@@ -500,6 +638,7 @@ impl Accumulator {
     /// Cancels leaf edges against each other and integrates the rest.
     fn leaf_edges(&mut self, mut edges: Vec<LeafEdge>) {
         edges.sort_by(|a, b| a.key.cmp(&b.key).then(a.form.cmp(&b.form)));
+        let mut unpaired = Vec::new();
         let mut start = 0;
         while start < edges.len() {
             let mut end = start + 1;
@@ -529,14 +668,116 @@ impl Accumulator {
                     }
                 }
             }
-            for (i, e) in group.iter().enumerate() {
-                if !used[i] {
-                    self.integrate(e.ctrl.clone(), e.form);
+            for (i, &used) in used.iter().enumerate() {
+                if !used {
+                    unpaired.push(i + start);
                 }
             }
             start = end;
         }
+        self.match_halves(&edges, unpaired);
     }
+
+    /// The leaf edges that found no partner of the same extent: an edge of a piece next to
+    /// two or more smaller pieces (or a patch edge next to a subdivided neighbour) is halved
+    /// (exact de Casteljau) as long as a half is some other unpaired edge traversed the other
+    /// way; matched halves cancel or become interfaces as in [`leaf_edges`](Self::leaf_edges),
+    /// the rest is integrated. Longer edges first, so that an edge is cut to the pieces of its
+    /// finer neighbours rather than the reverse.
+    fn match_halves(&mut self, edges: &[LeafEdge], unpaired: Vec<usize>) {
+        if unpaired.is_empty() {
+            return;
+        }
+        // `unpaired` is in key order (`edges` is sorted): lookups are binary searches.
+        let lookup = Lookup {
+            edges,
+            sorted: unpaired.clone(),
+        };
+        let extent = |e: &LeafEdge| {
+            let (a, b) = (e.ctrl[0], e.ctrl[e.ctrl.len() - 1]);
+            (0..3)
+                .map(|k| (a[k] / a[3] - b[k] / b[3]).powi(2))
+                .sum::<f64>()
+        };
+        let mut order = unpaired;
+        order.sort_by(|&a, &b| {
+            extent(&edges[b])
+                .total_cmp(&extent(&edges[a]))
+                .then(a.cmp(&b))
+        });
+        let mut consumed = vec![false; edges.len()];
+        for &i in &order {
+            if consumed[i] {
+                continue;
+            }
+            consumed[i] = true;
+            let e = &edges[i];
+            self.resolve_or_integrate(e.ctrl.clone(), e.form, 0, &lookup, &mut consumed);
+        }
+    }
+
+    /// Halves `ctrl` if a half has an unconsumed partner (see
+    /// [`match_halves`](Self::match_halves)), pairing each matched half, else integrates it.
+    fn resolve_or_integrate(
+        &mut self,
+        ctrl: Vec<Homogeneous>,
+        form: Form,
+        depth: u32,
+        lookup: &Lookup,
+        consumed: &mut [bool],
+    ) {
+        if depth < MAX_DEPTH {
+            let (a, b) = split_half(&ctrl);
+            let (ka, fa) = canonical_key(&a);
+            let (kb, fb) = canonical_key(&b);
+            let pa = lookup.partner(&ka, fa, consumed);
+            let pb = lookup.partner(&kb, fb, consumed);
+            if pa.is_some() || pb.is_some() {
+                for (half, partner) in [(a, pa), (b, pb)] {
+                    match partner {
+                        Some(j) => {
+                            consumed[j] = true;
+                            let other = &lookup.edges[j];
+                            if other.form != form {
+                                self.interface(&half, form, Some(&other.ctrl));
+                            }
+                        }
+                        None => self.resolve_or_integrate(half, form, depth + 1, lookup, consumed),
+                    }
+                }
+                return;
+            }
+        }
+        self.integrate(ctrl, form);
+    }
+}
+
+/// The unpaired leaf edges of [`Accumulator::match_halves`], sorted by key.
+struct Lookup<'a> {
+    edges: &'a [LeafEdge],
+    sorted: Vec<usize>,
+}
+
+impl Lookup<'_> {
+    /// An unconsumed edge with key `key` traversed against `forward`.
+    fn partner(&self, key: &[u64], forward: bool, consumed: &[bool]) -> Option<usize> {
+        let start = self
+            .sorted
+            .partition_point(|&i| self.edges[i].key.as_slice() < key);
+        self.sorted[start..]
+            .iter()
+            .copied()
+            .take_while(|&i| self.edges[i].key.as_slice() == key)
+            .find(|&i| !consumed[i] && self.edges[i].forward != forward)
+    }
+}
+
+/// A deferred boundary integral.
+enum Task {
+    /// A curve by its control points (query-relative, ray frame) with its piece's form.
+    Curve(Vec<Homogeneous>, Form),
+    /// Edge `e` of patch `p`, a surface-boundary edge (it may have precomputed samples).
+    Edge(usize, usize, Form),
 }
 
 /// An edge of a classified piece of a mixed patch.
@@ -551,16 +792,7 @@ struct LeafEdge {
 
 impl LeafEdge {
     fn new(ctrl: Vec<Homogeneous>, form: Form) -> LeafEdge {
-        let bits = |it: &mut dyn Iterator<Item = &Homogeneous>| -> Vec<u64> {
-            it.flat_map(|h| h.map(|c| (c + 0.0).to_bits())).collect()
-        };
-        let fwd = bits(&mut ctrl.iter());
-        let rev = bits(&mut ctrl.iter().rev());
-        let (key, forward) = if fwd <= rev {
-            (fwd, true)
-        } else {
-            (rev, false)
-        };
+        let (key, forward) = canonical_key(&ctrl);
         LeafEdge {
             key,
             forward,
@@ -568,6 +800,32 @@ impl LeafEdge {
             ctrl,
         }
     }
+}
+
+/// The bits of a curve's control points in its canonical direction (the lexicographically
+/// smaller of the two traversals), and whether that is `ctrl`'s own direction.
+fn canonical_key(ctrl: &[Homogeneous]) -> (Vec<u64>, bool) {
+    // `+ 0.0` turns −0.0 into +0.0, so the two zeros compare equal as in f64.
+    let bits = |h: &Homogeneous| h.map(|c| (c + 0.0).to_bits());
+    let forward = ctrl
+        .iter()
+        .map(bits)
+        .cmp(ctrl.iter().rev().map(bits))
+        .is_le();
+    let key = if forward {
+        ctrl.iter().flat_map(bits).collect()
+    } else {
+        ctrl.iter().rev().flat_map(bits).collect()
+    };
+    (key, forward)
+}
+
+/// The control points and weights of edge `e` of `patch`, in loop order.
+fn edges_of(patch: &Patch, e: usize) -> impl Iterator<Item = ([f64; 3], f64)> + '_ {
+    let (m, n) = patch.degree();
+    edge_indices(m, n, e)
+        .into_iter()
+        .map(move |k| (patch.points()[k], patch.weights()[k]))
 }
 
 /// The eight axis and diagonal directions of the `xy` plane.
@@ -737,10 +995,9 @@ fn split_net(net: Net) -> Vec<Net> {
     let mut out = Vec::with_capacity(4);
     for h in halves_s {
         if split_t {
-            let t = transpose(&h);
-            let (a, b) = split_rows(&t);
-            out.push(transpose(&a));
-            out.push(transpose(&b));
+            let (a, b) = split_columns(&h);
+            out.push(a);
+            out.push(b);
         } else {
             out.push(h);
         }
@@ -748,31 +1005,41 @@ fn split_net(net: Net) -> Vec<Net> {
     out
 }
 
-/// Halves a net in `s` (along its columns).
+/// Halves a net in `s` (each column halved by [`split_half_with`], bit for bit as
+/// [`split_half`] would).
 fn split_rows(net: &Net) -> (Net, Net) {
     let (m, n) = (net.m, net.n);
     let mut a = vec![[0.0; 4]; net.h.len()];
     let mut b = vec![[0.0; 4]; net.h.len()];
     for j in 0..=n {
-        let col: Vec<Homogeneous> = (0..=m).map(|i| net.h[i * (n + 1) + j]).collect();
-        let (l, r) = split_half(&col);
-        for i in 0..=m {
-            a[i * (n + 1) + j] = l[i];
-            b[i * (n + 1) + j] = r[i];
-        }
+        split_half_with(
+            m,
+            |i| net.h[i * (n + 1) + j],
+            |i, l, r| {
+                a[i * (n + 1) + j] = l;
+                b[i * (n + 1) + j] = r;
+            },
+        );
     }
     (Net { m, n, h: a }, Net { m, n, h: b })
 }
 
-fn transpose(net: &Net) -> Net {
+/// Halves a net in `t` (each row halved likewise).
+fn split_columns(net: &Net) -> (Net, Net) {
     let (m, n) = (net.m, net.n);
-    let mut h = vec![[0.0; 4]; net.h.len()];
+    let mut a = vec![[0.0; 4]; net.h.len()];
+    let mut b = vec![[0.0; 4]; net.h.len()];
     for i in 0..=m {
-        for j in 0..=n {
-            h[j * (m + 1) + i] = net.h[i * (n + 1) + j];
-        }
+        split_half_with(
+            n,
+            |j| net.h[i * (n + 1) + j],
+            |j, l, r| {
+                a[i * (n + 1) + j] = l;
+                b[i * (n + 1) + j] = r;
+            },
+        );
     }
-    Net { m: n, n: m, h }
+    (Net { m, n, h: a }, Net { m, n, h: b })
 }
 
 /// Distance from the origin (the query) to the box of a curve's Euclidean control points (a

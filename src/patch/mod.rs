@@ -7,6 +7,7 @@
 //! - [`boundary`]: the signed boundary (patch edges that no neighbour cancels exactly);
 //! - [`curve`]: rational Bézier curves and the two potentials of the solid-angle form;
 //! - [`quadrature`]: adaptive Gauss–Kronrod 7/15;
+//! - [`samples`]: precomputed quadrature samples of the surface-boundary curves;
 //! - [`eval`]: the evaluator [`PatchWindingNumber`];
 //! - [`tessellate`]: triangle meshes of patch sets (reference values, products);
 //! - [`surface_quadrature`]: the direct surface integral (the benchmark's baseline);
@@ -23,6 +24,7 @@ pub mod eval;
 pub mod io;
 pub mod model;
 pub mod quadrature;
+pub mod samples;
 #[cfg(feature = "io")]
 pub mod step;
 pub mod surface_quadrature;

@@ -182,6 +182,81 @@ pub fn integrate(
     }
 }
 
+/// The sums of one 15-point rule on an interval of half-length `h`, from the integrand values
+/// `f` and rounding bounds `noise` at the nodes of [`gauss_kronrod_nodes`] (increasing order):
+/// `(K15, G7, K15 of |f|, K15 of the rounding bound)`, as [`gk15`] returns them. For callers
+/// that evaluate the 15 nodes in one vectorisable loop (`super::samples`).
+#[inline]
+pub fn gk15_sums(f: &[f64; 15], noise: &[f64; 15], h: f64) -> (f64, f64, f64, f64) {
+    // The same summation order as `gk15` (centre, then symmetric pairs outwards-in).
+    let mut k = WGK[7] * f[7];
+    let mut g = WG[3] * f[7];
+    let mut kabs = WGK[7] * f[7].abs();
+    let mut nsum = WGK[7] * noise[7];
+    for i in 0..7 {
+        let (fl, fr) = (f[i], f[14 - i]);
+        k += WGK[i] * (fl + fr);
+        kabs += WGK[i] * (fl.abs() + fr.abs());
+        nsum += WGK[i] * (noise[i] + noise[14 - i]);
+        if i % 2 == 1 {
+            g += WG[i / 2] * (fl + fr);
+        }
+    }
+    (k * h, g * h, kabs * h.abs(), nsum * h.abs())
+}
+
+/// [`integrate`] over the dyadic interval `[index·2^-level, (index+1)·2^-level]` of `[0, 1]`,
+/// with the 15-point rule of each (dyadic) sub-interval supplied by `rule(level, index)` as
+/// [`gk15_sums`] returns it. The same acceptance tests as [`integrate`] (tolerance shared by
+/// length, rounding floors, depth limit [`MAX_DEPTH`] below the root, budget); knowing an
+/// interval by its level and index lets `rule` read precomputed samples.
+pub fn integrate_dyadic(
+    mut rule: impl FnMut(u32, u64) -> (f64, f64, f64, f64),
+    level: u32,
+    index: u64,
+    tol: f64,
+    budget: &mut Budget,
+) -> Integral {
+    let mut value = NeumaierSum::new();
+    let mut error = 0.0;
+    let mut evaluations = 0;
+    let mut capped = 0;
+    // Depth first: at most one pending interval per level below the root, plus the root.
+    let mut stack = [(0u32, 0u64); MAX_DEPTH as usize + 2];
+    stack[0] = (level, index);
+    let mut pending = 1;
+    while pending > 0 {
+        pending -= 1;
+        let (l, i) = stack[pending];
+        let (k, g, kabs, noise) = rule(l, i);
+        evaluations += GK_EVALUATIONS;
+        budget.remaining = budget.remaining.saturating_sub(GK_EVALUATIONS);
+        let err = (k - g).abs();
+        let rounding = (ROUNDING_FLOOR * kabs).max(NOISE_FLOOR * noise);
+        // This interval's share of the root's tolerance: its length relative to the root's.
+        let share = 0.5f64.powi((l - level) as i32);
+        let allowed = (tol * share).max(rounding);
+        let out_of_budget = budget.remaining == 0;
+        if err <= allowed || l - level >= MAX_DEPTH || !err.is_finite() || out_of_budget {
+            if out_of_budget && err > allowed {
+                capped += 1;
+            }
+            value.add(k);
+            error += err.max(rounding);
+        } else {
+            stack[pending] = (l + 1, 2 * i + 1);
+            stack[pending + 1] = (l + 1, 2 * i);
+            pending += 2;
+        }
+    }
+    Integral {
+        value: value.value(),
+        error,
+        evaluations,
+        capped,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

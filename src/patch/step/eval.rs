@@ -30,7 +30,8 @@ use super::super::curve::{
     Form, Homogeneous, evaluation_rounding, integrand_with_rounding, split_half,
 };
 use super::super::eval::MAX_EVALUATIONS;
-use super::super::quadrature::{Budget, integrate};
+use super::super::quadrature::{Budget, integrate, integrate_dyadic};
+use super::super::samples::CurveSamples;
 use super::model::{Face, FacePatch, HIT_MARGIN, StepModel};
 use super::trim::Side;
 use crate::base::compensated::NeumaierSum;
@@ -109,6 +110,12 @@ pub struct StepWindingNumber {
     options: StepOptions,
     dirs: Vec<[f64; 3]>,
     margin: f64,
+    /// Per face, the union of its patches' boxes: a ray that misses it (with the same padding)
+    /// misses every patch box of the face, so the face's patches are not visited.
+    face_boxes: Vec<([f64; 3], [f64; 3])>,
+    /// Precomputed quadrature samples of the surface-boundary curves (world coordinates,
+    /// `super::super::samples`), rotated into each ray's frame per query.
+    boundary_samples: Vec<CurveSamples>,
 }
 
 /// A ray frame: `e1`, `e2`, `d` right-handed.
@@ -203,8 +210,30 @@ impl StepWindingNumber {
     }
 
     fn build(model: &StepModel, options: StepOptions) -> Self {
+        let face_boxes = model
+            .faces
+            .iter()
+            .map(|face| {
+                let mut lo = [f64::INFINITY; 3];
+                let mut hi = [f64::NEG_INFINITY; 3];
+                for fp in &face.patches {
+                    for k in 0..3 {
+                        lo[k] = lo[k].min(fp.lo[k]);
+                        hi[k] = hi[k].max(fp.hi[k]);
+                    }
+                }
+                (lo, hi)
+            })
+            .collect();
+        let boundary_samples = model
+            .boundary
+            .iter()
+            .map(|c| CurveSamples::new(c.clone()))
+            .collect();
         StepWindingNumber {
             margin: HIT_MARGIN * model.diagonal(),
+            face_boxes,
+            boundary_samples,
             model: model.clone(),
             options,
             dirs: directions(),
@@ -330,7 +359,7 @@ impl StepWindingNumber {
         // Certify the boundary first (cheap), then the hits.
         let pieces = self.certify_boundary(q, &frame, mu, strict)?;
         let chi = self.crossings(q, &frame, margin, strict)?;
-        Ok(self.with_boundary(chi, &pieces))
+        Ok(self.with_boundary(chi, &pieces, q, &frame))
     }
 
     /// The surface boundary in the ray frame of `q`, halved into pieces certified against the
@@ -341,19 +370,35 @@ impl StepWindingNumber {
         frame: &RayFrame,
         mu: f64,
         strict: bool,
-    ) -> Result<Vec<Vec<Homogeneous>>, Reject> {
+    ) -> Result<Vec<BoundaryPiece>, Reject> {
         let mut pieces = Vec::new();
-        for c in &self.model.boundary {
+        for (curve, c) in self.model.boundary.iter().enumerate() {
             let h: Vec<Homogeneous> = c.iter().map(|&p| frame.hom(p, q)).collect();
-            if !certify(h, mu, 0, false, &mut pieces) && strict {
+            let mut out = Vec::new();
+            let ok = certify(h, mu, 0, 0, false, &mut out);
+            if !ok && strict {
                 return Err(Reject::Boundary);
             }
+            pieces.extend(out.into_iter().map(|(ctrl, level, index)| BoundaryPiece {
+                curve: Some(curve),
+                level,
+                index,
+                ctrl,
+            }));
         }
         Ok(pieces)
     }
 
     /// `χ` plus the boundary integral over the certified `pieces` (empty for a closed model).
-    fn with_boundary(&self, chi: i64, pieces: &[Vec<Homogeneous>]) -> StepEvaluation {
+    /// A piece far enough from `q` for the centred samples (`CurveSamples::usable_at`) is
+    /// integrated from them, rotated into `frame`; a nearer one from its control points.
+    fn with_boundary(
+        &self,
+        chi: i64,
+        pieces: &[BoundaryPiece],
+        q: [f64; 3],
+        frame: &RayFrame,
+    ) -> StepEvaluation {
         let mut sum = NeumaierSum::new();
         let mut err = 0.0;
         let tol = self.options.tolerance * FOUR_PI / (pieces.len().max(1) as f64);
@@ -363,7 +408,28 @@ impl StepWindingNumber {
             remaining: MAX_EVALUATIONS,
         };
         let mut capped = 0;
-        for c in pieces {
+        let rotation = [frame.e1, frame.e2, frame.d];
+        for piece in pieces {
+            let c = &piece.ctrl;
+            let samples = piece
+                .curve
+                .map(|i| &self.boundary_samples[i])
+                .filter(|samples| samples.usable_at(distance_to_box(c)));
+            if let Some(samples) = samples {
+                let delta = samples.offset(q);
+                let rounding = samples.rounding_rotated(delta);
+                let r = integrate_dyadic(
+                    |l, i| samples.rule_rotated(Form::Down, l, i, delta, &rotation, rounding),
+                    piece.level,
+                    piece.index,
+                    tol,
+                    &mut budget,
+                );
+                sum.add(r.value);
+                err += r.error;
+                capped += r.capped;
+                continue;
+            }
             let (en, edn) = evaluation_rounding(c);
             let r = integrate(
                 |t| {
@@ -456,7 +522,7 @@ impl StepWindingNumber {
                 for (chi, frame) in [(chi_up, &up), (chi_down, &down)] {
                     let Some(chi) = chi else { continue };
                     if let Ok(pieces) = self.certify_boundary(p, frame, MU, true) {
-                        let mut e = self.with_boundary(chi, &pieces);
+                        let mut e = self.with_boundary(chi, &pieces, p, frame);
                         e.rays = 1;
                         return e;
                     }
@@ -473,7 +539,12 @@ impl StepWindingNumber {
         let mut out = Vec::new();
         let column_margin = COLUMN_HIT_MARGIN * self.model.diagonal();
         let dedup = 1e-9 * self.model.diagonal();
-        for face in &self.model.faces {
+        for (face, (lo, hi)) in self.model.faces.iter().zip(&self.face_boxes) {
+            // Conservative: the slab test is monotone in the box, so a ray meeting a patch's
+            // padded box meets the face's.
+            if !ray_meets_box(q, frame.d, *lo, *hi, dedup) {
+                continue;
+            }
             for h in face_hits(face, q, frame, dedup) {
                 let n = cross(h.su, h.sv);
                 let nn = norm(n);
@@ -508,7 +579,10 @@ impl StepWindingNumber {
     ) -> Result<i64, Reject> {
         let mut chi = 0i64;
         let dedup = 1e-9 * self.model.diagonal();
-        for face in &self.model.faces {
+        for (face, (lo, hi)) in self.model.faces.iter().zip(&self.face_boxes) {
+            if !ray_meets_box(q, frame.d, *lo, *hi, dedup) {
+                continue;
+            }
             for h in face_hits(face, q, frame, dedup) {
                 let n = cross(h.su, h.sv);
                 let nn = norm(n);
@@ -649,13 +723,21 @@ impl StepWindingNumber {
         for (curves, through) in [(&point.others[..], false), (&point.incident[..], true)] {
             for curve in curves {
                 let h: Vec<Homogeneous> = curve.iter().map(|&p| frame.hom(p, c)).collect();
-                if !certify(h, MU, 0, through, &mut pieces) {
+                let mut out = Vec::new();
+                if !certify(h, MU, 0, 0, through, &mut out) {
                     return None;
                 }
+                // Not the model's curves (the incident ones are split at `c`): no cached samples.
+                pieces.extend(out.into_iter().map(|(ctrl, level, index)| BoundaryPiece {
+                    curve: None,
+                    level,
+                    index,
+                    ctrl,
+                }));
             }
         }
         let chi = self.crossings_from_boundary(c, &frame)?;
-        let mut e = self.with_boundary(chi, &pieces);
+        let mut e = self.with_boundary(chi, &pieces, c, &frame);
         // The arc, in the ray frame: γ(ψ) = cos ψ a + sin ψ b, a = −tangent_in, b the inward
         // direction in the tangent plane, ψ from 0 to the face's angle at c.
         let n = point.normal;
@@ -791,12 +873,14 @@ fn face_normal(face: &Face, c: [f64; 3], diag: f64) -> Option<[f64; 3]> {
 /// Certifies a boundary piece (homogeneous, ray frame) against the ray `+z` with margin `mu`,
 /// halving it up to [`CERT_DEPTH`] times; certified pieces go to `out`. Returns `false` (and
 /// still pushes the pieces) if some part could not be certified.
+/// Each piece is recorded with its dyadic `(level, index)` in the curve's parameter.
 fn certify(
     h: Vec<Homogeneous>,
     mu: f64,
     depth: u32,
+    index: u64,
     through_query: bool,
-    out: &mut Vec<Vec<Homogeneous>>,
+    out: &mut Vec<(Vec<Homogeneous>, u32, u64)>,
 ) -> bool {
     // `through_query`: control points exactly at the query (a boundary curve through a
     // boundary query's own point, `BoundaryPoint`) are left out: the hull of the origin and the
@@ -807,7 +891,7 @@ fn certify(
         .filter(|p| !(through_query && *p == [0.0; 3]))
         .collect();
     if pts.iter().all(|p| p[2] < 0.0) {
-        out.push(h);
+        out.push((h, depth, index));
         return true;
     }
     let (mut mx, mut my) = (0.0, 0.0);
@@ -827,18 +911,18 @@ fn certify(
                 .iter()
                 .all(|p| dot(n, *p) >= mu * norm(*p) && dot(n, *p) > 0.0)
             {
-                out.push(h);
+                out.push((h, depth, index));
                 return true;
             }
         }
     }
     if depth >= CERT_DEPTH {
-        out.push(h);
+        out.push((h, depth, index));
         return false;
     }
     let (a, b) = split_half(&h);
-    let ok_a = certify(a, mu, depth + 1, through_query, out);
-    let ok_b = certify(b, mu, depth + 1, through_query, out);
+    let ok_a = certify(a, mu, depth + 1, 2 * index, through_query, out);
+    let ok_b = certify(b, mu, depth + 1, 2 * index + 1, through_query, out);
     ok_a && ok_b
 }
 
@@ -882,6 +966,33 @@ fn ray_meets_box(q: [f64; 3], d: [f64; 3], lo: [f64; 3], hi: [f64; 3], pad: f64)
         }
     }
     true
+}
+
+/// A certified piece of a surface-boundary curve: curve, dyadic `(level, index)` in its
+/// parameter, control points in the ray frame relative to the query.
+struct BoundaryPiece {
+    /// The model's boundary curve the piece was cut from (its cached samples); `None` for a
+    /// curve of a boundary point's own (`on_boundary_along`), integrated from its control points.
+    curve: Option<usize>,
+    level: u32,
+    index: u64,
+    ctrl: Vec<Homogeneous>,
+}
+
+/// Distance from the origin (the query) to the box of a curve's Euclidean control points.
+fn distance_to_box(ctrl: &[Homogeneous]) -> f64 {
+    let mut d2 = 0.0;
+    for a in 0..3 {
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for h in ctrl {
+            let x = h[a] / h[3];
+            lo = lo.min(x);
+            hi = hi.max(x);
+        }
+        let gap = lo.max(-hi).max(0.0);
+        d2 += gap * gap;
+    }
+    d2.sqrt()
 }
 
 /// A hit of a grid column's line ([`StepWindingNumber::evaluate_column`]).
