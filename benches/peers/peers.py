@@ -681,7 +681,7 @@ def render_fast(results, args, meta) -> str:
         " libigl (Houdini's `UT_SolidAngle`) uses the distance from p̃ to the farthest corner of the node's"
         " bounding box, an upper bound on r. At the same nominal β libigl therefore opens more nodes and is"
         " more accurate. Both query trees are 4-wide with a float32 far field (gwn's near field is float64;"
-        " gwn visits two of its 4-wide nodes at a time, four float32 lanes each);"
+        " gwn visits two of its 4-wide nodes at a time, eight float32 lanes);"
         " gwn's `Admissibility::BoxCorner` reproduces libigl's rule, but on gwn's tree it still does not match"
         " libigl's error at the same β on every mesh, so the comparison uses the radius rule."
         + (

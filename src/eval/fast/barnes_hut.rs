@@ -1,7 +1,7 @@
 //! The Barnes–Hut engine shared by triangle soups and point clouds: per-node moments built
 //! bottom-up by re-centring, and the traversal of Barill et al.'s Algorithm 1.
 
-use wide::{CmpGt, CmpLt, f32x4};
+use wide::{CmpGt, CmpLt, f32x4, f32x8};
 
 use super::moments::{FarField, Moments};
 use super::tree::Tree;
@@ -70,9 +70,10 @@ impl FastParams {
     }
 }
 
-/// Lanes per node of the query tree: one `f32x4` per node. (A wider node would replace a far
-/// inner node that a query admits whole by its 2–4 children: on the shared meshes 8-wide nodes
-/// cost 47 % more expansions per query.)
+/// Lanes per node of the query tree. A query visits two nodes at a time (eight `f32` lanes, one
+/// AVX register), so the tree keeps the granularity of four lanes (a wider node would replace a
+/// far inner node that a query admits whole by its 2–4 children: on the shared meshes 8-wide
+/// nodes cost 47 % more expansions per query) while every visit fills eight lanes.
 const WIDTH: usize = 4;
 /// Marks a lane of a [`WideNode`] that refers to a leaf (its number in [`Hierarchy::leaves`]).
 const LEAF: u32 = 1 << 31;
@@ -302,11 +303,12 @@ impl Hierarchy {
     }
 
     /// The lanes of query-tree node `id` whose expansion is admissible at `q` (bit `l` for lane
-    /// `l`): `‖r‖ > β·size` with `r = p̃ − q`, in `f32`, and `r` itself. The value and the
-    /// gradient both decide with this function, so both expand the same nodes. `β·size < 0`
-    /// (β ≤ 0) admits every lane not at `q`; NaN (unused lanes, NaN β) admits none.
+    /// `l`): `‖r‖ > β·size` with `r = p̃ − q`, in `f32`. The gradient uses this function; the
+    /// value does the same operations on two nodes at once ([`Hierarchy::eval_lanes`]), so both
+    /// expand the same nodes. `β·size < 0` (β ≤ 0) admits every lane not at `q`; NaN (unused
+    /// lanes, NaN β) admits none.
     #[inline(always)]
-    fn admitted_lanes(&self, id: usize, q: [f64; 3], beta: f32, which: usize) -> ([f32x4; 3], u32) {
+    fn admit(&self, id: usize, q: [f64; 3], beta: f32, which: usize) -> u32 {
         let node = &self.wide[id];
         let dq = self.anchor_offset(id, q);
         let r = [0, 1, 2].map(|k| node.offset[k] + dq[k]);
@@ -314,12 +316,12 @@ impl Hierarchy {
         let bs = f32x4::splat(beta) * self.wide_size[which][id];
         let zero = f32x4::ZERO;
         let admit = d2.cmp_gt(zero) & (bs.cmp_lt(zero) | d2.cmp_gt(bs * bs));
-        (r, admit.move_mask() as u32)
+        admit.move_mask() as u32
     }
 
     /// FASTWN(q) (Algorithm 1), iteratively over the 4-wide query tree, two nodes per visit:
-    /// the lanes far enough from `q` contribute their expansions (a node's four evaluated at
-    /// once, the others masked out), a near leaf calls `leaf(number, range, sum)` to add its elements'
+    /// the lanes far enough from `q` contribute their expansions (all eight evaluated at once,
+    /// the others masked out), a near leaf calls `leaf(number, range, sum)` to add its elements'
     /// exact contributions (`range` indexes the elements in leaf order), a near inner node is
     /// pushed.
     ///
@@ -356,14 +358,6 @@ impl Hierarchy {
 
     /// The traversal of [`Hierarchy::eval`], inlined into each instantiation. The expansions
     /// are summed per lane in `f64` in traversal order (deterministic), then across the lanes.
-    ///
-    /// The two nodes of a visit are tested and evaluated one after the other, four `f32` lanes
-    /// each, and a node none of whose lanes is admissible is not evaluated. (Concatenating the
-    /// two nodes' 26 coefficient vectors into eight-lane vectors cost more than the arithmetic
-    /// it shared: `wide`'s `f32x8` is two SSE halves unless the whole crate is compiled for
-    /// AVX, and the concatenation went through memory; 11k instructions per query on
-    /// armadillo, see docs/benchmarks.md.) Lane `l` of node `a` and of node `b` keep their
-    /// accumulators `far[l]` and `far[4 + l]`, so the sums are those of the eight-lane visit.
     #[inline(always)]
     pub(crate) fn eval_lanes(
         &self,
@@ -374,29 +368,43 @@ impl Hierarchy {
         if self.wide.is_empty() {
             return 0.0;
         }
+        #[inline(always)]
+        fn cat(a: f32x4, b: f32x4) -> f32x8 {
+            let (a, b) = (a.to_array(), b.to_array());
+            f32x8::from([a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]])
+        }
         let pad = self.wide.len() - 1;
-        let beta = params.beta as f32;
+        let beta = f32x8::splat(params.beta as f32);
         let order = params.order;
         let which = params.admissibility as usize;
+        let zero = f32x8::ZERO;
         let mut far = [0.0f64; 2 * WIDTH];
         let mut sum = 0.0;
         let mut stack = [0u32; WIDE_STACK];
         let mut top = 0usize;
         let (mut a, mut b) = (0usize, pad);
         loop {
-            let mut mask = 0u32;
-            for (half, id) in [a, b].into_iter().enumerate() {
-                let (r, m) = self.admitted_lanes(id, q, beta, which);
-                if m != 0 {
-                    let w = self.wide_far[id].eval(r, order).to_array();
-                    let acc = &mut far[half * WIDTH..(half + 1) * WIDTH];
-                    for (l, (sum, &w)) in acc.iter_mut().zip(&w).enumerate() {
-                        *sum += if m & (1 << l) != 0 { f64::from(w) } else { 0.0 };
-                    }
+            let (na, nb) = (&self.wide[a], &self.wide[b]);
+            let (da, db) = (self.anchor_offset(a, q), self.anchor_offset(b, q));
+            let r = [0, 1, 2].map(|k| cat(na.offset[k] + da[k], nb.offset[k] + db[k]));
+            let d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+            let bs = beta * cat(self.wide_size[which][a], self.wide_size[which][b]);
+            let admit = d2.cmp_gt(zero) & (bs.cmp_lt(zero) | d2.cmp_gt(bs * bs));
+            let mask = admit.move_mask() as u32;
+            if mask != 0 {
+                let w = self.wide_far[a]
+                    .pair(&self.wide_far[b])
+                    .eval(r, order)
+                    .to_array();
+                for (l, (sum, &w)) in far.iter_mut().zip(&w).enumerate() {
+                    *sum += if mask & (1 << l) != 0 {
+                        f64::from(w)
+                    } else {
+                        0.0
+                    };
                 }
-                mask |= m << (half * WIDTH);
             }
-            let children = self.wide[a].child.iter().chain(self.wide[b].child.iter());
+            let children = na.child.iter().chain(nb.child.iter());
             for (l, &c) in children.enumerate() {
                 if c == EMPTY || mask & (1 << l) != 0 {
                     continue;
@@ -446,7 +454,7 @@ impl Hierarchy {
         let mut top = 0usize;
         let mut id = 0usize;
         loop {
-            let mask = self.admitted_lanes(id, q, beta, which).1;
+            let mask = self.admit(id, q, beta, which);
             for (l, &c) in self.wide[id].child.iter().enumerate() {
                 if c == EMPTY {
                     break;

@@ -23,7 +23,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use crate::base::vec3::sub;
-use wide::f32x4;
+use wide::{f32x4, f32x8};
 
 use crate::base::vec3::{cross, dot};
 
@@ -314,8 +314,9 @@ impl Moments {
 /// whatever the mesh's units, so the `f32` lanes neither underflow (a mesh in metres of size
 /// 1e-2 has `M2 ≈ 1e-10`, and `M2/d⁷` runs into subnormals) nor overflow.
 ///
-/// `T` is `f64` (one node) or `f32x4` (the four lanes of a node of the 4-wide query tree, as
-/// stored and evaluated): one generic formula serves both. `f32` halves the arithmetic and the memory of the far field; its
+/// `T` is `f64` (one node), `f32x4` (the four lanes of a node of the 4-wide query tree, as stored)
+/// or `f32x8` (two such nodes side by side, as evaluated): one
+/// generic formula serves both. `f32` halves the arithmetic and the memory of the far field; its
 /// rounding (~1e-7 relative per node) is four orders below the truncation error of the
 /// expansion (~1e-3), and the near field, which decides the β → ∞ limit, stays `f64`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -331,7 +332,7 @@ pub(crate) struct FarField<T = f64> {
     c: [T; 10],
 }
 
-/// The arithmetic [`FarField::eval`] needs, for `f64` and for four `f32` lanes of it.
+/// The arithmetic [`FarField::eval`] needs, for `f64` and for eight `f32` lanes of it.
 pub(crate) trait Lanes:
     Copy + std::ops::Add<Output = Self> + std::ops::Mul<Output = Self>
 {
@@ -346,10 +347,10 @@ impl Lanes for f64 {
     }
 }
 
-impl Lanes for f32x4 {
+impl Lanes for f32x8 {
     #[inline(always)]
     fn rsqrt(self) -> Self {
-        f32x4::ONE / self.sqrt()
+        f32x8::ONE / self.sqrt()
     }
 }
 
@@ -440,6 +441,27 @@ impl FarField<f32x4> {
             q: pack(f, |x| x.q),
             v: pack(f, |x| x.v),
             c: pack(f, |x| x.c),
+        }
+    }
+
+    /// Two four-lane records side by side: `self` in lanes 0–3, `other` in lanes 4–7.
+    #[inline(always)]
+    pub fn pair(&self, other: &Self) -> FarField<f32x8> {
+        #[inline(always)]
+        fn cat(a: f32x4, b: f32x4) -> f32x8 {
+            let (a, b) = (a.to_array(), b.to_array());
+            f32x8::from([a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]])
+        }
+        fn cat_n<const N: usize>(a: &[f32x4; N], b: &[f32x4; N]) -> [f32x8; N] {
+            std::array::from_fn(|i| cat(a[i], b[i]))
+        }
+        FarField {
+            inv_s: cat(self.inv_s, other.inv_s),
+            n: cat_n(&self.n, &other.n),
+            tr: cat(self.tr, other.tr),
+            q: cat_n(&self.q, &other.q),
+            v: cat_n(&self.v, &other.v),
+            c: cat_n(&self.c, &other.c),
         }
     }
 }
@@ -605,7 +627,7 @@ mod tests {
     }
 
     #[test]
-    fn four_lanes_in_f32_equal_the_scalar_far_field() {
+    fn eight_lanes_in_f32_equal_the_scalar_far_field() {
         let centres = [
             P,
             [0.2, 0.5, -0.1],
@@ -618,23 +640,14 @@ mod tests {
         let far = nodes.map(|m| FarField::new(&m));
         let low = FarField::<f32x4>::lanes(&[&far[0], &far[1], &far[2], &far[3]]);
         let high = FarField::<f32x4>::lanes(&[&far[4], &far[5]]);
+        let lanes = low.pair(&high);
         let q = [3.0, -2.0, 1.5];
         let r = nodes.map(|m| sub(m.center, q));
-        // Lanes 2 and 3 of `high` are missing (zero coefficients, `1/s = 0`: NaN, never
-        // admitted).
-        let rl = |first: usize| {
-            [0, 1, 2].map(|k| {
-                f32x4::from(std::array::from_fn::<f32, 4, _>(|l| {
-                    r[(first + l).min(5)][k] as f32
-                }))
-            })
-        };
+        // Lanes 6 and 7 are missing (zero coefficients, `1/s = 0`: NaN, never admitted).
+        let rl = [0, 1, 2]
+            .map(|k| f32x8::from(std::array::from_fn::<f32, 8, _>(|l| r[l.min(5)][k] as f32)));
         for order in 0..=2u8 {
-            let (lo, hi) = (
-                low.eval(rl(0), order).to_array(),
-                high.eval(rl(4), order).to_array(),
-            );
-            let got: Vec<f32> = lo.iter().chain(&hi).copied().collect();
+            let got = lanes.eval(rl, order).to_array();
             for l in 0..6 {
                 let want = nodes[l].far_field(q, order);
                 assert!(
