@@ -36,7 +36,9 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod crossings;
 pub mod extract;
+pub mod intersect;
 pub mod lattice;
 pub mod octree;
 pub mod place;
@@ -154,8 +156,10 @@ pub struct RemeshStats {
     pub split_cells: usize,
     /// Finest cells with differing corner classes (the band that is extracted).
     pub band_cells: usize,
-    /// Evaluations spent on bisection.
-    pub bisection_evaluations: usize,
+    /// Evaluations spent on vertex placement (verifications and bisection).
+    pub placement_evaluations: usize,
+    /// Vertices placed at a verified crossing with the input triangles (no bisection).
+    pub guided_vertices: usize,
 }
 
 /// The surface [`remesh`] returns.
@@ -165,6 +169,12 @@ pub struct Remeshed {
     pub positions: Vec<[f64; 3]>,
     /// Triangles, counter-clockwise seen from outside (`w ≤ ½`).
     pub triangles: Vec<[u32; 3]>,
+    /// The vertices exactly, in fixed point: lattice units times `ticks_per_cell` (the exact
+    /// self-intersection check, [`intersect::self_intersections`], runs on these; `positions`
+    /// are their images in world coordinates, rounded to `f64`).
+    pub fixed: Vec<[i64; 3]>,
+    /// Fixed-point units per lattice cell edge (`2^(bisection_steps + 1)`).
+    pub ticks_per_cell: i64,
     /// Lattice spacing `h`.
     pub cell_size: f64,
     /// Work counters.
@@ -179,6 +189,20 @@ pub struct Remeshed {
 /// whose coarse corners all miss it is not found (see `docs/remesh.md`).
 pub fn remesh<E: Evaluator + ?Sized>(
     evaluator: &E,
+    bounds: BoundingBox,
+    options: &RemeshOptions,
+) -> Result<Remeshed, RemeshError> {
+    remesh_guided(evaluator, None, bounds, options)
+}
+
+/// [`remesh`], with the input triangles (`guide`) proposing where each vertex goes: a lattice
+/// edge that crosses them once gets its vertex at the crossing after two evaluations of `w`
+/// confirm the class change there, instead of `bisection_steps` evaluations (see
+/// [`place`]). The output's guarantees and the vertex precision are those of [`remesh`]
+/// whatever `guide` holds; a guide that is not the evaluator's surface only costs time.
+pub fn remesh_guided<E: Evaluator + ?Sized>(
+    evaluator: &E,
+    guide: Option<&crossings::SegmentBvh>,
     bounds: BoundingBox,
     options: &RemeshOptions,
 ) -> Result<Remeshed, RemeshError> {
@@ -205,8 +229,13 @@ pub fn remesh<E: Evaluator + ?Sized>(
     if band.edges.len() > u32::MAX as usize {
         return Err(RemeshError::TooManyVertices);
     }
-    let positions =
-        place::place_vertices(evaluator, &lattice, &band.edges, options.bisection_steps);
+    let placed = place::place_vertices(
+        evaluator,
+        &lattice,
+        &band.edges,
+        options.bisection_steps,
+        guide,
+    );
     let stats = RemeshStats {
         lattice_cells: lattice.cells,
         coarse_cells: lattice.coarse_cells(),
@@ -214,11 +243,14 @@ pub fn remesh<E: Evaluator + ?Sized>(
         classified_points: classified.labels.len(),
         split_cells: classified.split.len(),
         band_cells: band.band_cells,
-        bisection_evaluations: band.edges.len() * options.bisection_steps as usize,
+        placement_evaluations: placed.evaluations,
+        guided_vertices: placed.guided,
     };
     Ok(Remeshed {
-        positions,
+        positions: placed.positions,
         triangles: band.triangles,
+        fixed: placed.fixed,
+        ticks_per_cell: placed.ticks_per_cell,
         cell_size: lattice.h,
         stats,
     })
