@@ -192,7 +192,30 @@ pub fn remesh<E: Evaluator + ?Sized>(
     bounds: BoundingBox,
     options: &RemeshOptions,
 ) -> Result<Remeshed, RemeshError> {
-    remesh_guided(evaluator, None, bounds, options)
+    remesh_guided(evaluator, None, bounds, options, &|_| {})
+}
+
+/// The steps of a [`remesh`] run, announced to the progress callback of [`remesh_guided`] as
+/// each begins.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RemeshPhase {
+    /// Corner classification (coarse grid, then the octree band).
+    Classify,
+    /// Marching tetrahedra over the band.
+    Extract,
+    /// Vertex placement (guided crossings, bisection).
+    Place,
+}
+
+impl RemeshPhase {
+    /// A short name for progress messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            RemeshPhase::Classify => "classifying lattice corners",
+            RemeshPhase::Extract => "extracting the surface",
+            RemeshPhase::Place => "placing vertices",
+        }
+    }
 }
 
 /// [`remesh`], with the input triangles (`guide`) proposing where each vertex goes: a lattice
@@ -200,11 +223,13 @@ pub fn remesh<E: Evaluator + ?Sized>(
 /// confirm the class change there, instead of `bisection_steps` evaluations (see
 /// [`place`]). The output's guarantees and the vertex precision are those of [`remesh`]
 /// whatever `guide` holds; a guide that is not the evaluator's surface only costs time.
+/// `progress` hears of each [`RemeshPhase`] as it begins.
 pub fn remesh_guided<E: Evaluator + ?Sized>(
     evaluator: &E,
     guide: Option<&crossings::SegmentBvh>,
     bounds: BoundingBox,
     options: &RemeshOptions,
+    progress: &dyn Fn(RemeshPhase),
 ) -> Result<Remeshed, RemeshError> {
     if options.resolution == 0 || options.resolution > MAX_RESOLUTION {
         return Err(RemeshError::BadResolution {
@@ -223,12 +248,15 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
             usize::try_from(bytes / BYTES_PER_CLASSIFIED_POINT).unwrap_or(usize::MAX)
         })
     });
+    progress(RemeshPhase::Classify);
     let classified = octree::classify(evaluator, &lattice, max_points)
         .ok_or(RemeshError::OutOfMemory { max_points })?;
+    progress(RemeshPhase::Extract);
     let band = extract::extract(&lattice, &classified);
     if band.edges.len() > u32::MAX as usize {
         return Err(RemeshError::TooManyVertices);
     }
+    progress(RemeshPhase::Place);
     let placed = place::place_vertices(
         evaluator,
         &lattice,
