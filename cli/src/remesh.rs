@@ -100,7 +100,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
     // The broad phase is linear on the remesher's output (every face in one lattice cell); the
     // budget only guards against a surprise.
     let budget = 1000 * out.triangles.len() as u64 + 1_000_000;
+    let check_start = std::time::Instant::now();
     let intersections = self_intersections(&out.fixed, &out.triangles, budget);
+    let check_secs = check_start.elapsed().as_secs_f64();
     let mesh = gwn::Mesh::new(out.positions, out.triangles)?;
     write_surface(std::io::BufWriter::new(file), format, &mesh)
         .map_err(|e| CliError(format!("{}: {e}", args.out.display())))?;
@@ -143,10 +145,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
     )?;
     match &intersections {
         Ok(r) => outln!(
-            "self-intersections (exact): {} face pairs ({} pairs tested, {} degenerate faces)",
+            "self-intersections (exact): {} face pairs ({} pairs tested, {} degenerate faces, \
+             {:.2} s)",
             r.pairs,
             r.tested_pairs,
-            r.degenerate_faces
+            r.degenerate_faces,
+            check_secs
         )?,
         Err(e) => outln!("self-intersections: not counted: {e}")?,
     }

@@ -15,11 +15,14 @@
 //!    corners differ: translation-invariant, hence conforming across cells, and a binary
 //!    labelling of the vertices of a triangulation of space has a separating surface that is a
 //!    closed 2-manifold, with no ambiguous case.
-//! 4. [`place`]: each output vertex moves along its lattice edge by bisection on `w > ½`
-//!    (a fixed number of steps), because `w` jumps across a sheet and linear interpolation of
-//!    `w` would misplace it.
-//! 5. [`report`]: closed, edge- and vertex-manifold, oriented, Euler characteristic,
-//!    components, printed and as JSON.
+//! 4. [`place`]: each output vertex moves along its lattice edge to where `w` crosses `½`:
+//!    at the edge's crossing with the input triangles ([`crossings`], with [`remesh_guided`])
+//!    once two evaluations confirm it, else by bisection (a fixed number of steps); `w` jumps
+//!    across a sheet, so linear interpolation of `w` would misplace it. Vertices stay strictly
+//!    inside their edges, which is all the no-self-intersection argument needs.
+//! 5. [`report`], [`intersect`]: closed, edge- and vertex-manifold, oriented, Euler
+//!    characteristic, components, the exact self-intersection count (on the fixed-point
+//!    vertices), the sampled Hausdorff distance, printed and as JSON.
 //!
 //! ```
 //! use gwn::eval::antipodal::WindingNumber;
