@@ -4,7 +4,8 @@
 //! ```text
 //! cargo run --release --features examples --example remesh_bench [-- RES... [--mesh FILE]...]
 //! ```
-//! Defaults: resolutions 64, 128, 256 on two shared meshes (`../shared/meshes`, or
+//! `--bisect-only` places every vertex by bisection (the input triangles are not used as a
+//! guide). Defaults: resolutions 64, 128, 256 on two shared meshes (`../shared/meshes`, or
 //! `$GWN_SHARED_DIR/meshes`); the thread count is rayon's (set `RAYON_NUM_THREADS`). Prints a
 //! Markdown table.
 
@@ -14,16 +15,19 @@ use std::time::Instant;
 use gwn::eval::antipodal::WindingNumber;
 use gwn::products::remesh::lattice::Lattice;
 use gwn::products::remesh::report::TopologyReport;
-use gwn::products::remesh::{DEFAULT_BISECTION_STEPS, extract, octree, place};
+use gwn::products::remesh::{DEFAULT_BISECTION_STEPS, crossings, extract, octree, place};
 
 const DEFAULT_MESHES: [&str; 2] = ["cgal-bunny00.off", "assimp-Spider_binary.stl"];
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut res = Vec::new();
     let mut meshes = Vec::new();
+    let mut guided = true;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
-        if a == "--mesh" {
+        if a == "--bisect-only" {
+            guided = false;
+        } else if a == "--mesh" {
             meshes.push(PathBuf::from(args.next().ok_or("--mesh needs a file")?));
         } else {
             res.push(a.parse::<usize>()?);
@@ -42,10 +46,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .collect();
     }
     println!(
-        "| mesh | input faces | res | classify s | extract s | bisect s | total s | points \
+        "| mesh | input faces | res | classify s | extract s | place s | evaluations | guided | total s | points \
          classified | band cells | output faces | closed+manifold+oriented | Euler | components |"
     );
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|");
     for path in &meshes {
         let mesh = gwn::io::load_mesh(path)?.mesh;
         let wn = WindingNumber::new(&mesh)?;
@@ -57,18 +61,27 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let t1 = Instant::now();
             let band = extract::extract(&lattice, &classified);
             let t2 = Instant::now();
-            let positions =
-                place::place_vertices(&wn, &lattice, &band.edges, DEFAULT_BISECTION_STEPS);
+            let guide = crossings::SegmentBvh::of_mesh(&mesh);
+            let placed = place::place_vertices(
+                &wn,
+                &lattice,
+                &band.edges,
+                DEFAULT_BISECTION_STEPS,
+                if guided { Some(&guide) } else { None },
+            );
+            let positions = placed.positions;
             let t3 = Instant::now();
             let rep = TopologyReport::of(&positions, &band.triangles);
             let ok = rep.closed && rep.edge_manifold && rep.vertex_manifold && rep.oriented;
             println!(
-                "| {} | {} | {r} | {:.2} | {:.2} | {:.2} | {:.2} | {} | {} | {} | {} | {} | {} |",
+                "| {} | {} | {r} | {:.2} | {:.2} | {:.2} | {} | {} | {:.2} | {} | {} | {} | {} | {} | {} |",
                 path.file_name().and_then(|n| n.to_str()).unwrap_or("?"),
                 mesh.triangles().len(),
                 (t1 - t0).as_secs_f64(),
                 (t2 - t1).as_secs_f64(),
                 (t3 - t2).as_secs_f64(),
+                placed.evaluations,
+                placed.guided,
                 (t3 - t0).as_secs_f64(),
                 classified.labels.len(),
                 classified.band.len(),

@@ -169,6 +169,20 @@ def voxelize(
 ) -> _Grid:
     """Winding numbers (exact by default) on a voxel grid: (values (D, H, W) indexed [z, y, x], origin, spacing)."""
 
+def remesh(
+    V: _Floats,
+    F: _Indices,
+    res: int = 128,
+    *,
+    bisect: int = 8,
+    method: Literal["exact", "direct", "fast"] = "exact",
+    beta: Optional[float] = None,
+    order: Optional[int] = None,
+    tolerance: Optional[float] = None,
+    threads: Optional[int] = None,
+) -> Tuple[_F64, _I64]:
+    """A closed, manifold, oriented surface of the solid w > 1/2 as (V float64 (n, 3), F int64 (m, 3))."""
+
 def sdf(
     V: _Floats,
     F: _Indices,

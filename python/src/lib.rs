@@ -31,6 +31,7 @@ fn _gwn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(products::slice, m)?)?;
     m.add_function(wrap_pyfunction!(products::classify, m)?)?;
     m.add_function(wrap_pyfunction!(products::filter_tets, m)?)?;
+    m.add_function(wrap_pyfunction!(products::remesh, m)?)?;
     m.add_function(wrap_pyfunction!(curve::gauwn, m)?)?;
     m.add_function(wrap_pyfunction!(label::label_dataset, m)?)?;
     m.add_function(wrap_pyfunction!(label::label_file, m)?)?;

@@ -16,7 +16,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 
-use crate::arrays::{array_nd, array1, indices_vec, with_points};
+use crate::arrays::{array_nd, array1, array2, indices_vec, with_points};
 use crate::errors::value_error;
 use crate::evaluator::SpecArgs;
 use crate::oneshot::mesh_from;
@@ -404,4 +404,59 @@ pub fn filter_tets<'py>(
         .map_err(value_error)
     })?;
     Ok(PyArray1::from_vec(py, keep))
+}
+
+/// Remeshes at w = 1/2: a closed, edge- and vertex-manifold, consistently oriented surface
+/// (no self-intersections) of the solid where the winding number (exact by default) is above
+/// 1/2, as ``gwn remesh`` writes it.
+///
+/// ``res`` is the finest resolution (cells of edge longest extent / ``res``); ``bisect`` the
+/// placement precision (each vertex within ``cell / 2**(bisect+1)`` of where ``w`` crosses 1/2
+/// along its lattice edge). Every solid is kept, double walls and inner faces vanish where ``w``
+/// says so, holes close where ``w`` decides. Returns ``(V, F)``: float64 (n, 3) and int64
+/// (m, 3), triangles counter-clockwise seen from outside. ``method``/``beta``/``order``/
+/// ``tolerance`` as in :func:`voxelize`; refused (``ValueError``) when the surface would not fit
+/// in memory.
+#[pyfunction]
+#[pyo3(signature = (V, F, res = 128, *, bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS, method = "exact", beta = None, order = None, tolerance = None, threads = None))]
+#[allow(non_snake_case, clippy::too_many_arguments)]
+pub fn remesh<'py>(
+    py: Python<'py>,
+    V: &Bound<'py, PyAny>,
+    F: &Bound<'py, PyAny>,
+    res: usize,
+    bisect: u32,
+    method: &str,
+    beta: Option<f64>,
+    order: Option<u8>,
+    tolerance: Option<f64>,
+    threads: Option<Threads>,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    use gwn::products::remesh::{RemeshOptions, crossings::SegmentBvh, remesh_guided};
+    let method = spec_of(method, beta, order, tolerance)?;
+    let mesh = mesh_from(V, F, "V", "F")?;
+    let Some(bounds) = mesh.bounding_box() else {
+        return Err(PyValueError::new_err(
+            "remesh needs a mesh with at least one vertex",
+        ));
+    };
+    let options = RemeshOptions {
+        resolution: res,
+        bisection_steps: bisect,
+        max_classified_points: None,
+    };
+    let out = threads::run(py, threads, || {
+        let wn = evaluator_for(&mesh, &method)?;
+        let guide = SegmentBvh::of_mesh(&mesh);
+        Ok::<_, Box<dyn std::error::Error + Send + Sync>>(remesh_guided(
+            &wn,
+            Some(&guide),
+            bounds,
+            &options,
+            &|_| {},
+        )?)
+    })?
+    .map_err(value_error)?;
+    let triangles: Vec<[i64; 3]> = out.triangles.iter().map(|t| t.map(i64::from)).collect();
+    Ok((array2(py, out.positions)?, array2(py, triangles)?))
 }

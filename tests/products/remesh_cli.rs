@@ -9,7 +9,7 @@ fn remesh_writes_every_format_and_a_report() {
     let input = dir.join("cube.obj");
     let cube = gwn::testing::unit_cube(false);
     gwn::mesh::write_obj(std::fs::File::create(&input).unwrap(), &cube).unwrap();
-    for ext in ["obj", "ply", "stl"] {
+    for ext in ["obj", "ply", "stl", "glb"] {
         let out = dir.join(format!("out.{ext}"));
         let report = dir.join(format!("report-{ext}.json"));
         let (ok, stdout, stderr) = gwn(&[
@@ -35,6 +35,9 @@ fn remesh_writes_every_format_and_a_report() {
             "\"euler_characteristic\": 2",
             "\"components\": 1",
             "\"occupancy_agreement\": ",
+            "\"self_intersections\": 0",
+            "\"collinear_faces\": 0",
+            "\"hausdorff_cells\": ",
         ] {
             assert!(json.contains(member), "{member} not in {json}");
         }

@@ -15,11 +15,14 @@
 //!    corners differ: translation-invariant, hence conforming across cells, and a binary
 //!    labelling of the vertices of a triangulation of space has a separating surface that is a
 //!    closed 2-manifold, with no ambiguous case.
-//! 4. [`place`]: each output vertex moves along its lattice edge by bisection on `w > ½`
-//!    (a fixed number of steps), because `w` jumps across a sheet and linear interpolation of
-//!    `w` would misplace it.
-//! 5. [`report`]: closed, edge- and vertex-manifold, oriented, Euler characteristic,
-//!    components, printed and as JSON.
+//! 4. [`place`]: each output vertex moves along its lattice edge to where `w` crosses `½`:
+//!    at the edge's crossing with the input triangles ([`crossings`], with [`remesh_guided`])
+//!    once two evaluations confirm it, else by bisection (a fixed number of steps); `w` jumps
+//!    across a sheet, so linear interpolation of `w` would misplace it. Vertices stay strictly
+//!    inside their edges, which is all the no-self-intersection argument needs.
+//! 5. [`report`], [`intersect`]: closed, edge- and vertex-manifold, oriented, Euler
+//!    characteristic, components, the exact self-intersection count (on the fixed-point
+//!    vertices), the sampled Hausdorff distance, printed and as JSON.
 //!
 //! ```
 //! use gwn::eval::antipodal::WindingNumber;
@@ -36,7 +39,9 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod crossings;
 pub mod extract;
+pub mod intersect;
 pub mod lattice;
 pub mod octree;
 pub mod place;
@@ -154,8 +159,10 @@ pub struct RemeshStats {
     pub split_cells: usize,
     /// Finest cells with differing corner classes (the band that is extracted).
     pub band_cells: usize,
-    /// Evaluations spent on bisection.
-    pub bisection_evaluations: usize,
+    /// Evaluations spent on vertex placement (verifications and bisection).
+    pub placement_evaluations: usize,
+    /// Vertices placed at a verified crossing with the input triangles (no bisection).
+    pub guided_vertices: usize,
 }
 
 /// The surface [`remesh`] returns.
@@ -165,6 +172,12 @@ pub struct Remeshed {
     pub positions: Vec<[f64; 3]>,
     /// Triangles, counter-clockwise seen from outside (`w ≤ ½`).
     pub triangles: Vec<[u32; 3]>,
+    /// The vertices exactly, in fixed point: lattice units times `ticks_per_cell` (the exact
+    /// self-intersection check, [`intersect::self_intersections`], runs on these; `positions`
+    /// are their images in world coordinates, rounded to `f64`).
+    pub fixed: Vec<[i64; 3]>,
+    /// Fixed-point units per lattice cell edge (`2^(bisection_steps + 1)`).
+    pub ticks_per_cell: i64,
     /// Lattice spacing `h`.
     pub cell_size: f64,
     /// Work counters.
@@ -181,6 +194,45 @@ pub fn remesh<E: Evaluator + ?Sized>(
     evaluator: &E,
     bounds: BoundingBox,
     options: &RemeshOptions,
+) -> Result<Remeshed, RemeshError> {
+    remesh_guided(evaluator, None, bounds, options, &|_| {})
+}
+
+/// The steps of a [`remesh`] run, announced to the progress callback of [`remesh_guided`] as
+/// each begins.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RemeshPhase {
+    /// Corner classification (coarse grid, then the octree band).
+    Classify,
+    /// Marching tetrahedra over the band.
+    Extract,
+    /// Vertex placement (guided crossings, bisection).
+    Place,
+}
+
+impl RemeshPhase {
+    /// A short name for progress messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            RemeshPhase::Classify => "classifying lattice corners",
+            RemeshPhase::Extract => "extracting the surface",
+            RemeshPhase::Place => "placing vertices",
+        }
+    }
+}
+
+/// [`remesh`], with the input triangles (`guide`) proposing where each vertex goes: a lattice
+/// edge that crosses them once gets its vertex at the crossing after two evaluations of `w`
+/// confirm the class change there, instead of `bisection_steps` evaluations (see
+/// [`place`]). The output's guarantees and the vertex precision are those of [`remesh`]
+/// whatever `guide` holds; a guide that is not the evaluator's surface only costs time.
+/// `progress` hears of each [`RemeshPhase`] as it begins.
+pub fn remesh_guided<E: Evaluator + ?Sized>(
+    evaluator: &E,
+    guide: Option<&crossings::SegmentBvh>,
+    bounds: BoundingBox,
+    options: &RemeshOptions,
+    progress: &dyn Fn(RemeshPhase),
 ) -> Result<Remeshed, RemeshError> {
     if options.resolution == 0 || options.resolution > MAX_RESOLUTION {
         return Err(RemeshError::BadResolution {
@@ -199,14 +251,22 @@ pub fn remesh<E: Evaluator + ?Sized>(
             usize::try_from(bytes / BYTES_PER_CLASSIFIED_POINT).unwrap_or(usize::MAX)
         })
     });
+    progress(RemeshPhase::Classify);
     let classified = octree::classify(evaluator, &lattice, max_points)
         .ok_or(RemeshError::OutOfMemory { max_points })?;
+    progress(RemeshPhase::Extract);
     let band = extract::extract(&lattice, &classified);
     if band.edges.len() > u32::MAX as usize {
         return Err(RemeshError::TooManyVertices);
     }
-    let positions =
-        place::place_vertices(evaluator, &lattice, &band.edges, options.bisection_steps);
+    progress(RemeshPhase::Place);
+    let placed = place::place_vertices(
+        evaluator,
+        &lattice,
+        &band.edges,
+        options.bisection_steps,
+        guide,
+    );
     let stats = RemeshStats {
         lattice_cells: lattice.cells,
         coarse_cells: lattice.coarse_cells(),
@@ -214,11 +274,14 @@ pub fn remesh<E: Evaluator + ?Sized>(
         classified_points: classified.labels.len(),
         split_cells: classified.split.len(),
         band_cells: band.band_cells,
-        bisection_evaluations: band.edges.len() * options.bisection_steps as usize,
+        placement_evaluations: placed.evaluations,
+        guided_vertices: placed.guided,
     };
     Ok(Remeshed {
-        positions,
+        positions: placed.positions,
         triangles: band.triangles,
+        fixed: placed.fixed,
+        ticks_per_cell: placed.ticks_per_cell,
         cell_size: lattice.h,
         stats,
     })

@@ -260,3 +260,89 @@ where
         .count();
     Some(agree as f64 / samples as f64)
 }
+
+/// An evaluator that is never asked: [`SignedDistance`](crate::products::sdf::SignedDistance)
+/// needs one, the unsigned distance of [`hausdorff_distance`] does not use it.
+struct Unused;
+
+impl crate::eval::Evaluator for Unused {
+    fn eval(&self, _q: [f64; 3]) -> f64 {
+        0.0
+    }
+}
+
+/// Symmetric Hausdorff distance between two triangle meshes, sampled: the largest distance from
+/// a point of one to the other, over `samples` points per mesh drawn uniformly by area (seeded).
+/// A lower bound of the true distance that converges to it as samples grow; `None` when either
+/// mesh has no triangle.
+pub fn hausdorff_distance(
+    a: &crate::Mesh,
+    b: &crate::Mesh,
+    samples: usize,
+    seed: u64,
+) -> Option<f64> {
+    use rayon::prelude::*;
+    if a.is_empty() || b.is_empty() {
+        return None;
+    }
+    let one_sided = |from: &crate::Mesh, to: &crate::Mesh, seed: u64| -> f64 {
+        let distance = crate::products::sdf::SignedDistance::with_evaluator(to, Unused);
+        let triangles: Vec<[[f64; 3]; 3]> = (0..from.triangles().len())
+            .map(|f| from.triangle_positions(f))
+            .collect();
+        let points = surface_samples(&triangles, samples, seed);
+        points
+            .par_iter()
+            .map(|&p| distance.unsigned(p))
+            .reduce(|| 0.0, f64::max)
+    };
+    Some(one_sided(a, b, seed).max(one_sided(b, a, seed ^ 0x5bd1_e995)))
+}
+
+/// `samples` points uniform by area on `triangles` (seeded SplitMix64).
+fn surface_samples(triangles: &[[[f64; 3]; 3]], samples: usize, seed: u64) -> Vec<[f64; 3]> {
+    let mut points: Vec<[f64; 3]> = Vec::with_capacity(samples);
+    let area = |t: &[[f64; 3]; 3]| {
+        let u = [0, 1, 2].map(|k| t[1][k] - t[0][k]);
+        let v = [0, 1, 2].map(|k| t[2][k] - t[0][k]);
+        let n = [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ];
+        0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
+    };
+    let mut cumulative = Vec::with_capacity(triangles.len());
+    let mut total = 0.0;
+    for t in triangles {
+        let a = area(t);
+        total += if a.is_finite() { a } else { 0.0 };
+        cumulative.push(total);
+    }
+    if total <= 0.0 {
+        return points;
+    }
+    let mut state = seed;
+    let mut next = move || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for _ in 0..samples {
+        let x = next() * total;
+        let f = cumulative
+            .partition_point(|&c| c <= x)
+            .min(triangles.len() - 1);
+        let (mut r1, mut r2) = (next(), next());
+        if r1 + r2 > 1.0 {
+            (r1, r2) = (1.0 - r1, 1.0 - r2);
+        }
+        let t = &triangles[f];
+        points.push(std::array::from_fn(|k| {
+            t[0][k] + r1 * (t[1][k] - t[0][k]) + r2 * (t[2][k] - t[0][k])
+        }));
+    }
+    points
+}

@@ -1,0 +1,58 @@
+"""gwn.remesh: a closed, manifold, oriented surface of w > 1/2 (closed forms on cubes)."""
+
+import numpy as np
+import pytest
+
+import gwn
+from conftest import CUBE_F, CUBE_V, OPEN_BOX_F, random_points
+
+
+def edge_census(F):
+    """(every directed edge appears once, every undirected edge twice): closed and oriented."""
+    directed = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
+    unique_directed = np.unique(directed, axis=0)
+    undirected, counts = np.unique(np.sort(directed, axis=1), axis=0, return_counts=True)
+    return len(unique_directed) == len(directed), bool(np.all(counts == 2)), len(undirected)
+
+
+def volume(V, F):
+    a, b, c = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
+    return np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0
+
+
+def test_cube_gives_a_closed_oriented_sphere_of_the_right_volume():
+    V, F = gwn.remesh(CUBE_V, CUBE_F, res=16)
+    assert V.dtype == np.float64 and V.shape[1] == 3
+    assert F.dtype == np.int64 and F.shape[1] == 3 and len(F) > 0
+    once, twice, edges = edge_census(F)
+    assert once and twice
+    assert len(np.unique(F)) - edges + len(F) == 2  # Euler characteristic of a sphere
+    # Cut corners and edges lose at most about a cell's worth of volume.
+    assert 0.85 < volume(V, F) <= 1.0 + 1e-9
+    # Away from the surface the output's own winding number agrees with the cube's.
+    q = random_points(2000, seed=3)
+    far = np.min(np.minimum(np.abs(q), np.abs(q - 1)), axis=1) > 2.0 / 16
+    w_in = gwn.winding_number(CUBE_V, CUBE_F, q[far])
+    w_out = gwn.winding_number(V, F, q[far])
+    np.testing.assert_array_equal(w_in > 0.5, w_out > 0.5)
+
+
+def test_disjoint_cubes_stay_two_solids_and_open_box_closes():
+    V2 = np.concatenate([CUBE_V, CUBE_V + [2.0, 0.0, 0.0]])
+    F2 = np.concatenate([CUBE_F, CUBE_F + len(CUBE_V)])
+    V, F = gwn.remesh(V2, F2, res=24, threads=1)
+    once, twice, edges = edge_census(F)
+    assert once and twice
+    assert len(np.unique(F)) - edges + len(F) == 4
+    V, F = gwn.remesh(CUBE_V, OPEN_BOX_F, res=12)
+    once, twice, _ = edge_census(F)
+    assert once and twice and len(F) > 0
+
+
+def test_bad_arguments_are_value_errors():
+    with pytest.raises(ValueError, match="resolution"):
+        gwn.remesh(CUBE_V, CUBE_F, res=0)
+    with pytest.raises(ValueError, match="bisection"):
+        gwn.remesh(CUBE_V, CUBE_F, res=8, bisect=99)
+    with pytest.raises(ValueError):
+        gwn.remesh(CUBE_V, CUBE_F, res=8, method="nope")

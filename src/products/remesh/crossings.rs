@@ -1,0 +1,259 @@
+//! Where a short segment (a lattice edge of the band) crosses the input triangles: a binary BVH
+//! over the triangles' boxes and a floating-point segment–triangle test.
+//!
+//! This only *proposes* where an output vertex goes. [`super::place`] accepts a proposal only
+//! after two evaluations of `w` on either side of it confirm a class change, so a rounding error
+//! here, a missed triangle or a spurious hit costs evaluations (the edge falls back to
+//! bisection), never a wrong placement.
+
+/// Triangles per leaf.
+const LEAF_SIZE: usize = 4;
+
+/// Relative slack of the box and barycentric tests: a triangle grazed by the segment counts as
+/// hit (a spurious hit is rejected by the verification in `place`; a missed one would cost a
+/// bisection instead of two evaluations).
+const SLACK: f64 = 1e-9;
+
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    lo: [f64; 3],
+    hi: [f64; 3],
+    /// Leaf: first triangle; inner: first child.
+    first: u32,
+    /// Inner: second child.
+    second: u32,
+    /// Triangles in a leaf; 0 for an inner node.
+    count: u32,
+}
+
+/// A BVH over triangles for segment queries.
+#[derive(Clone, Debug, Default)]
+pub struct SegmentBvh {
+    triangles: Vec<[[f64; 3]; 3]>,
+    nodes: Vec<Node>,
+}
+
+impl SegmentBvh {
+    /// The hierarchy over `triangles` (median splits along the longest axis of the centroids).
+    /// Triangles with a non-finite coordinate are left out (they cannot guide a placement).
+    pub fn new(triangles: impl IntoIterator<Item = [[f64; 3]; 3]>) -> SegmentBvh {
+        let mut triangles: Vec<[[f64; 3]; 3]> = triangles
+            .into_iter()
+            .filter(|t| t.iter().flatten().all(|v| v.is_finite()))
+            .collect();
+        let mut nodes = Vec::with_capacity(2 * triangles.len() / LEAF_SIZE + 1);
+        if !triangles.is_empty() {
+            build(&mut triangles, 0, &mut nodes);
+        }
+        SegmentBvh { triangles, nodes }
+    }
+
+    /// The hierarchy over the triangles of `mesh`.
+    pub fn of_mesh(mesh: &crate::Mesh) -> SegmentBvh {
+        SegmentBvh::new((0..mesh.triangles().len()).map(|f| mesh.triangle_positions(f)))
+    }
+
+    /// Triangles held.
+    pub fn len(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// Whether it holds no triangle.
+    pub fn is_empty(&self) -> bool {
+        self.triangles.is_empty()
+    }
+
+    /// Pushes onto `out` the parameters `t ∈ [0, 1]` (clamped) at which the segment `p → q`
+    /// crosses a triangle, in no particular order.
+    pub fn crossings(&self, p: [f64; 3], q: [f64; 3], out: &mut Vec<f64>) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let d = [0, 1, 2].map(|a| q[a] - p[a]);
+        // Median splits keep the depth near log2(n / LEAF_SIZE): 64 levels hold any input.
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let node = self.nodes[stack[top] as usize];
+            if !segment_hits_box(p, d, node.lo, node.hi) {
+                continue;
+            }
+            if node.count > 0 {
+                let first = node.first as usize;
+                for tri in &self.triangles[first..first + node.count as usize] {
+                    if let Some(t) = segment_triangle(p, d, tri) {
+                        out.push(t.clamp(0.0, 1.0));
+                    }
+                }
+            } else if top + 2 <= stack.len() {
+                stack[top] = node.first;
+                stack[top + 1] = node.second;
+                top += 2;
+            }
+        }
+    }
+}
+
+/// Builds the subtree over `triangles` (whose first one is triangle `offset` of the whole
+/// array) and returns its node index.
+fn build(triangles: &mut [[[f64; 3]; 3]], offset: usize, nodes: &mut Vec<Node>) -> u32 {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    let mut clo = [f64::INFINITY; 3];
+    let mut chi = [f64::NEG_INFINITY; 3];
+    for t in triangles.iter() {
+        for a in 0..3 {
+            for v in t {
+                lo[a] = lo[a].min(v[a]);
+                hi[a] = hi[a].max(v[a]);
+            }
+            let c = t[0][a] + t[1][a] + t[2][a];
+            clo[a] = clo[a].min(c);
+            chi[a] = chi[a].max(c);
+        }
+    }
+    // Pad by a relative slack so that rounding in the slab test never culls a grazed triangle.
+    for a in 0..3 {
+        let pad = SLACK
+            * (hi[a] - lo[a])
+                .max(lo[a].abs())
+                .max(hi[a].abs())
+                .max(1e-300);
+        lo[a] -= pad;
+        hi[a] += pad;
+    }
+    let index = nodes.len();
+    nodes.push(Node {
+        lo,
+        hi,
+        first: offset as u32,
+        second: 0,
+        count: triangles.len() as u32,
+    });
+    if triangles.len() <= LEAF_SIZE {
+        return index as u32;
+    }
+    let axis = (0..3)
+        .max_by(|&a, &b| (chi[a] - clo[a]).total_cmp(&(chi[b] - clo[b])))
+        .unwrap_or(0);
+    let mid = triangles.len() / 2;
+    let key = |t: &[[f64; 3]; 3]| t[0][axis] + t[1][axis] + t[2][axis];
+    triangles.select_nth_unstable_by(mid, |x, y| key(x).total_cmp(&key(y)));
+    let (left, right) = triangles.split_at_mut(mid);
+    let first = build(left, offset, nodes);
+    let second = build(right, offset + mid, nodes);
+    nodes[index].first = first;
+    nodes[index].second = second;
+    nodes[index].count = 0;
+    index as u32
+}
+
+/// Whether the segment `p + t d`, `t ∈ [0, 1]`, meets the box (slab test; an axis with `d = 0`
+/// needs `p` inside the slab).
+fn segment_hits_box(p: [f64; 3], d: [f64; 3], lo: [f64; 3], hi: [f64; 3]) -> bool {
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for a in 0..3 {
+        if d[a] == 0.0 {
+            if p[a] < lo[a] || p[a] > hi[a] {
+                return false;
+            }
+            continue;
+        }
+        let (mut ta, mut tb) = ((lo[a] - p[a]) / d[a], (hi[a] - p[a]) / d[a]);
+        if ta > tb {
+            std::mem::swap(&mut ta, &mut tb);
+        }
+        t0 = t0.max(ta);
+        t1 = t1.min(tb);
+        if t0 > t1 {
+            return false;
+        }
+    }
+    true
+}
+
+/// Where the segment `p + t d` crosses the triangle (Möller–Trumbore, with a small slack on the
+/// barycentric bounds); `None` when it misses or is parallel to the triangle's plane.
+fn segment_triangle(p: [f64; 3], d: [f64; 3], tri: &[[f64; 3]; 3]) -> Option<f64> {
+    let sub = |x: [f64; 3], y: [f64; 3]| [x[0] - y[0], x[1] - y[1], x[2] - y[2]];
+    let cross = |x: [f64; 3], y: [f64; 3]| {
+        [
+            x[1] * y[2] - x[2] * y[1],
+            x[2] * y[0] - x[0] * y[2],
+            x[0] * y[1] - x[1] * y[0],
+        ]
+    };
+    let dot = |x: [f64; 3], y: [f64; 3]| x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+    let e1 = sub(tri[1], tri[0]);
+    let e2 = sub(tri[2], tri[0]);
+    let pv = cross(d, e2);
+    let det = dot(e1, pv);
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let tv = sub(p, tri[0]);
+    let u = dot(tv, pv) * inv;
+    if !(-SLACK..=1.0 + SLACK).contains(&u) {
+        return None;
+    }
+    let qv = cross(tv, e1);
+    let v = dot(d, qv) * inv;
+    if v < -SLACK || u + v > 1.0 + SLACK {
+        return None;
+    }
+    let t = dot(e2, qv) * inv;
+    (-SLACK..=1.0 + SLACK).contains(&t).then_some(t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Brute force over every triangle, same test: the BVH must find exactly the same hits.
+    #[test]
+    fn bvh_finds_what_brute_force_finds() {
+        let mut state = 7u64;
+        let mut next = move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let tris: Vec<[[f64; 3]; 3]> = (0..500)
+            .map(|_| {
+                let c = [next(), next(), next()];
+                std::array::from_fn(|_| std::array::from_fn(|a| c[a] + 0.1 * (next() - 0.5)))
+            })
+            .collect();
+        let bvh = SegmentBvh::new(tris.clone());
+        assert_eq!(bvh.len(), 500);
+        for _ in 0..300 {
+            let p = [next(), next(), next()];
+            let q = [0, 1, 2].map(|a| p[a] + 0.2 * (next() - 0.5));
+            let mut got = Vec::new();
+            bvh.crossings(p, q, &mut got);
+            let d = [0, 1, 2].map(|a| q[a] - p[a]);
+            let mut want: Vec<f64> = tris
+                .iter()
+                .filter_map(|t| segment_triangle(p, d, t))
+                .map(|t| t.clamp(0.0, 1.0))
+                .collect();
+            got.sort_by(f64::total_cmp);
+            want.sort_by(f64::total_cmp);
+            assert_eq!(got, want);
+        }
+    }
+
+    #[test]
+    fn axis_segment_through_a_triangle() {
+        let bvh = SegmentBvh::new([[[0.0, 0.0, 0.5], [1.0, 0.0, 0.5], [0.0, 1.0, 0.5]]]);
+        let mut t = Vec::new();
+        bvh.crossings([0.25, 0.25, 0.0], [0.25, 0.25, 1.0], &mut t);
+        assert_eq!(t, vec![0.5]);
+        t.clear();
+        bvh.crossings([0.75, 0.75, 0.0], [0.75, 0.75, 1.0], &mut t);
+        assert!(t.is_empty());
+    }
+}

@@ -1,0 +1,419 @@
+//! Exact self-intersection count of a triangle surface with integer (fixed-point) vertices.
+//!
+//! Two faces *self-intersect* when they meet anywhere other than in what they share: nothing,
+//! one common vertex, or one common edge (coincident positions count as shared, whatever the
+//! indices). Every sign is exact: `orient3d` and `orient2d` are the kernel's 60-bit integer
+//! predicates (`kernel::predicates::W128`: a floating-point filter, then exact integers), so
+//! coordinates must be below `2^60` in magnitude.
+//!
+//! - no shared vertex: they meet iff an edge of one meets the other (closed sets; this covers
+//!   the coplanar case too, containment included);
+//! - one shared vertex: iff the edge opposite it in one meets the other;
+//! - one shared edge: iff both lie in one plane with the opposite vertices on the same side of
+//!   the edge (a fold);
+//! - three: a duplicated face.
+//!
+//! Degenerate faces (collinear vertices) are counted apart and not tested.
+//!
+//! Broad phase: every face is bucketed by the cell of its box's minimum corner, on a grid whose
+//! cell is the largest box extent; two faces whose boxes overlap then sit in the same or
+//! neighbouring cells. This is linear for surfaces of evenly sized faces (the remesher's output:
+//! every face lies in one lattice cell) and refuses, with [`IntersectError::TooManyCandidates`],
+//! when uneven face sizes would make it quadratic beyond a budget.
+
+use rayon::prelude::*;
+
+use crate::kernel::predicates::{W128, Width};
+
+/// Largest accepted coordinate magnitude (the 60-bit predicates need differences below `2^61`).
+pub const MAX_COORDINATE: i64 = 1 << 60;
+
+/// The result of [`self_intersections`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SelfIntersections {
+    /// Pairs of faces that meet outside their common vertices and edge.
+    pub pairs: usize,
+    /// Faces whose three vertices are collinear (not tested).
+    pub degenerate_faces: usize,
+    /// Pairs of faces whose boxes overlap (the exact tests run).
+    pub tested_pairs: usize,
+}
+
+/// Why [`self_intersections`] refused.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IntersectError {
+    /// A coordinate is `MAX_COORDINATE` or more in magnitude.
+    CoordinateTooLarge {
+        /// Vertex index.
+        vertex: usize,
+    },
+    /// A face refers to a vertex that does not exist.
+    BadIndex {
+        /// Face index.
+        face: usize,
+    },
+    /// The broad phase would test more than the budget of candidate pairs.
+    TooManyCandidates {
+        /// The candidate pairs counted.
+        candidates: u64,
+        /// The budget.
+        budget: u64,
+    },
+}
+
+impl std::fmt::Display for IntersectError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            IntersectError::CoordinateTooLarge { vertex } => write!(
+                f,
+                "vertex {vertex} has a coordinate of magnitude 2^60 or more"
+            ),
+            IntersectError::BadIndex { face } => {
+                write!(f, "face {face} refers to a vertex that does not exist")
+            }
+            IntersectError::TooManyCandidates { candidates, budget } => write!(
+                f,
+                "{candidates} candidate face pairs exceed the budget of {budget} (face sizes too \
+                 uneven for the grid broad phase)"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for IntersectError {}
+
+type P = [i64; 3];
+
+/// Counts the self-intersecting face pairs of `triangles` over the exact integer `points`,
+/// testing at most `budget` candidate pairs (grid neighbours, before the box test).
+pub fn self_intersections(
+    points: &[P],
+    triangles: &[[u32; 3]],
+    budget: u64,
+) -> Result<SelfIntersections, IntersectError> {
+    if let Some(vertex) = points
+        .iter()
+        .position(|p| p.iter().any(|c| c.unsigned_abs() >= MAX_COORDINATE as u64))
+    {
+        return Err(IntersectError::CoordinateTooLarge { vertex });
+    }
+    if let Some(face) = triangles
+        .iter()
+        .position(|t| t.iter().any(|&v| v as usize >= points.len()))
+    {
+        return Err(IntersectError::BadIndex { face });
+    }
+    let tri = |f: usize| triangles[f].map(|v| points[v as usize]);
+    let boxes: Vec<(P, P)> = (0..triangles.len())
+        .map(|f| {
+            let t = tri(f);
+            (
+                std::array::from_fn(|a| t[0][a].min(t[1][a]).min(t[2][a])),
+                std::array::from_fn(|a| t[0][a].max(t[1][a]).max(t[2][a])),
+            )
+        })
+        .collect();
+    let cell = boxes
+        .iter()
+        .map(|(lo, hi)| (0..3).map(|a| hi[a] - lo[a]).max().unwrap_or(0))
+        .max()
+        .unwrap_or(0)
+        .max(1);
+    // Faces sorted by the cell of their box's minimum corner.
+    let cell_of = |p: P| p.map(|c| c.div_euclid(cell));
+    let mut order: Vec<(P, u32)> = boxes
+        .iter()
+        .enumerate()
+        .map(|(f, (lo, _))| (cell_of(*lo), f as u32))
+        .collect();
+    order.par_sort_unstable();
+    let mut ranges: std::collections::HashMap<P, (usize, usize)> = Default::default();
+    let mut start = 0;
+    while start < order.len() {
+        let key = order[start].0;
+        let mut end = start + 1;
+        while end < order.len() && order[end].0 == key {
+            end += 1;
+        }
+        ranges.insert(key, (start, end));
+        start = end;
+    }
+    // The 13 neighbours "after" a cell, plus the cell itself: every unordered pair of cells at
+    // distance ≤ 1 is visited once.
+    let forward: Vec<P> = (-1..=1i64)
+        .flat_map(|z| (-1..=1i64).flat_map(move |y| (-1..=1i64).map(move |x| [x, y, z])))
+        .filter(|d| (d[2], d[1], d[0]) > (0, 0, 0))
+        .collect();
+    let cells: Vec<(P, (usize, usize))> = ranges.iter().map(|(k, r)| (*k, *r)).collect();
+    let candidates: u64 = cells
+        .par_iter()
+        .map(|&(key, (s, e))| {
+            let n = (e - s) as u64;
+            let mut c = n * n.saturating_sub(1) / 2;
+            for d in &forward {
+                if let Some(&(s2, e2)) = ranges.get(&[0, 1, 2].map(|a| key[a] + d[a])) {
+                    c += n * (e2 - s2) as u64;
+                }
+            }
+            c
+        })
+        .sum();
+    if candidates > budget {
+        return Err(IntersectError::TooManyCandidates { candidates, budget });
+    }
+    let overlap = |f: usize, g: usize| {
+        let ((alo, ahi), (blo, bhi)) = (boxes[f], boxes[g]);
+        (0..3).all(|a| alo[a] <= bhi[a] && blo[a] <= ahi[a])
+    };
+    let degenerate: Vec<bool> = (0..triangles.len())
+        .into_par_iter()
+        .map(|f| {
+            let t = tri(f);
+            normal(t[0], t[1], t[2]) == [0; 3]
+        })
+        .collect();
+    let test = |f: usize, g: usize, acc: &mut (usize, usize)| {
+        if degenerate[f] || degenerate[g] || !overlap(f, g) {
+            return;
+        }
+        acc.1 += 1;
+        if faces_intersect(tri(f), tri(g)) {
+            acc.0 += 1;
+        }
+    };
+    let (pairs, tested_pairs) = cells
+        .par_iter()
+        .map(|&(key, (s, e))| {
+            let mut acc = (0usize, 0usize);
+            for i in s..e {
+                let f = order[i].1 as usize;
+                for item in &order[i + 1..e] {
+                    test(f, item.1 as usize, &mut acc);
+                }
+                for d in &forward {
+                    if let Some(&(s2, e2)) = ranges.get(&[0, 1, 2].map(|a| key[a] + d[a])) {
+                        for item in &order[s2..e2] {
+                            test(f, item.1 as usize, &mut acc);
+                        }
+                    }
+                }
+            }
+            acc
+        })
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+    Ok(SelfIntersections {
+        pairs,
+        degenerate_faces: degenerate.iter().filter(|&&d| d).count(),
+        tested_pairs,
+    })
+}
+
+fn sub(a: P, b: P) -> P {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+/// Exact `(b − a) × (c − a)` (differences below `2^61`, products below `2^122`).
+fn normal(a: P, b: P, c: P) -> [i128; 3] {
+    let (u, v) = (sub(b, a), sub(c, a));
+    let m = |x: i64, y: i64| i128::from(x) * i128::from(y);
+    [
+        m(u[1], v[2]) - m(u[2], v[1]),
+        m(u[2], v[0]) - m(u[0], v[2]),
+        m(u[0], v[1]) - m(u[1], v[0]),
+    ]
+}
+
+/// Sign of `(d − a) · ((b − a) × (c − a))`.
+fn orient(a: P, b: P, c: P, d: P) -> i32 {
+    W128::orient3d_sign(sub(d, a), sub(b, a), sub(c, a))
+}
+
+/// The two axes kept when projecting along `axis`.
+fn plane_axes(axis: usize) -> (usize, usize) {
+    ((axis + 1) % 3, (axis + 2) % 3)
+}
+
+/// Sign of the 2D orientation of `(a, b, c)` in the plane of axes `(i, j)`.
+fn orient2(a: P, b: P, c: P, (i, j): (usize, usize)) -> i32 {
+    W128::det2_sign(b[i] - a[i], b[j] - a[j], c[i] - a[i], c[j] - a[j])
+}
+
+/// An axis along which the (non-degenerate) triangle's normal is nonzero.
+fn projection_axis(n: [i128; 3]) -> usize {
+    (0..3).find(|&a| n[a] != 0).unwrap_or(2)
+}
+
+/// Whether the faces `s` and `t` (non-degenerate) meet outside what they share.
+pub fn faces_intersect(s: [P; 3], t: [P; 3]) -> bool {
+    let shared: Vec<(usize, usize)> = (0..3)
+        .flat_map(|i| (0..3).map(move |j| (i, j)))
+        .filter(|&(i, j)| s[i] == t[j])
+        .collect();
+    match shared.len() {
+        0 => {
+            // Quick rejection: one face strictly on one side of the other's plane.
+            let side = t.map(|p| orient(s[0], s[1], s[2], p));
+            if side.iter().all(|&x| x > 0) || side.iter().all(|&x| x < 0) {
+                return false;
+            }
+            let side = s.map(|p| orient(t[0], t[1], t[2], p));
+            if side.iter().all(|&x| x > 0) || side.iter().all(|&x| x < 0) {
+                return false;
+            }
+            (0..3).any(|k| segment_meets_triangle(s[k], s[(k + 1) % 3], t))
+                || (0..3).any(|k| segment_meets_triangle(t[k], t[(k + 1) % 3], s))
+        }
+        1 => {
+            let (i, j) = shared[0];
+            segment_meets_triangle(s[(i + 1) % 3], s[(i + 2) % 3], t)
+                || segment_meets_triangle(t[(j + 1) % 3], t[(j + 2) % 3], s)
+        }
+        2 => {
+            let (u, v) = (s[shared[0].0], s[shared[1].0]);
+            let a = s[3 - shared[0].0 - shared[1].0];
+            let b = t[3 - shared[0].1 - shared[1].1];
+            if orient(u, v, a, b) != 0 {
+                return false;
+            }
+            let axes = plane_axes(projection_axis(normal(u, v, a)));
+            orient2(u, v, a, axes) == orient2(u, v, b, axes)
+        }
+        _ => true,
+    }
+}
+
+/// Whether the closed segment `p q` meets the closed (non-degenerate) triangle `t`.
+fn segment_meets_triangle(p: P, q: P, t: [P; 3]) -> bool {
+    let op = orient(t[0], t[1], t[2], p);
+    let oq = orient(t[0], t[1], t[2], q);
+    if op == oq && op != 0 {
+        return false;
+    }
+    if op == 0 && oq == 0 {
+        let axes = plane_axes(projection_axis(normal(t[0], t[1], t[2])));
+        return point_in_triangle_2d(p, t, axes)
+            || point_in_triangle_2d(q, t, axes)
+            || (0..3).any(|k| segments_meet_2d(p, q, t[k], t[(k + 1) % 3], axes));
+    }
+    // The segment meets the plane in one point; the line through it passes through the closed
+    // triangle iff the three edge volumes have no two opposite strict signs.
+    let s = [
+        orient(p, q, t[0], t[1]),
+        orient(p, q, t[1], t[2]),
+        orient(p, q, t[2], t[0]),
+    ];
+    !(s.contains(&1) && s.contains(&-1))
+}
+
+fn point_in_triangle_2d(p: P, t: [P; 3], axes: (usize, usize)) -> bool {
+    let s = [
+        orient2(t[0], t[1], p, axes),
+        orient2(t[1], t[2], p, axes),
+        orient2(t[2], t[0], p, axes),
+    ];
+    !(s.contains(&1) && s.contains(&-1))
+}
+
+/// Whether the closed segments `a b` and `c d`, coplanar, meet (projected on `axes`).
+fn segments_meet_2d(a: P, b: P, c: P, d: P, axes: (usize, usize)) -> bool {
+    let d1 = orient2(c, d, a, axes);
+    let d2 = orient2(c, d, b, axes);
+    let d3 = orient2(a, b, c, axes);
+    let d4 = orient2(a, b, d, axes);
+    if d1 * d2 < 0 && d3 * d4 < 0 {
+        return true;
+    }
+    let within =
+        |x: P, y: P, z: P| (0..3).all(|k| x[k].min(y[k]) <= z[k] && z[k] <= x[k].max(y[k]));
+    (d1 == 0 && within(c, d, a))
+        || (d2 == 0 && within(c, d, b))
+        || (d3 == 0 && within(a, b, c))
+        || (d4 == 0 && within(a, b, d))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const T: [P; 3] = [[0, 0, 0], [10, 0, 0], [0, 10, 0]];
+
+    #[test]
+    fn piercing_and_separate() {
+        // A vertical triangle through T's interior.
+        assert!(faces_intersect(T, [[2, 2, -5], [3, 2, 5], [2, 3, 5]]));
+        // The same, lifted above the plane.
+        assert!(!faces_intersect(T, [[2, 2, 1], [3, 2, 5], [2, 3, 5]]));
+        // Touching T's interior with one vertex.
+        assert!(faces_intersect(T, [[2, 2, 0], [3, 2, 5], [2, 3, 5]]));
+    }
+
+    #[test]
+    fn shared_edge_fold_and_hinge() {
+        // Same plane, opposite sides of the common edge: a flat hinge, no intersection.
+        assert!(!faces_intersect(T, [[10, 0, 0], [0, 0, 0], [5, -5, 0]]));
+        // Same plane, same side: folded over.
+        assert!(faces_intersect(T, [[10, 0, 0], [0, 0, 0], [2, 2, 0]]));
+        // Out of plane: a proper dihedral.
+        assert!(!faces_intersect(T, [[10, 0, 0], [0, 0, 0], [2, 2, 3]]));
+    }
+
+    #[test]
+    fn shared_vertex() {
+        // A fan neighbour in the plane, outside T.
+        assert!(!faces_intersect(T, [[0, 0, 0], [-5, 5, 0], [-5, -5, 0]]));
+        // Overlapping sector in the plane.
+        assert!(faces_intersect(T, [[0, 0, 0], [5, 1, 0], [5, 2, 0]]));
+        // Its opposite edge passing through T from above to below.
+        assert!(faces_intersect(T, [[0, 0, 0], [3, 3, 4], [3, 4, -4]]));
+        // Rising out of the plane.
+        assert!(!faces_intersect(T, [[0, 0, 0], [3, 3, 4], [3, 4, 4]]));
+    }
+
+    #[test]
+    fn coplanar_disjoint_and_contained() {
+        assert!(!faces_intersect(T, [[20, 20, 0], [30, 20, 0], [20, 30, 0]]));
+        assert!(faces_intersect(T, [[1, 1, 0], [3, 1, 0], [1, 3, 0]]));
+    }
+
+    #[test]
+    fn octahedron_is_clean_and_a_crossed_pair_counts_once() {
+        let p = [
+            [10, 0, 0],
+            [-10, 0, 0],
+            [0, 10, 0],
+            [0, -10, 0],
+            [0, 0, 10],
+            [0, 0, -10],
+        ];
+        let f = [
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ];
+        let r = self_intersections(&p, &f, u64::MAX).unwrap();
+        assert_eq!((r.pairs, r.degenerate_faces), (0, 0));
+        let mut p2 = p.to_vec();
+        p2.extend([[1, 1, -20], [2, 1, 20], [1, 2, 20]]);
+        let mut f2 = f.to_vec();
+        f2.push([6, 7, 8]);
+        // The spike pierces the top and the bottom face it passes through.
+        assert_eq!(self_intersections(&p2, &f2, u64::MAX).unwrap().pairs, 2);
+        assert!(matches!(
+            self_intersections(&p2, &f2, 1),
+            Err(IntersectError::TooManyCandidates { .. })
+        ));
+        assert_eq!(
+            self_intersections(&[[1 << 61, 0, 0]], &[], 10),
+            Err(IntersectError::CoordinateTooLarge { vertex: 0 })
+        );
+        assert_eq!(
+            self_intersections(&p, &[[0, 1, 9]], 10),
+            Err(IntersectError::BadIndex { face: 0 })
+        );
+    }
+}
