@@ -177,16 +177,15 @@ pub const ORIENT2D_FILTER_CONVERSION: f64 = 2.0 * 2.0 * (f64::EPSILON * 0.5);
 /// Rounding term of [`orient2d_filtered`]'s bound, relative to `|p1| + |p2|`: `2·4u`.
 pub const ORIENT2D_FILTER_RELATIVE: f64 = 2.0 * 4.0 * (f64::EPSILON * 0.5);
 
-/// Why a sign [`orient2d_filtered`] gives on the 60-bit lattice is also the sign for the exact
-/// inputs, whose vertices and query lie up to half a cell per coordinate off their lattice points
-/// (issue 21): with `Σ = |ax| + |ay| + |bx| + |by|` (lattice offsets, integers), moving both ends
-/// of each offset by `≤ 1/2` changes `D` by at most `Σ + 2 ≤ 3Σ` (`Σ ≥ 1`; `Σ = 0` gives `d = 0`,
-/// never decided). A decided `|d|` exceeds the bound, twice the rounding error, so the lattice
-/// `|D| >` half the bound `≥ CONVERSION/2 · limit · Σ = 128·Σ` at `limit = 2^59`: the snapping
-/// cannot reach zero. So only the filter's undecided edges need the exact inputs.
-pub const SNAP_WITHIN_FILTER: bool =
-    ORIENT2D_FILTER_CONVERSION * 0.5 * ((1_u64 << 59) as f64) >= 3.0;
-const _: () = assert!(SNAP_WITHIN_FILTER);
+// Why a sign [`orient2d_filtered`] gives on the 60-bit lattice is also the sign for the exact
+// inputs, whose vertices and query lie up to half a cell per coordinate off their lattice points
+// (issue 21): with `Σ = |ax| + |ay| + |bx| + |by|` (lattice offsets, integers), moving both ends
+// of each offset by `≤ 1/2` changes `D` by at most `Σ + 2 ≤ 3Σ` (`Σ ≥ 1`; `Σ = 0` gives `d = 0`,
+// never decided). A decided `|d|` exceeds the bound, twice the rounding error, so the lattice
+// `|D| >` half the bound `≥ CONVERSION/2 · limit · Σ = 128·Σ` at `limit = 2^59`: the snapping
+// cannot reach zero. So only the filter's undecided edges need the exact inputs.
+// (Checked at compile time: a constant only a `const _` reads counts as unused on Rust 1.88.)
+const _: () = assert!(ORIENT2D_FILTER_CONVERSION * 0.5 * ((1_u64 << 59) as f64) >= 3.0);
 
 /// The atan2 numerator's sign `−sign((a−q)×(b−q))_z` for a query whose ray cannot meet the mesh
 /// (outside the padded box across the ray): `q` is farther than the mesh's extent from every
