@@ -165,8 +165,9 @@ impl BoundaryEdges {
     /// lattice points are `a[i]`, `b[i]`): kept when some endpoint is off the lattice. Every sign
     /// the loops cannot take from their `f64` filter is then decided on these (the filter's own
     /// decisions are already exact for them: see the snapping argument after
-    /// `ORIENT2D_FILTER_RELATIVE` in `predicates.rs`), and an edge is left out as parallel to the ray only when its input endpoints are (a snapped
-    /// edge can be vertical on the lattice and tilted in the input).
+    /// `ORIENT2D_FILTER_RELATIVE` in `predicates.rs`), and an edge is left out as parallel to the
+    /// ray only when its input endpoints are (a snapped edge can be vertical on the lattice and
+    /// tilted in the input).
     pub fn with_inputs(
         a: Vec<[i64; 3]>,
         b: Vec<[i64; 3]>,
