@@ -113,6 +113,32 @@ pub fn integrand_with_rounding(
     (f, noise)
 }
 
+/// The box of a curve's Euclidean control points (the curve lies in it: convex-hull property).
+pub fn control_box(ctrl: &[Homogeneous]) -> ([f64; 3], [f64; 3]) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for h in ctrl {
+        for a in 0..3 {
+            let x = h[a] / h[3];
+            lo[a] = lo[a].min(x);
+            hi[a] = hi[a].max(x);
+        }
+    }
+    (lo, hi)
+}
+
+/// Distance from the origin (the query, in query-centred coordinates) to [`control_box`]: a
+/// lower bound on the curve's distance.
+pub fn distance_to_control_box(ctrl: &[Homogeneous]) -> f64 {
+    let (lo, hi) = control_box(ctrl);
+    let mut d2 = 0.0;
+    for a in 0..3 {
+        let gap = lo[a].max(-hi[a]).max(0.0);
+        d2 += gap * gap;
+    }
+    d2.sqrt()
+}
+
 /// Splits a curve at `t = 1/2` (de Casteljau). The two halves share the middle point bit for bit.
 pub fn split_half(ctrl: &[Homogeneous]) -> (Vec<Homogeneous>, Vec<Homogeneous>) {
     let d = ctrl.len() - 1;

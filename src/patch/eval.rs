@@ -1045,15 +1045,7 @@ fn split_columns(net: &Net) -> (Net, Net) {
 /// Distance from the origin (the query) to the box of a curve's Euclidean control points (a
 /// lower bound on the curve's distance, by the convex-hull property), and the box's diagonal.
 fn distance_and_size(ctrl: &[Homogeneous]) -> (f64, f64) {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for h in ctrl {
-        for a in 0..3 {
-            let x = h[a] / h[3];
-            lo[a] = lo[a].min(x);
-            hi[a] = hi[a].max(x);
-        }
-    }
+    let (lo, hi) = super::curve::control_box(ctrl);
     let mut d2 = 0.0;
     let mut s2 = 0.0;
     for a in 0..3 {

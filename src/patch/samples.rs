@@ -180,7 +180,7 @@ impl CurveSamples {
         for l in 0..=CACHE_LEVELS {
             let n = 1u64 << l;
             for (k, piece) in pieces.iter().enumerate() {
-                boxes.push(control_box(piece));
+                boxes.push(super::curve::control_box(piece));
                 let (a, b) = (k as f64 / n as f64, (k + 1) as f64 / n as f64);
                 samples.push(IntervalSamples::at_nodes(
                     &centred,
@@ -319,20 +319,6 @@ impl CurveSamples {
         let s = IntervalSamples::at_nodes(&self.centred, c, h);
         interval_sums(&s, form, delta, en, edn, h)
     }
-}
-
-/// The control box of a curve's Euclidean points.
-fn control_box(ctrl: &[Homogeneous]) -> ([f64; 3], [f64; 3]) {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for h in ctrl {
-        for a in 0..3 {
-            let x = h[a] / h[3];
-            lo[a] = lo[a].min(x);
-            hi[a] = hi[a].max(x);
-        }
-    }
-    (lo, hi)
 }
 
 /// [`super::curve::integrand_with_rounding`] at the 15 nodes of `s` shifted by `−N_w δ`, in one

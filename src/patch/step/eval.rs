@@ -414,7 +414,9 @@ impl StepWindingNumber {
             let samples = piece
                 .curve
                 .map(|i| &self.boundary_samples[i])
-                .filter(|samples| samples.usable_at(distance_to_box(c)));
+                .filter(|samples| {
+                    samples.usable_at(super::super::curve::distance_to_control_box(c))
+                });
             if let Some(samples) = samples {
                 let delta = samples.offset(q);
                 let rounding = samples.rounding_rotated(delta);
@@ -977,22 +979,6 @@ struct BoundaryPiece {
     level: u32,
     index: u64,
     ctrl: Vec<Homogeneous>,
-}
-
-/// Distance from the origin (the query) to the box of a curve's Euclidean control points.
-fn distance_to_box(ctrl: &[Homogeneous]) -> f64 {
-    let mut d2 = 0.0;
-    for a in 0..3 {
-        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-        for h in ctrl {
-            let x = h[a] / h[3];
-            lo = lo.min(x);
-            hi = hi.max(x);
-        }
-        let gap = lo.max(-hi).max(0.0);
-        d2 += gap * gap;
-    }
-    d2.sqrt()
 }
 
 /// A hit of a grid column's line ([`StepWindingNumber::evaluate_column`]).
