@@ -252,7 +252,7 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
         })
     });
     progress(RemeshPhase::Classify);
-    let classified = octree::classify(evaluator, &lattice, max_points)
+    let classified = octree::classify(evaluator, &lattice, guide, max_points)
         .ok_or(RemeshError::OutOfMemory { max_points })?;
     progress(RemeshPhase::Extract);
     let band = extract::extract(&lattice, &classified);
