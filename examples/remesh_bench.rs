@@ -56,12 +56,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let bounds = mesh.bounding_box().ok_or("empty mesh")?;
         for &r in &res {
             let lattice = Lattice::new(bounds, r).ok_or("bad bounds")?;
+            // As in `remesh_guided`: the guide also refines the cells its triangles meet (its
+            // build is timed with classification).
             let t0 = Instant::now();
-            let classified = octree::classify(&wn, &lattice, usize::MAX).ok_or("too large")?;
+            let guide = crossings::SegmentBvh::of_mesh(&mesh);
+            let classified = octree::classify(
+                &wn,
+                &lattice,
+                if guided { Some(&guide) } else { None },
+                usize::MAX,
+            )
+            .ok_or("too large")?;
             let t1 = Instant::now();
             let band = extract::extract(&lattice, &classified);
             let t2 = Instant::now();
-            let guide = crossings::SegmentBvh::of_mesh(&mesh);
             let placed = place::place_vertices(
                 &wn,
                 &lattice,

@@ -233,6 +233,60 @@ fn disjoint_cubes_stay_two_solids() {
     assert_eq!((r.euler_characteristic, r.components), (4, 2), "{r}");
 }
 
+/// A plate 2.5 finest cells thick between two coarse lattice planes (res 256: a coarse cell is 4
+/// finest cells), so no coarse corner is inside it: corner differences alone never find it; the
+/// cells its triangles meet are refined and it is kept, closed and with its volume.
+#[test]
+fn plate_thinner_than_a_coarse_cell_is_kept() {
+    use gwn::products::remesh::lattice::Lattice;
+    let bounds = gwn::BoundingBox {
+        min: [0.0; 3],
+        max: [1.0; 3],
+    };
+    let res = 256;
+    let lattice = Lattice::new(bounds, res).unwrap();
+    assert_eq!(lattice.levels, 2);
+    let h = lattice.h;
+    let coarse = 4.0 * h;
+    // Coarse planes sit at origin + k·coarse on every axis; the plate spans (0.75 h, 3.25 h)
+    // past one of them in z, and starts and ends off the lattice in x and y.
+    let o = lattice.origin;
+    let lo = [
+        o[0] + 30.0 * coarse + 0.3 * h,
+        o[1] + 31.0 * coarse + 0.6 * h,
+        o[2] + 33.0 * coarse + 0.75 * h,
+    ];
+    let size = [0.12, 0.1, 2.5 * h];
+    let cube = common::unit_cube();
+    let positions: Vec<[f64; 3]> = cube
+        .positions()
+        .iter()
+        .map(|p| std::array::from_fn(|a| lo[a] + p[a] * size[a]))
+        .collect();
+    let plate = Mesh::new(positions, cube.triangles().to_vec()).unwrap();
+    let wn = WindingNumber::new(&plate).unwrap();
+    let options = RemeshOptions::with_resolution(res);
+    // Without the triangles, only corner differences refine: nothing is found.
+    let blind = remesh(&wn, bounds, &options).unwrap();
+    assert!(blind.triangles.is_empty(), "{:?}", blind.stats);
+    let guide = SegmentBvh::of_mesh(&plate);
+    let out = remesh_guided(&wn, Some(&guide), bounds, &options, &|_| {}).unwrap();
+    let r = TopologyReport::of(&out.positions, &out.triangles);
+    assert_closed_manifold(&r);
+    assert_eq!((r.euler_characteristic, r.components), (2, 1), "{r}");
+    assert_no_self_intersections(&out);
+    let vol = signed_volume(&out, |_| true);
+    let want = size[0] * size[1] * size[2];
+    assert!((vol / want - 1.0).abs() < 0.1, "volume {vol}, plate {want}");
+    // Refinement follows the plate, not the whole box.
+    let lattice_points: usize = out.stats.lattice_cells.iter().map(|n| n + 1).product();
+    assert!(
+        out.stats.classified_points * 10 < lattice_points,
+        "{:?}",
+        out.stats
+    );
+}
+
 #[test]
 fn double_walls_and_inner_faces_vanish() {
     // Two cubes sharing the face x = 1: the double wall is inside the union (w = 1 on both sides).

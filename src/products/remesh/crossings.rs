@@ -1,5 +1,7 @@
 //! Where a short segment (a lattice edge of the band) crosses the input triangles: a binary BVH
-//! over the triangles' boxes and a floating-point segment–triangle test.
+//! over the triangles' boxes and a floating-point segment–triangle test. The same hierarchy
+//! answers whether any triangle meets an octree cell ([`SegmentBvh::meets_box`]), which decides
+//! where [`super::octree`] refines beyond the cells whose corners differ.
 //!
 //! This only *proposes* where an output vertex goes. [`super::place`] accepts a proposal only
 //! after two evaluations of `w` on either side of it confirm a class change, so a rounding error
@@ -93,6 +95,91 @@ impl SegmentBvh {
             }
         }
     }
+}
+
+impl SegmentBvh {
+    /// Whether some triangle may meet the closed box `lo..=hi`, conservatively: `true` whenever
+    /// one does (a separating-axis test on a box grown by `pad` on every side, which absorbs the
+    /// rounding of the projections), and possibly for a triangle that only passes within about
+    /// `pad` of it. Only refinement depends on the answer, never a label, so a spurious `true`
+    /// costs time and a `false` must never be wrong.
+    pub fn meets_box(&self, lo: [f64; 3], hi: [f64; 3], pad: f64) -> bool {
+        if self.nodes.is_empty() {
+            return false;
+        }
+        let (blo, bhi) = (
+            [0, 1, 2].map(|a| lo[a] - pad),
+            [0, 1, 2].map(|a| hi[a] + pad),
+        );
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let node = self.nodes[stack[top] as usize];
+            if (0..3).any(|a| node.lo[a] > bhi[a] || node.hi[a] < blo[a]) {
+                continue;
+            }
+            if node.count > 0 {
+                let first = node.first as usize;
+                let tris = &self.triangles[first..first + node.count as usize];
+                if tris.iter().any(|t| triangle_meets_box(t, blo, bhi)) {
+                    return true;
+                }
+            } else if top + 2 <= stack.len() {
+                stack[top] = node.first;
+                stack[top + 1] = node.second;
+                top += 2;
+            }
+        }
+        false
+    }
+}
+
+/// The separating-axis test of a triangle against a box (Akenine-Möller): the box's 3 axes, the
+/// triangle's normal and the 9 cross products of their edges. A degenerate axis (a zero cross
+/// product) projects everything to 0 and separates nothing, so degenerate triangles fall back to
+/// the remaining axes: the test errs towards `true`.
+fn triangle_meets_box(tri: &[[f64; 3]; 3], lo: [f64; 3], hi: [f64; 3]) -> bool {
+    let c = [0, 1, 2].map(|a| 0.5 * (lo[a] + hi[a]));
+    let e = [0, 1, 2].map(|a| 0.5 * (hi[a] - lo[a]));
+    let v = tri.map(|p| [p[0] - c[0], p[1] - c[1], p[2] - c[2]]);
+    for a in 0..3 {
+        let (mn, mx) = (
+            v[0][a].min(v[1][a]).min(v[2][a]),
+            v[0][a].max(v[1][a]).max(v[2][a]),
+        );
+        if mn > e[a] || mx < -e[a] {
+            return false;
+        }
+    }
+    let sub = |x: [f64; 3], y: [f64; 3]| [x[0] - y[0], x[1] - y[1], x[2] - y[2]];
+    let cross = |x: [f64; 3], y: [f64; 3]| {
+        [
+            x[1] * y[2] - x[2] * y[1],
+            x[2] * y[0] - x[0] * y[2],
+            x[0] * y[1] - x[1] * y[0],
+        ]
+    };
+    let separates = |axis: [f64; 3]| {
+        let r = e[0] * axis[0].abs() + e[1] * axis[1].abs() + e[2] * axis[2].abs();
+        let p = v.map(|q| q[0] * axis[0] + q[1] * axis[1] + q[2] * axis[2]);
+        let (mn, mx) = (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
+        mn > r || mx < -r
+    };
+    let edges = [sub(v[1], v[0]), sub(v[2], v[1]), sub(v[0], v[2])];
+    if separates(cross(edges[0], edges[1])) {
+        return false;
+    }
+    for f in edges {
+        for a in 0..3 {
+            let mut unit = [0.0; 3];
+            unit[a] = 1.0;
+            if separates(cross(unit, f)) {
+                return false;
+            }
+        }
+    }
+    true
 }
 
 /// Builds the subtree over `triangles` (whose first one is triangle `offset` of the whole
@@ -244,6 +331,65 @@ mod tests {
             want.sort_by(f64::total_cmp);
             assert_eq!(got, want);
         }
+    }
+
+    /// Against dense point sampling: a box that holds a sample of a triangle must be met; a box
+    /// more than the pad away from every triangle's box must not be.
+    #[test]
+    fn meets_box_is_conservative_and_culls_far_boxes() {
+        let mut state = 11u64;
+        let mut next = move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let tris: Vec<[[f64; 3]; 3]> = (0..40)
+            .map(|_| {
+                let c = [next(), next(), next()];
+                std::array::from_fn(|_| std::array::from_fn(|a| c[a] + 0.3 * (next() - 0.5)))
+            })
+            .collect();
+        let bvh = SegmentBvh::new(tris.clone());
+        let (mut met, mut missed) = (0, 0);
+        for _ in 0..400 {
+            let lo = [next(), next(), next()];
+            let s = 0.02 + 0.05 * next();
+            let hi = lo.map(|x| x + s);
+            let inside = |p: [f64; 3]| (0..3).all(|a| lo[a] <= p[a] && p[a] <= hi[a]);
+            let holds_sample = tris.iter().any(|t| {
+                (0..=20).any(|i| {
+                    (0..=20 - i).any(|j| {
+                        let (u, w) = (i as f64 / 20.0, j as f64 / 20.0);
+                        inside(std::array::from_fn(|a| {
+                            t[0][a] + u * (t[1][a] - t[0][a]) + w * (t[2][a] - t[0][a])
+                        }))
+                    })
+                })
+            });
+            let got = bvh.meets_box(lo, hi, 1e-9);
+            if holds_sample {
+                assert!(got, "a box holding a point of a triangle was culled");
+            }
+            let far = tris.iter().all(|t| {
+                (0..3).any(|a| {
+                    t.iter().all(|p| p[a] > hi[a] + 1e-6) || t.iter().all(|p| p[a] < lo[a] - 1e-6)
+                })
+            });
+            if far {
+                assert!(!got, "a box away from every triangle's box was met");
+            }
+            if got { met += 1 } else { missed += 1 }
+        }
+        // Both answers occur, so the assertions above were exercised.
+        assert!(met > 20 && missed > 20, "{met} {missed}");
+        // A box just beside a tilted triangle's plane, inside its bounding box: only the normal
+        // axis separates them.
+        let t = [[0.0, 0.0, 0.0], [1.0, 0.0, 1.0], [0.0, 1.0, 1.0]];
+        let one = SegmentBvh::new([t]);
+        assert!(!one.meets_box([0.6, 0.6, 0.0], [0.7, 0.7, 0.1], 1e-9));
+        assert!(one.meets_box([0.2, 0.2, 0.3], [0.3, 0.3, 0.5], 1e-9));
+        assert!(!SegmentBvh::default().meets_box([0.0; 3], [1.0; 3], 1.0));
     }
 
     #[test]

@@ -7,7 +7,8 @@
 //!    coarse cell of margin whose outermost corners are *declared* outside (so the output is
 //!    closed even when `w > ½` reaches the box).
 //! 2. [`octree`]: corners of a coarse level are classified with [`crate::grid::evaluate`] (ray
-//!    reuse along columns); cells whose corner classes differ are split down to the finest level,
+//!    reuse along columns); cells whose corner classes differ, or that an input triangle meets
+//!    (with [`remesh_guided`]), are split down to the finest level,
 //!    and the refinement is closed under neighbours (a cell is split whenever any classified
 //!    lattice point on its closed box disagrees with it), which makes the labelling of the whole
 //!    finest lattice well defined. Memory grows with the surface, not with `res³`.
@@ -188,8 +189,9 @@ pub struct Remeshed {
 /// `longest extent of bounds / options.resolution`.
 ///
 /// Output guarantees, whatever the evaluator returns: closed, edge- and vertex-manifold,
-/// consistently oriented (outward from `w > ½`). A part of the solid thinner than a coarse cell
-/// whose coarse corners all miss it is not found (see `docs/remesh.md`).
+/// consistently oriented (outward from `w > ½`). Without the input triangles (this function;
+/// see [`remesh_guided`]), a part of the solid thinner than a coarse cell whose coarse corners all
+/// miss it is not found (see `docs/remesh.md`).
 pub fn remesh<E: Evaluator + ?Sized>(
     evaluator: &E,
     bounds: BoundingBox,
@@ -224,8 +226,12 @@ impl RemeshPhase {
 /// [`remesh`], with the input triangles (`guide`) proposing where each vertex goes: a lattice
 /// edge that crosses them once gets its vertex at the crossing after two evaluations of `w`
 /// confirm the class change there, instead of `bisection_steps` evaluations (see
-/// [`place`]). The output's guarantees and the vertex precision are those of [`remesh`]
-/// whatever `guide` holds; a guide that is not the evaluator's surface only costs time.
+/// [`place`]). Every octree cell that a triangle of `guide` meets is also refined to the finest
+/// level: when `w` jumps only across the guide's triangles (a closed input as its own guide),
+/// every finest lattice point is labelled by its true class, so no part of the solid holding a
+/// finest lattice point is lost. The output's guarantees and the vertex precision are those of
+/// [`remesh`] whatever `guide` holds; a guide that is not the evaluator's surface only costs
+/// time.
 /// `progress` hears of each [`RemeshPhase`] as it begins.
 pub fn remesh_guided<E: Evaluator + ?Sized>(
     evaluator: &E,
@@ -252,7 +258,7 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
         })
     });
     progress(RemeshPhase::Classify);
-    let classified = octree::classify(evaluator, &lattice, max_points)
+    let classified = octree::classify(evaluator, &lattice, guide, max_points)
         .ok_or(RemeshError::OutOfMemory { max_points })?;
     progress(RemeshPhase::Extract);
     let band = extract::extract(&lattice, &classified);

@@ -13,9 +13,21 @@
 //! child whose closed box holds classified points of two classes, and (3) every leaf whose
 //! closed box holds a newly classified point of the other class. Each round classifies the new
 //! corners of all cells split in it with one parallel batch.
+//!
+//! # Refining where the input triangles are
+//! With the input triangles at hand (`guide`), (1) and (2) also split every coarse cell and
+//! every new child that a triangle meets ([`SegmentBvh::meets_box`], conservative), down to the
+//! finest level. Splitting more cells keeps the invariant: rules (2) and (3) apply to them as to
+//! any other. It finds what corner differences cannot: where `w` jumps only across the triangles
+//! (a closed, consistently oriented input), a leaf above the finest level meets no triangle, so
+//! `w` is constant on its closed box and the class it lends to its unclassified points is
+//! right. Every finest lattice point is then labelled by its true class, and a part of the
+//! solid that holds a finest lattice point is in the output, however far it is from any coarse
+//! corner (a plate thinner than a coarse cell, say).
 
 use rayon::prelude::*;
 
+use super::crossings::SegmentBvh;
 use super::lattice::{Corner, KeyMap, KeySet, Lattice, pack};
 use crate::eval::Evaluator;
 use crate::grid::{GridSpec, evaluate};
@@ -91,11 +103,29 @@ pub fn offset(m: Corner, b: usize, size: u32) -> Corner {
     [0, 1, 2].map(|a| m[a] + if b >> a & 1 == 1 { size } else { 0 })
 }
 
+/// Whether a triangle of `guide` meets the closed box of the cell `(level, m)`.
+fn touched(guide: Option<&SegmentBvh>, lattice: &Lattice, level: u32, m: Corner) -> bool {
+    let Some(guide) = guide else {
+        return false;
+    };
+    let size = 1u32 << level;
+    let lo = lattice.corner_position(m);
+    let hi = lattice.corner_position(m.map(|x| x + size));
+    // The pad only has to outgrow the rounding of the test (relative 1e-16 of coordinates at
+    // most MAX_RESOLUTION cells from the box); a millionth of a cell does, and a triangle that
+    // close to the box costs one needless split at worst.
+    let scale = (0..3).fold(0.0f64, |s, a| s.max(lo[a].abs()).max(hi[a].abs()));
+    let pad = 1e-6 * lattice.h + 1e-12 * scale;
+    guide.meets_box(lo, hi, pad)
+}
+
 /// Classifies the lattice (see the [module documentation](self)); `None` as soon as more than
-/// `max_points` lattice points would be classified.
+/// `max_points` lattice points would be classified. `guide`: the input triangles, whose cells
+/// are refined to the finest level too.
 pub fn classify<E: Evaluator + ?Sized>(
     evaluator: &E,
     lattice: &Lattice,
+    guide: Option<&SegmentBvh>,
     max_points: usize,
 ) -> Option<Classified> {
     let mut out = Classified::default();
@@ -141,8 +171,21 @@ pub fn classify<E: Evaluator + ?Sized>(
         out.band = coarse_mixed;
         return Some(out);
     }
-    let mut queue: Vec<Cell> = coarse_mixed.iter().map(|&m| (levels, pack(m))).collect();
-    let mut queued_min: KeyMap<Corner> = coarse_mixed.iter().map(|&m| (pack(m), m)).collect();
+    // Coarse cells that a triangle meets, whatever their corners say.
+    let coarse_touched: Vec<Corner> = if guide.is_some() {
+        let all: Vec<Corner> = (0..cc[2])
+            .flat_map(|k| (0..cc[1]).flat_map(move |j| (0..cc[0]).map(move |i| [i, j, k])))
+            .map(|c| c.map(|x| x as u32 * coarse))
+            .collect();
+        all.into_par_iter()
+            .filter(|&m| touched(guide, lattice, levels, m))
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let first = coarse_mixed.iter().chain(&coarse_touched);
+    let mut queue: Vec<Cell> = first.clone().map(|&m| (levels, pack(m))).collect();
+    let mut queued_min: KeyMap<Corner> = first.map(|&m| (pack(m), m)).collect();
     while !queue.is_empty() {
         queue.sort_unstable();
         queue.dedup();
@@ -185,20 +228,21 @@ pub fn classify<E: Evaluator + ?Sized>(
         for (p, w) in interior.iter().zip(values) {
             out.labels.insert(pack(*p), w > 0.5);
         }
-        let mut next: Vec<(u32, Corner)> = Vec::new();
-        // (2) new children whose closed box is mixed.
-        for &(level, m) in &cells {
-            if level - 1 == 0 {
-                continue;
-            }
-            let half = 1u32 << (level - 1);
-            for b in 0..8 {
-                let child = offset(m, b, half);
-                if out.closed_box_mixed(level - 1, child) {
-                    next.push((level - 1, child));
-                }
-            }
-        }
+        // (2) new children whose closed box is mixed or that a triangle meets.
+        let mut next: Vec<(u32, Corner)> = cells
+            .par_iter()
+            .filter(|&&(level, _)| level > 1)
+            .flat_map_iter(|&(level, m)| {
+                let half = 1u32 << (level - 1);
+                let out = &out;
+                (0..8).filter_map(move |b| {
+                    let child = offset(m, b, half);
+                    (out.closed_box_mixed(level - 1, child)
+                        || touched(guide, lattice, level - 1, child))
+                    .then_some((level - 1, child))
+                })
+            })
+            .collect();
         // (3) leaves around each new point that it contradicts.
         for &p in &new_points {
             let lp = out.label(p);
