@@ -1,9 +1,10 @@
 //! The Barnes–Hut engine shared by triangle soups and point clouds: per-node moments built
 //! bottom-up by re-centring, and the traversal of Barill et al.'s Algorithm 1.
 
-use wide::{CmpGt, CmpLt, f32x4, f32x8};
+use wide::{CmpGt, CmpLt, f32x4};
 
 use super::moments::{FarField, Moments};
+use super::packet::{Lanes8, PACKET};
 use super::tree::Tree;
 
 /// Which node size the admissibility test `‖q − p̃‖ > β · size` uses.
@@ -70,18 +71,17 @@ impl FastParams {
     }
 }
 
-/// Lanes per node of the query tree. A query visits two nodes at a time (eight `f32` lanes, one
-/// AVX register), so the tree keeps the granularity of four lanes (a wider node would replace a
-/// far inner node that a query admits whole by its 2–4 children: on the shared meshes 8-wide
-/// nodes cost 47 % more expansions per query) while every visit fills eight lanes.
+/// Lanes per node of the query tree. A wider node would replace a far inner node that a query
+/// admits whole by its 2–4 children: on the shared meshes 8-wide nodes cost 47 % more
+/// expansions per query.
 const WIDTH: usize = 4;
 /// Marks a lane of a [`WideNode`] that refers to a leaf (its number in [`Hierarchy::leaves`]).
 const LEAF: u32 = 1 << 31;
 /// Marks an unused lane (always at the end of a node).
 const EMPTY: u32 = u32::MAX;
-/// Upper bound of the query stack: a visit pops two nodes and pushes at most `2·WIDTH`, and every
+/// Upper bound of the query stack: a visit pops one node and pushes at most `WIDTH`, and every
 /// level of the query tree is at least one level of the binary tree (depth ≤ 34).
-const WIDE_STACK: usize = 2 * WIDTH * 35 + 2 * WIDTH;
+const WIDE_STACK: usize = WIDTH * 35 + WIDTH;
 
 /// A node of the query tree: up to four nodes of the binary tree, one per lane, collapsed from
 /// the levels below one binary node (the node's *anchor*), so that one pass over the lanes
@@ -114,8 +114,7 @@ pub(crate) struct Hierarchy {
     pub moments: Vec<Moments>,
     /// Element ranges of the leaves of `tree`, in element order (`order[range]`).
     pub leaves: Vec<std::ops::Range<usize>>,
-    /// The query tree; node 0 holds the root of `tree` in its first lane, and the last node is
-    /// a padding node (no lanes) that a visit pairs with the last node on the stack.
+    /// The query tree; node 0 holds the root of `tree` in its first lane.
     wide: Vec<WideNode>,
     /// Per query-tree node, the lanes' admissibility sizes, one vector per [`Admissibility`]
     /// (`as usize`): a query reads only the one it uses.
@@ -280,8 +279,6 @@ impl Hierarchy {
             let id = push(m[b].center, &lanes, &mut work);
             links.push((parent, lane, id as u32));
         }
-        // The padding node: NaN offsets (admits nothing), zero coefficients, no children.
-        push([0.0; 3], &[], &mut work);
         for (parent, lane, id) in links {
             wide[parent].child[lane] = id;
         }
@@ -291,27 +288,21 @@ impl Hierarchy {
         self.wide_binary = wide_binary;
     }
 
-    /// `anchor − q` of query-tree node `id`, rounded to `f32`, in four lanes.
+    /// `r = p̃ − q` of the four lanes of query-tree node `id`: `offset + (anchor − q)`, with
+    /// `anchor − q` rounded once to `f32`.
     #[inline(always)]
-    fn anchor_offset(&self, id: usize, q: [f64; 3]) -> [f32x4; 3] {
-        let a = self.wide[id].anchor;
-        [
-            f32x4::splat((a[0] - q[0]) as f32),
-            f32x4::splat((a[1] - q[1]) as f32),
-            f32x4::splat((a[2] - q[2]) as f32),
-        ]
+    fn lane_offsets(&self, id: usize, q: [f64; 3]) -> [f32x4; 3] {
+        let node = &self.wide[id];
+        std::array::from_fn(|k| node.offset[k] + f32x4::splat((node.anchor[k] - q[k]) as f32))
     }
 
-    /// The lanes of query-tree node `id` whose expansion is admissible at `q` (bit `l` for lane
-    /// `l`): `‖r‖ > β·size` with `r = p̃ − q`, in `f32`. The gradient uses this function; the
-    /// value does the same operations on two nodes at once ([`Hierarchy::eval_lanes`]), so both
-    /// expand the same nodes. `β·size < 0` (β ≤ 0) admits every lane not at `q`; NaN (unused
-    /// lanes, NaN β) admits none.
+    /// The lanes of query-tree node `id` whose expansion is admissible (bit `l` for lane `l`):
+    /// `‖r‖ > β·size`, in `f32`, with `r` from [`Hierarchy::lane_offsets`]. `β·size < 0`
+    /// (β ≤ 0) admits every lane not at `q`; NaN (unused lanes, NaN β) admits none. The value,
+    /// the gradient and the packets all decide with these operations, so they expand the same
+    /// nodes.
     #[inline(always)]
-    fn admit(&self, id: usize, q: [f64; 3], beta: f32, which: usize) -> u32 {
-        let node = &self.wide[id];
-        let dq = self.anchor_offset(id, q);
-        let r = [0, 1, 2].map(|k| node.offset[k] + dq[k]);
+    fn admit(&self, id: usize, r: &[f32x4; 3], beta: f32, which: usize) -> u32 {
         let d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
         let bs = f32x4::splat(beta) * self.wide_size[which][id];
         let zero = f32x4::ZERO;
@@ -319,11 +310,10 @@ impl Hierarchy {
         admit.move_mask() as u32
     }
 
-    /// FASTWN(q) (Algorithm 1), iteratively over the 4-wide query tree, two nodes per visit:
-    /// the lanes far enough from `q` contribute their expansions (all eight evaluated at once,
-    /// the others masked out), a near leaf calls `leaf(number, range, sum)` to add its elements'
-    /// exact contributions (`range` indexes the elements in leaf order), a near inner node is
-    /// pushed.
+    /// FASTWN(q) (Algorithm 1), iteratively over the 4-wide query tree: the lanes far enough
+    /// from `q` contribute their expansions (all four evaluated at once, the others masked
+    /// out), a near leaf calls `leaf(number, range, sum)` to add its elements' exact
+    /// contributions (`range` indexes the elements in leaf order), a near inner node is pushed.
     ///
     /// Runs the AVX2 instantiation of the traversal when the CPU has AVX2 (checked at run time,
     /// as the exact loops do) and the portable one otherwise; both do the same IEEE operations
@@ -357,7 +347,8 @@ impl Hierarchy {
     }
 
     /// The traversal of [`Hierarchy::eval`], inlined into each instantiation. The expansions
-    /// are summed per lane in `f64` in traversal order (deterministic), then across the lanes.
+    /// are summed in `f64`, one sum per lane position in traversal order, then the four sums;
+    /// [`Hierarchy::eval_packet_lanes`] sums in exactly this order.
     #[inline(always)]
     pub(crate) fn eval_lanes(
         &self,
@@ -368,45 +359,30 @@ impl Hierarchy {
         if self.wide.is_empty() {
             return 0.0;
         }
-        #[inline(always)]
-        fn cat(a: f32x4, b: f32x4) -> f32x8 {
-            let (a, b) = (a.to_array(), b.to_array());
-            f32x8::from([a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]])
-        }
-        let pad = self.wide.len() - 1;
-        let beta = f32x8::splat(params.beta as f32);
+        let beta = params.beta as f32;
         let order = params.order;
         let which = params.admissibility as usize;
-        let zero = f32x8::ZERO;
-        let mut far = [0.0f64; 2 * WIDTH];
+        let mut far = [0.0f64; WIDTH];
         let mut sum = 0.0;
         let mut stack = [0u32; WIDE_STACK];
         let mut top = 0usize;
-        let (mut a, mut b) = (0usize, pad);
+        let mut id = 0usize;
         loop {
-            let (na, nb) = (&self.wide[a], &self.wide[b]);
-            let (da, db) = (self.anchor_offset(a, q), self.anchor_offset(b, q));
-            let r = [0, 1, 2].map(|k| cat(na.offset[k] + da[k], nb.offset[k] + db[k]));
-            let d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-            let bs = beta * cat(self.wide_size[which][a], self.wide_size[which][b]);
-            let admit = d2.cmp_gt(zero) & (bs.cmp_lt(zero) | d2.cmp_gt(bs * bs));
-            let mask = admit.move_mask() as u32;
+            let r = self.lane_offsets(id, q);
+            let mask = self.admit(id, &r, beta, which);
             if mask != 0 {
-                let w = self.wide_far[a]
-                    .pair(&self.wide_far[b])
-                    .eval(r, order)
-                    .to_array();
-                for (l, (sum, &w)) in far.iter_mut().zip(&w).enumerate() {
-                    *sum += if mask & (1 << l) != 0 {
-                        f64::from(w)
-                    } else {
-                        0.0
-                    };
+                let w = self.wide_far[id].eval(r, order).to_array();
+                for l in 0..WIDTH {
+                    if mask & (1 << l) != 0 {
+                        far[l] += f64::from(w[l]);
+                    }
                 }
             }
-            let children = na.child.iter().chain(nb.child.iter());
-            for (l, &c) in children.enumerate() {
-                if c == EMPTY || mask & (1 << l) != 0 {
+            for (l, &c) in self.wide[id].child.iter().enumerate() {
+                if c == EMPTY {
+                    break;
+                }
+                if mask & (1 << l) != 0 {
                     continue;
                 }
                 if c & LEAF != 0 {
@@ -417,19 +393,130 @@ impl Hierarchy {
                     top += 1;
                 }
             }
-            match top {
-                0 => break,
-                1 => {
-                    (a, b) = (stack[0] as usize, pad);
-                    top = 0;
+            if top == 0 {
+                break;
+            }
+            top -= 1;
+            id = stack[top] as usize;
+        }
+        sum + (far[0] + far[1] + far[2] + far[3])
+    }
+
+    /// [`Hierarchy::eval`] for a packet of neighbouring queries (bit `i` of `active` set for
+    /// the queries to evaluate), walking the tree once for all of them: per node and lane, the
+    /// admissibility of every query at once, and the lane's expansion evaluated for every query
+    /// that admits it in one pass (the queries in the lanes of [`Lanes8`]). `leaf(query,
+    /// number, range, sum)` adds a near leaf's exact terms for one query. Each query gets
+    /// exactly the value [`Hierarchy::eval`] gives it (module `packet`); inactive queries get 0.
+    #[inline]
+    pub fn eval_packet(
+        &self,
+        q: &[[f64; 3]; PACKET],
+        active: u32,
+        params: &FastParams,
+        leaf: impl FnMut(usize, usize, std::ops::Range<usize>, &mut f64),
+    ) -> [f64; PACKET] {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: as in `eval`: compiled for AVX2, and the CPU was just checked to have it.
+            #[allow(unsafe_code)]
+            return unsafe { self.eval_packet_avx2(q, active, params, leaf) };
+        }
+        self.eval_packet_lanes(q, active, params, leaf)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn eval_packet_avx2(
+        &self,
+        q: &[[f64; 3]; PACKET],
+        active: u32,
+        params: &FastParams,
+        leaf: impl FnMut(usize, usize, std::ops::Range<usize>, &mut f64),
+    ) -> [f64; PACKET] {
+        self.eval_packet_lanes(q, active, params, leaf)
+    }
+
+    /// The traversal of [`Hierarchy::eval_packet`]. Per query it makes the decisions of
+    /// [`Hierarchy::eval_lanes`] with the same `f32` operations (`r`, `d²`, `β·size` and the
+    /// comparisons of [`Hierarchy::admit`]) and adds the same terms to the same sums in the same
+    /// order.
+    #[inline(always)]
+    pub(crate) fn eval_packet_lanes(
+        &self,
+        q: &[[f64; 3]; PACKET],
+        active: u32,
+        params: &FastParams,
+        mut leaf: impl FnMut(usize, usize, std::ops::Range<usize>, &mut f64),
+    ) -> [f64; PACKET] {
+        let mut sum = [0.0f64; PACKET];
+        if self.wide.is_empty() || active == 0 {
+            return sum;
+        }
+        let beta = params.beta as f32;
+        let order = params.order;
+        let which = params.admissibility as usize;
+        let qk: [[f64; PACKET]; 3] = std::array::from_fn(|k| q.map(|p| p[k]));
+        let mut far = [[0.0f64; PACKET]; WIDTH];
+        let mut stack = [(0u32, 0u32); WIDE_STACK];
+        let mut top = 0usize;
+        let (mut id, mut mask) = (0usize, active);
+        loop {
+            let node = &self.wide[id];
+            let dq: [Lanes8; 3] = std::array::from_fn(|k| {
+                Lanes8::from_array(qk[k].map(|v| (node.anchor[k] - v) as f32))
+            });
+            let size = self.wide_size[which][id].as_array_ref();
+            for (l, &c) in node.child.iter().enumerate() {
+                if c == EMPTY {
+                    break;
                 }
-                _ => {
-                    (a, b) = (stack[top - 1] as usize, stack[top - 2] as usize);
-                    top -= 2;
+                let r: [Lanes8; 3] = std::array::from_fn(|k| {
+                    Lanes8::splat(node.offset[k].as_array_ref()[l]) + dq[k]
+                });
+                let d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+                let bs = beta * size[l];
+                let mut admitted = d2.admissible(bs);
+                admitted &= mask;
+                if admitted != 0 {
+                    let w = self.wide_far[id]
+                        .lane(l, Lanes8::splat)
+                        .eval(r, order)
+                        .to_array();
+                    // Adding 0.0 leaves a sum unchanged (a sum that starts at +0.0 is never
+                    // −0.0 in round-to-nearest), so this branch-free form adds exactly what
+                    // `eval_lanes` adds.
+                    for (i, (acc, &w)) in far[l].iter_mut().zip(&w).enumerate() {
+                        *acc += if admitted & (1 << i) != 0 {
+                            f64::from(w)
+                        } else {
+                            0.0
+                        };
+                    }
+                }
+                let rest = mask & !admitted;
+                if rest == 0 {
+                    continue;
+                }
+                if c & LEAF != 0 {
+                    let k = (c & !LEAF) as usize;
+                    for (i, sum) in sum.iter_mut().enumerate() {
+                        if rest & (1 << i) != 0 {
+                            leaf(i, k, self.leaves[k].clone(), sum);
+                        }
+                    }
+                } else {
+                    stack[top] = (c, rest);
+                    top += 1;
                 }
             }
+            if top == 0 {
+                break;
+            }
+            top -= 1;
+            (id, mask) = (stack[top].0 as usize, stack[top].1);
         }
-        sum + far.iter().sum::<f64>()
+        std::array::from_fn(|i| sum[i] + (far[0][i] + far[1][i] + far[2][i] + far[3][i]))
     }
 }
 
@@ -454,7 +541,7 @@ impl Hierarchy {
         let mut top = 0usize;
         let mut id = 0usize;
         loop {
-            let mask = self.admit(id, q, beta, which);
+            let mask = self.admit(id, &self.lane_offsets(id, q), beta, which);
             for (l, &c) in self.wide[id].child.iter().enumerate() {
                 if c == EMPTY {
                     break;

@@ -64,6 +64,7 @@ mod area;
 mod barnes_hut;
 mod cloud;
 mod moments;
+mod packet;
 mod soup;
 mod tree;
 

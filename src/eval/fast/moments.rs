@@ -23,7 +23,9 @@
 #![allow(clippy::needless_range_loop)]
 
 use crate::base::vec3::sub;
-use wide::{f32x4, f32x8};
+use wide::f32x4;
+
+use super::packet::Lanes8;
 
 use crate::base::vec3::{cross, dot};
 
@@ -314,9 +316,9 @@ impl Moments {
 /// whatever the mesh's units, so the `f32` lanes neither underflow (a mesh in metres of size
 /// 1e-2 has `M2 ≈ 1e-10`, and `M2/d⁷` runs into subnormals) nor overflow.
 ///
-/// `T` is `f64` (one node), `f32x4` (the four lanes of a node of the 4-wide query tree, as stored)
-/// or `f32x8` (two such nodes side by side, as evaluated): one
-/// generic formula serves both. `f32` halves the arithmetic and the memory of the far field; its
+/// `T` is `f64` (one node), `f32x4` (the four lanes of a node of the 4-wide query tree, as stored
+/// and as one query evaluates them) or [`Lanes8`] (one lane, splat, for the eight queries of a
+/// packet): one generic formula serves all three. `f32` halves the arithmetic and the memory of the far field; its
 /// rounding (~1e-7 relative per node) is four orders below the truncation error of the
 /// expansion (~1e-3), and the near field, which decides the β → ∞ limit, stays `f64`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -332,7 +334,11 @@ pub(crate) struct FarField<T = f64> {
     c: [T; 10],
 }
 
-/// The arithmetic [`FarField::eval`] needs, for `f64` and for eight `f32` lanes of it.
+/// The arithmetic [`FarField::eval`] needs: `f64` (the reference [`Moments::far_field`] is
+/// checked against), four `f32` lanes (one query, the four lanes of a query-tree node) and
+/// eight `f32` lanes (one lane of a node, eight queries of a packet). Every implementation
+/// rounds each operation lane by lane as IEEE `f32`, so a lane's value does not depend on
+/// the width it was computed in: a batch equals the same points evaluated one by one.
 pub(crate) trait Lanes:
     Copy + std::ops::Add<Output = Self> + std::ops::Mul<Output = Self>
 {
@@ -347,10 +353,17 @@ impl Lanes for f64 {
     }
 }
 
-impl Lanes for f32x8 {
+impl Lanes for f32x4 {
     #[inline(always)]
     fn rsqrt(self) -> Self {
-        f32x8::ONE / self.sqrt()
+        f32x4::ONE / self.sqrt()
+    }
+}
+
+impl Lanes for Lanes8 {
+    #[inline(always)]
+    fn rsqrt(self) -> Self {
+        Lanes8::splat(1.0) / self.sqrt()
     }
 }
 
@@ -444,24 +457,17 @@ impl FarField<f32x4> {
         }
     }
 
-    /// Two four-lane records side by side: `self` in lanes 0–3, `other` in lanes 4–7.
+    /// Lane `l` of the record, the same coefficients in every lane of `T`.
     #[inline(always)]
-    pub fn pair(&self, other: &Self) -> FarField<f32x8> {
-        #[inline(always)]
-        fn cat(a: f32x4, b: f32x4) -> f32x8 {
-            let (a, b) = (a.to_array(), b.to_array());
-            f32x8::from([a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]])
-        }
-        fn cat_n<const N: usize>(a: &[f32x4; N], b: &[f32x4; N]) -> [f32x8; N] {
-            std::array::from_fn(|i| cat(a[i], b[i]))
-        }
+    pub fn lane<T: Copy>(&self, l: usize, splat: impl Fn(f32) -> T) -> FarField<T> {
+        let get = |v: &f32x4| splat(v.as_array_ref()[l]);
         FarField {
-            inv_s: cat(self.inv_s, other.inv_s),
-            n: cat_n(&self.n, &other.n),
-            tr: cat(self.tr, other.tr),
-            q: cat_n(&self.q, &other.q),
-            v: cat_n(&self.v, &other.v),
-            c: cat_n(&self.c, &other.c),
+            inv_s: get(&self.inv_s),
+            n: self.n.each_ref().map(get),
+            tr: get(&self.tr),
+            q: self.q.each_ref().map(get),
+            v: self.v.each_ref().map(get),
+            c: self.c.each_ref().map(get),
         }
     }
 }
@@ -627,34 +633,39 @@ mod tests {
     }
 
     #[test]
-    fn eight_lanes_in_f32_equal_the_scalar_far_field() {
-        let centres = [
-            P,
-            [0.2, 0.5, -0.1],
-            [-1.0, 0.3, 0.2],
-            [0.0, 0.0, 0.0],
-            [0.7, -0.4, 0.9],
-            [-0.3, -0.8, 0.1],
-        ];
+    fn f32_lanes_equal_the_scalar_far_field_and_each_other_bit_for_bit() {
+        let centres = [P, [0.2, 0.5, -0.1], [-1.0, 0.3, 0.2], [0.7, -0.4, 0.9]];
         let nodes = centres.map(|c| Moments::of_triangle(A, B, C, P).recentred(c));
         let far = nodes.map(|m| FarField::new(&m));
-        let low = FarField::<f32x4>::lanes(&[&far[0], &far[1], &far[2], &far[3]]);
-        let high = FarField::<f32x4>::lanes(&[&far[4], &far[5]]);
-        let lanes = low.pair(&high);
-        let q = [3.0, -2.0, 1.5];
-        let r = nodes.map(|m| sub(m.center, q));
-        // Lanes 6 and 7 are missing (zero coefficients, `1/s = 0`: NaN, never admitted).
-        let rl = [0, 1, 2]
-            .map(|k| f32x8::from(std::array::from_fn::<f32, 8, _>(|l| r[l.min(5)][k] as f32)));
+        let lanes = FarField::<f32x4>::lanes(&[&far[0], &far[1], &far[2]]);
+        let queries: [[f64; 3]; 8] = std::array::from_fn(|i| {
+            let t = i as f64;
+            [3.0 - 0.7 * t, -2.0 + 0.3 * t * t, 1.5 + (0.9 * t).sin()]
+        });
         for order in 0..=2u8 {
-            let got = lanes.eval(rl, order).to_array();
-            for l in 0..6 {
-                let want = nodes[l].far_field(q, order);
-                assert!(
-                    (f64::from(got[l]) - want).abs() <= 1e-6 * want.abs().max(1e-3),
-                    "order {order}, lane {l}: {} vs {want}",
-                    got[l]
-                );
+            // One query, four lanes (lane 3 missing: zero coefficients, NaN, never admitted).
+            for q in queries {
+                let r = [0, 1, 2].map(|k| {
+                    f32x4::from(std::array::from_fn::<f32, 4, _>(|l| {
+                        (nodes[l].center[k] - q[k]) as f32
+                    }))
+                });
+                let got = lanes.eval(r, order).to_array();
+                for l in 0..3 {
+                    let want = nodes[l].far_field(q, order);
+                    assert!(
+                        (f64::from(got[l]) - want).abs() <= 1e-6 * want.abs().max(1e-3),
+                        "order {order}, lane {l}: {} vs {want}",
+                        got[l]
+                    );
+                    // The same lane for eight queries: the same f32 operations, lane by lane.
+                    let r8 = [0, 1, 2].map(|k| {
+                        Lanes8::from_array(queries.map(|p| (nodes[l].center[k] - p[k]) as f32))
+                    });
+                    let w8 = lanes.lane(l, Lanes8::splat).eval(r8, order).to_array();
+                    let i = queries.iter().position(|p| *p == q).expect("a query");
+                    assert_eq!(w8[i].to_bits(), got[l].to_bits(), "order {order}, lane {l}");
+                }
             }
         }
     }

@@ -1,0 +1,231 @@
+//! Batches evaluated in packets: the queries are sorted along a Morton curve and cut into
+//! packets of [`PACKET`] neighbours, and each packet walks the query tree once
+//! ([`Hierarchy::eval_packet`](super::barnes_hut::Hierarchy)), with one lane per query.
+//!
+//! Why: a single query pays, per node, for loading the node (anchor, offsets, sizes and about
+//! twenty far-field coefficients per lane), for the stack and for a branch per lane, and uses
+//! four `f32` lanes of which some are masked out. Neighbouring queries open nearly the same
+//! nodes, so a packet loads each node once for eight queries and evaluates one lane's expansion
+//! for all of them in one eight-lane pass (one AVX register in the AVX2 instantiation).
+//!
+//! Why the values do not change: each query keeps its own admissibility mask, so it expands and
+//! opens exactly the nodes it would alone; its far-field terms are the same `f32` operations
+//! lane by lane (see [`Lanes8`]); and they are added to the same accumulators in the same
+//! order, because the packet's depth-first walk, restricted to the entries holding one query,
+//! is that query's own walk (a stack restricted to a fixed subset of its entries is still a
+//! stack). So a batch equals the points evaluated one by one, bit for bit, whatever the packets,
+//! the sort or the number of threads (tested).
+
+use rayon::prelude::*;
+use wide::{CmpGt, CmpLt, f32x8};
+
+/// Queries per packet.
+pub(crate) const PACKET: usize = 8;
+
+/// Eight `f32` lanes, one per query of a packet (`wide::f32x8`: one AVX register where the
+/// build targets AVX, two SSE registers otherwise). Each operation is one IEEE `f32` operation
+/// per lane, as in `f32x4`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Lanes8(pub f32x8);
+
+impl Lanes8 {
+    #[inline(always)]
+    pub fn splat(v: f32) -> Self {
+        Lanes8(f32x8::splat(v))
+    }
+
+    #[inline(always)]
+    pub fn from_array(v: [f32; PACKET]) -> Self {
+        Lanes8(f32x8::from(v))
+    }
+
+    #[inline(always)]
+    pub fn to_array(self) -> [f32; PACKET] {
+        self.0.to_array()
+    }
+
+    #[inline(always)]
+    pub fn sqrt(self) -> Self {
+        Lanes8(self.0.sqrt())
+    }
+
+    /// Bit `i` set where lane `i` is `> 0` and (`bs < 0` or `> bs²`): the admissibility test.
+    #[inline(always)]
+    pub fn admissible(self, bs: f32) -> u32 {
+        let (zero, bs) = (f32x8::ZERO, f32x8::splat(bs));
+        let admit = self.0.cmp_gt(zero) & (bs.cmp_lt(zero) | self.0.cmp_gt(bs * bs));
+        admit.move_mask() as u32
+    }
+}
+
+macro_rules! lanes8_op {
+    ($trait:ident, $method:ident, $op:tt) => {
+        impl std::ops::$trait for Lanes8 {
+            type Output = Lanes8;
+            #[inline(always)]
+            fn $method(self, other: Lanes8) -> Lanes8 {
+                Lanes8(self.0 $op other.0)
+            }
+        }
+    };
+}
+lanes8_op!(Add, add, +);
+lanes8_op!(Sub, sub, -);
+lanes8_op!(Mul, mul, *);
+lanes8_op!(Div, div, /);
+
+/// Evaluates `points` packet by packet on rayon and returns the values in input order.
+///
+/// `eval_packet(points, active)` evaluates one packet: `active` has bit `i` set for the real
+/// queries (a last, short packet repeats its first point in the unused lanes).
+pub(crate) fn eval_in_packets(
+    points: &[[f64; 3]],
+    eval_packet: impl Fn(&[[f64; 3]; PACKET], u32) -> [f64; PACKET] + Sync,
+) -> Vec<f64> {
+    let order = morton_order(points);
+    let mut sorted = vec![0.0; points.len()];
+    sorted
+        .par_chunks_mut(PACKET)
+        .zip(order.par_chunks(PACKET))
+        .for_each(|(out, ids)| {
+            let packet: [[f64; 3]; PACKET] =
+                std::array::from_fn(|i| points[ids[i.min(ids.len() - 1)] as usize]);
+            let active = (1u32 << ids.len()) - 1;
+            let values = eval_packet(&packet, active);
+            out.copy_from_slice(&values[..ids.len()]);
+        });
+    let mut values = vec![0.0; points.len()];
+    for (&id, &v) in order.iter().zip(&sorted) {
+        values[id as usize] = v;
+    }
+    values
+}
+
+/// Bits per axis of the Morton code (three axes in a `u64`).
+const MORTON_BITS: u32 = 21;
+
+/// The point indices sorted by the Morton code of their position in the box of the finite
+/// points (non-finite points last), ties by index: deterministic.
+fn morton_order(points: &[[f64; 3]]) -> Vec<u32> {
+    assert!(
+        points.len() <= u32::MAX as usize,
+        "too many points for one batch"
+    );
+    let finite = |p: &[f64; 3]| p.iter().all(|c| c.is_finite());
+    let (lo, hi) = points
+        .par_iter()
+        .filter(|p| finite(p))
+        .fold(
+            || ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+            |(lo, hi), p| {
+                (
+                    std::array::from_fn(|k| lo[k].min(p[k])),
+                    std::array::from_fn(|k| hi[k].max(p[k])),
+                )
+            },
+        )
+        .reduce(
+            || ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+            |(a, b), (c, d)| {
+                (
+                    std::array::from_fn(|k| a[k].min(c[k])),
+                    std::array::from_fn(|k| b[k].max(d[k])),
+                )
+            },
+        );
+    let cells = f64::from(1u32 << MORTON_BITS);
+    // Per axis: cells per unit length (0 for a flat or empty axis; the extent may overflow to
+    // +∞ for points near ±f64::MAX, which gives 0 too, and only a worse order).
+    let scale: [f64; 3] = std::array::from_fn(|k| {
+        let s = cells / (hi[k] - lo[k]);
+        if s.is_finite() { s } else { 0.0 }
+    });
+    let mut keys: Vec<(u64, u32)> = points
+        .par_iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let code = if finite(p) {
+                let cell = |k: usize| {
+                    // `as` saturates, and NaN (0 · ∞ cannot occur: the scale is finite) maps to 0.
+                    (((p[k] - lo[k]) * scale[k]) as u64).min((1 << MORTON_BITS) - 1)
+                };
+                spread(cell(0)) | (spread(cell(1)) << 1) | (spread(cell(2)) << 2)
+            } else {
+                u64::MAX
+            };
+            (code, i as u32)
+        })
+        .collect();
+    keys.par_sort_unstable();
+    keys.into_iter().map(|(_, i)| i).collect()
+}
+
+/// The low 21 bits of `v`, two zero bits inserted after each.
+#[inline]
+fn spread(v: u64) -> u64 {
+    let mut x = v & 0x1f_ffff;
+    x = (x | (x << 32)) & 0x1f00000000ffff;
+    x = (x | (x << 16)) & 0x1f0000ff0000ff;
+    x = (x | (x << 8)) & 0x100f00f00f00f00f;
+    x = (x | (x << 4)) & 0x10c30c30c30c30c3;
+    x = (x | (x << 2)) & 0x1249249249249249;
+    x
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spread_interleaves_bits() {
+        for v in [0u64, 1, 2, 3, 0x1f_ffff, 0b1011] {
+            let s = spread(v);
+            for b in 0..MORTON_BITS {
+                assert_eq!((s >> (3 * b)) & 1, (v >> b) & 1, "v {v:#x} bit {b}");
+            }
+            assert_eq!(s & !0x1249249249249249, 0);
+        }
+    }
+
+    #[test]
+    fn packets_cover_every_point_once_in_input_order() {
+        let mut points: Vec<[f64; 3]> = (0..37)
+            .map(|i| {
+                let t = f64::from(i);
+                [(t * 0.7).sin(), (t * 1.3).cos(), t * 0.01]
+            })
+            .collect();
+        points[5] = [f64::NAN, 0.0, 0.0];
+        points[9] = [f64::INFINITY, 1.0, 0.0];
+        let seen = std::sync::Mutex::new(Vec::new());
+        let values = eval_in_packets(&points, |packet, active| {
+            assert!(active != 0 && active < (1 << PACKET));
+            seen.lock().unwrap().push(active.count_ones());
+            // The value of a point is its own x: any mix-up shows.
+            packet.map(|p| p[0])
+        });
+        for (p, v) in points.iter().zip(&values) {
+            assert!(p[0] == *v || (p[0].is_nan() && v.is_nan()));
+        }
+        let seen = seen.into_inner().unwrap();
+        assert_eq!(seen.iter().sum::<u32>(), 37);
+        assert_eq!(seen.len(), 37usize.div_ceil(PACKET));
+    }
+
+    #[test]
+    fn morton_order_groups_neighbours() {
+        // A 4×4×4 grid listed x-fastest: every aligned 2×2×2 block is one packet.
+        let points: Vec<[f64; 3]> = (0..64)
+            .map(|i| [f64::from(i % 4), f64::from(i / 4 % 4), f64::from(i / 16)])
+            .collect();
+        let order = morton_order(&points);
+        for packet in order.chunks(PACKET) {
+            let p0 = points[packet[0] as usize];
+            for &i in packet {
+                let p = points[i as usize];
+                assert!((0..3).all(|k| (p[k] / 2.0).floor() == (p0[k] / 2.0).floor()));
+            }
+        }
+        assert!(morton_order(&[]).is_empty());
+    }
+}
