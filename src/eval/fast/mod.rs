@@ -10,9 +10,11 @@
 //! triangle corner or point below the node) and the [`Moments`] of order 0, 1 and 2 (exact
 //! closed forms for triangles: centroid rule and edge-midpoint rule), built bottom-up by
 //! re-centring the children's moments (parallel-axis shifts). For the queries the binary tree is
-//! collapsed into a 4-wide one, and a query visits two of its nodes at a time, so that one
-//! `f32x8` test decides eight admissibilities and one `f32x8` evaluation computes eight
-//! expansions (AVX2 when the CPU has it, chosen at run time; bit-identical either way). `FASTWN(q)` (Algorithm 1) uses a node's
+//! collapsed into a 4-wide one: one `f32x4` test decides a node's four admissibilities and one
+//! `f32x4` evaluation computes its four expansions (AVX2 when the CPU has it, chosen at run time;
+//! bit-identical either way). Batches walk the tree in Morton-sorted packets of eight queries,
+//! one `f32x8` lane per query, with the values of the queries one by one, bit for bit
+//! (`packet.rs`). `FASTWN(q)` (Algorithm 1) uses a node's
 //! expansion when `‖q − p̃‖ > β r`, sums exact Van Oosterom–Strackee solid angles (four triangles
 //! at a time, one complex product instead of one `atan2` per triangle) or exact dipoles over a
 //! near leaf, and otherwise opens the node. Per query the cost is

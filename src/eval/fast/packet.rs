@@ -6,7 +6,9 @@
 //! twenty far-field coefficients per lane), for the stack and for a branch per lane, and uses
 //! four `f32` lanes of which some are masked out. Neighbouring queries open nearly the same
 //! nodes, so a packet loads each node once for eight queries and evaluates one lane's expansion
-//! for all of them in one eight-lane pass (one AVX register in the AVX2 instantiation).
+//! for all of them in one eight-lane pass (one AVX register where the build targets AVX, two
+//! SSE registers otherwise: `wide` fixes the representation when it is compiled; plain arrays
+//! left to the auto-vectorizer came out slower, split into scalar and SSE code).
 //!
 //! Why the values do not change: each query keeps its own admissibility mask, so it expands and
 //! opens exactly the nodes it would alone; its far-field terms are the same `f32` operations
