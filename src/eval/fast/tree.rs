@@ -164,7 +164,14 @@ impl Split<'_> {
             max: hi,
         };
         pair[0] = child(start, start + half, left_inner, left_first, llo, lhi);
-        pair[1] = child(start + half, start + count, right_inner, right_first, rlo, rhi);
+        pair[1] = child(
+            start + half,
+            start + count,
+            right_inner,
+            right_first,
+            rlo,
+            rhi,
+        );
         (
             std::array::from_fn(|k| llo[k].min(rlo[k])),
             std::array::from_fn(|k| lhi[k].max(rhi[k])),
