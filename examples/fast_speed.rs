@@ -384,7 +384,9 @@ fn main() {
             || one.install(|| fast.eval_batch(&qs)),
             |v| {
                 if let Some((i, x, y)) = first_difference(v, &reference) {
-                    panic!("{label}: eval_batch is not deterministic: point {i} gave {x:e}, then {y:e}");
+                    panic!(
+                        "{label}: eval_batch is not deterministic: point {i} gave {x:e}, then {y:e}"
+                    );
                 }
             },
         );
@@ -416,7 +418,9 @@ fn main() {
             let (many_build_cpu, many_build_wall) =
                 time_best(reps, true, || many.install(build), |_| {});
             let built_on_many = many.install(build);
-            if let Some((i, x, y)) = first_difference(&one.install(|| built_on_many.eval_batch(&qs)), &reference) {
+            if let Some((i, x, y)) =
+                first_difference(&one.install(|| built_on_many.eval_batch(&qs)), &reference)
+            {
                 panic!(
                     "{label}: the evaluator built on {threads} threads differs from the one built on 1 at point {i} ({x:e} vs {y:e}): the build must not depend on the thread count"
                 );
@@ -427,7 +431,9 @@ fn main() {
                 || many.install(|| fast.eval_batch(&qs)),
                 |v| {
                     if let Some((i, x, y)) = first_difference(v, &reference) {
-                        panic!("{label}: eval_batch on {threads} threads differs from 1 thread at point {i} ({x:e} vs {y:e})");
+                        panic!(
+                            "{label}: eval_batch on {threads} threads differs from 1 thread at point {i} ({x:e} vs {y:e})"
+                        );
                     }
                 },
             );
