@@ -191,11 +191,11 @@ impl Hierarchy {
         // root, anchored at the root's own centre, and for the padding node) and its lanes'
         // binary nodes.
         let capacity = nodes.len() / (WIDTH - 1) + 2;
-        let mut shape: Vec<(Option<usize>, Vec<usize>)> = Vec::with_capacity(capacity);
+        let mut shape: Vec<(Option<usize>, Lanes)> = Vec::with_capacity(capacity);
         let mut child: Vec<[u32; WIDTH]> = Vec::with_capacity(capacity);
         // (query-tree node, lane, binary inner node whose query-tree node is linked there).
         let mut work: Vec<(usize, usize, usize)> = Vec::new();
-        let mut push = |anchor: Option<usize>, lanes: Vec<usize>, work: &mut Vec<_>| {
+        let mut push = |anchor: Option<usize>, lanes: &[usize], work: &mut Vec<_>| {
             let id = shape.len();
             let mut c = [EMPTY; WIDTH];
             for (l, &b) in lanes.iter().enumerate() {
@@ -205,28 +205,35 @@ impl Hierarchy {
                     work.push((id, l, b));
                 }
             }
-            shape.push((anchor, lanes));
+            let mut fixed = Lanes {
+                binary: [0; WIDTH],
+                len: lanes.len(),
+            };
+            fixed.binary[..lanes.len()].copy_from_slice(lanes);
+            shape.push((anchor, fixed));
             child.push(c);
             id
         };
-        push(None, vec![0], &mut work);
+        push(None, &[0], &mut work);
         let mut links: Vec<(usize, usize, u32)> = Vec::new();
         while let Some((parent, lane, b)) = work.pop() {
-            let mut lanes = vec![nodes[b].left as usize, nodes[b].left as usize + 1];
-            while lanes.len() < WIDTH {
-                let widest = (0..lanes.len())
+            let mut lanes = [nodes[b].left as usize, nodes[b].left as usize + 1, 0, 0];
+            let mut len = 2;
+            while len < WIDTH {
+                let widest = (0..len)
                     .filter(|&i| !nodes[lanes[i]].is_leaf())
                     .max_by(|&i, &j| m[lanes[i]].radius.total_cmp(&m[lanes[j]].radius));
                 let Some(i) = widest else { break };
                 let l = nodes[lanes[i]].left as usize;
                 lanes[i] = l;
-                lanes.push(l + 1);
+                lanes[len] = l + 1;
+                len += 1;
             }
-            let id = push(Some(b), lanes, &mut work);
+            let id = push(Some(b), &lanes[..len], &mut work);
             links.push((parent, lane, id as u32));
         }
         // The padding node: NaN offsets (admits nothing), zero coefficients, no children.
-        push(None, Vec::new(), &mut work);
+        push(None, &[], &mut work);
         for (parent, lane, id) in links {
             child[parent][lane] = id;
         }
@@ -260,7 +267,7 @@ impl Hierarchy {
         let sizes = |f: &(dyn Fn(usize) -> f64 + Sync)| -> Vec<f32x4> {
             shape
                 .par_iter()
-                .map(|(_, lanes)| lanes_of(lanes, f))
+                .map(|(_, lanes)| lanes_of(lanes.get(), f))
                 .collect()
         };
         self.wide_size = [sizes(&radius), sizes(&diag), sizes(&corner)];
@@ -270,14 +277,21 @@ impl Hierarchy {
         self.wide_far = shape
             .par_iter()
             .map(|(_, lanes)| {
-                let far: Vec<FarField> = lanes.iter().map(|&b| FarField::new(&m[b])).collect();
-                let refs: Vec<&FarField> = far.iter().collect();
-                FarField::lanes(&refs)
+                let far: [FarField; WIDTH] = std::array::from_fn(|l| {
+                    lanes
+                        .get()
+                        .get(l)
+                        .map_or_else(FarField::default, |&b| FarField::new(&m[b]))
+                });
+                let refs: [&FarField; WIDTH] = std::array::from_fn(|l| &far[l]);
+                FarField::lanes(&refs[..lanes.len])
             })
             .collect();
         self.wide_binary = shape
             .iter()
-            .map(|(_, lanes)| std::array::from_fn(|l| lanes.get(l).map_or(EMPTY, |&b| b as u32)))
+            .map(|(_, lanes)| {
+                std::array::from_fn(|l| lanes.get().get(l).map_or(EMPTY, |&b| b as u32))
+            })
             .collect();
         self.wide = shape
             .par_iter()
@@ -287,7 +301,8 @@ impl Hierarchy {
                 let anchor = anchor(id, *a);
                 WideNode {
                     anchor,
-                    offset: [0, 1, 2].map(|k| lanes_of(lanes, &|b| m[b].center[k] - anchor[k])),
+                    offset: [0, 1, 2]
+                        .map(|k| lanes_of(lanes.get(), &|b| m[b].center[k] - anchor[k])),
                     child,
                 }
             })
@@ -482,6 +497,19 @@ impl Hierarchy {
             id = stack[top] as usize;
         }
         g
+    }
+}
+
+/// The binary nodes of a query-tree node's lanes (the first `len` of `binary`).
+#[derive(Clone, Copy, Debug)]
+struct Lanes {
+    binary: [usize; WIDTH],
+    len: usize,
+}
+
+impl Lanes {
+    fn get(&self) -> &[usize] {
+        &self.binary[..self.len]
     }
 }
 
