@@ -10,7 +10,9 @@
 //!   splitmix64 (`--seed S`, default 1).
 //!
 //! `--dump-points FILE.npy` writes the query points (float64, N × 3) so that
-//! `igl_fast_cpu.py --points FILE.npy` times libigl on the same points (one mesh only).
+//! `igl_fast_cpu.py --points FILE.npy` times libigl on the same points (one mesh only);
+//! `--dump-mesh FILE.off` writes the mesh as gwn read it (coordinates round-trip exactly), for
+//! meshes libigl's readers reject (pymeshlab-face000.ply).
 //!
 //! `--cloud N` times [`PointCloudWindingNumber`] instead, on N points sampled area-uniformly from
 //! each mesh with the seeded generator (normal = the face's unit normal, area = total area / N);
@@ -37,7 +39,7 @@
 //!
 //! `cargo run --release --features examples --example fast_speed -- [--beta B] [--order K]
 //! [--rule radius|box-corner] [--reps N] [--threads T] [--points grid|random] [--count N]
-//! [--seed S] [--dump-points FILE.npy] [--cloud N] [--dump-cloud FILE.npy] [--accuracy K] MESH...`
+//! [--seed S] [--dump-points FILE.npy] [--dump-mesh FILE.off] [--cloud N] [--dump-cloud FILE.npy] [--accuracy K] MESH...`
 
 use gwn::eval::direct::winding_number_direct;
 use gwn::eval::fast::{
@@ -93,6 +95,21 @@ fn write_npy<const C: usize>(path: &str, rows: &[[f64; C]]) -> std::io::Result<(
     out.extend_from_slice(header.as_bytes());
     for v in rows.iter().flatten() {
         out.extend_from_slice(&v.to_le_bytes());
+    }
+    std::fs::write(path, out)
+}
+
+/// Writes `mesh` as an OFF file; `{:?}` prints the shortest decimal that reads back to the same
+/// `f64`.
+fn write_off(path: &str, mesh: &gwn::Mesh) -> std::io::Result<()> {
+    use std::fmt::Write as _;
+    let (p, t) = (mesh.positions(), mesh.triangles());
+    let mut out = format!("OFF\n{} {} 0\n", p.len(), t.len());
+    for v in p {
+        let _ = writeln!(out, "{:?} {:?} {:?}", v[0], v[1], v[2]);
+    }
+    for f in t {
+        let _ = writeln!(out, "3 {} {} {}", f[0], f[1], f[2]);
     }
     std::fs::write(path, out)
 }
@@ -217,6 +234,7 @@ fn main() {
     let mut count = 32768usize;
     let mut seed = 1u64;
     let mut dump_points: Option<String> = None;
+    let mut dump_mesh: Option<String> = None;
     let mut cloud: Option<usize> = None;
     let mut dump_cloud: Option<String> = None;
     let mut accuracy = 0usize;
@@ -254,6 +272,7 @@ fn main() {
             "--count" => count = value(&mut args, "--count N"),
             "--seed" => seed = value(&mut args, "--seed S"),
             "--dump-points" => dump_points = Some(value(&mut args, "--dump-points FILE.npy")),
+            "--dump-mesh" => dump_mesh = Some(value(&mut args, "--dump-mesh FILE.off")),
             "--cloud" => cloud = Some(value(&mut args, "--cloud N")),
             "--dump-cloud" => dump_cloud = Some(value(&mut args, "--dump-cloud FILE.npy")),
             "--accuracy" => accuracy = value(&mut args, "--accuracy K"),
@@ -261,8 +280,8 @@ fn main() {
         }
     }
     assert!(
-        (dump_points.is_none() && dump_cloud.is_none()) || meshes.len() == 1,
-        "--dump-points / --dump-cloud write one file: give one mesh"
+        (dump_points.is_none() && dump_cloud.is_none() && dump_mesh.is_none()) || meshes.len() == 1,
+        "--dump-points / --dump-cloud / --dump-mesh write one file: give one mesh"
     );
     assert!(
         dump_cloud.is_none() || cloud.is_some(),
@@ -335,6 +354,9 @@ fn main() {
             }
             qs
         };
+        if let Some(file) = &dump_mesh {
+            write_off(file, &mesh).unwrap_or_else(|e| panic!("writing {file}: {e}"));
+        }
         if let Some(file) = &dump_points {
             write_npy(file, &qs).unwrap_or_else(|e| panic!("writing {file}: {e}"));
         }
