@@ -470,7 +470,7 @@ fn main() {
             );
         }
         if accuracy > 0 {
-            let stride = (qs.len() / accuracy).max(1);
+            let stride = qs.len().checked_div(accuracy).unwrap_or(1).max(1);
             let picked: Vec<usize> = (0..qs.len()).step_by(stride).take(accuracy).collect();
             let exact: Vec<f64> = picked
                 .par_iter()

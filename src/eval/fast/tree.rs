@@ -69,7 +69,7 @@ pub(crate) fn inner_nodes(count: usize, leaf_size: usize) -> usize {
         let (a, b) = pair(m / 2, leaf_size); // inner(h), inner(h + 1), h = ⌊m/2⌋
         // m = 2h splits into (h, h) and m + 1 into (h, h + 1); m = 2h + 1 into (h, h + 1) and
         // m + 1 into (h + 1, h + 1).
-        let (split_m, split_next) = if m % 2 == 0 {
+        let (split_m, split_next) = if m.is_multiple_of(2) {
             (1 + 2 * a, 1 + a + b)
         } else {
             (1 + a + b, 1 + 2 * b)
