@@ -10,4 +10,5 @@ mod curve2d;
 mod curve2d_open;
 mod curve2d_svg;
 mod fast;
+mod fast_build;
 mod fast_vs_libigl;

@@ -1,11 +1,12 @@
 //! The Barnes–Hut engine shared by triangle soups and point clouds: per-node moments built
 //! bottom-up by re-centring, and the traversal of Barill et al.'s Algorithm 1.
 
+use rayon::prelude::*;
 use wide::{CmpGt, CmpLt, f32x4};
 
 use super::moments::{FarField, Moments};
 use super::packet::{Lanes8, PACKET};
-use super::tree::Tree;
+use super::tree::{PARALLEL_GRAIN, Tree};
 
 /// Which node size the admissibility test `‖q − p̃‖ > β · size` uses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -139,47 +140,20 @@ impl Hierarchy {
     /// elements, found by branch and bound over the node's subtree ([`farthest2`]).
     pub fn build(
         tree: Tree,
-        area_centroid: impl Fn(usize) -> (f64, [f64; 3]),
-        elem_moments: impl Fn(usize, [f64; 3]) -> Moments,
-        max_dist2: impl Fn(usize, [f64; 3]) -> f64,
+        area_centroid: impl Fn(usize) -> (f64, [f64; 3]) + Sync,
+        elem_moments: impl Fn(usize, [f64; 3]) -> Moments + Sync,
+        max_dist2: impl Fn(usize, [f64; 3]) -> f64 + Sync,
     ) -> Self {
         let n = tree.len();
         let mut moments = vec![Moments::default(); n];
-        for id in (0..n).rev() {
-            let node = tree.nodes[id];
-            let elems = &tree.order[node.range()];
-            let box_center = [0, 1, 2].map(|k| 0.5 * (node.min[k] + node.max[k]));
-            let mut m = if node.is_leaf() {
-                let mut area = 0.0;
-                let mut acc = [0.0; 3];
-                for &e in elems {
-                    let (a, g) = area_centroid(e as usize);
-                    area += a;
-                    for k in 0..3 {
-                        acc[k] += a * g[k];
-                    }
-                }
-                let center = centre(area, acc, box_center);
-                let mut m = Moments {
-                    center,
-                    ..Moments::default()
-                };
-                for &e in elems {
-                    m.accumulate(&elem_moments(e as usize, center));
-                }
-                m
-            } else {
-                let l = node.left as usize;
-                let (a, b) = (&moments[l], &moments[l + 1]);
-                let area = a.area + b.area;
-                let acc = [0, 1, 2].map(|k| a.area * a.center[k] + b.area * b.center[k]);
-                let center = centre(area, acc, box_center);
-                let mut m = a.recentred(center);
-                m.accumulate(&b.recentred(center));
-                m
+        if n > 0 {
+            let builder = MomentBuilder {
+                tree: &tree,
+                area_centroid: &area_centroid,
+                elem_moments: &elem_moments,
+                max_dist2: &max_dist2,
             };
-            m.radius = farthest2(&tree, id, m.center, &max_dist2).sqrt();
-            moments[id] = m;
+            moments[0] = builder.subtree(0, &mut moments[1..]);
         }
         let mut h = Hierarchy {
             tree,
@@ -210,7 +184,56 @@ impl Hierarchy {
         }
         self.leaves = leaves.iter().map(|&i| nodes[i].range()).collect();
         let m = &self.moments;
-        let far: Vec<FarField> = m.iter().map(FarField::new).collect();
+        // The shape of the query tree first (cheap, one thread: the numbering is the order of a
+        // work stack), then the per-node data from it (the costly part, in parallel).
+        // A query-tree node: its anchor (the binary node it was collapsed from; `None` for the
+        // root, anchored at the root's own centre) and its lanes' binary nodes.
+        let capacity = nodes.len() / (WIDTH - 1) + 2;
+        let mut shape: Vec<(Option<usize>, Lanes)> = Vec::with_capacity(capacity);
+        let mut child: Vec<[u32; WIDTH]> = Vec::with_capacity(capacity);
+        // (query-tree node, lane, binary inner node whose query-tree node is linked there).
+        let mut work: Vec<(usize, usize, usize)> = Vec::new();
+        let mut push = |anchor: Option<usize>, lanes: &[usize], work: &mut Vec<_>| {
+            let id = shape.len();
+            let mut c = [EMPTY; WIDTH];
+            for (l, &b) in lanes.iter().enumerate() {
+                if nodes[b].is_leaf() {
+                    c[l] = LEAF | leaf_of[b];
+                } else {
+                    work.push((id, l, b));
+                }
+            }
+            let mut fixed = Lanes {
+                binary: [0; WIDTH],
+                len: lanes.len(),
+            };
+            fixed.binary[..lanes.len()].copy_from_slice(lanes);
+            shape.push((anchor, fixed));
+            child.push(c);
+            id
+        };
+        push(None, &[0], &mut work);
+        let mut links: Vec<(usize, usize, u32)> = Vec::new();
+        while let Some((parent, lane, b)) = work.pop() {
+            let mut lanes = [nodes[b].left as usize, nodes[b].left as usize + 1, 0, 0];
+            let mut len = 2;
+            while len < WIDTH {
+                let widest = (0..len)
+                    .filter(|&i| !nodes[lanes[i]].is_leaf())
+                    .max_by(|&i, &j| m[lanes[i]].radius.total_cmp(&m[lanes[j]].radius));
+                let Some(i) = widest else { break };
+                let l = nodes[lanes[i]].left as usize;
+                lanes[i] = l;
+                lanes[len] = l + 1;
+                len += 1;
+            }
+            let id = push(Some(b), &lanes[..len], &mut work);
+            links.push((parent, lane, id as u32));
+        }
+        for (parent, lane, id) in links {
+            child[parent][lane] = id;
+        }
+        let anchor = |a: Option<usize>| a.map_or(m[0].center, |b| m[b].center);
         let corner = |b: usize| {
             let (n, c) = (&nodes[b], m[b].center);
             (0..3)
@@ -225,67 +248,55 @@ impl Hierarchy {
                 .sum::<f64>()
                 .sqrt()
         };
-        let capacity = nodes.len() / (WIDTH - 1) + 2;
-        let mut wide: Vec<WideNode> = Vec::with_capacity(capacity);
-        let mut wide_size: [Vec<f32x4>; 3] = std::array::from_fn(|_| Vec::with_capacity(capacity));
-        let mut wide_far = Vec::with_capacity(capacity);
-        let mut wide_binary = Vec::with_capacity(capacity);
-        let mut push =
-            |anchor: [f64; 3], lanes: &[usize], work: &mut Vec<(usize, usize, usize)>| {
-                let id = wide.len();
-                let get = |f: &dyn Fn(usize) -> f64| {
-                    f32x4::from(std::array::from_fn::<f32, WIDTH, _>(|l| {
-                        lanes.get(l).map_or(f32::NAN, |&b| f(b) as f32)
-                    }))
-                };
-                let mut child = [EMPTY; WIDTH];
-                for (l, &b) in lanes.iter().enumerate() {
-                    if nodes[b].is_leaf() {
-                        child[l] = LEAF | leaf_of[b];
-                    } else {
-                        work.push((id, l, b));
-                    }
-                }
-                wide.push(WideNode {
-                    anchor,
-                    offset: [0, 1, 2].map(|k| get(&|b| m[b].center[k] - anchor[k])),
-                    child,
+        let radius = |b: usize| m[b].radius;
+        // One `f32` per lane (NaN in unused lanes: never admissible).
+        let lanes_of = |lanes: &[usize], f: &(dyn Fn(usize) -> f64 + Sync)| {
+            f32x4::from(std::array::from_fn::<f32, WIDTH, _>(|l| {
+                lanes.get(l).map_or(f32::NAN, |&b| f(b) as f32)
+            }))
+        };
+        let sizes = |f: &(dyn Fn(usize) -> f64 + Sync)| -> Vec<f32x4> {
+            shape
+                .par_iter()
+                .map(|(_, lanes)| lanes_of(lanes.get(), f))
+                .collect()
+        };
+        self.wide_size = [sizes(&radius), sizes(&diag), sizes(&corner)];
+        debug_assert_eq!(Admissibility::Radius as usize, 0);
+        debug_assert_eq!(Admissibility::BoxDiagonal as usize, 1);
+        debug_assert_eq!(Admissibility::BoxCorner as usize, 2);
+        self.wide_far = shape
+            .par_iter()
+            .map(|(_, lanes)| {
+                let far: [FarField; WIDTH] = std::array::from_fn(|l| {
+                    lanes
+                        .get()
+                        .get(l)
+                        .map_or_else(FarField::default, |&b| FarField::new(&m[b]))
                 });
-                wide_size[Admissibility::Radius as usize].push(get(&|b| m[b].radius));
-                wide_size[Admissibility::BoxDiagonal as usize].push(get(&diag));
-                wide_size[Admissibility::BoxCorner as usize].push(get(&corner));
-                let refs: Vec<&FarField> = lanes.iter().map(|&b| &far[b]).collect();
-                wide_far.push(FarField::lanes(&refs));
-                wide_binary.push(std::array::from_fn(|l| {
-                    lanes.get(l).map_or(EMPTY, |&b| b as u32)
-                }));
-                id
-            };
-        // (query-tree node, lane, binary inner node whose query-tree node is linked there).
-        let mut work: Vec<(usize, usize, usize)> = Vec::new();
-        let mut links: Vec<(usize, usize, u32)> = Vec::new();
-        push(m[0].center, &[0], &mut work);
-        while let Some((parent, lane, b)) = work.pop() {
-            let mut lanes = vec![nodes[b].left as usize, nodes[b].left as usize + 1];
-            while lanes.len() < WIDTH {
-                let widest = (0..lanes.len())
-                    .filter(|&i| !nodes[lanes[i]].is_leaf())
-                    .max_by(|&i, &j| m[lanes[i]].radius.total_cmp(&m[lanes[j]].radius));
-                let Some(i) = widest else { break };
-                let l = nodes[lanes[i]].left as usize;
-                lanes[i] = l;
-                lanes.push(l + 1);
-            }
-            let id = push(m[b].center, &lanes, &mut work);
-            links.push((parent, lane, id as u32));
-        }
-        for (parent, lane, id) in links {
-            wide[parent].child[lane] = id;
-        }
-        self.wide = wide;
-        self.wide_size = wide_size;
-        self.wide_far = wide_far;
-        self.wide_binary = wide_binary;
+                let refs: [&FarField; WIDTH] = std::array::from_fn(|l| &far[l]);
+                FarField::lanes(&refs[..lanes.len])
+            })
+            .collect();
+        self.wide_binary = shape
+            .iter()
+            .map(|(_, lanes)| {
+                std::array::from_fn(|l| lanes.get().get(l).map_or(EMPTY, |&b| b as u32))
+            })
+            .collect();
+        self.wide = shape
+            .par_iter()
+            .zip(&child)
+            .map(|((a, lanes), &child)| {
+                let anchor = anchor(*a);
+                WideNode {
+                    anchor,
+                    offset: [0, 1, 2]
+                        .map(|k| lanes_of(lanes.get(), &|b| m[b].center[k] - anchor[k])),
+                    child,
+                }
+            })
+            .collect();
     }
 
     /// `r = p̃ − q` of the four lanes of query-tree node `id`: `offset + (anchor − q)`, with
@@ -566,6 +577,100 @@ impl Hierarchy {
             id = stack[top] as usize;
         }
         g
+    }
+}
+
+/// The binary nodes of a query-tree node's lanes (the first `len` of `binary`).
+#[derive(Clone, Copy, Debug)]
+struct Lanes {
+    binary: [usize; WIDTH],
+    len: usize,
+}
+
+impl Lanes {
+    fn get(&self) -> &[usize] {
+        &self.binary[..self.len]
+    }
+}
+
+/// The bottom-up moments pass of [`Hierarchy::build`], one subtree at a time.
+struct MomentBuilder<'a, A, E, D> {
+    tree: &'a Tree,
+    area_centroid: &'a A,
+    elem_moments: &'a E,
+    max_dist2: &'a D,
+}
+
+impl<A, E, D> MomentBuilder<'_, A, E, D>
+where
+    A: Fn(usize) -> (f64, [f64; 3]) + Sync,
+    E: Fn(usize, [f64; 3]) -> Moments + Sync,
+    D: Fn(usize, [f64; 3]) -> f64 + Sync,
+{
+    /// The moments of node `id`, after filling `below` with those of its descendants (the ids
+    /// `left ..` of [`Tree`]'s numbering: its two children, then the left child's descendants,
+    /// then the right child's). Subtrees of at least [`PARALLEL_GRAIN`] elements go to
+    /// `rayon::join`. Each node's moments are computed from its children's by the same
+    /// operations whichever thread runs it, so the values do not depend on the thread count.
+    fn subtree(&self, id: usize, below: &mut [Moments]) -> Moments {
+        let node = self.tree.nodes[id];
+        let box_center = [0, 1, 2].map(|k| 0.5 * (node.min[k] + node.max[k]));
+        let mut m = if node.is_leaf() {
+            debug_assert!(below.is_empty());
+            let elems = &self.tree.order[node.range()];
+            let mut area = 0.0;
+            let mut acc = [0.0; 3];
+            for &e in elems {
+                let (a, g) = (self.area_centroid)(e as usize);
+                area += a;
+                for k in 0..3 {
+                    acc[k] += a * g[k];
+                }
+            }
+            let center = centre(area, acc, box_center);
+            let mut m = Moments {
+                center,
+                ..Moments::default()
+            };
+            for &e in elems {
+                m.accumulate(&(self.elem_moments)(e as usize, center));
+            }
+            m
+        } else {
+            let l = node.left as usize;
+            let right = self.tree.nodes[l + 1];
+            // The left child's descendants end where the right child's begin (its own children),
+            // or at the end of `below` when the right child is a leaf.
+            let left_span = if right.is_leaf() {
+                below.len() - 2
+            } else {
+                right.left as usize - l - 2
+            };
+            let (pair, rest) = below.split_at_mut(2);
+            let (left_below, right_below) = rest.split_at_mut(left_span);
+            let (a, b) = if node.range().len() >= PARALLEL_GRAIN {
+                rayon::join(
+                    || self.subtree(l, left_below),
+                    || self.subtree(l + 1, right_below),
+                )
+            } else {
+                (
+                    self.subtree(l, left_below),
+                    self.subtree(l + 1, right_below),
+                )
+            };
+            pair[0] = a;
+            pair[1] = b;
+            let (a, b) = (&pair[0], &pair[1]);
+            let area = a.area + b.area;
+            let acc = [0, 1, 2].map(|k| a.area * a.center[k] + b.area * b.center[k]);
+            let center = centre(area, acc, box_center);
+            let mut m = a.recentred(center);
+            m.accumulate(&b.recentred(center));
+            m
+        };
+        m.radius = farthest2(self.tree, id, m.center, self.max_dist2).sqrt();
+        m
     }
 }
 
