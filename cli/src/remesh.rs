@@ -6,6 +6,7 @@ use clap::Args as ClapArgs;
 use gwn::products::remesh::crossings::SegmentBvh;
 use gwn::products::remesh::intersect::self_intersections;
 use gwn::products::remesh::report::{TopologyReport, hausdorff_distance, occupancy_agreement};
+use gwn::products::remesh::thicken::ThickenedSheets;
 use gwn::products::remesh::write::{SurfaceFormat, write_surface};
 use gwn::products::remesh::{DEFAULT_BISECTION_STEPS, RemeshOptions, remesh_guided};
 
@@ -46,6 +47,11 @@ pub struct Args {
     /// guarantees, more evaluations; for comparison).
     #[arg(long)]
     pub no_guide: bool,
+    /// Close open sheets (cloth, leaves, single walls: w near 1/2 on both sides, no volume) into
+    /// slabs of half-thickness EPS (world units, at least one finest cell) where w says the
+    /// surface is open; solids are left as they are. Meshes and soups only. Off by default.
+    #[arg(long, value_name = "EPS")]
+    pub thicken: Option<f64>,
     #[command(flatten)]
     pub method: MethodArgs,
     #[command(flatten)]
@@ -68,7 +74,39 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let bounds = input
         .bounding_box()
         .ok_or_else(|| CliError::msg(format!("{}: has no geometry", args.mesh.display())))?;
-    let wn = crate::method::build(&method, &input, &args.mesh)?;
+    let built = crate::method::build(&method, &input, &args.mesh)?;
+    let thickened = match (args.thicken, input.mesh()) {
+        (None, _) => None,
+        (Some(_), None) => {
+            return Err(CliError::msg(format!(
+                "{}: --thicken needs triangles (a mesh or soup), not a point cloud or patches",
+                args.mesh.display()
+            )));
+        }
+        (Some(eps), Some(mesh)) => {
+            let extent = (0..3)
+                .map(|k| bounds.max[k] - bounds.min[k])
+                .fold(0.0, f64::max);
+            let cell = extent / args.res.max(1) as f64;
+            // Thinner slabs can fall between the lattice points and vanish.
+            if eps.is_nan() || eps < cell {
+                return Err(CliError::msg(format!(
+                    "{}: --thicken {eps} is below one finest cell ({cell:.4e} at --res {}): \
+                     use at least that",
+                    args.mesh.display(),
+                    args.res
+                )));
+            }
+            Some(
+                ThickenedSheets::new(mesh, &*built, eps)
+                    .map_err(|e| CliError(format!("{}: --thicken: {e}", args.mesh.display())))?,
+            )
+        }
+    };
+    let wn: &dyn gwn::eval::Evaluator = match &thickened {
+        Some(t) => t,
+        None => &*built,
+    };
     let options = RemeshOptions {
         resolution: args.res,
         bisection_steps: args.bisect,
@@ -87,7 +125,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             bar.inc(1);
         }
     };
-    let out = remesh_guided(&*wn, guide.as_ref(), bounds, &options, &announce)
+    let out = remesh_guided(wn, guide.as_ref(), bounds, &options, &announce)
         .map_err(|e| CliError(format!("{}: {e}", args.mesh.display())))?;
     let secs = start.elapsed().as_secs_f64();
     bar.inc(1);
@@ -117,7 +155,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     // The agreement compares against the written surface's own exact winding number.
     let agreement = if args.samples > 0 && !mesh.is_empty() {
         let output = gwn::eval::antipodal::WindingNumber::new(&mesh)?;
-        occupancy_agreement(&*wn, &output, bounds, args.samples, 0x9e57)
+        occupancy_agreement(wn, &output, bounds, args.samples, 0x9e57)
     } else {
         None
     };
@@ -162,6 +200,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
             d / cell_size
         )?;
     }
+    if let Some(t) = &thickened {
+        outln!(
+            "thickened open sheets: half-thickness {:.4e} = {:.3} cells (agreement is against \
+             the thickened solid)",
+            t.eps(),
+            t.eps() / cell_size
+        )?;
+    }
     if let Some(a) = agreement {
         outln!(
             "occupancy agreement {:.3} % of {} samples in the box",
@@ -190,6 +236,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
         if let Some(d) = hausdorff {
             extra.push(("hausdorff", format!("{d:?}")));
             extra.push(("hausdorff_cells", format!("{:?}", d / cell_size)));
+        }
+        if let Some(t) = &thickened {
+            extra.push(("thicken", format!("{:?}", t.eps())));
         }
         if let Some(a) = agreement {
             extra.push(("occupancy_agreement", format!("{a:?}")));

@@ -180,6 +180,7 @@ def remesh(
     order: Optional[int] = None,
     tolerance: Optional[float] = None,
     threads: Optional[int] = None,
+    thicken: Optional[float] = None,
 ) -> Tuple[_F64, _I64]:
     """A closed, manifold, oriented surface of the solid w > 1/2 as (V float64 (n, 3), F int64 (m, 3))."""
 

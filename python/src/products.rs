@@ -416,9 +416,11 @@ pub fn filter_tets<'py>(
 /// says so, holes close where ``w`` decides. Returns ``(V, F)``: float64 (n, 3) and int64
 /// (m, 3), triangles counter-clockwise seen from outside. ``method``/``beta``/``order``/
 /// ``tolerance`` as in :func:`voxelize`; refused (``ValueError``) when the surface would not fit
-/// in memory.
+/// in memory. ``thicken=EPS`` closes open sheets (``w`` near 1/2 on both sides, no volume) into
+/// slabs of half-thickness ``EPS`` where ``w`` says the surface is open, as ``gwn remesh
+/// --thicken``; ``EPS`` must be at least one finest cell.
 #[pyfunction]
-#[pyo3(signature = (V, F, res = 128, *, bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS, method = "exact", beta = None, order = None, tolerance = None, threads = None))]
+#[pyo3(signature = (V, F, res = 128, *, bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS, method = "exact", beta = None, order = None, tolerance = None, threads = None, thicken = None))]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub fn remesh<'py>(
     py: Python<'py>,
@@ -431,8 +433,11 @@ pub fn remesh<'py>(
     order: Option<u8>,
     tolerance: Option<f64>,
     threads: Option<Threads>,
+    thicken: Option<f64>,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
-    use gwn::products::remesh::{RemeshOptions, crossings::SegmentBvh, remesh_guided};
+    use gwn::products::remesh::{
+        RemeshOptions, crossings::SegmentBvh, remesh_guided, thicken::ThickenedSheets,
+    };
     let method = spec_of(method, beta, order, tolerance)?;
     let mesh = mesh_from(V, F, "V", "F")?;
     let Some(bounds) = mesh.bounding_box() else {
@@ -445,16 +450,29 @@ pub fn remesh<'py>(
         bisection_steps: bisect,
         max_classified_points: None,
     };
+    if let Some(eps) = thicken {
+        let extent = (0..3)
+            .map(|k| bounds.max[k] - bounds.min[k])
+            .fold(0.0, f64::max);
+        let cell = extent / res.max(1) as f64;
+        // Thinner slabs can fall between the lattice points and vanish.
+        if eps.is_nan() || eps < cell {
+            return Err(PyValueError::new_err(format!(
+                "thicken={eps} is below one finest cell ({cell:.4e} at res={res})"
+            )));
+        }
+    }
     let out = threads::run(py, threads, || {
         let wn = evaluator_for(&mesh, &method)?;
         let guide = SegmentBvh::of_mesh(&mesh);
-        Ok::<_, Box<dyn std::error::Error + Send + Sync>>(remesh_guided(
-            &wn,
-            Some(&guide),
-            bounds,
-            &options,
-            &|_| {},
-        )?)
+        let out = match thicken {
+            Some(eps) => {
+                let thick = ThickenedSheets::new(&mesh, &wn, eps)?;
+                remesh_guided(&thick, Some(&guide), bounds, &options, &|_| {})?
+            }
+            None => remesh_guided(&wn, Some(&guide), bounds, &options, &|_| {})?,
+        };
+        Ok::<_, Box<dyn std::error::Error + Send + Sync>>(out)
     })?
     .map_err(value_error)?;
     let triangles: Vec<[i64; 3]> = out.triangles.iter().map(|t| t.map(i64::from)).collect();

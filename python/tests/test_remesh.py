@@ -56,3 +56,15 @@ def test_bad_arguments_are_value_errors():
         gwn.remesh(CUBE_V, CUBE_F, res=8, bisect=99)
     with pytest.raises(ValueError):
         gwn.remesh(CUBE_V, CUBE_F, res=8, method="nope")
+
+
+def test_thicken_turns_an_open_square_into_a_slab():
+    V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], dtype=np.float64)
+    F = np.array([[0, 1, 2], [0, 2, 3]])
+    V2, F2 = gwn.remesh(V, F, res=24, thicken=0.08)
+    once, twice, _ = edge_census(F2)
+    assert once and twice and len(F2) > 0
+    # A slab of about 1 x 1 x 0.16 (lattice-rounded).
+    assert 0.1 < volume(V2, F2) < 0.22
+    with pytest.raises(ValueError, match="finest cell"):
+        gwn.remesh(V, F, res=24, thicken=0.01)

@@ -529,3 +529,49 @@ fn hausdorff_distance_of_a_sphere_is_below_one_cell() {
     assert!(far > 0.2 - out.cell_size, "{far}");
     assert_eq!(hausdorff_distance(&Mesh::default(), &out_mesh, 10, 1), None);
 }
+
+/// `--thicken`: an open square (w = ±½ beside it, no volume) becomes a closed slab of thickness
+/// about `2·eps`; a closed sphere next to it is not thickened at all.
+#[test]
+fn thicken_turns_open_sheets_into_slabs_and_leaves_solids_alone() {
+    use gwn::products::remesh::thicken::ThickenedSheets;
+    let square = |z: f64| {
+        Mesh::new(
+            vec![[0., 0., z], [1., 0., z], [1., 1., z], [0., 1., z]],
+            vec![[0, 1, 2], [0, 2, 3]],
+        )
+        .unwrap()
+    };
+    let ball = sphere([0.5, 0.5, 1.0], 0.3, 24, false);
+    let mut positions = square(0.0).positions().to_vec();
+    let mut triangles = square(0.0).triangles().to_vec();
+    let n = positions.len() as u32;
+    positions.extend_from_slice(ball.positions());
+    triangles.extend(ball.triangles().iter().map(|t| t.map(|i| i + n)));
+    let both = Mesh::new(positions, triangles).unwrap();
+    let bounds = both.bounding_box().unwrap();
+    let options = RemeshOptions::with_resolution(48);
+    let guide = SegmentBvh::of_mesh(&both);
+    let wn = WindingNumber::new(&both).unwrap();
+    let eps = 0.05;
+    let thick = ThickenedSheets::new(&both, &wn, eps).unwrap();
+    let plain = remesh_guided(&wn, Some(&guide), bounds, &options, &|_| {}).unwrap();
+    let out = remesh_guided(&thick, Some(&guide), bounds, &options, &|_| {}).unwrap();
+    assert_no_self_intersections(&out);
+    let report = TopologyReport::of(&out.positions, &out.triangles);
+    assert_closed_manifold(&report);
+    assert_eq!(report.components, 2, "{report}");
+    // The sphere's part is the same surface with or without thickening.
+    let upper = |p: [f64; 3]| p[2] > 0.5;
+    let (v_plain, v_thick) = (signed_volume(&plain, upper), signed_volume(&out, upper));
+    assert!((v_plain - v_thick).abs() < 1e-12, "{v_plain} vs {v_thick}");
+    // Without thickening the square leaves (next to) nothing; with it, a slab of volume
+    // ≈ 1 × 2·eps (the lattice rounds its faces to cells of 1/48).
+    let lower = |p: [f64; 3]| p[2] <= 0.5;
+    let before = signed_volume(&plain, lower);
+    assert!(before.abs() < 1e-5, "{before}");
+    let slab = signed_volume(&out, lower);
+    assert!((0.07..0.13).contains(&slab), "slab volume {slab}");
+    assert!(ThickenedSheets::new(&both, &wn, 0.0).is_err());
+    assert!(ThickenedSheets::new(&both, &wn, f64::NAN).is_err());
+}

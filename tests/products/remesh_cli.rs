@@ -87,3 +87,63 @@ fn remesh_errors_are_one_line() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn remesh_thickens_an_open_sheet_on_request() {
+    let dir = std::env::temp_dir().join(format!("gwn-cli-remesh-thick-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let input = dir.join("sheet.obj");
+    std::fs::write(
+        &input,
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n",
+    )
+    .unwrap();
+    let (input, out, report) = (
+        input.to_str().unwrap().to_owned(),
+        dir.join("o.obj").to_str().unwrap().to_owned(),
+        dir.join("r.json").to_str().unwrap().to_owned(),
+    );
+    let args = |extra: &[&'static str]| {
+        let mut a = vec![
+            "remesh",
+            &input,
+            "--res",
+            "24",
+            "--out",
+            &out,
+            "--samples",
+            "500",
+        ];
+        a.extend_from_slice(extra);
+        a.iter().map(|s| s.to_string()).collect::<Vec<_>>()
+    };
+    let call = |a: Vec<String>| gwn(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    let mut with_report = args(&["--thicken", "0.08", "--report"]);
+    with_report.push(report.clone());
+    let (ok, stdout, stderr) = call(with_report);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("closed: yes"), "{stdout}");
+    assert!(stdout.contains("thickened open sheets"), "{stdout}");
+    let json = std::fs::read_to_string(&report).unwrap();
+    for member in [
+        "\"thicken\": 0.08",
+        "\"closed\": true",
+        "\"self_intersections\": 0",
+    ] {
+        assert!(json.contains(member), "{member} not in {json}");
+    }
+    // Below one finest cell (1/24) the slab could fall between lattice points: refused.
+    for (eps, needle) in [
+        ("0.01", "below one finest cell"),
+        ("nan", "below one finest cell"),
+    ] {
+        let (ok, _, stderr) = call(args(&["--thicken", eps]));
+        assert!(!ok);
+        assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+        assert!(
+            stderr.contains(needle) && stderr.contains("sheet.obj"),
+            "{stderr}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -47,6 +47,7 @@ pub mod lattice;
 pub mod octree;
 pub mod place;
 pub mod report;
+pub mod thicken;
 pub mod write;
 
 use crate::base::bounding_box::BoundingBox;
