@@ -116,22 +116,7 @@ impl Split<'_> {
             return (lo, hi);
         }
         // The centroids' box picks the split; the element boxes are merged bottom-up below.
-        let (mut clo, mut chi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-        for &e in order.iter() {
-            let c = self.centroids[e as usize];
-            for k in 0..3 {
-                clo[k] = clo[k].min(c[k]);
-                chi[k] = chi[k].max(c[k]);
-            }
-        }
-        let ext = [0, 1, 2].map(|k| chi[k] - clo[k]);
-        let axis = if ext[0] >= ext[1] && ext[0] >= ext[2] {
-            0
-        } else if ext[1] >= ext[2] {
-            1
-        } else {
-            2
-        };
+        let axis = split_axis(self.centroids, order);
         let half = count / 2;
         let centroids = self.centroids;
         order.select_nth_unstable_by(half, |&a, &b| {
@@ -236,6 +221,26 @@ pub(crate) fn box_dist2(q: [f64; 3], min: [f64; 3], max: [f64; 3]) -> f64 {
     d2
 }
 
+/// The longest axis of the box of the centroids of `elems` (ties: the lower axis).
+fn split_axis(centroids: &[[f64; 3]], elems: &[u32]) -> usize {
+    let (mut clo, mut chi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for &e in elems {
+        let c = centroids[e as usize];
+        for k in 0..3 {
+            clo[k] = clo[k].min(c[k]);
+            chi[k] = chi[k].max(c[k]);
+        }
+    }
+    let ext = [0, 1, 2].map(|k| chi[k] - clo[k]);
+    if ext[0] >= ext[1] && ext[0] >= ext[2] {
+        0
+    } else if ext[1] >= ext[2] {
+        1
+    } else {
+        2
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -266,22 +271,7 @@ mod tests {
             if count <= leaf_size {
                 continue;
             }
-            let (mut clo, mut chi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-            for &e in slice.iter() {
-                let c = centroids[e as usize];
-                for k in 0..3 {
-                    clo[k] = clo[k].min(c[k]);
-                    chi[k] = chi[k].max(c[k]);
-                }
-            }
-            let ext = [0, 1, 2].map(|k| chi[k] - clo[k]);
-            let axis = if ext[0] >= ext[1] && ext[0] >= ext[2] {
-                0
-            } else if ext[1] >= ext[2] {
-                1
-            } else {
-                2
-            };
+            let axis = split_axis(centroids, slice);
             let half = count / 2;
             slice.select_nth_unstable_by(half, |&a, &b| {
                 centroids[a as usize][axis].total_cmp(&centroids[b as usize][axis])
