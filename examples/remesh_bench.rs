@@ -17,9 +17,7 @@ use std::time::Instant;
 use gwn::eval::antipodal::WindingNumber;
 use gwn::products::remesh::lattice::Lattice;
 use gwn::products::remesh::report::TopologyReport;
-use gwn::products::remesh::{
-    DEFAULT_BISECTION_STEPS, crossings, extract, octree, place, simplify,
-};
+use gwn::products::remesh::{DEFAULT_BISECTION_STEPS, crossings, extract, octree, place, simplify};
 
 const DEFAULT_MESHES: [&str; 2] = ["cgal-bunny00.off", "assimp-Spider_binary.stl"];
 
@@ -102,6 +100,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     .iter()
                     .map(|&v| placed.positions[v as usize])
                     .collect();
+                eprintln!("{:?}", s.stats);
                 (positions, s.triangles)
             } else {
                 (placed.positions, band.triangles.clone())

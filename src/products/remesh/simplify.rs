@@ -172,7 +172,7 @@ pub struct Simplifier<'a> {
     /// of their box's minimum corner: a face of class `k` meeting a box `lo..=hi` has its
     /// minimum corner in `lo − 2^k cells..=hi`, so a query visits a few buckets per class and
     /// only faces of about its size.
-    grids: Vec<KeyMap<Vec<u32>>>,
+    grids: Vec<KeyMap<Vec<(u32, P, P)>>>,
     ticks: i64,
     max_extent: i64,
     /// Squared distance bound, lattice units.
@@ -264,11 +264,16 @@ impl<'a> Simplifier<'a> {
     /// faces are left.
     pub fn run(&mut self, target_faces: usize) {
         let n = self.points.len();
+        // Lazy invalidation: an entry counts only if its version is the vertex's. `queued` is the
+        // cost of the vertex's valid entry, if any: a vertex whose best cost did not change keeps
+        // its entry (popping it re-examines every target anyway).
         let mut version = vec![0u32; n];
+        let mut queued: Vec<Option<u64>> = vec![None; n];
         let mut heap: BinaryHeap<Reverse<(u64, u32, u32)>> = BinaryHeap::new();
         for u in 0..n as u32 {
             if let Some(c) = self.best_cost(u) {
                 heap.push(Reverse((c.to_bits(), u, 0)));
+                queued[u as usize] = Some(c.to_bits());
             }
         }
         let mut candidates: Vec<(u64, u32)> = Vec::new();
@@ -279,6 +284,7 @@ impl<'a> Simplifier<'a> {
             if self.removed[u as usize] || ver != version[u as usize] {
                 continue;
             }
+            queued[u as usize] = None;
             let ring = self.neighbours(u);
             candidates.clear();
             for &v in &ring {
@@ -292,9 +298,13 @@ impl<'a> Simplifier<'a> {
                 match self.collapse(u, v) {
                     Ok(()) => {
                         for &x in &ring {
-                            version[x as usize] += 1;
-                            if let Some(c) = self.best_cost(x) {
-                                heap.push(Reverse((c.to_bits(), x, version[x as usize])));
+                            let best = self.best_cost(x).map(f64::to_bits);
+                            if best != queued[x as usize] || best.is_none() {
+                                version[x as usize] += 1;
+                                queued[x as usize] = best;
+                                if let Some(c) = best {
+                                    heap.push(Reverse((c, x, version[x as usize])));
+                                }
                             }
                         }
                         break;
@@ -453,10 +463,8 @@ impl<'a> Simplifier<'a> {
             new.push(n);
         }
         // Distance: u and every vertex u's faces answer for, to the nearest new face.
-        let triangles: Vec<[[f64; 3]; 3]> = new
-            .iter()
-            .map(|t| t.map(|x| self.at[x as usize]))
-            .collect();
+        let triangles: Vec<[[f64; 3]; 3]> =
+            new.iter().map(|t| t.map(|x| self.at[x as usize])).collect();
         let mut support = vec![Vec::new(); new.len()];
         let points = std::iter::once(u).chain(
             old.iter()
@@ -500,10 +508,13 @@ impl<'a> Simplifier<'a> {
             let bucket = self.ticks << (k + 1);
             for_buckets(reach, hi, bucket, |key| {
                 if let Some(list) = grid.get(&key) {
-                    near.extend(list.iter().copied().filter(|&g| {
-                        !old.contains(&g)
-                            && boxes_overlap(face_box(self.faces[g as usize].map(p)), (lo, hi))
-                    }));
+                    near.extend(
+                        list.iter()
+                            .filter(|(g, l, h)| {
+                                boxes_overlap((*l, *h), (lo, hi)) && !old.contains(g)
+                            })
+                            .map(|e| e.0),
+                    );
                 }
             });
         }
@@ -577,8 +588,8 @@ impl<'a> Simplifier<'a> {
         let key = bucket_key(lo.map(|c| c.div_euclid(bucket)));
         let list = self.grids[k].entry(key).or_default();
         if insert {
-            list.push(f);
-        } else if let Some(i) = list.iter().position(|&g| g == f) {
+            list.push((f, lo, hi));
+        } else if let Some(i) = list.iter().position(|e| e.0 == f) {
             list.swap_remove(i);
         }
     }
@@ -625,7 +636,9 @@ fn dot_sign(a: [i128; 3], b: [i128; 3]) -> i32 {
         return -1;
     }
     use num_bigint::BigInt;
-    let exact: BigInt = (0..3).map(|k| BigInt::from(a[k]) * BigInt::from(b[k])).sum();
+    let exact: BigInt = (0..3)
+        .map(|k| BigInt::from(a[k]) * BigInt::from(b[k]))
+        .sum();
     match exact.sign() {
         num_bigint::Sign::Plus => 1,
         num_bigint::Sign::Minus => -1,
@@ -687,7 +700,8 @@ pub fn point_triangle_distance2(p: [f64; 3], t: &[[f64; 3]; 3]) -> f64 {
         let d = s(p, q);
         dot(d, d)
     };
-    let along = |o: [f64; 3], e: [f64; 3], k: f64| [o[0] + k * e[0], o[1] + k * e[1], o[2] + k * e[2]];
+    let along =
+        |o: [f64; 3], e: [f64; 3], k: f64| [o[0] + k * e[0], o[1] + k * e[1], o[2] + k * e[2]];
     let (d1, d2) = (dot(ab, ap), dot(ac, ap));
     if d1 <= 0.0 && d2 <= 0.0 {
         return closest(a);
@@ -722,7 +736,11 @@ pub fn point_triangle_distance2(p: [f64; 3], t: &[[f64; 3]; 3]) -> f64 {
             .map(|&(x, y)| {
                 let e = s(y, x);
                 let l = dot(e, e);
-                let k = if l > 0.0 { (dot(s(p, x), e) / l).clamp(0.0, 1.0) } else { 0.0 };
+                let k = if l > 0.0 {
+                    (dot(s(p, x), e) / l).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
                 closest(along(x, e, k))
             })
             .fold(f64::INFINITY, f64::min);
