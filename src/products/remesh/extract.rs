@@ -193,3 +193,49 @@ fn outward(edges: &[(Corner, Corner); 3]) -> bool {
     let d = [0, 1, 2].map(|a| i64::from(o[a]) - i64::from(i[a]));
     n[0] * d[0] + n[1] * d[1] + n[2] * d[2] > 0
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn marching_cubes_counts_of_the_classic_cases() {
+        let case = |corners: &[usize]| corners.iter().fold(0u8, |c, &b| c | (1 << b));
+        // Nothing, one corner, an edge, a face, two corners across a face (ambiguous: two
+        // triangles), across the cube, three corners of a face, a corner and its three
+        // neighbours (a hexagon: four triangles).
+        assert_eq!(marching_cubes_triangles(0), 0);
+        assert_eq!(marching_cubes_triangles(0xff), 0);
+        assert_eq!(marching_cubes_triangles(case(&[0])), 1);
+        assert_eq!(marching_cubes_triangles(case(&[0, 1])), 2);
+        assert_eq!(marching_cubes_triangles(case(&[0, 1, 2, 3])), 2);
+        assert_eq!(marching_cubes_triangles(case(&[0, 3])), 2);
+        assert_eq!(marching_cubes_triangles(case(&[0, 7])), 2);
+        assert_eq!(marching_cubes_triangles(case(&[0, 1, 2])), 3);
+        assert_eq!(marching_cubes_triangles(case(&[0, 1, 2, 4])), 4);
+        let table = marching_cubes_table();
+        // Every unambiguous case (no face with its inside corners on a diagonal) counts the
+        // same as its complement; at most 5 triangles per cube, as in the classic table.
+        let ambiguous = |c: u8| {
+            [
+                (0, 3, 1, 2),
+                (4, 7, 5, 6),
+                (0, 5, 1, 4),
+                (2, 7, 3, 6),
+                (0, 6, 2, 4),
+                (1, 7, 3, 5),
+            ]
+            .iter()
+            .any(|&(a, b, p, q)| {
+                let i = |k: usize| c & (1 << k) != 0;
+                i(a) == i(b) && i(p) == i(q) && i(a) != i(p)
+            })
+        };
+        for c in 0..=255u8 {
+            assert!(table[c as usize] <= 5, "{c:#010b}");
+            if !ambiguous(c) {
+                assert_eq!(table[c as usize], table[!c as usize], "{c:#010b}");
+            }
+        }
+    }
+}
