@@ -202,7 +202,7 @@ impl<'a> Simplifier<'a> {
         options: &SimplifyOptions,
     ) -> Option<Simplifier<'a>> {
         if ticks_per_cell <= 0
-            || !(options.max_distance >= 0.0)
+            || !(options.max_distance.is_finite() && options.max_distance >= 0.0)
             || points
                 .iter()
                 .any(|p| p.iter().any(|c| c.unsigned_abs() >= MAX_COORDINATE as u64))
@@ -477,7 +477,7 @@ impl<'a> Simplifier<'a> {
                 .enumerate()
                 .map(|(k, t)| (k, point_triangle_distance2(q, t)))
                 .fold((0, f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
-            if !(d2 <= self.max_distance2) {
+            if d2.is_nan() || d2 > self.max_distance2 {
                 return Err(Refusal::Distance);
             }
             support[best].push(x);
@@ -729,7 +729,7 @@ pub fn point_triangle_distance2(p: [f64; 3], t: &[[f64; 3]; 3]) -> f64 {
         return closest(along(b, s(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6))));
     }
     let denom = va + vb + vc;
-    if !(denom > 0.0) {
+    if denom.is_nan() || denom <= 0.0 {
         // Degenerate (collinear) triangle: the nearest of its edges.
         return [(a, b), (b, c), (c, a)]
             .iter()
