@@ -100,7 +100,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     .iter()
                     .map(|&v| placed.positions[v as usize])
                     .collect();
-                eprintln!("{:?}", s.stats);
                 (positions, s.triangles)
             } else {
                 (placed.positions, band.triangles.clone())

@@ -175,13 +175,14 @@ def remesh(
     res: int = 128,
     *,
     bisect: int = 8,
+    simplify: bool = True,
     method: Literal["exact", "direct", "fast"] = "exact",
     beta: Optional[float] = None,
     order: Optional[int] = None,
     tolerance: Optional[float] = None,
     threads: Optional[int] = None,
 ) -> Tuple[_F64, _I64]:
-    """A closed, manifold, oriented surface of the solid w > 1/2 as (V float64 (n, 3), F int64 (m, 3))."""
+    """A closed, manifold, oriented surface of the solid w > 1/2 as (V float64 (n, 3), F int64 (m, 3)); simplify=False: the raw marching-tetrahedra surface."""
 
 def sdf(
     V: _Floats,

@@ -50,7 +50,7 @@ pub const DEFAULT_MAX_DISTANCE: f64 = 0.5;
 pub const DEFAULT_MAX_FACE_EXTENT: u32 = 6;
 
 /// Default [`SimplifyOptions::target_fraction_of_marching_cubes`].
-pub const DEFAULT_TARGET_FRACTION: f64 = 0.35;
+pub const DEFAULT_TARGET_FRACTION: f64 = 0.45;
 
 /// Weight of the squared edge length (lattice units) added to the quadric error: in flat
 /// regions, where the quadric is 0 for every target, short edges collapse first (rounder faces).
