@@ -249,9 +249,9 @@ pub fn faces_intersect(s: [P; 3], t: [P; 3]) -> bool {
     // every collapse the simplification tries).
     let mut shared = [(0usize, 0usize); 3];
     let mut count = 0;
-    for i in 0..3 {
-        for j in 0..3 {
-            if s[i] == t[j] && count < 3 {
+    for (i, p) in s.iter().enumerate() {
+        for (j, q) in t.iter().enumerate() {
+            if p == q && count < 3 {
                 shared[count] = (i, j);
                 count += 1;
             }
