@@ -4,7 +4,7 @@
 
 use crate::common;
 use crate::remesh::{
-    assert_closed_manifold, occupancy_agreement, raw, run, run_raw, run_with, sphere, torus,
+    assert_closed_manifold, occupancy_agreement, raw, run, run_with, sphere, torus,
 };
 
 use gwn::Mesh;
@@ -28,13 +28,24 @@ fn simplified_closed_forms_keep_every_guarantee() {
         .concatenated(&sphere([0.0; 3], 0.5, 16, true))
         .unwrap();
     let cases: [(&str, Mesh, usize); 4] = [
-        ("sphere", sphere([0.1, -0.2, 0.3], 1.0, 24, false), 40),
-        ("torus", torus(1.0, 0.4, 24), 40),
-        ("shell", shell, 40),
-        ("cubes", cubes, 24),
+        ("sphere", sphere([0.1, -0.2, 0.3], 1.0, 24, false), 20),
+        ("torus", torus(1.0, 0.4, 24), 24),
+        ("shell", shell, 20),
+        ("cubes", cubes, 16),
     ];
     for (name, mesh, res) in cases {
-        let (before, rb) = run_raw(&mesh, res);
+        // The raw surface's own checks are in remesh.rs: only its counts are needed here.
+        let before = gwn::products::remesh::remesh_guided(
+            &gwn::eval::antipodal::WindingNumber::new(&mesh).unwrap(),
+            Some(&gwn::products::remesh::crossings::SegmentBvh::of_mesh(
+                &mesh,
+            )),
+            mesh.bounding_box().unwrap(),
+            &raw(res),
+            &|_| {},
+        )
+        .unwrap();
+        let rb = TopologyReport::of(&before.positions, &before.triangles);
         let (after, ra) = run(&mesh, res);
         assert_closed_manifold(&ra);
         assert_eq!(
@@ -72,7 +83,7 @@ fn simplified_closed_forms_keep_every_guarantee() {
         );
         let out_mesh = Mesh::new(after.positions.clone(), after.triangles.clone()).unwrap();
         let raw_mesh = Mesh::new(before.positions.clone(), before.triangles.clone()).unwrap();
-        let moved = hausdorff_distance(&raw_mesh, &out_mesh, 4000, 7).unwrap();
+        let moved = hausdorff_distance(&raw_mesh, &out_mesh, 1500, 7).unwrap();
         assert!(
             moved < after.cell_size,
             "{name}: {moved} from the raw surface, cell {}",
@@ -80,16 +91,16 @@ fn simplified_closed_forms_keep_every_guarantee() {
         );
         // Closed inputs (not the cubes, whose shared wall is inside the union and rightly gone).
         if name != "cubes" {
-            let d = hausdorff_distance(&mesh, &out_mesh, 4000, 7).unwrap();
+            let d = hausdorff_distance(&mesh, &out_mesh, 1500, 7).unwrap();
             assert!(
                 d < after.cell_size,
                 "{name}: Hausdorff {d}, cell {}",
                 after.cell_size
             );
         }
-        let (agreement, compared) = occupancy_agreement(&mesh, &after, 2000, 1.0);
+        let (agreement, compared) = occupancy_agreement(&mesh, &after, 1000, 1.0);
         assert!(
-            compared > 1000 && agreement == 1.0,
+            compared > 250 && agreement == 1.0,
             "{name}: {agreement} of {compared}"
         );
     }
@@ -103,7 +114,7 @@ fn simplification_is_the_same_for_every_run_and_thread_count() {
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| run(&mesh, 32).0)
+            .install(|| run(&mesh, 20).0)
     };
     let one = on(1);
     assert_eq!(one, on(2));
