@@ -5,7 +5,9 @@
 //! cargo run --release --features examples --example remesh_bench [-- RES... [--mesh FILE]...]
 //! ```
 //! `--bisect-only` places every vertex by bisection (the input triangles are not used as a
-//! guide). Defaults: resolutions 64, 128, 256 on two shared meshes (`../shared/meshes`, or
+//! guide); `--no-simplify` skips the edge collapses (`simplify s` 0, output = marching
+//! tetrahedra). "MT faces" are the marching-tetrahedra triangles before simplification, "MC
+//! faces" a dense marching cubes' count on the same corner classes (counted, not built). Defaults: resolutions 64, 128, 256 on two shared meshes (`../shared/meshes`, or
 //! `$GWN_SHARED_DIR/meshes`); the thread count is rayon's (set `RAYON_NUM_THREADS`). Prints a
 //! Markdown table.
 
@@ -15,7 +17,7 @@ use std::time::Instant;
 use gwn::eval::antipodal::WindingNumber;
 use gwn::products::remesh::lattice::Lattice;
 use gwn::products::remesh::report::TopologyReport;
-use gwn::products::remesh::{DEFAULT_BISECTION_STEPS, crossings, extract, octree, place};
+use gwn::products::remesh::{DEFAULT_BISECTION_STEPS, crossings, extract, octree, place, simplify};
 
 const DEFAULT_MESHES: [&str; 2] = ["cgal-bunny00.off", "assimp-Spider_binary.stl"];
 
@@ -23,10 +25,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut res = Vec::new();
     let mut meshes = Vec::new();
     let mut guided = true;
+    let mut simplified = true;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         if a == "--bisect-only" {
             guided = false;
+        } else if a == "--no-simplify" {
+            simplified = false;
         } else if a == "--mesh" {
             meshes.push(PathBuf::from(args.next().ok_or("--mesh needs a file")?));
         } else {
@@ -46,10 +51,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .collect();
     }
     println!(
-        "| mesh | input faces | res | classify s | extract s | place s | evaluations | guided | total s | points \
-         classified | band cells | output faces | closed+manifold+oriented | Euler | components |"
+        "| mesh | input faces | res | classify s | extract s | place s | simplify s | evaluations | guided | \
+         total s | points classified | band cells | MT faces | MC faces | output faces | output / MC | \
+         closed+manifold+oriented | Euler | components |"
     );
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|");
+    println!(
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|"
+    );
     for path in &meshes {
         let mesh = gwn::io::load_mesh(path)?.mesh;
         let wn = WindingNumber::new(&mesh)?;
@@ -77,23 +85,45 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 DEFAULT_BISECTION_STEPS,
                 if guided { Some(&guide) } else { None },
             );
-            let positions = placed.positions;
             let t3 = Instant::now();
-            let rep = TopologyReport::of(&positions, &band.triangles);
+            let (positions, triangles) = if simplified {
+                let s = simplify::simplify(
+                    &placed.fixed,
+                    &band.triangles,
+                    placed.ticks_per_cell,
+                    &simplify::SimplifyOptions::default(),
+                    (simplify::DEFAULT_TARGET_FRACTION * band.marching_cubes_triangles as f64)
+                        as usize,
+                );
+                let positions: Vec<[f64; 3]> = s
+                    .vertices
+                    .iter()
+                    .map(|&v| placed.positions[v as usize])
+                    .collect();
+                (positions, s.triangles)
+            } else {
+                (placed.positions, band.triangles.clone())
+            };
+            let t4 = Instant::now();
+            let rep = TopologyReport::of(&positions, &triangles);
             let ok = rep.closed && rep.edge_manifold && rep.vertex_manifold && rep.oriented;
             println!(
-                "| {} | {} | {r} | {:.2} | {:.2} | {:.2} | {} | {} | {:.2} | {} | {} | {} | {} | {} | {} |",
+                "| {} | {} | {r} | {:.2} | {:.2} | {:.2} | {:.2} | {} | {} | {:.2} | {} | {} | {} | {} | {} | {:.3} | {} | {} | {} |",
                 path.file_name().and_then(|n| n.to_str()).unwrap_or("?"),
                 mesh.triangles().len(),
                 (t1 - t0).as_secs_f64(),
                 (t2 - t1).as_secs_f64(),
                 (t3 - t2).as_secs_f64(),
+                (t4 - t3).as_secs_f64(),
                 placed.evaluations,
                 placed.guided,
-                (t3 - t0).as_secs_f64(),
+                (t4 - t0).as_secs_f64(),
                 classified.labels.len(),
                 classified.band.len(),
+                band.triangles.len(),
+                band.marching_cubes_triangles,
                 rep.faces,
+                rep.faces as f64 / band.marching_cubes_triangles.max(1) as f64,
                 if ok { "yes" } else { "NO" },
                 rep.euler_characteristic,
                 rep.components

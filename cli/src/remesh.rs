@@ -6,6 +6,7 @@ use clap::Args as ClapArgs;
 use gwn::products::remesh::crossings::SegmentBvh;
 use gwn::products::remesh::intersect::self_intersections;
 use gwn::products::remesh::report::{TopologyReport, hausdorff_distance, occupancy_agreement};
+use gwn::products::remesh::simplify::SimplifyOptions;
 use gwn::products::remesh::thicken::ThickenedSheets;
 use gwn::products::remesh::write::{SurfaceFormat, write_surface};
 use gwn::products::remesh::{DEFAULT_BISECTION_STEPS, RemeshOptions, remesh_guided};
@@ -52,6 +53,18 @@ pub struct Args {
     /// surface is open; solids are left as they are. Meshes and soups only. Off by default.
     #[arg(long, value_name = "EPS")]
     pub thicken: Option<f64>,
+    /// Keep the raw marching-tetrahedra surface: no edge collapses (about 12x the faces of the
+    /// simplified surface, vertices within one tick of the class change).
+    #[arg(long)]
+    pub no_simplify: bool,
+    /// Simplification tolerance: every removed vertex stays within this many finest cells of
+    /// the simplified surface.
+    #[arg(long, default_value_t = gwn::products::remesh::simplify::DEFAULT_MAX_DISTANCE)]
+    pub simplify_distance: f64,
+    /// Stop simplifying at this fraction of a dense marching cubes' face count (0: as far as
+    /// the tolerance allows).
+    #[arg(long, default_value_t = gwn::products::remesh::simplify::DEFAULT_TARGET_FRACTION)]
+    pub simplify_target: f64,
     #[command(flatten)]
     pub method: MethodArgs,
     #[command(flatten)]
@@ -111,9 +124,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
         resolution: args.res,
         bisection_steps: args.bisect,
         max_classified_points: None,
+        simplify: (!args.no_simplify).then_some(SimplifyOptions {
+            max_distance: args.simplify_distance,
+            target_fraction_of_marching_cubes: args.simplify_target,
+            ..SimplifyOptions::default()
+        }),
     };
-    // Phases: classify, extract, place, write, self-intersections, Hausdorff, agreement.
-    let bar = crate::common::progress(7, "remesh");
+    // Phases: classify, extract, place, [simplify,] write, self-intersections, Hausdorff,
+    // agreement.
+    let bar = crate::common::progress(if args.no_simplify { 7 } else { 8 }, "remesh");
     let start = std::time::Instant::now();
     let guide = match input.mesh() {
         Some(m) if !args.no_guide => Some(SegmentBvh::of_mesh(m)),
@@ -175,10 +194,29 @@ pub fn run(args: Args) -> Result<(), CliError> {
         s.band_cells
     )?;
     outln!("{topology}")?;
+    if options.simplify.is_some() {
+        outln!(
+            "faces: {} marching tetrahedra, {} after {} edge collapses ({:.1} %); a dense marching \
+             cubes would have {} ({:.1} % of it)",
+            s.extracted_faces,
+            topology.faces,
+            s.simplify.collapses,
+            100.0 * topology.faces as f64 / s.extracted_faces.max(1) as f64,
+            s.marching_cubes_faces,
+            100.0 * topology.faces as f64 / s.marching_cubes_faces.max(1) as f64
+        )?;
+    } else {
+        outln!(
+            "faces: {} marching tetrahedra (not simplified); a dense marching cubes would have {}",
+            s.extracted_faces,
+            s.marching_cubes_faces
+        )?;
+    }
     outln!(
-        "vertices placed at a verified crossing with the input: {} of {} ({} evaluations)",
+        "marching-tetrahedra vertices placed at a verified crossing with the input: {} of {} ({} \
+         evaluations)",
         s.guided_vertices,
-        mesh.positions().len(),
+        s.extracted_vertices,
         s.placement_evaluations
     )?;
     match &intersections {
@@ -225,6 +263,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
             ("method", format!("\"{}\"", gwn::eval::Evaluator::name(&wn))),
             ("guided_vertices", s.guided_vertices.to_string()),
             ("placement_evaluations", s.placement_evaluations.to_string()),
+            ("simplified", options.simplify.is_some().to_string()),
+            ("marching_tetrahedra_faces", s.extracted_faces.to_string()),
+            ("marching_cubes_faces", s.marching_cubes_faces.to_string()),
+            ("collapses", s.simplify.collapses.to_string()),
         ];
         match &intersections {
             Ok(r) => {

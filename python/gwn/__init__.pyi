@@ -175,6 +175,7 @@ def remesh(
     res: int = 128,
     *,
     bisect: int = 8,
+    simplify: bool = True,
     method: Literal["exact", "direct", "fast"] = "exact",
     beta: Optional[float] = None,
     order: Optional[int] = None,
@@ -182,7 +183,7 @@ def remesh(
     threads: Optional[int] = None,
     thicken: Optional[float] = None,
 ) -> Tuple[_F64, _I64]:
-    """A closed, manifold, oriented surface of the solid w > 1/2 as (V float64 (n, 3), F int64 (m, 3))."""
+    """A closed, manifold, oriented surface of the solid w > 1/2 as (V float64 (n, 3), F int64 (m, 3)); simplify=False: the raw marching-tetrahedra surface."""
 
 def sdf(
     V: _Floats,

@@ -412,7 +412,9 @@ pub fn filter_tets<'py>(
 ///
 /// ``res`` is the finest resolution (cells of edge longest extent / ``res``); ``bisect`` the
 /// placement precision (each vertex within ``cell / 2**(bisect+1)`` of where ``w`` crosses 1/2
-/// along its lattice edge). Every solid is kept, double walls and inner faces vanish where ``w``
+/// along its lattice edge); ``simplify`` (default on) reduces the marching-tetrahedra surface by
+/// edge collapses that keep every guarantee (each removed vertex within half a cell of the
+/// result; ``False``: the raw surface). Every solid is kept, double walls and inner faces vanish where ``w``
 /// says so, holes close where ``w`` decides. Returns ``(V, F)``: float64 (n, 3) and int64
 /// (m, 3), triangles counter-clockwise seen from outside. ``method``/``beta``/``order``/
 /// ``tolerance`` as in :func:`voxelize`; refused (``ValueError``) when the surface would not fit
@@ -420,7 +422,7 @@ pub fn filter_tets<'py>(
 /// slabs of half-thickness ``EPS`` where ``w`` says the surface is open, as ``gwn remesh
 /// --thicken``; ``EPS`` must be at least one finest cell.
 #[pyfunction]
-#[pyo3(signature = (V, F, res = 128, *, bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS, method = "exact", beta = None, order = None, tolerance = None, threads = None, thicken = None))]
+#[pyo3(signature = (V, F, res = 128, *, bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS, simplify = true, method = "exact", beta = None, order = None, tolerance = None, threads = None, thicken = None))]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub fn remesh<'py>(
     py: Python<'py>,
@@ -428,6 +430,7 @@ pub fn remesh<'py>(
     F: &Bound<'py, PyAny>,
     res: usize,
     bisect: u32,
+    simplify: bool,
     method: &str,
     beta: Option<f64>,
     order: Option<u8>,
@@ -449,6 +452,7 @@ pub fn remesh<'py>(
         resolution: res,
         bisection_steps: bisect,
         max_classified_points: None,
+        simplify: simplify.then(gwn::products::remesh::simplify::SimplifyOptions::default),
     };
     if let Some(eps) = thicken {
         let extent = (0..3)

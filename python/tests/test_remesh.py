@@ -49,6 +49,19 @@ def test_disjoint_cubes_stay_two_solids_and_open_box_closes():
     assert once and twice and len(F) > 0
 
 
+def test_simplify_false_gives_the_raw_surface_with_more_faces():
+    V, F = gwn.remesh(CUBE_V, CUBE_F, res=16)
+    Vr, Fr = gwn.remesh(CUBE_V, CUBE_F, res=16, simplify=False)
+    for V_, F_ in ((V, F), (Vr, Fr)):
+        once, twice, edges = edge_census(F_)
+        assert once and twice
+        assert len(np.unique(F_)) - edges + len(F_) == 2
+    assert len(F) * 3 < len(Fr)
+    # The simplified vertices are vertices of the raw surface.
+    raw = {tuple(p) for p in Vr}
+    assert all(tuple(p) in raw for p in V[np.unique(F)])
+
+
 def test_bad_arguments_are_value_errors():
     with pytest.raises(ValueError, match="resolution"):
         gwn.remesh(CUBE_V, CUBE_F, res=0)

@@ -13,3 +13,4 @@ mod label;
 mod products;
 mod remesh;
 mod remesh_cli;
+mod remesh_simplify;

@@ -13,7 +13,7 @@ use gwn::products::remesh::{RemeshError, RemeshOptions, Remeshed, remesh, remesh
 use gwn::products::sdf::SignedDistance;
 
 /// UV sphere of radius `r` centred at `c`, outward (`flip`: inward), `n` segments.
-fn sphere(c: [f64; 3], r: f64, n: usize, flip: bool) -> Mesh {
+pub(crate) fn sphere(c: [f64; 3], r: f64, n: usize, flip: bool) -> Mesh {
     let (rings, segs) = (n, 2 * n);
     let mut v = vec![[c[0], c[1], c[2] - r], [c[0], c[1], c[2] + r]];
     for i in 1..rings {
@@ -42,7 +42,7 @@ fn sphere(c: [f64; 3], r: f64, n: usize, flip: bool) -> Mesh {
 }
 
 /// Torus around z, radii `big` and `small`, outward.
-fn torus(big: f64, small: f64, n: usize) -> Mesh {
+pub(crate) fn torus(big: f64, small: f64, n: usize) -> Mesh {
     let (nu, nv) = (2 * n, n);
     let mut v = Vec::new();
     for i in 0..nu {
@@ -64,16 +64,32 @@ fn torus(big: f64, small: f64, n: usize) -> Mesh {
     Mesh::new(v, f).unwrap()
 }
 
-/// Remeshes `mesh` with its own triangles as the placement guide, and checks with exact
-/// predicates that the output has no self-intersection.
-fn run(mesh: &Mesh, res: usize) -> (Remeshed, TopologyReport) {
+/// Remeshes `mesh` (simplified, the default) with its own triangles as the placement guide,
+/// and checks with exact predicates that the output has no self-intersection.
+pub(crate) fn run(mesh: &Mesh, res: usize) -> (Remeshed, TopologyReport) {
+    run_with(mesh, &RemeshOptions::with_resolution(res))
+}
+
+/// [`run`] without simplification: the marching-tetrahedra surface.
+pub(crate) fn run_raw(mesh: &Mesh, res: usize) -> (Remeshed, TopologyReport) {
+    run_with(mesh, &raw(res))
+}
+
+pub(crate) fn raw(res: usize) -> RemeshOptions {
+    RemeshOptions {
+        simplify: None,
+        ..RemeshOptions::with_resolution(res)
+    }
+}
+
+pub(crate) fn run_with(mesh: &Mesh, options: &RemeshOptions) -> (Remeshed, TopologyReport) {
     let wn = WindingNumber::new(mesh).unwrap();
     let guide = SegmentBvh::of_mesh(mesh);
     let out = remesh_guided(
         &wn,
         Some(&guide),
         mesh.bounding_box().unwrap(),
-        &RemeshOptions::with_resolution(res),
+        options,
         &|_| {},
     )
     .unwrap();
@@ -85,14 +101,14 @@ fn run(mesh: &Mesh, res: usize) -> (Remeshed, TopologyReport) {
     (out, report)
 }
 
-fn assert_no_self_intersections(out: &Remeshed) {
+pub(crate) fn assert_no_self_intersections(out: &Remeshed) {
     let si = self_intersections(&out.fixed, &out.triangles, u64::MAX).unwrap();
     assert_eq!((si.pairs, si.degenerate_faces), (0, 0), "{si:?}");
     // Neighbouring faces were really compared.
     assert!(si.tested_pairs >= out.triangles.len(), "{si:?}");
 }
 
-fn assert_closed_manifold(r: &TopologyReport) {
+pub(crate) fn assert_closed_manifold(r: &TopologyReport) {
     assert!(r.faces > 0, "{r}");
     assert!(
         r.closed && r.edge_manifold && r.vertex_manifold && r.oriented,
@@ -102,7 +118,7 @@ fn assert_closed_manifold(r: &TopologyReport) {
 }
 
 /// Signed volume of the triangles selected by `keep` (outward orientation: positive).
-fn signed_volume(out: &Remeshed, keep: impl Fn([f64; 3]) -> bool) -> f64 {
+pub(crate) fn signed_volume(out: &Remeshed, keep: impl Fn([f64; 3]) -> bool) -> f64 {
     let mut vol = 0.0;
     for t in &out.triangles {
         let [a, b, c] = t.map(|i| out.positions[i as usize]);
@@ -118,7 +134,12 @@ fn signed_volume(out: &Remeshed, keep: impl Fn([f64; 3]) -> bool) -> f64 {
 
 /// Fraction of `n` random points in the input's box (grown by 10 %) farther than `cells` cells
 /// from the output surface where input and output agree on `w > ½`; also the number compared.
-fn occupancy_agreement(mesh: &Mesh, out: &Remeshed, n: usize, cells: f64) -> (f64, usize) {
+pub(crate) fn occupancy_agreement(
+    mesh: &Mesh,
+    out: &Remeshed,
+    n: usize,
+    cells: f64,
+) -> (f64, usize) {
     let input = WindingNumber::new(mesh).unwrap();
     let out_mesh = Mesh::new(out.positions.clone(), out.triangles.clone()).unwrap();
     let output = SignedDistance::new(&out_mesh).unwrap();
@@ -146,7 +167,7 @@ fn occupancy_agreement(mesh: &Mesh, out: &Remeshed, n: usize, cells: f64) -> (f6
 fn sphere_is_a_closed_genus_zero_manifold_near_the_input() {
     let mesh = sphere([0.1, -0.2, 0.3], 1.0, 24, false);
     for res in [8, 32, 100] {
-        let (out, r) = run(&mesh, res);
+        let (out, r) = run_raw(&mesh, res);
         assert_closed_manifold(&r);
         assert_eq!(
             (r.euler_characteristic, r.components),
@@ -174,7 +195,7 @@ fn resolution_256_refines_only_the_band() {
     // Topology and memory do not depend on placement: no bisection keeps the test short.
     let options = RemeshOptions {
         bisection_steps: 0,
-        ..RemeshOptions::with_resolution(256)
+        ..raw(256)
     };
     let out = remesh(&wn, mesh.bounding_box().unwrap(), &options).unwrap();
     let r = TopologyReport::of(&out.positions, &out.triangles);
@@ -364,7 +385,13 @@ fn labelling_of_every_kind_gives_a_closed_manifold() {
         max: [2.0, 1.5, 1.0],
     };
     for res in [7, 20, 130] {
-        let out = remesh(&Noise, bounds, &RemeshOptions::with_resolution(res)).unwrap();
+        // Simplified too where the exact check runs (the largest case would only cost time).
+        let options = if res <= 20 {
+            RemeshOptions::with_resolution(res)
+        } else {
+            raw(res)
+        };
+        let out = remesh(&Noise, bounds, &options).unwrap();
         let r = TopologyReport::of(&out.positions, &out.triangles);
         assert_closed_manifold(&r);
         // No self-intersection either, whatever the labelling (docs/remesh.md's argument; the
@@ -451,9 +478,9 @@ fn guided_placement_matches_bisection_with_far_fewer_evaluations() {
     let mesh = sphere([0.1, -0.2, 0.3], 1.0, 24, false);
     let wn = WindingNumber::new(&mesh).unwrap();
     let bounds = mesh.bounding_box().unwrap();
-    let options = RemeshOptions::with_resolution(40);
+    let options = raw(40);
     let bisected = remesh(&wn, bounds, &options).unwrap();
-    let (guided, _) = run(&mesh, 40);
+    let (guided, _) = run_raw(&mesh, 40);
     // Extraction does not depend on placement: the same triangles over the same lattice edges.
     assert_eq!(guided.triangles, bisected.triangles);
     let vertices = guided.positions.len();
@@ -499,7 +526,7 @@ fn a_misleading_guide_costs_evaluations_not_correctness() {
     let mesh = sphere([0.0; 3], 1.0, 24, false);
     let wn = WindingNumber::new(&mesh).unwrap();
     let bounds = mesh.bounding_box().unwrap();
-    let options = RemeshOptions::with_resolution(32);
+    let options = raw(32);
     let bisected = remesh(&wn, bounds, &options).unwrap();
     let wrong = SegmentBvh::of_mesh(&mesh.translated([3.0 * 2.0 / 32.0, 0.0, 0.0]));
     let out = remesh_guided(&wn, Some(&wrong), bounds, &options, &|_| {}).unwrap();
@@ -550,7 +577,11 @@ fn thicken_turns_open_sheets_into_slabs_and_leaves_solids_alone() {
     triangles.extend(ball.triangles().iter().map(|t| t.map(|i| i + n)));
     let both = Mesh::new(positions, triangles).unwrap();
     let bounds = both.bounding_box().unwrap();
-    let options = RemeshOptions::with_resolution(48);
+    // Raw surfaces: the simplification's stopping point depends on the whole face count.
+    let options = RemeshOptions {
+        simplify: None,
+        ..RemeshOptions::with_resolution(48)
+    };
     let guide = SegmentBvh::of_mesh(&both);
     let wn = WindingNumber::new(&both).unwrap();
     let eps = 0.05;

@@ -38,6 +38,10 @@ fn remesh_writes_every_format_and_a_report() {
             "\"self_intersections\": 0",
             "\"collinear_faces\": 0",
             "\"hausdorff_cells\": ",
+            "\"simplified\": true",
+            "\"marching_tetrahedra_faces\": ",
+            "\"marching_cubes_faces\": ",
+            "\"collapses\": ",
         ] {
             assert!(json.contains(member), "{member} not in {json}");
         }
@@ -48,6 +52,55 @@ fn remesh_writes_every_format_and_a_report() {
         assert!(r.closed && r.edge_manifold && r.oriented, "{ext}: {r}");
         assert_eq!(r.euler_characteristic, 2, "{ext}: {r}");
     }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `--no-simplify` writes the marching-tetrahedra surface: the face count the simplified run
+/// reports as before simplification, and more faces than the simplified run.
+#[test]
+fn no_simplify_writes_the_marching_tetrahedra_surface() {
+    let dir = std::env::temp_dir().join(format!("gwn-cli-remesh-raw-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let input = dir.join("cube.obj");
+    gwn::mesh::write_obj(
+        std::fs::File::create(&input).unwrap(),
+        &gwn::testing::unit_cube(false),
+    )
+    .unwrap();
+    let faces = |extra: &[&str]| -> (usize, usize) {
+        let out = dir.join("o.ply");
+        let report = dir.join("r.json");
+        let mut args = vec![
+            "remesh",
+            input.to_str().unwrap(),
+            "--res",
+            "12",
+            "--samples",
+            "0",
+            "--out",
+            out.to_str().unwrap(),
+            "--report",
+            report.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let (ok, _, stderr) = gwn(&args);
+        assert!(ok, "{stderr}");
+        let json = std::fs::read_to_string(&report).unwrap();
+        let member = |key: &str| -> usize {
+            let at = json.find(&format!("\"{key}\": ")).unwrap() + key.len() + 4;
+            json[at..]
+                .split(|c: char| !c.is_ascii_digit())
+                .next()
+                .unwrap()
+                .parse()
+                .unwrap()
+        };
+        (member("faces"), member("marching_tetrahedra_faces"))
+    };
+    let (simplified, before) = faces(&[]);
+    let (raw, raw_before) = faces(&["--no-simplify"]);
+    assert_eq!((raw, raw_before), (before, before));
+    assert!(simplified < raw, "{simplified} vs {raw}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -64,7 +117,7 @@ fn remesh_errors_are_one_line() {
     let input = input.to_str().unwrap();
     let out = dir.join("o.obj");
     let out = out.to_str().unwrap();
-    let cases: [(&[&str], &str); 4] = [
+    let cases: [(&[&str], &str); 5] = [
         (
             &["remesh", input, "--out", "x.vtk"],
             "unknown output extension",
@@ -78,6 +131,10 @@ fn remesh_errors_are_one_line() {
             "bisection steps",
         ),
         (&["remesh", "/nonexistent/m.obj", "--out", out], "m.obj"),
+        (
+            &["remesh", input, "--simplify-distance=-1", "--out", out],
+            "simplification option",
+        ),
     ];
     for (args, needle) in cases {
         let (ok, _, stderr) = gwn(args);

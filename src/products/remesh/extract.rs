@@ -36,6 +36,9 @@ pub struct Band {
     pub triangles: Vec<[u32; 3]>,
     /// Finest cells in the band.
     pub band_cells: usize,
+    /// Triangles a dense marching cubes would give on the same corner classes
+    /// ([`marching_cubes_triangles`] summed over the band: only band cells have any).
+    pub marching_cubes_triangles: usize,
 }
 
 /// Extracts the separating surface of the band of `classified`.
@@ -55,9 +58,12 @@ pub fn extract(lattice: &Lattice, classified: &Classified) -> Band {
                 (edges.len() - 1) as u32
             })
     };
+    let mc_table = marching_cubes_table();
     for &m in &classified.band {
         let corners: [Corner; 8] = std::array::from_fn(|b| offset(m, b, 1));
         let inside: [bool; 8] = std::array::from_fn(|b| classified.label(corners[b]));
+        let case = (0..8).filter(|&b| inside[b]).fold(0, |c, b| c | (1 << b));
+        band.marching_cubes_triangles += usize::from(mc_table[case]);
         for tet in FREUDENTHAL {
             let v = tet.map(|b| corners[b]);
             let ins = tet.map(|b| inside[b]);
@@ -93,6 +99,80 @@ pub fn extract(lattice: &Lattice, classified: &Classified) -> Band {
     band
 }
 
+/// Triangles of marching cubes in a cube whose inside corners are the set bits of `case`
+/// (corner bits x: 1, y: 2, z: 4): the surface crosses the `k` edges whose corners differ and
+/// is cut into polygons, one per cycle of the crossing points joined across the cube's faces,
+/// and a polygon of `n` points is `n − 2` triangles, so the count is `k − 2·cycles`. A face with
+/// four crossings (two diagonal inside corners: the ambiguous case) is resolved by separating
+/// the inside corners. This is the count of the classic table (Lorensen & Cline) for every
+/// unambiguous case; in the ambiguous ones any resolution gives `k − 2·cycles` for its own
+/// cycles, and differs from this one by at most 2 triangles per cube.
+pub fn marching_cubes_triangles(case: u8) -> u8 {
+    let inside = |b: usize| case & (1 << b) != 0;
+    // The 12 cube edges as corner pairs, and their index.
+    let mut edges: Vec<(usize, usize)> = Vec::new();
+    for a in 0..8usize {
+        for bit in [1, 2, 4] {
+            if a & bit == 0 {
+                edges.push((a, a | bit));
+            }
+        }
+    }
+    let edge_index = |a: usize, b: usize| {
+        edges
+            .iter()
+            .position(|&e| e == (a.min(b), a.max(b)))
+            .unwrap_or(0)
+    };
+    let cut: Vec<bool> = edges.iter().map(|&(a, b)| inside(a) != inside(b)).collect();
+    let mut parent: Vec<usize> = (0..12).collect();
+    fn root(parent: &mut [usize], mut x: usize) -> usize {
+        while parent[x] != x {
+            x = parent[x];
+        }
+        x
+    }
+    let mut join = |a: usize, b: usize| {
+        let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+        parent[ra] = rb;
+    };
+    for axis in [1usize, 2, 4] {
+        let (p, q) = match axis {
+            1 => (2, 4),
+            2 => (4, 1),
+            _ => (1, 2),
+        };
+        for side in [0, axis] {
+            // The face's corners in cyclic order, and its edges e_i = (c_i, c_i+1).
+            let c = [side, side | p, side | p | q, side | q];
+            let e: [usize; 4] = std::array::from_fn(|i| edge_index(c[i], c[(i + 1) % 4]));
+            let crossed: Vec<usize> = (0..4).filter(|&i| cut[e[i]]).collect();
+            match crossed.len() {
+                2 => join(e[crossed[0]], e[crossed[1]]),
+                4 => {
+                    // Separate the inside corners: pair the two edges around each of them.
+                    for i in 0..4 {
+                        if inside(c[i]) {
+                            join(e[(i + 3) % 4], e[i]);
+                        }
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+    let k = cut.iter().filter(|&&x| x).count();
+    let cycles = (0..12)
+        .filter(|&i| cut[i] && root(&mut parent, i) == i)
+        .count();
+    (k - 2 * cycles) as u8
+}
+
+/// [`marching_cubes_triangles`] for every case.
+pub fn marching_cubes_table() -> [u8; 256] {
+    std::array::from_fn(|case| marching_cubes_triangles(case as u8))
+}
+
 /// Whether the triangle through the midpoints of `edges` (inside, outside corners) has its
 /// normal pointing from the inside corner to the outside corner of `edges[0]` (exact: twice the
 /// midpoints are integers; the product is nonzero because the midpoint plane of a tetrahedron
@@ -112,4 +192,50 @@ fn outward(edges: &[(Corner, Corner); 3]) -> bool {
     let (i, o) = edges[0];
     let d = [0, 1, 2].map(|a| i64::from(o[a]) - i64::from(i[a]));
     n[0] * d[0] + n[1] * d[1] + n[2] * d[2] > 0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn marching_cubes_counts_of_the_classic_cases() {
+        let case = |corners: &[usize]| corners.iter().fold(0u8, |c, &b| c | (1 << b));
+        // Nothing, one corner, an edge, a face, two corners across a face (ambiguous: two
+        // triangles), across the cube, three corners of a face, a corner and its three
+        // neighbours (a hexagon: four triangles).
+        assert_eq!(marching_cubes_triangles(0), 0);
+        assert_eq!(marching_cubes_triangles(0xff), 0);
+        assert_eq!(marching_cubes_triangles(case(&[0])), 1);
+        assert_eq!(marching_cubes_triangles(case(&[0, 1])), 2);
+        assert_eq!(marching_cubes_triangles(case(&[0, 1, 2, 3])), 2);
+        assert_eq!(marching_cubes_triangles(case(&[0, 3])), 2);
+        assert_eq!(marching_cubes_triangles(case(&[0, 7])), 2);
+        assert_eq!(marching_cubes_triangles(case(&[0, 1, 2])), 3);
+        assert_eq!(marching_cubes_triangles(case(&[0, 1, 2, 4])), 4);
+        let table = marching_cubes_table();
+        // Every unambiguous case (no face with its inside corners on a diagonal) counts the
+        // same as its complement; at most 5 triangles per cube, as in the classic table.
+        let ambiguous = |c: u8| {
+            [
+                (0, 3, 1, 2),
+                (4, 7, 5, 6),
+                (0, 5, 1, 4),
+                (2, 7, 3, 6),
+                (0, 6, 2, 4),
+                (1, 7, 3, 5),
+            ]
+            .iter()
+            .any(|&(a, b, p, q)| {
+                let i = |k: usize| c & (1 << k) != 0;
+                i(a) == i(b) && i(p) == i(q) && i(a) != i(p)
+            })
+        };
+        for c in 0..=255u8 {
+            assert!(table[c as usize] <= 5, "{c:#010b}");
+            if !ambiguous(c) {
+                assert_eq!(table[c as usize], table[!c as usize], "{c:#010b}");
+            }
+        }
+    }
 }

@@ -245,11 +245,19 @@ fn projection_axis(n: [i128; 3]) -> usize {
 
 /// Whether the faces `s` and `t` (non-degenerate) meet outside what they share.
 pub fn faces_intersect(s: [P; 3], t: [P; 3]) -> bool {
-    let shared: Vec<(usize, usize)> = (0..3)
-        .flat_map(|i| (0..3).map(move |j| (i, j)))
-        .filter(|&(i, j)| s[i] == t[j])
-        .collect();
-    match shared.len() {
+    // At most three shared corners (no allocation: this runs for every candidate pair, and for
+    // every collapse the simplification tries).
+    let mut shared = [(0usize, 0usize); 3];
+    let mut count = 0;
+    for (i, p) in s.iter().enumerate() {
+        for (j, q) in t.iter().enumerate() {
+            if p == q && count < 3 {
+                shared[count] = (i, j);
+                count += 1;
+            }
+        }
+    }
+    match count {
         0 => {
             // Quick rejection: one face strictly on one side of the other's plane.
             let side = t.map(|p| orient(s[0], s[1], s[2], p));

@@ -21,7 +21,11 @@
 //!    once two evaluations confirm it, else by bisection (a fixed number of steps); `w` jumps
 //!    across a sheet, so linear interpolation of `w` would misplace it. Vertices stay strictly
 //!    inside their edges, which is all the no-self-intersection argument needs.
-//! 5. [`report`], [`intersect`]: closed, edge- and vertex-manifold, oriented, Euler
+//! 5. [`simplify`] (on by default, [`RemeshOptions::simplify`]): half-edge collapses that keep
+//!    every vertex on its exact fixed-point position and refuse any collapse that would break the
+//!    manifold (link condition), flip a face, move a removed vertex farther than a tolerance, or
+//!    make two faces meet (exact test), down to a fraction of a dense marching cubes' face count.
+//! 6. [`report`], [`intersect`]: closed, edge- and vertex-manifold, oriented, Euler
 //!    characteristic, components, the exact self-intersection count (on the fixed-point
 //!    vertices), the sampled Hausdorff distance, printed and as JSON.
 //!
@@ -47,6 +51,7 @@ pub mod lattice;
 pub mod octree;
 pub mod place;
 pub mod report;
+pub mod simplify;
 pub mod thicken;
 pub mod write;
 
@@ -82,15 +87,19 @@ pub struct RemeshOptions {
     /// `None`: the memory available ([`crate::grid::available_memory`]) over
     /// [`BYTES_PER_CLASSIFIED_POINT`] (2³¹ points where unknown).
     pub max_classified_points: Option<usize>,
+    /// Simplify the marching-tetrahedra surface by edge collapses ([`simplify`]) that keep every
+    /// guarantee; `None`: the raw marching-tetrahedra surface.
+    pub simplify: Option<simplify::SimplifyOptions>,
 }
 
 impl RemeshOptions {
-    /// `resolution` with the default bisection steps.
+    /// `resolution` with the default bisection steps and the default simplification.
     pub fn with_resolution(resolution: usize) -> Self {
         RemeshOptions {
             resolution,
             bisection_steps: DEFAULT_BISECTION_STEPS,
             max_classified_points: None,
+            simplify: Some(simplify::SimplifyOptions::default()),
         }
     }
 }
@@ -110,6 +119,14 @@ pub enum RemeshError {
     },
     /// The bounds are not finite, or `min > max` on some axis.
     BadBounds,
+    /// A simplification option is out of range: a tolerance or target that is negative or not
+    /// finite, or a face extent of 0.
+    BadSimplification {
+        /// The option's name.
+        option: &'static str,
+        /// Its value.
+        value: f64,
+    },
     /// The output would have more than `u32::MAX` vertices.
     TooManyVertices,
     /// Classification reached its point budget ([`RemeshOptions::max_classified_points`]):
@@ -133,6 +150,11 @@ impl std::fmt::Display for RemeshError {
             RemeshError::BadBounds => {
                 f.write_str("bounds must be finite with min <= max on every axis")
             }
+            RemeshError::BadSimplification { option, value } => write!(
+                f,
+                "simplification option {option} = {value} is out of range (finite, >= 0; the \
+                 face extent >= 1)"
+            ),
             RemeshError::TooManyVertices => f.write_str("the output has more than 2^32 vertices"),
             RemeshError::OutOfMemory { max_points } => write!(
                 f,
@@ -165,6 +187,15 @@ pub struct RemeshStats {
     pub placement_evaluations: usize,
     /// Vertices placed at a verified crossing with the input triangles (no bisection).
     pub guided_vertices: usize,
+    /// Triangles of the marching-tetrahedra surface (before simplification).
+    pub extracted_faces: usize,
+    /// Vertices of the marching-tetrahedra surface (before simplification).
+    pub extracted_vertices: usize,
+    /// Triangles a dense marching cubes would give on the same corner classes (counted per band
+    /// cell from its case, [`extract::marching_cubes_triangles`]; not built).
+    pub marching_cubes_faces: usize,
+    /// Simplification counters (all 0 without simplification).
+    pub simplify: simplify::SimplifyStats,
 }
 
 /// The surface [`remesh`] returns.
@@ -211,6 +242,8 @@ pub enum RemeshPhase {
     Extract,
     /// Vertex placement (guided crossings, bisection).
     Place,
+    /// Edge collapses ([`RemeshOptions::simplify`]).
+    Simplify,
 }
 
 impl RemeshPhase {
@@ -220,6 +253,7 @@ impl RemeshPhase {
             RemeshPhase::Classify => "classifying lattice corners",
             RemeshPhase::Extract => "extracting the surface",
             RemeshPhase::Place => "placing vertices",
+            RemeshPhase::Simplify => "simplifying",
         }
     }
 }
@@ -251,6 +285,26 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
             steps: options.bisection_steps,
         });
     }
+    if let Some(s) = options.simplify {
+        let bad = |x: f64| !(x.is_finite() && x >= 0.0);
+        for (option, value, wrong) in [
+            ("max_distance", s.max_distance, bad(s.max_distance)),
+            (
+                "target_fraction_of_marching_cubes",
+                s.target_fraction_of_marching_cubes,
+                bad(s.target_fraction_of_marching_cubes),
+            ),
+            (
+                "max_face_extent",
+                f64::from(s.max_face_extent),
+                s.max_face_extent == 0,
+            ),
+        ] {
+            if wrong {
+                return Err(RemeshError::BadSimplification { option, value });
+            }
+        }
+    }
     let lattice =
         lattice::Lattice::new(bounds, options.resolution).ok_or(RemeshError::BadBounds)?;
     let max_points = options.max_classified_points.unwrap_or_else(|| {
@@ -274,7 +328,7 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
         options.bisection_steps,
         guide,
     );
-    let stats = RemeshStats {
+    let mut stats = RemeshStats {
         lattice_cells: lattice.cells,
         coarse_cells: lattice.coarse_cells(),
         levels: lattice.levels,
@@ -283,11 +337,40 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
         band_cells: band.band_cells,
         placement_evaluations: placed.evaluations,
         guided_vertices: placed.guided,
+        extracted_faces: band.triangles.len(),
+        extracted_vertices: band.edges.len(),
+        marching_cubes_faces: band.marching_cubes_triangles,
+        simplify: simplify::SimplifyStats::default(),
+    };
+    drop(classified);
+    let (positions, fixed, triangles) = match &options.simplify {
+        None => (placed.positions, placed.fixed, band.triangles),
+        Some(simplify_options) => {
+            progress(RemeshPhase::Simplify);
+            let s = simplify::simplify(
+                &placed.fixed,
+                &band.triangles,
+                placed.ticks_per_cell,
+                simplify_options,
+                (simplify_options.target_fraction_of_marching_cubes
+                    * band.marching_cubes_triangles as f64) as usize,
+            );
+            stats.simplify = s.stats;
+            let keep = |v: &u32| *v as usize;
+            (
+                s.vertices
+                    .iter()
+                    .map(|v| placed.positions[keep(v)])
+                    .collect(),
+                s.vertices.iter().map(|v| placed.fixed[keep(v)]).collect(),
+                s.triangles,
+            )
+        }
     };
     Ok(Remeshed {
-        positions: placed.positions,
-        triangles: band.triangles,
-        fixed: placed.fixed,
+        positions,
+        triangles,
+        fixed,
         ticks_per_cell: placed.ticks_per_cell,
         cell_size: lattice.h,
         stats,

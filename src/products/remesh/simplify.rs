@@ -1,0 +1,754 @@
+//! Simplification of the extracted surface by half-edge collapses on the fixed-point vertices.
+//!
+//! A collapse `u → v` removes the vertex `u` and moves its faces to `v`, which keeps its exact
+//! fixed-point position: every vertex of the result is a vertex of the marching-tetrahedra
+//! surface, so the exact predicates of [`super::intersect`] apply to it unchanged. Collapses run
+//! in the order of a quadric error (the area-weighted mean squared distance of `v` to the planes
+//! of the faces merged into `u`, plus a small length term so that flat regions collapse short
+//! edges first), from a priority queue with lazy invalidation, one at a time: the result is the
+//! same on every run and for every thread count.
+//!
+//! A collapse is made only if it keeps every guarantee of the surface; it is refused when
+//! - **link** ([`Refusal::Link`]): `u` and `v` have other common neighbours than the two
+//!   vertices opposite their edge, or both faces over those two exist (a tetrahedron): the
+//!   collapse would pinch the surface or create a duplicate face. Otherwise the collapse of an
+//!   edge of a closed 2-manifold leaves a closed 2-manifold of the same topology (Dey, Edelsbrunner
+//!   et al., "Topology preserving edge contraction"), and consistently oriented: each moved face
+//!   keeps its vertex order;
+//! - **flip** ([`Refusal::Flip`]): a moved face `(u, a, b) → (v, a, b)` would be degenerate
+//!   (collinear, exact cross product 0) or turn by 90° or more (exact sign of the dot product of
+//!   the old and new normals);
+//! - **size** ([`Refusal::FaceTooLarge`]): a new face's box would exceed
+//!   [`SimplifyOptions::max_face_extent`] cells along an axis (bounds the spatial index's work);
+//! - **distance** ([`Refusal::Distance`]): `u`, or a vertex removed earlier into one of `u`'s faces,
+//!   would be farther than [`SimplifyOptions::max_distance`] cells from the new faces (computed
+//!   in `f64`: a geometric tolerance, not a topological guarantee). Every removed vertex stays
+//!   within that distance of the surface, which bounds how far the simplified surface moves from
+//!   the marching-tetrahedra one;
+//! - **intersection** ([`Refusal::Intersection`]): a new face meets, outside what they share, any
+//!   other face of the surface ([`super::intersect::faces_intersect`], exact) whose box overlaps
+//!   it, or another new face. The marching-tetrahedra surface has no self-intersection
+//!   (`docs/remesh.md`) and no collapse adds one, so neither does the result.
+//!
+//! The input must be a closed, edge- and vertex-manifold, consistently oriented surface without
+//! collinear faces (what [`super::extract`] and [`super::place`] produce); any other input is
+//! returned unchanged ([`SimplifyStats::skipped`]).
+
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+use super::intersect::{MAX_COORDINATE, faces_intersect};
+use super::lattice::KeyMap;
+use crate::kernel::predicates::cross_exact;
+
+type P = [i64; 3];
+
+/// Default [`SimplifyOptions::max_distance`], in finest cells.
+pub const DEFAULT_MAX_DISTANCE: f64 = 0.5;
+
+/// Default [`SimplifyOptions::max_face_extent`], in finest cells.
+pub const DEFAULT_MAX_FACE_EXTENT: u32 = 6;
+
+/// Default [`SimplifyOptions::target_fraction_of_marching_cubes`].
+pub const DEFAULT_TARGET_FRACTION: f64 = 0.45;
+
+/// Weight of the squared edge length (lattice units) added to the quadric error: in flat
+/// regions, where the quadric is 0 for every target, short edges collapse first (rounder faces).
+const LENGTH_WEIGHT: f64 = 1e-3;
+
+/// Options of [`simplify`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SimplifyOptions {
+    /// Largest distance, in finest cells, from a removed vertex to the simplified surface.
+    pub max_distance: f64,
+    /// Largest extent of a face's bounding box along any axis, in finest cells.
+    pub max_face_extent: u32,
+    /// Stop once the face count is at most this fraction of a dense marching cubes' on the same
+    /// corner classes (the remesher's [`super::RemeshStats::marching_cubes_faces`]; [`simplify`]
+    /// itself takes a face count); 0: collapse as far as the other bounds allow. Collapses run
+    /// cheapest first, so stopping early keeps the flattest regions simplified and the curved
+    /// ones closest to the marching-tetrahedra surface.
+    pub target_fraction_of_marching_cubes: f64,
+}
+
+impl Default for SimplifyOptions {
+    fn default() -> Self {
+        SimplifyOptions {
+            max_distance: DEFAULT_MAX_DISTANCE,
+            max_face_extent: DEFAULT_MAX_FACE_EXTENT,
+            target_fraction_of_marching_cubes: DEFAULT_TARGET_FRACTION,
+        }
+    }
+}
+
+/// Why a collapse `u → v` was refused.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Refusal {
+    /// `u` or `v` was removed, or `u v` is not an edge with exactly two faces.
+    NotAnEdge,
+    /// The link condition fails (the surface would pinch or get a duplicate face).
+    Link,
+    /// A new face would be larger than [`SimplifyOptions::max_face_extent`].
+    FaceTooLarge,
+    /// A moved face would become degenerate or turn by 90° or more.
+    Flip,
+    /// A removed vertex would be farther than [`SimplifyOptions::max_distance`] from the surface.
+    Distance,
+    /// A new face would meet another face of the surface.
+    Intersection,
+}
+
+/// Counters of one [`simplify`] run.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SimplifyStats {
+    /// Faces before.
+    pub faces_before: usize,
+    /// Faces after.
+    pub faces_after: usize,
+    /// Collapses made.
+    pub collapses: usize,
+    /// Collapses refused, by reason: link, face size, flip, distance, intersection.
+    pub refused: [usize; 5],
+    /// The input was not a closed oriented manifold without collinear faces: left unchanged.
+    pub skipped: bool,
+}
+
+/// The result of [`simplify`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Simplified {
+    /// Triangles over the kept vertices (indices into [`Simplified::vertices`]).
+    pub triangles: Vec<[u32; 3]>,
+    /// For each kept vertex, its index in the input.
+    pub vertices: Vec<u32>,
+    /// Counters.
+    pub stats: SimplifyStats,
+}
+
+/// Simplifies the closed surface `triangles` over the exact `points` (fixed point,
+/// `ticks_per_cell` units per finest cell) by half-edge collapses that keep it closed, manifold,
+/// oriented, of the same topology and free of self-intersections (see the module documentation).
+/// Collapses stop once at most `target_faces` faces are left (0: no target).
+pub fn simplify(
+    points: &[P],
+    triangles: &[[u32; 3]],
+    ticks_per_cell: i64,
+    options: &SimplifyOptions,
+    target_faces: usize,
+) -> Simplified {
+    match Simplifier::new(points, triangles, ticks_per_cell, options) {
+        Some(mut s) => {
+            s.run(target_faces);
+            s.finish()
+        }
+        None => Simplified {
+            triangles: triangles.to_vec(),
+            vertices: (0..points.len() as u32).collect(),
+            stats: SimplifyStats {
+                faces_before: triangles.len(),
+                faces_after: triangles.len(),
+                skipped: true,
+                ..SimplifyStats::default()
+            },
+        },
+    }
+}
+
+/// The state of a simplification: a face list with removed faces marked dead, vertex-to-face
+/// lists, the removed vertices each face answers for, quadrics, and a spatial index of the faces.
+#[derive(Debug)]
+pub struct Simplifier<'a> {
+    points: &'a [P],
+    /// `points` in lattice units.
+    at: Vec<[f64; 3]>,
+    faces: Vec<[u32; 3]>,
+    alive: Vec<bool>,
+    vertex_faces: Vec<Vec<u32>>,
+    removed: Vec<bool>,
+    /// Per face: the removed vertices it answers for (each within `max_distance` of it).
+    support: Vec<Vec<u32>>,
+    /// Per vertex: area-weighted plane quadric (10 coefficients) and total area.
+    quadric: Vec<[f64; 11]>,
+    /// Faces by size class `k` (box extent at most `2^k` cells) and the bucket (`2^(k+1)` cells)
+    /// of their box's minimum corner: a face of class `k` meeting a box `lo..=hi` has its
+    /// minimum corner in `lo − 2^k cells..=hi`, so a query visits a few buckets per class and
+    /// only faces of about its size.
+    grids: Vec<KeyMap<Vec<(u32, P, P)>>>,
+    ticks: i64,
+    max_extent: i64,
+    /// Squared distance bound, lattice units.
+    max_distance2: f64,
+    stats: SimplifyStats,
+}
+
+/// What a collapse changes, computed by [`Simplifier::plan`].
+#[derive(Debug)]
+struct Plan {
+    /// Faces of `u` (all die).
+    old: Vec<u32>,
+    /// The new faces.
+    new: Vec<[u32; 3]>,
+    /// Per new face, the removed vertices it will answer for.
+    support: Vec<Vec<u32>>,
+}
+
+impl<'a> Simplifier<'a> {
+    /// The state for `triangles` over `points`; `None` when the input is not a closed, edge- and
+    /// vertex-manifold, consistently oriented surface without collinear faces, or has a
+    /// coordinate the exact predicates cannot take.
+    pub fn new(
+        points: &'a [P],
+        triangles: &[[u32; 3]],
+        ticks_per_cell: i64,
+        options: &SimplifyOptions,
+    ) -> Option<Simplifier<'a>> {
+        if ticks_per_cell <= 0
+            || !(options.max_distance.is_finite() && options.max_distance >= 0.0)
+            || points
+                .iter()
+                .any(|p| p.iter().any(|c| c.unsigned_abs() >= MAX_COORDINATE as u64))
+            || triangles
+                .iter()
+                .any(|t| t.iter().any(|&v| v as usize >= points.len()))
+        {
+            return None;
+        }
+        let scale = 1.0 / ticks_per_cell as f64;
+        let at: Vec<[f64; 3]> = points.iter().map(|p| p.map(|c| c as f64 * scale)).collect();
+        let report = super::report::TopologyReport::of(&at, triangles);
+        if !(report.closed && report.edge_manifold && report.vertex_manifold && report.oriented)
+            || report.degenerate_faces > 0
+        {
+            return None;
+        }
+        let mut vertex_faces = vec![Vec::new(); points.len()];
+        let mut quadric = vec![[0.0; 11]; points.len()];
+        for (f, t) in triangles.iter().enumerate() {
+            let p = t.map(|v| points[v as usize]);
+            if cross_exact(sub(p[1], p[0]), sub(p[2], p[0])) == [0; 3] {
+                return None;
+            }
+            let q = plane_quadric(t.map(|v| at[v as usize]));
+            for &v in t {
+                vertex_faces[v as usize].push(f as u32);
+                for (a, b) in quadric[v as usize].iter_mut().zip(&q) {
+                    *a += b;
+                }
+            }
+        }
+        let max_extent = i64::from(options.max_face_extent.max(1)).saturating_mul(ticks_per_cell);
+        let mut s = Simplifier {
+            points,
+            at,
+            faces: triangles.to_vec(),
+            alive: vec![true; triangles.len()],
+            vertex_faces,
+            removed: vec![false; points.len()],
+            support: vec![Vec::new(); triangles.len()],
+            quadric,
+            grids: Vec::new(),
+            ticks: ticks_per_cell,
+            max_extent,
+            max_distance2: (options.max_distance * options.max_distance),
+            stats: SimplifyStats {
+                faces_before: triangles.len(),
+                ..SimplifyStats::default()
+            },
+        };
+        for f in 0..s.faces.len() {
+            s.index(f as u32, true);
+        }
+        Some(s)
+    }
+
+    /// Greedy collapses in quadric-error order until none is allowed or at most `target_faces`
+    /// faces are left.
+    pub fn run(&mut self, target_faces: usize) {
+        let n = self.points.len();
+        // Lazy invalidation: an entry counts only if its version is the vertex's. `queued` is the
+        // cost of the vertex's valid entry, if any: a vertex whose best cost did not change keeps
+        // its entry (popping it re-examines every target anyway).
+        let mut version = vec![0u32; n];
+        let mut queued: Vec<Option<u64>> = vec![None; n];
+        let mut heap: BinaryHeap<Reverse<(u64, u32, u32)>> = BinaryHeap::new();
+        for u in 0..n as u32 {
+            if let Some(c) = self.best_cost(u) {
+                heap.push(Reverse((c.to_bits(), u, 0)));
+                queued[u as usize] = Some(c.to_bits());
+            }
+        }
+        let mut candidates: Vec<(u64, u32)> = Vec::new();
+        while let Some(Reverse((_, u, ver))) = heap.pop() {
+            if self.stats.faces_before - 2 * self.stats.collapses <= target_faces {
+                break;
+            }
+            if self.removed[u as usize] || ver != version[u as usize] {
+                continue;
+            }
+            queued[u as usize] = None;
+            let ring = self.neighbours(u);
+            candidates.clear();
+            for &v in &ring {
+                let c = self.cost(u, v);
+                if c <= self.max_distance2 {
+                    candidates.push((c.to_bits(), v));
+                }
+            }
+            candidates.sort_unstable();
+            for &(_, v) in &candidates {
+                match self.collapse(u, v) {
+                    Ok(()) => {
+                        for &x in &ring {
+                            let best = self.best_cost(x).map(f64::to_bits);
+                            if best != queued[x as usize] || best.is_none() {
+                                version[x as usize] += 1;
+                                queued[x as usize] = best;
+                                if let Some(c) = best {
+                                    heap.push(Reverse((c, x, version[x as usize])));
+                                }
+                            }
+                        }
+                        break;
+                    }
+                    Err(r) => {
+                        let k = match r {
+                            Refusal::NotAnEdge => continue,
+                            Refusal::Link => 0,
+                            Refusal::FaceTooLarge => 1,
+                            Refusal::Flip => 2,
+                            Refusal::Distance => 3,
+                            Refusal::Intersection => 4,
+                        };
+                        self.stats.refused[k] += 1;
+                    }
+                }
+            }
+        }
+    }
+
+    /// The surface: kept vertices renumbered in input order, live faces in creation order.
+    pub fn finish(mut self) -> Simplified {
+        let mut index = vec![u32::MAX; self.points.len()];
+        let mut vertices = Vec::new();
+        for (v, &gone) in self.removed.iter().enumerate() {
+            if !gone && !self.vertex_faces[v].is_empty() {
+                index[v] = vertices.len() as u32;
+                vertices.push(v as u32);
+            }
+        }
+        let triangles: Vec<[u32; 3]> = self
+            .faces
+            .iter()
+            .zip(&self.alive)
+            .filter(|(_, a)| **a)
+            .map(|(t, _)| t.map(|v| index[v as usize]))
+            .collect();
+        self.stats.faces_after = triangles.len();
+        Simplified {
+            triangles,
+            vertices,
+            stats: self.stats,
+        }
+    }
+
+    /// Counters so far.
+    pub fn stats(&self) -> SimplifyStats {
+        self.stats
+    }
+
+    /// Collapses `u` into `v` if every check passes.
+    pub fn collapse(&mut self, u: u32, v: u32) -> Result<(), Refusal> {
+        let plan = self.plan(u, v)?;
+        for &f in &plan.old {
+            self.alive[f as usize] = false;
+            self.index(f, false);
+            for x in self.faces[f as usize] {
+                if x != u {
+                    self.vertex_faces[x as usize].retain(|&g| g != f);
+                }
+            }
+        }
+        self.vertex_faces[u as usize].clear();
+        self.removed[u as usize] = true;
+        for (t, support) in plan.new.into_iter().zip(plan.support) {
+            let f = self.faces.len() as u32;
+            self.faces.push(t);
+            self.alive.push(true);
+            self.support.push(support);
+            for x in t {
+                self.vertex_faces[x as usize].push(f);
+            }
+            self.index(f, true);
+        }
+        for &f in &plan.old {
+            self.support[f as usize] = Vec::new();
+        }
+        let qu = self.quadric[u as usize];
+        for (a, b) in self.quadric[v as usize].iter_mut().zip(&qu) {
+            *a += b;
+        }
+        self.stats.collapses += 1;
+        Ok(())
+    }
+
+    /// Whether `u → v` passes every check, without making it.
+    pub fn check(&self, u: u32, v: u32) -> Result<(), Refusal> {
+        self.plan(u, v).map(|_| ())
+    }
+
+    /// The live faces now (vertex indices of the input).
+    pub fn faces(&self) -> Vec<[u32; 3]> {
+        self.faces
+            .iter()
+            .zip(&self.alive)
+            .filter(|(_, a)| **a)
+            .map(|(t, _)| *t)
+            .collect()
+    }
+
+    fn plan(&self, u: u32, v: u32) -> Result<Plan, Refusal> {
+        if u == v
+            || self.removed[u as usize]
+            || self.removed[v as usize]
+            || u as usize >= self.points.len()
+            || v as usize >= self.points.len()
+        {
+            return Err(Refusal::NotAnEdge);
+        }
+        let old = self.vertex_faces[u as usize].clone();
+        let mut opposite = Vec::with_capacity(2);
+        for &f in &old {
+            let t = self.faces[f as usize];
+            if t.contains(&v) {
+                opposite.push(t[0] ^ t[1] ^ t[2] ^ u ^ v);
+            }
+        }
+        if opposite.len() != 2 {
+            return Err(Refusal::NotAnEdge);
+        }
+        // Link condition: the common neighbours are exactly the two opposite vertices, and the
+        // edge between them is not in both links (the tetrahedron).
+        let nu = self.neighbours(u);
+        let nv = self.neighbours(v);
+        let common = nu.iter().filter(|x| nv.binary_search(x).is_ok()).count();
+        if common != 2 {
+            return Err(Refusal::Link);
+        }
+        let has_face = |x: u32, a: u32, b: u32| {
+            self.vertex_faces[x as usize].iter().any(|&f| {
+                let t = self.faces[f as usize];
+                t.contains(&a) && t.contains(&b)
+            })
+        };
+        let (w1, w2) = (opposite[0], opposite[1]);
+        if has_face(u, w1, w2) && has_face(v, w1, w2) {
+            return Err(Refusal::Link);
+        }
+        let p = |x: u32| self.points[x as usize];
+        let mut new = Vec::with_capacity(old.len());
+        for &f in &old {
+            let t = self.faces[f as usize];
+            if t.contains(&v) {
+                continue;
+            }
+            let n = t.map(|x| if x == u { v } else { x });
+            let (lo, hi) = face_box(n.map(p));
+            if (0..3).any(|a| hi[a] - lo[a] > self.max_extent) {
+                return Err(Refusal::FaceTooLarge);
+            }
+            let before = normal(t.map(p));
+            let after = normal(n.map(p));
+            if after == [0; 3] || dot_sign(before, after) <= 0 {
+                return Err(Refusal::Flip);
+            }
+            new.push(n);
+        }
+        // Distance: u and every vertex u's faces answer for, to the nearest new face.
+        let triangles: Vec<[[f64; 3]; 3]> =
+            new.iter().map(|t| t.map(|x| self.at[x as usize])).collect();
+        let mut support = vec![Vec::new(); new.len()];
+        let points = std::iter::once(u).chain(
+            old.iter()
+                .flat_map(|&f| self.support[f as usize].iter().copied()),
+        );
+        for x in points {
+            let q = self.at[x as usize];
+            let (best, d2) = triangles
+                .iter()
+                .enumerate()
+                .map(|(k, t)| (k, point_triangle_distance2(q, t)))
+                .fold((0, f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
+            if d2.is_nan() || d2 > self.max_distance2 {
+                return Err(Refusal::Distance);
+            }
+            support[best].push(x);
+        }
+        // Intersections: new faces against each other and against the live faces near them.
+        let exact: Vec<[P; 3]> = new.iter().map(|t| t.map(p)).collect();
+        for i in 0..exact.len() {
+            for j in i + 1..exact.len() {
+                if boxes_overlap(face_box(exact[i]), face_box(exact[j]))
+                    && faces_intersect(exact[i], exact[j])
+                {
+                    return Err(Refusal::Intersection);
+                }
+            }
+        }
+        let mut lo = [i64::MAX; 3];
+        let mut hi = [i64::MIN; 3];
+        for t in &exact {
+            let (l, h) = face_box(*t);
+            for a in 0..3 {
+                lo[a] = lo[a].min(l[a]);
+                hi[a] = hi[a].max(h[a]);
+            }
+        }
+        let mut near: Vec<u32> = Vec::new();
+        for (k, grid) in self.grids.iter().enumerate() {
+            let reach = lo.map(|c| c - (self.ticks << k));
+            let bucket = self.ticks << (k + 1);
+            for_buckets(reach, hi, bucket, |key| {
+                if let Some(list) = grid.get(&key) {
+                    near.extend(
+                        list.iter()
+                            .filter(|(g, l, h)| {
+                                boxes_overlap((*l, *h), (lo, hi)) && !old.contains(g)
+                            })
+                            .map(|e| e.0),
+                    );
+                }
+            });
+        }
+        for &g in &near {
+            let tg = self.faces[g as usize].map(p);
+            let bg = face_box(tg);
+            for t in &exact {
+                if boxes_overlap(face_box(*t), bg) && faces_intersect(*t, tg) {
+                    return Err(Refusal::Intersection);
+                }
+            }
+        }
+        Ok(Plan { old, new, support })
+    }
+
+    /// Sorted distinct neighbours of `x`.
+    fn neighbours(&self, x: u32) -> Vec<u32> {
+        let mut n: Vec<u32> = self.vertex_faces[x as usize]
+            .iter()
+            .flat_map(|&f| self.faces[f as usize])
+            .filter(|&y| y != x)
+            .collect();
+        n.sort_unstable();
+        n.dedup();
+        n
+    }
+
+    /// The ordering error of `u → v`: the area-weighted mean squared distance of `v` to the
+    /// planes merged into `u` (lattice units²), plus the length term.
+    fn cost(&self, u: u32, v: u32) -> f64 {
+        let q = &self.quadric[u as usize];
+        let [x, y, z] = self.at[v as usize];
+        let pu = self.at[u as usize];
+        let e = q[0] * x * x
+            + 2.0 * q[1] * x * y
+            + 2.0 * q[2] * x * z
+            + 2.0 * q[3] * x
+            + q[4] * y * y
+            + 2.0 * q[5] * y * z
+            + 2.0 * q[6] * y
+            + q[7] * z * z
+            + 2.0 * q[8] * z
+            + q[9];
+        let len2 = (x - pu[0]).powi(2) + (y - pu[1]).powi(2) + (z - pu[2]).powi(2);
+        (e / q[10].max(f64::MIN_POSITIVE)).max(0.0) + LENGTH_WEIGHT * len2
+    }
+
+    fn best_cost(&self, u: u32) -> Option<f64> {
+        if self.removed[u as usize] {
+            return None;
+        }
+        self.neighbours(u)
+            .into_iter()
+            .map(|v| self.cost(u, v))
+            .filter(|&c| c <= self.max_distance2)
+            .min_by(f64::total_cmp)
+    }
+
+    /// Adds face `f` to (or removes it from) the spatial index.
+    fn index(&mut self, f: u32, insert: bool) {
+        let (lo, hi) = face_box(self.faces[f as usize].map(|x| self.points[x as usize]));
+        let extent = (0..3).map(|a| hi[a] - lo[a]).max().unwrap_or(0);
+        let mut k = 0;
+        while (self.ticks << k) < extent {
+            k += 1;
+        }
+        if self.grids.len() <= k {
+            self.grids.resize_with(k + 1, KeyMap::default);
+        }
+        let bucket = self.ticks << (k + 1);
+        let key = bucket_key(lo.map(|c| c.div_euclid(bucket)));
+        let list = self.grids[k].entry(key).or_default();
+        if insert {
+            list.push((f, lo, hi));
+        } else if let Some(i) = list.iter().position(|e| e.0 == f) {
+            list.swap_remove(i);
+        }
+    }
+}
+
+/// Calls `f` with the key of every bucket (side `bucket`) that the box `lo..=hi` overlaps.
+fn for_buckets(lo: P, hi: P, bucket: i64, mut f: impl FnMut(u64)) {
+    let b = |c: i64| c.div_euclid(bucket);
+    for z in b(lo[2])..=b(hi[2]) {
+        for y in b(lo[1])..=b(hi[1]) {
+            for x in b(lo[0])..=b(hi[0]) {
+                f(bucket_key([x, y, z]));
+            }
+        }
+    }
+}
+
+/// A bucket key: 21 bits per axis (bucket coordinates are below `2^20` for lattice coordinates
+/// below `2^21` cells; wrapping only merges far buckets, which costs box tests, never a miss).
+fn bucket_key(b: P) -> u64 {
+    let m = |c: i64| (c as u64) & ((1 << 21) - 1);
+    m(b[0]) | (m(b[1]) << 21) | (m(b[2]) << 42)
+}
+
+fn sub(a: P, b: P) -> P {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+/// Exact `(b − a) × (c − a)`.
+fn normal(t: [P; 3]) -> [i128; 3] {
+    cross_exact(sub(t[1], t[0]), sub(t[2], t[0]))
+}
+
+/// Exact sign of `a · b` for `i128` vectors (components below `2^123`): an `f64` filter, then
+/// arbitrary precision.
+fn dot_sign(a: [i128; 3], b: [i128; 3]) -> i32 {
+    let products: [f64; 3] = std::array::from_fn(|k| a[k] as f64 * b[k] as f64);
+    let sum: f64 = products.iter().sum();
+    let bound: f64 = 8.0 * f64::EPSILON * products.iter().map(|x| x.abs()).sum::<f64>();
+    if sum > bound {
+        return 1;
+    }
+    if sum < -bound {
+        return -1;
+    }
+    use num_bigint::BigInt;
+    let exact: BigInt = (0..3)
+        .map(|k| BigInt::from(a[k]) * BigInt::from(b[k]))
+        .sum();
+    match exact.sign() {
+        num_bigint::Sign::Plus => 1,
+        num_bigint::Sign::Minus => -1,
+        num_bigint::Sign::NoSign => 0,
+    }
+}
+
+fn face_box(t: [P; 3]) -> (P, P) {
+    (
+        std::array::from_fn(|a| t[0][a].min(t[1][a]).min(t[2][a])),
+        std::array::from_fn(|a| t[0][a].max(t[1][a]).max(t[2][a])),
+    )
+}
+
+fn boxes_overlap((alo, ahi): (P, P), (blo, bhi): (P, P)) -> bool {
+    (0..3).all(|a| alo[a] <= bhi[a] && blo[a] <= ahi[a])
+}
+
+/// The area-weighted quadric of the plane of `t`: 10 coefficients of `(n·x + d)²` times the
+/// area, and the area.
+fn plane_quadric(t: [[f64; 3]; 3]) -> [f64; 11] {
+    let u = [0, 1, 2].map(|k| t[1][k] - t[0][k]);
+    let v = [0, 1, 2].map(|k| t[2][k] - t[0][k]);
+    let n = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    if len == 0.0 || !len.is_finite() {
+        return [0.0; 11];
+    }
+    let [a, b, c] = n.map(|x| x / len);
+    let d = -(a * t[0][0] + b * t[0][1] + c * t[0][2]);
+    let w = 0.5 * len;
+    [
+        w * a * a,
+        w * a * b,
+        w * a * c,
+        w * a * d,
+        w * b * b,
+        w * b * c,
+        w * b * d,
+        w * c * c,
+        w * c * d,
+        w * d * d,
+        w,
+    ]
+}
+
+/// Squared distance from `p` to the closed triangle `t` (Ericson, "Real-Time Collision
+/// Detection", 5.1.5).
+pub fn point_triangle_distance2(p: [f64; 3], t: &[[f64; 3]; 3]) -> f64 {
+    let s = |x: [f64; 3], y: [f64; 3]| [x[0] - y[0], x[1] - y[1], x[2] - y[2]];
+    let dot = |x: [f64; 3], y: [f64; 3]| x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+    let [a, b, c] = *t;
+    let (ab, ac, ap) = (s(b, a), s(c, a), s(p, a));
+    let closest = |q: [f64; 3]| {
+        let d = s(p, q);
+        dot(d, d)
+    };
+    let along =
+        |o: [f64; 3], e: [f64; 3], k: f64| [o[0] + k * e[0], o[1] + k * e[1], o[2] + k * e[2]];
+    let (d1, d2) = (dot(ab, ap), dot(ac, ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return closest(a);
+    }
+    let bp = s(p, b);
+    let (d3, d4) = (dot(ab, bp), dot(ac, bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return closest(b);
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return closest(along(a, ab, d1 / (d1 - d3)));
+    }
+    let cp = s(p, c);
+    let (d5, d6) = (dot(ab, cp), dot(ac, cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return closest(c);
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return closest(along(a, ac, d2 / (d2 - d6)));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        return closest(along(b, s(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6))));
+    }
+    let denom = va + vb + vc;
+    if denom.is_nan() || denom <= 0.0 {
+        // Degenerate (collinear) triangle: the nearest of its edges.
+        return [(a, b), (b, c), (c, a)]
+            .iter()
+            .map(|&(x, y)| {
+                let e = s(y, x);
+                let l = dot(e, e);
+                let k = if l > 0.0 {
+                    (dot(s(p, x), e) / l).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                closest(along(x, e, k))
+            })
+            .fold(f64::INFINITY, f64::min);
+    }
+    let (v, w) = (vb / denom, vc / denom);
+    closest([
+        a[0] + ab[0] * v + ac[0] * w,
+        a[1] + ab[1] * v + ac[1] * w,
+        a[2] + ab[2] * v + ac[2] * w,
+    ])
+}

@@ -1,0 +1,320 @@
+//! `products::remesh::simplify`: the simplified surface keeps every guarantee of the
+//! marching-tetrahedra one (closed forms), and the collapses that would break one are refused
+//! (hand-made surfaces on the fixed-point lattice).
+
+use crate::common;
+use crate::remesh::{
+    assert_closed_manifold, occupancy_agreement, raw, run, run_with, sphere, torus,
+};
+
+use gwn::Mesh;
+use gwn::products::remesh::RemeshOptions;
+use gwn::products::remesh::report::{TopologyReport, hausdorff_distance};
+use gwn::products::remesh::simplify::{
+    DEFAULT_TARGET_FRACTION, Refusal, Simplifier, SimplifyOptions, simplify,
+};
+
+/// Sphere, torus, hollow shell, two cubes sharing a face: after simplification the surface is
+/// still closed, manifold, oriented, of the same Euler characteristic and components, with 0
+/// exact self-intersections (checked in `run`), at most the target fraction of a dense
+/// marching cubes' faces, within one cell of the input (sampled Hausdorff), and with the same
+/// `w > ½` label as the input everywhere farther than a cell from it.
+#[test]
+fn simplified_closed_forms_keep_every_guarantee() {
+    let cubes = common::unit_cube()
+        .concatenated(&common::unit_cube().translated([1.0, 0.0, 0.0]))
+        .unwrap();
+    let shell = sphere([0.0; 3], 1.0, 24, false)
+        .concatenated(&sphere([0.0; 3], 0.5, 16, true))
+        .unwrap();
+    let cases: [(&str, Mesh, usize); 4] = [
+        ("sphere", sphere([0.1, -0.2, 0.3], 1.0, 24, false), 20),
+        ("torus", torus(1.0, 0.4, 24), 24),
+        ("shell", shell, 20),
+        ("cubes", cubes, 16),
+    ];
+    for (name, mesh, res) in cases {
+        // The raw surface's own checks are in remesh.rs: only its counts are needed here.
+        let before = gwn::products::remesh::remesh_guided(
+            &gwn::eval::antipodal::WindingNumber::new(&mesh).unwrap(),
+            Some(&gwn::products::remesh::crossings::SegmentBvh::of_mesh(
+                &mesh,
+            )),
+            mesh.bounding_box().unwrap(),
+            &raw(res),
+            &|_| {},
+        )
+        .unwrap();
+        let rb = TopologyReport::of(&before.positions, &before.triangles);
+        let (after, ra) = run(&mesh, res);
+        assert_closed_manifold(&ra);
+        assert_eq!(
+            (ra.euler_characteristic, ra.components),
+            (rb.euler_characteristic, rb.components),
+            "{name}: {ra} vs {rb}"
+        );
+        let s = after.stats;
+        assert_eq!(s.extracted_faces, before.triangles.len(), "{name}");
+        assert_eq!(s.simplify.faces_before, before.triangles.len(), "{name}");
+        assert_eq!(s.simplify.faces_after, after.triangles.len(), "{name}");
+        // At most the target fraction of marching cubes (collapses stop there; two faces go per
+        // collapse), and far below the marching-tetrahedra count.
+        let target = (DEFAULT_TARGET_FRACTION * s.marching_cubes_faces as f64) as usize;
+        assert!(
+            after.triangles.len() <= target,
+            "{name}: {} faces, target {target}",
+            after.triangles.len()
+        );
+        assert!(
+            after.triangles.len() * 5 < before.triangles.len(),
+            "{name}: {} of {}",
+            after.triangles.len(),
+            before.triangles.len()
+        );
+        // Every vertex is a vertex of the marching-tetrahedra surface, at the same fixed point.
+        let mut raw_fixed = before.fixed.clone();
+        raw_fixed.sort_unstable();
+        assert!(
+            after
+                .fixed
+                .iter()
+                .all(|p| raw_fixed.binary_search(p).is_ok()),
+            "{name}"
+        );
+        let out_mesh = Mesh::new(after.positions.clone(), after.triangles.clone()).unwrap();
+        let raw_mesh = Mesh::new(before.positions.clone(), before.triangles.clone()).unwrap();
+        let moved = hausdorff_distance(&raw_mesh, &out_mesh, 1500, 7).unwrap();
+        assert!(
+            moved < after.cell_size,
+            "{name}: {moved} from the raw surface, cell {}",
+            after.cell_size
+        );
+        // Closed inputs (not the cubes, whose shared wall is inside the union and rightly gone).
+        if name != "cubes" {
+            let d = hausdorff_distance(&mesh, &out_mesh, 1500, 7).unwrap();
+            assert!(
+                d < after.cell_size,
+                "{name}: Hausdorff {d}, cell {}",
+                after.cell_size
+            );
+        }
+        let (agreement, compared) = occupancy_agreement(&mesh, &after, 1000, 1.0);
+        assert!(
+            compared > 250 && agreement == 1.0,
+            "{name}: {agreement} of {compared}"
+        );
+    }
+}
+
+#[test]
+fn simplification_is_the_same_for_every_run_and_thread_count() {
+    let mesh = torus(1.0, 0.4, 24);
+    let on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| run(&mesh, 20).0)
+    };
+    let one = on(1);
+    assert_eq!(one, on(2));
+    assert_eq!(one, on(1));
+}
+
+#[test]
+fn simplification_options_are_checked_and_zero_tolerance_keeps_flat_collapses_only() {
+    let mesh = sphere([0.0; 3], 1.0, 16, false);
+    let wn = gwn::eval::antipodal::WindingNumber::new(&mesh).unwrap();
+    let bb = mesh.bounding_box().unwrap();
+    for bad in [
+        SimplifyOptions {
+            max_distance: f64::NAN,
+            ..SimplifyOptions::default()
+        },
+        SimplifyOptions {
+            target_fraction_of_marching_cubes: -1.0,
+            ..SimplifyOptions::default()
+        },
+        SimplifyOptions {
+            max_face_extent: 0,
+            ..SimplifyOptions::default()
+        },
+    ] {
+        let options = RemeshOptions {
+            simplify: Some(bad),
+            ..RemeshOptions::with_resolution(8)
+        };
+        let e = gwn::products::remesh::remesh(&wn, bb, &options).unwrap_err();
+        assert!(e.to_string().contains("simplification option"), "{e}");
+    }
+    // Tolerance 0: only collapses whose removed vertices lie exactly on the new faces (flat
+    // fans) are made; the surface still has every guarantee.
+    let zero = RemeshOptions {
+        simplify: Some(SimplifyOptions {
+            max_distance: 0.0,
+            target_fraction_of_marching_cubes: 0.0,
+            ..SimplifyOptions::default()
+        }),
+        ..RemeshOptions::with_resolution(20)
+    };
+    let (out, r) = run_with(&mesh, &zero);
+    assert_closed_manifold(&r);
+    assert_eq!((r.euler_characteristic, r.components), (2, 1), "{r}");
+    let (before, _) = run_with(&mesh, &raw(20));
+    assert!(out.triangles.len() <= before.triangles.len());
+}
+
+/// Ticks per cell of the hand-made surfaces below.
+const T: i64 = 16;
+
+/// A bipyramid: `ring` (counter-clockwise seen from +z), a top apex and a bottom apex; outward.
+/// Returns points and triangles, the top apex at index `offset + ring.len()`.
+fn bipyramid(
+    ring: &[[i64; 3]],
+    top: [i64; 3],
+    bottom: [i64; 3],
+    offset: u32,
+) -> (Vec<[i64; 3]>, Vec<[u32; 3]>) {
+    let n = ring.len() as u32;
+    let mut points = ring.to_vec();
+    points.push(top);
+    points.push(bottom);
+    let (t, b) = (offset + n, offset + n + 1);
+    let mut faces = Vec::new();
+    for i in 0..n {
+        let (p, q) = (offset + i, offset + (i + 1) % n);
+        faces.push([t, p, q]);
+        faces.push([b, q, p]);
+    }
+    (points, faces)
+}
+
+fn hexagon(z: i64) -> Vec<[i64; 3]> {
+    (0..6)
+        .map(|k| {
+            let a = std::f64::consts::PI / 3.0 * k as f64;
+            [
+                (48.0 * a.cos()).round() as i64,
+                (48.0 * a.sin()).round() as i64,
+                z,
+            ]
+        })
+        .collect()
+}
+
+fn generous() -> SimplifyOptions {
+    SimplifyOptions {
+        max_distance: 4.0,
+        max_face_extent: 16,
+        target_fraction_of_marching_cubes: 0.0,
+    }
+}
+
+fn is_clean(points: &[[i64; 3]], faces: &[[u32; 3]]) -> bool {
+    let positions: Vec<[f64; 3]> = points.iter().map(|p| p.map(|c| c as f64)).collect();
+    let r = TopologyReport::of(&positions, faces);
+    let si = gwn::products::remesh::intersect::self_intersections(points, faces, u64::MAX).unwrap();
+    r.closed && r.edge_manifold && r.vertex_manifold && r.oriented && si.pairs == 0
+}
+
+/// Solid A: a hexagonal bipyramid whose top apex `u` is sunk into a valley (z 0, rim z 10).
+/// Solid B above it: a bipyramid whose bottom apex hangs into the valley (z 5, rim z 20), one
+/// cell (16 ticks) away from A nowhere less than 5 ticks. Collapsing `u` onto a rim vertex
+/// flattens A's top at z 10, through B's tip: refused as an intersection, although it passes the
+/// link, flip and (generous) distance checks: without B the same collapse is made.
+#[test]
+fn a_collapse_through_another_sheet_is_refused() {
+    let (mut points, mut faces) = bipyramid(&hexagon(10), [0, 0, 0], [0, 0, -30], 0);
+    let a_len = points.len() as u32;
+    let u = 6;
+    let v = 0;
+    let alone = points.clone();
+    let alone_faces = faces.clone();
+    let (pb, fb) = bipyramid(&hexagon(20), [0, 0, 40], [0, 0, 5], a_len);
+    points.extend(pb);
+    faces.extend(fb);
+    assert!(is_clean(&points, &faces));
+    let s = Simplifier::new(&points, &faces, T, &generous()).unwrap();
+    assert_eq!(s.check(u, v), Err(Refusal::Intersection));
+    let mut alone_s = Simplifier::new(&alone, &alone_faces, T, &generous()).unwrap();
+    assert_eq!(alone_s.collapse(u, v), Ok(()));
+    assert!(is_clean(&alone, &alone_s.faces()));
+    // The whole run refuses it too and leaves two clean solids.
+    let out = simplify(&points, &faces, T, &generous(), 0);
+    let kept: Vec<[i64; 3]> = out.vertices.iter().map(|&i| points[i as usize]).collect();
+    assert!(is_clean(&kept, &out.triangles));
+    let r = TopologyReport::of(
+        &kept.iter().map(|p| p.map(|c| c as f64)).collect::<Vec<_>>(),
+        &out.triangles,
+    );
+    assert_eq!((r.components, r.euler_characteristic), (2, 4), "{r}");
+}
+
+/// A star-shaped but not convex fan: the top apex `u` over a ring in which the edge `a1 a2`
+/// separates `u` from the ring vertex `v`. Moving `u`'s faces to `v` turns `(u, a1, a2)` over:
+/// refused as a flip; the collapse onto a vertex that sees the whole ring is made.
+#[test]
+fn a_collapse_that_flips_a_face_is_refused() {
+    let ring = [
+        [48, 0, 0],
+        [16, 16, 0],
+        [32, 48, 0],
+        [-16, 16, 0],
+        [-16, -16, 0],
+        [16, -16, 0],
+    ];
+    let (points, faces) = bipyramid(&ring, [0, 0, 16], [0, 0, -16], 0);
+    assert!(is_clean(&points, &faces));
+    let u = 6;
+    let mut s = Simplifier::new(&points, &faces, T, &generous()).unwrap();
+    assert_eq!(s.check(u, 0), Err(Refusal::Flip));
+    // The ring seen from [-16, -16]: every new face keeps its orientation.
+    assert_eq!(s.collapse(u, 4), Ok(()));
+    assert!(is_clean(&points, &s.faces()));
+}
+
+/// The link condition: a tetrahedron has no allowed collapse (it would vanish into a doubled
+/// triangle), and an octahedron simplifies to the smallest closed surfaces it can.
+#[test]
+fn the_link_condition_keeps_small_solids_closed() {
+    let tet: Vec<[i64; 3]> = vec![[0, 0, 0], [32, 0, 0], [0, 32, 0], [0, 0, 32]];
+    let tf = vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]];
+    let s = Simplifier::new(&tet, &tf, T, &generous()).unwrap();
+    for u in 0..4 {
+        for v in 0..4 {
+            if u != v {
+                assert_eq!(s.check(u, v), Err(Refusal::Link), "{u} -> {v}");
+            }
+        }
+    }
+    assert_eq!(simplify(&tet, &tf, T, &generous(), 0).triangles.len(), 4);
+    let oct: Vec<[i64; 3]> = vec![
+        [32, 0, 0],
+        [-32, 0, 0],
+        [0, 32, 0],
+        [0, -32, 0],
+        [0, 0, 32],
+        [0, 0, -32],
+    ];
+    let of = vec![
+        [0, 2, 4],
+        [2, 1, 4],
+        [1, 3, 4],
+        [3, 0, 4],
+        [2, 0, 5],
+        [1, 2, 5],
+        [3, 1, 5],
+        [0, 3, 5],
+    ];
+    let out = simplify(&oct, &of, T, &generous(), 0);
+    let kept: Vec<[i64; 3]> = out.vertices.iter().map(|&i| oct[i as usize]).collect();
+    assert!(is_clean(&kept, &out.triangles));
+    assert!(
+        out.triangles.len() >= 4 && out.triangles.len() < 8,
+        "{:?}",
+        out.stats
+    );
+    // Not a closed manifold: left unchanged, and said so.
+    let open = simplify(&oct, &of[..7], T, &generous(), 0);
+    assert!(open.stats.skipped && open.triangles == of[..7].to_vec());
+}
