@@ -48,6 +48,7 @@ use gwn::eval::fast::{
     Admissibility, FastParams, FastWindingNumber, PointCloudWindingNumber,
     winding_number_points_direct,
 };
+use gwn::testing::SplitMix64;
 use rayon::prelude::*;
 
 /// CPU time of this process (user + system), from /proc (10 ms ticks; runs last ≥ 0.5 s).
@@ -61,24 +62,6 @@ fn cpu_seconds() -> f64 {
 
 /// A measured run lasts at least this much CPU (or wall) time, repeated as needed.
 const MIN_SECONDS: f64 = 0.5;
-
-/// splitmix64 (Steele, Lea & Flood): a small seeded generator, enough for sample points.
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1) with 53 random bits.
-    fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
-}
 
 /// Writes `rows` (each of `C` float64) as a NumPy `.npy` file (format 1.0, little-endian, C order).
 fn write_npy<const C: usize>(path: &str, rows: &[[f64; C]]) -> std::io::Result<()> {

@@ -35,6 +35,7 @@ use rayon::prelude::*;
 
 use super::npz::NpzWriter;
 use super::sdf::SignedDistance;
+use crate::base::splitmix::SplitMix64;
 use crate::error::{LoadError, LoadErrorKind, Location};
 use crate::eval::antipodal::BuildError;
 use crate::io::{LoadOptions, load_mesh_with, regular_file_metadata};
@@ -219,33 +220,14 @@ impl fmt::Display for LabelError {
 
 impl std::error::Error for LabelError {}
 
-/// SplitMix64 (Steele, Lea & Flood 2014): tiny, and its output is fixed by its definition.
-#[derive(Clone, Debug)]
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in `[0, 1)` with 53 random bits.
-    fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
-
-    /// Two independent standard normals (Box–Muller with `libm`, so every platform gets the same
-    /// bits).
-    fn normal_pair(&mut self) -> (f64, f64) {
-        let u1 = 1.0 - self.unit(); // (0, 1]: the logarithm stays finite
-        let u2 = self.unit();
-        let r = libm::sqrt(-2.0 * libm::log(u1));
-        let t = 2.0 * std::f64::consts::PI * u2;
-        (r * libm::cos(t), r * libm::sin(t))
-    }
+/// Two independent standard normals (Box–Muller with `libm`, so every platform gets the same
+/// bits).
+fn normal_pair(rng: &mut SplitMix64) -> (f64, f64) {
+    let u1 = 1.0 - rng.unit(); // (0, 1]: the logarithm stays finite
+    let u2 = rng.unit();
+    let r = libm::sqrt(-2.0 * libm::log(u1));
+    let t = 2.0 * std::f64::consts::PI * u2;
+    (r * libm::cos(t), r * libm::sin(t))
 }
 
 /// The seed of one mesh: the run's seed mixed with an FNV-1a hash of its key.
@@ -308,8 +290,8 @@ pub fn sample_points(
                 if r1 + r2 > 1.0 {
                     (r1, r2) = (1.0 - r1, 1.0 - r2);
                 }
-                let (n0, n1) = rng.normal_pair();
-                let (n2, _) = rng.normal_pair();
+                let (n0, n1) = normal_pair(&mut rng);
+                let (n2, _) = normal_pair(&mut rng);
                 let n = [n0, n1, n2];
                 points.push(std::array::from_fn(|j| {
                     a[j] + r1 * (b[j] - a[j]) + r2 * (c[j] - a[j]) + s * n[j]
@@ -975,7 +957,7 @@ mod tests {
         let n = 200_000;
         let (mut s, mut s2) = (0.0, 0.0);
         for _ in 0..n / 2 {
-            let (a, b) = r.normal_pair();
+            let (a, b) = normal_pair(&mut r);
             s += a + b;
             s2 += a * a + b * b;
         }

@@ -48,20 +48,7 @@ impl<'a> Source<'a> {
     }
 }
 
-/// SplitMix64 (Steele, Lea & Flood): the deterministic generator behind seeded cases.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct SplitMix64(pub u64);
-
-impl SplitMix64 {
-    /// The next 64 pseudo-random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-}
+pub use crate::base::splitmix::SplitMix64;
 
 #[cfg(test)]
 mod tests {

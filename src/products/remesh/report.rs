@@ -239,15 +239,8 @@ where
     if samples == 0 {
         return None;
     }
-    let mut state = seed;
-    // SplitMix64: reproducible without a dependency.
-    let mut next = move || {
-        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rng = crate::base::splitmix::SplitMix64(seed);
+    let mut next = move || rng.unit();
     let points: Vec<[f64; 3]> = (0..samples)
         .map(|_| std::array::from_fn(|a| bounds.min[a] + next() * (bounds.max[a] - bounds.min[a])))
         .collect();
@@ -322,14 +315,8 @@ fn surface_samples(triangles: &[[[f64; 3]; 3]], samples: usize, seed: u64) -> Ve
     if total <= 0.0 {
         return points;
     }
-    let mut state = seed;
-    let mut next = move || {
-        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rng = crate::base::splitmix::SplitMix64(seed);
+    let mut next = move || rng.unit();
     for _ in 0..samples {
         let x = next() * total;
         let f = cumulative
