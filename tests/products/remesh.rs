@@ -606,3 +606,36 @@ fn thicken_turns_open_sheets_into_slabs_and_leaves_solids_alone() {
     assert!(ThickenedSheets::new(&both, &wn, 0.0).is_err());
     assert!(ThickenedSheets::new(&both, &wn, f64::NAN).is_err());
 }
+
+/// Patch sets go through the same pipeline as meshes (bisection placement: no triangles to
+/// guide it): the exact rational sphere comes out a closed genus-0 manifold whose vertices lie
+/// within a cell of the unit sphere, with the ball's volume and no self-intersection.
+#[test]
+fn rational_sphere_patches_remesh_to_a_closed_sphere() {
+    use gwn::patch::{PatchSet, PatchWindingNumber};
+    let set = PatchSet::new(common::rational_sphere_patches()).unwrap();
+    let wn = PatchWindingNumber::new(&set);
+    let (lo, hi) = set.bounding_box();
+    let bounds = gwn::BoundingBox { min: lo, max: hi };
+    for res in [8, 16] {
+        let out = remesh(&wn, bounds, &raw(res)).unwrap();
+        assert_no_self_intersections(&out);
+        let r = TopologyReport::of(&out.positions, &out.triangles);
+        assert_closed_manifold(&r);
+        assert_eq!(
+            (r.euler_characteristic, r.components),
+            (2, 1),
+            "res {res}: {r}"
+        );
+        for p in &out.positions {
+            let d = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+            assert!(
+                (d - 1.0).abs() < out.cell_size,
+                "res {res}: vertex at radius {d}"
+            );
+        }
+        let vol = signed_volume(&out, |_| true);
+        let ball = 4.0 / 3.0 * std::f64::consts::PI;
+        assert!((vol / ball - 1.0).abs() < 0.06, "res {res}: volume {vol}");
+    }
+}
