@@ -11,7 +11,7 @@ enlarged by 10 % of its largest extent per side), every `step`-th point in grid 
 `winding_number(points, accuracy_scale)`.
 
     benches/peers/.venv/bin/python benches/peers/fast_accuracy.py [MESH_OR_DIR ...]
-        [--gwn target/release/gwn] [--betas 2,2.35] [--budget 1e7] [--rust]
+        [--gwn target/release/gwn] [--betas 2,2.35] [--budget 1e7] [--grid 32] [--rust]
 
 Meshes libigl cannot read (its reader crashes on pymeshlab-face000.ply) are reported and skipped.
 """
@@ -47,6 +47,8 @@ def main() -> None:
     ap.add_argument("--budget", type=float, default=1e7)
     ap.add_argument("--max-faces", type=int, default=1_100_000)
     ap.add_argument("--rust", action="store_true", help="print the Rust table of libigl's errors")
+    ap.add_argument("--grid", type=int, default=32,
+                    help="grid points per axis (32: the test's points; another value gives a held-out set)")
     args = ap.parse_args()
     import igl
 
@@ -75,7 +77,7 @@ def main() -> None:
             npz.unlink()
             if len(F) == 0 or len(F) > args.max_faces:
                 continue
-            P = grid_points(V, F, 32)
+            P = grid_points(V, F, args.grid)
             S = P[subset(P, len(F), args.budget)]
             R = V[np.unique(F.ravel())]
             diag = float(np.linalg.norm(R.max(0) - R.min(0)))
