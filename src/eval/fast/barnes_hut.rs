@@ -5,7 +5,9 @@ use rayon::prelude::*;
 use wide::{CmpGt, CmpLt, f32x4};
 
 use super::moments::{FarField, Moments};
-use super::packet::{Lanes8, PACKET};
+#[cfg(target_arch = "x86_64")]
+use super::packet::{Avx2, Avx8};
+use super::packet::{EightLanes, Lanes8, PACKET};
 use super::tree::{PARALLEL_GRAIN, Tree};
 
 /// Which node size the admissibility test `‖q − p̃‖ > β · size` uses.
@@ -428,24 +430,27 @@ impl Hierarchy {
         leaf: impl FnMut(usize, usize, std::ops::Range<usize>, &mut f64),
     ) -> [f64; PACKET] {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
+        if let Some(avx2) = Avx2::detect() {
             // SAFETY: as in `eval`: compiled for AVX2, and the CPU was just checked to have it.
             #[allow(unsafe_code)]
-            return unsafe { self.eval_packet_avx2(q, active, params, leaf) };
+            return unsafe { self.eval_packet_avx2(avx2, q, active, params, leaf) };
         }
-        self.eval_packet_lanes(q, active, params, leaf)
+        self.eval_packet_lanes::<Lanes8>((), q, active, params, leaf)
     }
 
+    /// The packet walk with the eight lanes in one AVX register ([`Avx8`]): the same IEEE
+    /// operations as the portable [`Lanes8`], so the same bits.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     fn eval_packet_avx2(
         &self,
+        avx2: Avx2,
         q: &[[f64; 3]; PACKET],
         active: u32,
         params: &FastParams,
         leaf: impl FnMut(usize, usize, std::ops::Range<usize>, &mut f64),
     ) -> [f64; PACKET] {
-        self.eval_packet_lanes(q, active, params, leaf)
+        self.eval_packet_lanes::<Avx8>(avx2, q, active, params, leaf)
     }
 
     /// The traversal of [`Hierarchy::eval_packet`]. Per query it makes the decisions of
@@ -453,8 +458,9 @@ impl Hierarchy {
     /// comparisons of [`Hierarchy::admit`]) and adds the same terms to the same sums in the same
     /// order.
     #[inline(always)]
-    pub(crate) fn eval_packet_lanes(
+    pub(crate) fn eval_packet_lanes<L: EightLanes>(
         &self,
+        token: L::Token,
         q: &[[f64; 3]; PACKET],
         active: u32,
         params: &FastParams,
@@ -474,16 +480,16 @@ impl Hierarchy {
         let (mut id, mut mask) = (0usize, active);
         loop {
             let node = &self.wide[id];
-            let dq: [Lanes8; 3] = std::array::from_fn(|k| {
-                Lanes8::from_array(qk[k].map(|v| (node.anchor[k] - v) as f32))
+            let dq: [L; 3] = std::array::from_fn(|k| {
+                L::from_array(token, qk[k].map(|v| (node.anchor[k] - v) as f32))
             });
             let size = self.wide_size[which][id].as_array_ref();
             for (l, &c) in node.child.iter().enumerate() {
                 if c == EMPTY {
                     break;
                 }
-                let r: [Lanes8; 3] = std::array::from_fn(|k| {
-                    Lanes8::splat(node.offset[k].as_array_ref()[l]) + dq[k]
+                let r: [L; 3] = std::array::from_fn(|k| {
+                    L::splat(token, node.offset[k].as_array_ref()[l]) + dq[k]
                 });
                 let d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
                 let bs = beta * size[l];
@@ -491,7 +497,7 @@ impl Hierarchy {
                 admitted &= mask;
                 if admitted != 0 {
                     let w = self.wide_far[id]
-                        .lane(l, Lanes8::splat)
+                        .lane(l, |v| L::splat(token, v))
                         .eval(r, order)
                         .to_array();
                     // Adding 0.0 leaves a sum unchanged (a sum that starts at +0.0 is never

@@ -13,7 +13,8 @@
 //! collapsed into a 4-wide one: one `f32x4` test decides a node's four admissibilities and one
 //! `f32x4` evaluation computes its four expansions (AVX2 when the CPU has it, chosen at run time;
 //! bit-identical either way). Batches walk the tree in Morton-sorted packets of eight queries,
-//! one `f32x8` lane per query, with the values of the queries one by one, bit for bit
+//! one lane of an 8-lane `f32` vector per query (one AVX register on CPUs with AVX2), with the
+//! values of the queries one by one, bit for bit
 //! (`packet.rs`). `FASTWN(q)` (Algorithm 1) uses a node's
 //! expansion when `‖q − p̃‖ > β r`, sums exact Van Oosterom–Strackee solid angles (four triangles
 //! at a time, one complex product instead of one `atan2` per triangle) or exact dipoles over a

@@ -25,7 +25,7 @@
 use crate::base::vec3::sub;
 use wide::f32x4;
 
-use super::packet::Lanes8;
+use super::packet::{EightLanes, Lanes8};
 
 use crate::base::vec3::{cross, dot};
 
@@ -363,7 +363,7 @@ impl Lanes for f32x4 {
 impl Lanes for Lanes8 {
     #[inline(always)]
     fn rsqrt(self) -> Self {
-        Lanes8::splat(1.0) / self.sqrt()
+        Lanes8::splat((), 1.0) / self.sqrt()
     }
 }
 
@@ -660,11 +660,31 @@ mod tests {
                     );
                     // The same lane for eight queries: the same f32 operations, lane by lane.
                     let r8 = [0, 1, 2].map(|k| {
-                        Lanes8::from_array(queries.map(|p| (nodes[l].center[k] - p[k]) as f32))
+                        Lanes8::from_array((), queries.map(|p| (nodes[l].center[k] - p[k]) as f32))
                     });
-                    let w8 = lanes.lane(l, Lanes8::splat).eval(r8, order).to_array();
+                    let w8 = lanes
+                        .lane(l, |v| Lanes8::splat((), v))
+                        .eval(r8, order)
+                        .to_array();
                     let i = queries.iter().position(|p| *p == q).expect("a query");
                     assert_eq!(w8[i].to_bits(), got[l].to_bits(), "order {order}, lane {l}");
+                    // And in one AVX register, where the CPU has AVX2.
+                    #[cfg(target_arch = "x86_64")]
+                    if let Some(t) = super::super::packet::Avx2::detect() {
+                        use super::super::packet::Avx8;
+                        let r8 = [0, 1, 2].map(|k| {
+                            Avx8::from_array(t, queries.map(|p| (nodes[l].center[k] - p[k]) as f32))
+                        });
+                        let w8 = lanes
+                            .lane(l, |v| Avx8::splat(t, v))
+                            .eval(r8, order)
+                            .to_array();
+                        assert_eq!(
+                            w8[i].to_bits(),
+                            got[l].to_bits(),
+                            "AVX, order {order}, lane {l}"
+                        );
+                    }
                 }
             }
         }

@@ -6,9 +6,12 @@
 //! twenty far-field coefficients per lane), for the stack and for a branch per lane, and uses
 //! four `f32` lanes of which some are masked out. Neighbouring queries open nearly the same
 //! nodes, so a packet loads each node once for eight queries and evaluates one lane's expansion
-//! for all of them in one eight-lane pass (one AVX register where the build targets AVX, two
-//! SSE registers otherwise: `wide` fixes the representation when it is compiled; plain arrays
-//! left to the auto-vectorizer came out slower, split into scalar and SSE code).
+//! for all of them in one eight-lane pass: [`Avx8`], one AVX register, on CPUs with AVX2
+//! (chosen at run time, like the exact loops), else [`Lanes8`], `wide::f32x8`, which is two SSE
+//! registers in a portable build (`wide` fixes its representation when it is compiled, so a
+//! function compiled for AVX2 still gets the SSE pairs: measured on an AMD EPYC, 1.47–1.81× less
+//! time per batch with one AVX register; plain arrays left to the auto-vectorizer came out
+//! slower, split into scalar and SSE code).
 //!
 //! Why the values do not change: each query keeps its own admissibility mask, so it expands and
 //! opens exactly the nodes it would alone; its far-field terms are the same `f32` operations
@@ -24,36 +27,54 @@ use wide::{CmpGt, CmpLt, f32x8};
 /// Queries per packet.
 pub(crate) const PACKET: usize = 8;
 
-/// Eight `f32` lanes, one per query of a packet (`wide::f32x8`: one AVX register where the
-/// build targets AVX, two SSE registers otherwise). Each operation is one IEEE `f32` operation
-/// per lane, as in `f32x4`.
+/// Eight `f32` lanes, one per query of a packet: what the packet walk needs of them. Every
+/// operation is one IEEE `f32` operation per lane (no fused multiply–add), so every
+/// implementation gives every lane the bits `f32x4` gives it.
+///
+/// `Token` proves that the implementation can run: `()` for the portable one, and for [`Avx8`]
+/// an [`Avx2`] that only exists once the CPU was found to have AVX2.
+pub(crate) trait EightLanes:
+    super::moments::Lanes + std::ops::Sub<Output = Self> + std::ops::Div<Output = Self>
+{
+    type Token: Copy;
+    fn splat(token: Self::Token, v: f32) -> Self;
+    fn from_array(token: Self::Token, v: [f32; PACKET]) -> Self;
+    fn to_array(self) -> [f32; PACKET];
+    fn sqrt(self) -> Self;
+    /// Bit `i` set where lane `i` is `> 0` and (`bs < 0` or `> bs²`): the admissibility test.
+    fn admissible(self, bs: f32) -> u32;
+}
+
+/// The portable eight lanes, `wide::f32x8` (one AVX register where the build targets AVX, two
+/// SSE registers otherwise).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Lanes8(pub f32x8);
 
-impl Lanes8 {
+impl EightLanes for Lanes8 {
+    type Token = ();
+
     #[inline(always)]
-    pub fn splat(v: f32) -> Self {
+    fn splat((): (), v: f32) -> Self {
         Lanes8(f32x8::splat(v))
     }
 
     #[inline(always)]
-    pub fn from_array(v: [f32; PACKET]) -> Self {
+    fn from_array((): (), v: [f32; PACKET]) -> Self {
         Lanes8(f32x8::from(v))
     }
 
     #[inline(always)]
-    pub fn to_array(self) -> [f32; PACKET] {
+    fn to_array(self) -> [f32; PACKET] {
         self.0.to_array()
     }
 
     #[inline(always)]
-    pub fn sqrt(self) -> Self {
+    fn sqrt(self) -> Self {
         Lanes8(self.0.sqrt())
     }
 
-    /// Bit `i` set where lane `i` is `> 0` and (`bs < 0` or `> bs²`): the admissibility test.
     #[inline(always)]
-    pub fn admissible(self, bs: f32) -> u32 {
+    fn admissible(self, bs: f32) -> u32 {
         let (zero, bs) = (f32x8::ZERO, f32x8::splat(bs));
         let admit = self.0.cmp_gt(zero) & (bs.cmp_lt(zero) | self.0.cmp_gt(bs * bs));
         admit.move_mask() as u32
@@ -75,6 +96,115 @@ lanes8_op!(Add, add, +);
 lanes8_op!(Sub, sub, -);
 lanes8_op!(Mul, mul, *);
 lanes8_op!(Div, div, /);
+
+#[cfg(target_arch = "x86_64")]
+pub(crate) use avx::{Avx2, Avx8};
+
+/// Eight lanes in one AVX register, for CPUs with AVX2 in a portable build.
+///
+/// Why `unsafe` here (the only place in the fast evaluator besides the run-time dispatch): the
+/// AVX intrinsics may only run on a CPU that has AVX, and the methods of an operator trait
+/// cannot carry `#[target_feature]`, so each call is an `unsafe` block. It is sound because
+/// every `Avx8` is made from an [`Avx2`] token (or from another `Avx8`), and an `Avx2` exists
+/// only after `is_x86_feature_detected!("avx2")` returned true. Inlined into the packet walk
+/// compiled for AVX2 (`Hierarchy::eval_packet_avx2`), the intrinsics become single instructions.
+/// The benchmark that justifies it is in the module docs.
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)]
+mod avx {
+    use super::{EightLanes, PACKET};
+    use std::arch::x86_64::{
+        __m256, _CMP_GT_OQ, _CMP_LT_OQ, _mm256_add_ps, _mm256_and_ps, _mm256_cmp_ps, _mm256_div_ps,
+        _mm256_loadu_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_ps, _mm256_set1_ps,
+        _mm256_setzero_ps, _mm256_sqrt_ps, _mm256_storeu_ps, _mm256_sub_ps,
+    };
+
+    /// Proof that the CPU has AVX2 (and so AVX): made only by [`Avx2::detect`].
+    #[derive(Clone, Copy, Debug)]
+    pub(crate) struct Avx2(());
+
+    impl Avx2 {
+        /// The token, when the CPU has AVX2.
+        #[inline]
+        pub(crate) fn detect() -> Option<Avx2> {
+            std::arch::is_x86_feature_detected!("avx2").then_some(Avx2(()))
+        }
+    }
+
+    #[derive(Clone, Copy, Debug)]
+    pub(crate) struct Avx8(__m256);
+
+    macro_rules! avx8_op {
+        ($trait:ident, $method:ident, $intrinsic:ident) => {
+            impl std::ops::$trait for Avx8 {
+                type Output = Avx8;
+                #[inline(always)]
+                fn $method(self, other: Avx8) -> Avx8 {
+                    // SAFETY: `self` exists, so the CPU has AVX (module docs).
+                    Avx8(unsafe { $intrinsic(self.0, other.0) })
+                }
+            }
+        };
+    }
+    avx8_op!(Add, add, _mm256_add_ps);
+    avx8_op!(Sub, sub, _mm256_sub_ps);
+    avx8_op!(Mul, mul, _mm256_mul_ps);
+    avx8_op!(Div, div, _mm256_div_ps);
+
+    impl EightLanes for Avx8 {
+        type Token = Avx2;
+
+        #[inline(always)]
+        fn splat(_: Avx2, v: f32) -> Self {
+            // SAFETY: the token proves AVX2.
+            Avx8(unsafe { _mm256_set1_ps(v) })
+        }
+
+        #[inline(always)]
+        fn from_array(_: Avx2, v: [f32; PACKET]) -> Self {
+            // SAFETY: the token proves AVX2; the load reads the eight `f32` of `v`.
+            Avx8(unsafe { _mm256_loadu_ps(v.as_ptr()) })
+        }
+
+        #[inline(always)]
+        fn to_array(self) -> [f32; PACKET] {
+            let mut out = [0.0f32; PACKET];
+            // SAFETY: `self` proves AVX; the store writes the eight `f32` of `out`.
+            unsafe { _mm256_storeu_ps(out.as_mut_ptr(), self.0) };
+            out
+        }
+
+        #[inline(always)]
+        fn sqrt(self) -> Self {
+            // SAFETY: `self` proves AVX.
+            Avx8(unsafe { _mm256_sqrt_ps(self.0) })
+        }
+
+        #[inline(always)]
+        fn admissible(self, bs: f32) -> u32 {
+            // SAFETY: `self` proves AVX. Ordered compares, false on NaN, as `wide`'s.
+            unsafe {
+                let (zero, bs) = (_mm256_setzero_ps(), _mm256_set1_ps(bs));
+                let bs2 = _mm256_mul_ps(bs, bs);
+                let far = _mm256_or_ps(
+                    _mm256_cmp_ps::<_CMP_LT_OQ>(bs, zero),
+                    _mm256_cmp_ps::<_CMP_GT_OQ>(self.0, bs2),
+                );
+                let admit = _mm256_and_ps(_mm256_cmp_ps::<_CMP_GT_OQ>(self.0, zero), far);
+                _mm256_movemask_ps(admit) as u32
+            }
+        }
+    }
+
+    impl super::super::moments::Lanes for Avx8 {
+        #[inline(always)]
+        fn rsqrt(self) -> Self {
+            // SAFETY: `self` proves AVX.
+            let one = Avx8(unsafe { _mm256_set1_ps(1.0) });
+            one / self.sqrt()
+        }
+    }
+}
 
 /// Evaluates `points` packet by packet on rayon and returns the values in input order.
 ///

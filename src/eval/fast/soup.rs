@@ -234,7 +234,13 @@ impl FastWindingNumber {
                 self.add_leaf_terms(&mut angles[i], q[i], k, range, sum)
             };
             let far_and_rare = if portable {
-                self.hierarchy.eval_packet_lanes(&q, active, &params, leaf)
+                self.hierarchy.eval_packet_lanes::<super::packet::Lanes8>(
+                    (),
+                    &q,
+                    active,
+                    &params,
+                    leaf,
+                )
             } else {
                 self.hierarchy.eval_packet(&q, active, &params, leaf)
             };
