@@ -480,9 +480,7 @@ impl Hierarchy {
         let (mut id, mut mask) = (0usize, active);
         loop {
             let node = &self.wide[id];
-            let dq: [L; 3] = std::array::from_fn(|k| {
-                L::from_array(token, qk[k].map(|v| (node.anchor[k] - v) as f32))
-            });
+            let dq: [L; 3] = std::array::from_fn(|k| L::difference(token, node.anchor[k], &qk[k]));
             let size = self.wide_size[which][id].as_array_ref();
             for (l, &c) in node.child.iter().enumerate() {
                 if c == EMPTY {

@@ -304,7 +304,10 @@ impl FastWindingNumber {
 /// test (`|det| ≤ 1e-12·|a||b||c|`), `|r|²` outside `(1e-180, 1e180)`, an overflow, and the
 /// ill-conditioned triangles (`√(det² + den²) < SOLID_ANGLE_CONDITION·|a||b||c|`, a query near
 /// an edge), whose `f64` value errs by `≈ 2e-17/d` at distance `d` (issue 22: 0.44 at 1e-17).
-#[inline]
+// Always inlined: called from the AVX2 walks, an out-of-line copy runs as the portable build's
+// SSE code (with the 4-triangle leaves it was half of all query time on a soup when the
+// inliner left it out).
+#[inline(always)]
 fn push_solid_angles(angles: &mut AngleSum, t: &[f64x4; 9], q: [f64; 3]) -> u32 {
     let [qx, qy, qz] = q.map(f64x4::splat);
     let (ax, ay, az) = (t[0] - qx, t[1] - qy, t[2] - qz);
