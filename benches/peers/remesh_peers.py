@@ -67,6 +67,29 @@ def write_off(path: Path, v: np.ndarray, f: np.ndarray) -> None:
             np.savetxt(out, np.hstack([np.full((len(f), 1), 3), f]).astype(np.int64), fmt="%d")
 
 
+def read_off_with_comments(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """ASCII OFF with `#` comment lines, which point-cloud-utils' reader refuses (triangles and
+    polygons, fanned)."""
+    tokens = []
+    for line in path.read_text(errors="replace").splitlines():
+        line = line.split("#", 1)[0].strip()
+        if line:
+            tokens += line.split()
+    if not tokens or not tokens[0].endswith("OFF"):
+        raise ValueError("not an ASCII OFF file")
+    nv, nf = int(tokens[1]), int(tokens[2])
+    at = 4
+    v = np.array(tokens[at : at + 3 * nv], dtype=np.float64).reshape(nv, 3)
+    at += 3 * nv
+    faces = []
+    for _ in range(nf):
+        k = int(tokens[at])
+        poly = [int(x) for x in tokens[at + 1 : at + 1 + k]]
+        at += 1 + k
+        faces += [[poly[0], poly[i], poly[i + 1]] for i in range(1, k - 1)]
+    return v, np.array(faces, dtype=np.int64).reshape(-1, 3)
+
+
 def topology(f: np.ndarray) -> dict:
     """Boundary, non-manifold and misoriented edges of the faces `f`."""
     if len(f) == 0:
@@ -193,10 +216,12 @@ def main() -> int:
     for path in files:
         try:
             v, f = pcu.load_mesh_vf(str(path))
+            if (f is None or len(f) == 0) and path.suffix.lower() == ".off":
+                v, f = read_off_with_comments(path)
         except Exception as e:  # a reader's failure is a row, not a crash
             print(f"| {path.name} | – | (load failed: {str(e)[:60]}) |", flush=True)
             continue
-        if len(f) == 0:
+        if f is None or v is None or len(f) == 0:
             print(f"| {path.name} | 0 | (no triangles read by point-cloud-utils' loader) |", flush=True)
             continue
         v, f = weld(np.asarray(v, dtype=np.float64).reshape(-1, 3), np.asarray(f, dtype=np.int64).reshape(-1, 3))
