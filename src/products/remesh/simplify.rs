@@ -38,7 +38,9 @@ use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
 use super::intersect::{MAX_COORDINATE, faces_intersect};
-use super::lattice::KeyMap;
+use rayon::prelude::*;
+
+use super::lattice::{KeyMap, KeySet};
 use crate::kernel::predicates::cross_exact;
 
 type P = [i64; 3];
@@ -55,6 +57,11 @@ pub const DEFAULT_TARGET_FRACTION: f64 = 0.45;
 /// Weight of the squared edge length (lattice units) added to the quadric error: in flat
 /// regions, where the quadric is 0 for every target, short edges collapse first (rounder faces).
 const LENGTH_WEIGHT: f64 = 1e-3;
+
+/// Most collapses planned together (in parallel) in one round of [`Simplifier::run`]. A
+/// constant, so that the result does not depend on the thread count; small enough that a
+/// round stays close to the global cost order.
+const ROUND: usize = 1024;
 
 /// Options of [`simplify`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -189,6 +196,10 @@ struct Plan {
     new: Vec<[u32; 3]>,
     /// Per new face, the removed vertices it will answer for.
     support: Vec<Vec<u32>>,
+    /// The kept vertex.
+    v: u32,
+    /// The neighbours of `u` (their best collapses change), when known.
+    ring: Vec<u32>,
 }
 
 impl<'a> Simplifier<'a> {
@@ -261,7 +272,16 @@ impl<'a> Simplifier<'a> {
     }
 
     /// Greedy collapses in quadric-error order until none is allowed or at most `target_faces`
-    /// faces are left.
+    /// faces are left, in rounds: each round takes the cheapest vertices whose neighbourhoods
+    /// are pairwise disjoint in space ([`ROUND`] at most), plans their collapses in parallel
+    /// against the surface at the start of the round, and makes them in cost order.
+    ///
+    /// Why the plans stay valid: a plan for `u` reads only the faces and vertex lists of `u`'s
+    /// closed 1-ring and the faces meeting the box of that ring (every new face lies in it);
+    /// a collapse of `u'` writes only faces and vertices of its own closed 1-ring, all inside
+    /// its ring's box. Two rounds members have disjoint closed ring boxes, so neither sees the
+    /// other's changes. The selection and the order of the changes are serial, so the result
+    /// does not depend on the thread count.
     pub fn run(&mut self, target_faces: usize) {
         let n = self.points.len();
         // Lazy invalidation: an entry counts only if its version is the vertex's. `queued` is the
@@ -269,60 +289,129 @@ impl<'a> Simplifier<'a> {
         // its entry (popping it re-examines every target anyway).
         let mut version = vec![0u32; n];
         let mut queued: Vec<Option<u64>> = vec![None; n];
-        let mut heap: BinaryHeap<Reverse<(u64, u32, u32)>> = BinaryHeap::new();
-        for u in 0..n as u32 {
-            if let Some(c) = self.best_cost(u) {
-                heap.push(Reverse((c.to_bits(), u, 0)));
-                queued[u as usize] = Some(c.to_bits());
+        let costs: Vec<Option<f64>> = (0..n as u32)
+            .into_par_iter()
+            .map(|u| self.best_cost(u))
+            .collect();
+        let mut heap: BinaryHeap<Reverse<(u64, u32, u32)>> = BinaryHeap::with_capacity(2 * n);
+        for (u, c) in costs.into_iter().enumerate() {
+            if let Some(c) = c {
+                heap.push(Reverse((c.to_bits(), u as u32, 0)));
+                queued[u] = Some(c.to_bits());
             }
         }
-        let mut candidates: Vec<(u64, u32)> = Vec::new();
-        while let Some(Reverse((_, u, ver))) = heap.pop() {
-            if self.stats.faces_before - 2 * self.stats.collapses <= target_faces {
+        let mut taken = KeySet::<u64>::default();
+        let mut selected: Vec<u32> = Vec::with_capacity(ROUND);
+        let mut deferred = Vec::new();
+        let mut touched: Vec<u32> = Vec::new();
+        loop {
+            let faces_now = self.stats.faces_before - 2 * self.stats.collapses;
+            taken.clear();
+            selected.clear();
+            while selected.len() < ROUND && faces_now - 2 * selected.len() > target_faces {
+                let Some(Reverse(entry)) = heap.pop() else {
+                    break;
+                };
+                let (_, u, ver) = entry;
+                if self.removed[u as usize] || ver != version[u as usize] {
+                    continue;
+                }
+                let (lo, hi) = self.ring_box(u);
+                let bucket = 2 * self.ticks;
+                let mut free = true;
+                for_buckets(lo, hi, bucket, |key| free &= !taken.contains(&key));
+                if !free {
+                    deferred.push(Reverse(entry));
+                    continue;
+                }
+                for_buckets(lo, hi, bucket, |key| {
+                    taken.insert(key);
+                });
+                queued[u as usize] = None;
+                selected.push(u);
+            }
+            if selected.is_empty() {
                 break;
             }
-            if self.removed[u as usize] || ver != version[u as usize] {
-                continue;
-            }
-            queued[u as usize] = None;
-            let ring = self.neighbours(u);
-            candidates.clear();
-            for &v in &ring {
-                let c = self.cost(u, v);
-                if c <= self.max_distance2 {
-                    candidates.push((c.to_bits(), v));
+            let plans: Vec<(Option<Plan>, [usize; 5])> =
+                selected.par_iter().map(|&u| self.plan_best(u)).collect();
+            touched.clear();
+            for (&u, (plan, refused)) in selected.iter().zip(plans) {
+                for (a, b) in self.stats.refused.iter_mut().zip(refused) {
+                    *a += b;
+                }
+                if let Some(plan) = plan {
+                    touched.extend(plan.ring.iter().copied());
+                    self.apply(u, plan);
                 }
             }
-            candidates.sort_unstable();
-            for &(_, v) in &candidates {
-                match self.collapse(u, v) {
-                    Ok(()) => {
-                        for &x in &ring {
-                            let best = self.best_cost(x).map(f64::to_bits);
-                            if best != queued[x as usize] || best.is_none() {
-                                version[x as usize] += 1;
-                                queued[x as usize] = best;
-                                if let Some(c) = best {
-                                    heap.push(Reverse((c, x, version[x as usize])));
-                                }
-                            }
-                        }
-                        break;
+            touched.sort_unstable();
+            touched.dedup();
+            let best: Vec<Option<u64>> = touched
+                .par_iter()
+                .map(|&x| self.best_cost(x).map(f64::to_bits))
+                .collect();
+            for (&x, best) in touched.iter().zip(best) {
+                if best != queued[x as usize] || best.is_none() {
+                    version[x as usize] += 1;
+                    queued[x as usize] = best;
+                    if let Some(c) = best {
+                        heap.push(Reverse((c, x, version[x as usize])));
                     }
-                    Err(r) => {
-                        let k = match r {
-                            Refusal::NotAnEdge => continue,
-                            Refusal::Link => 0,
-                            Refusal::FaceTooLarge => 1,
-                            Refusal::Flip => 2,
-                            Refusal::Distance => 3,
-                            Refusal::Intersection => 4,
-                        };
-                        self.stats.refused[k] += 1;
-                    }
+                }
+            }
+            heap.extend(deferred.drain(..));
+        }
+    }
+
+    /// The first allowed collapse of `u` into a neighbour, cheapest first, and the refusals
+    /// on the way (link, face size, flip, distance, intersection).
+    fn plan_best(&self, u: u32) -> (Option<Plan>, [usize; 5]) {
+        let mut refused = [0; 5];
+        let ring = self.neighbours(u);
+        let mut candidates: Vec<(u64, u32)> = ring
+            .iter()
+            .map(|&v| (self.cost(u, v), v))
+            .filter(|&(c, _)| c <= self.max_distance2)
+            .map(|(c, v)| (c.to_bits(), v))
+            .collect();
+        candidates.sort_unstable();
+        for &(_, v) in &candidates {
+            match self.plan(u, v) {
+                Ok(mut plan) => {
+                    plan.ring = ring;
+                    return (Some(plan), refused);
+                }
+                Err(r) => {
+                    let k = match r {
+                        Refusal::NotAnEdge => continue,
+                        Refusal::Link => 0,
+                        Refusal::FaceTooLarge => 1,
+                        Refusal::Flip => 2,
+                        Refusal::Distance => 3,
+                        Refusal::Intersection => 4,
+                    };
+                    refused[k] += 1;
                 }
             }
         }
+        (None, refused)
+    }
+
+    /// The box of `u` and its neighbours.
+    fn ring_box(&self, u: u32) -> (P, P) {
+        let p = self.points[u as usize];
+        let (mut lo, mut hi) = (p, p);
+        for &f in &self.vertex_faces[u as usize] {
+            for x in self.faces[f as usize] {
+                let q = self.points[x as usize];
+                for a in 0..3 {
+                    lo[a] = lo[a].min(q[a]);
+                    hi[a] = hi[a].max(q[a]);
+                }
+            }
+        }
+        (lo, hi)
     }
 
     /// The surface: kept vertices renumbered in input order, live faces in creation order.
@@ -358,6 +447,13 @@ impl<'a> Simplifier<'a> {
     /// Collapses `u` into `v` if every check passes.
     pub fn collapse(&mut self, u: u32, v: u32) -> Result<(), Refusal> {
         let plan = self.plan(u, v)?;
+        self.apply(u, plan);
+        Ok(())
+    }
+
+    /// Makes the collapse `plan` of `u` (computed on the current surface).
+    fn apply(&mut self, u: u32, plan: Plan) {
+        let v = plan.v;
         for &f in &plan.old {
             self.alive[f as usize] = false;
             self.index(f, false);
@@ -387,7 +483,6 @@ impl<'a> Simplifier<'a> {
             *a += b;
         }
         self.stats.collapses += 1;
-        Ok(())
     }
 
     /// Whether `u → v` passes every check, without making it.
@@ -527,7 +622,13 @@ impl<'a> Simplifier<'a> {
                 }
             }
         }
-        Ok(Plan { old, new, support })
+        Ok(Plan {
+            old,
+            new,
+            support,
+            v,
+            ring: Vec::new(),
+        })
     }
 
     /// Sorted distinct neighbours of `x`.
