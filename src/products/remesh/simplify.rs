@@ -44,6 +44,7 @@ use super::lattice::{KeyMap, KeySet};
 use crate::kernel::predicates::cross_exact;
 
 type P = [i64; 3];
+type Q = [i32; 3];
 
 /// Default [`SimplifyOptions::max_distance`], in finest cells.
 pub const DEFAULT_MAX_DISTANCE: f64 = 0.5;
@@ -179,7 +180,11 @@ pub struct Simplifier<'a> {
     /// of their box's minimum corner: a face of class `k` meeting a box `lo..=hi` has its
     /// minimum corner in `lo − 2^k cells..=hi`, so a query visits a few buckets per class and
     /// only faces of about its size.
-    grids: Vec<KeyMap<Vec<(u32, P, P)>>>,
+    /// The boxes in the lists are the face boxes in units of `2^shift` ticks, rounded outward
+    /// to `i32` (half the bytes to scan; exact when `shift` is 0, as for every remesher
+    /// output below 2^30 ticks): a prefilter, the exact box test follows.
+    grids: Vec<KeyMap<Vec<(u32, Q, Q)>>>,
+    shift: u32,
     ticks: i64,
     max_extent: i64,
     /// Squared distance bound, lattice units.
@@ -246,6 +251,12 @@ impl<'a> Simplifier<'a> {
                 }
             }
         }
+        let largest = points
+            .iter()
+            .flat_map(|p| p.iter().map(|c| c.unsigned_abs()))
+            .max()
+            .unwrap_or(0);
+        let shift = (64 - largest.leading_zeros()).saturating_sub(30);
         let max_extent = i64::from(options.max_face_extent.max(1)).saturating_mul(ticks_per_cell);
         let mut s = Simplifier {
             points,
@@ -257,6 +268,7 @@ impl<'a> Simplifier<'a> {
             support: vec![Vec::new(); triangles.len()],
             quadric,
             grids: Vec::new(),
+            shift,
             ticks: ticks_per_cell,
             max_extent,
             max_distance2: (options.max_distance * options.max_distance),
@@ -598,6 +610,7 @@ impl<'a> Simplifier<'a> {
             }
         }
         let mut near: Vec<u32> = Vec::new();
+        let (qlo, qhi) = coarse((lo, hi), self.shift);
         for (k, grid) in self.grids.iter().enumerate() {
             let reach = lo.map(|c| c - (self.ticks << k));
             let bucket = self.ticks << (k + 1);
@@ -606,7 +619,7 @@ impl<'a> Simplifier<'a> {
                     near.extend(
                         list.iter()
                             .filter(|(g, l, h)| {
-                                boxes_overlap((*l, *h), (lo, hi)) && !old.contains(g)
+                                (0..3).all(|a| l[a] <= qhi[a] && qlo[a] <= h[a]) && !old.contains(g)
                             })
                             .map(|e| e.0),
                     );
@@ -667,8 +680,12 @@ impl<'a> Simplifier<'a> {
         if self.removed[u as usize] {
             return None;
         }
-        self.neighbours(u)
-            .into_iter()
+        // Over the faces rather than the sorted ring (no allocation: this runs for every
+        // neighbour of every collapse); each neighbour is seen twice, which leaves the minimum.
+        self.vertex_faces[u as usize]
+            .iter()
+            .flat_map(|&f| self.faces[f as usize])
+            .filter(|&v| v != u)
             .map(|v| self.cost(u, v))
             .filter(|&c| c <= self.max_distance2)
             .min_by(f64::total_cmp)
@@ -687,13 +704,23 @@ impl<'a> Simplifier<'a> {
         }
         let bucket = self.ticks << (k + 1);
         let key = bucket_key(lo.map(|c| c.div_euclid(bucket)));
+        let (qlo, qhi) = coarse((lo, hi), self.shift);
         let list = self.grids[k].entry(key).or_default();
         if insert {
-            list.push((f, lo, hi));
+            list.push((f, qlo, qhi));
         } else if let Some(i) = list.iter().position(|e| e.0 == f) {
             list.swap_remove(i);
         }
     }
+}
+
+/// The box `lo..=hi` in units of `2^shift`, rounded outward (`shift` leaves the coordinates
+/// below `2^30`).
+fn coarse((lo, hi): (P, P), shift: u32) -> (Q, Q) {
+    (
+        lo.map(|c| (c >> shift) as i32),
+        hi.map(|c| (-((-c) >> shift)) as i32),
+    )
 }
 
 /// Calls `f` with the key of every bucket (side `bucket`) that the box `lo..=hi` overlaps.
