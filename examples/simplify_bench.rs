@@ -147,15 +147,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         for t in &s.triangles {
             for &v in t {
                 h = (h ^ u64::from(s.vertices[v as usize])).wrapping_mul(0x100_0000_01b3);
+                for c in s.points[v as usize] {
+                    h = (h ^ c as u64).wrapping_mul(0x100_0000_01b3);
+                }
             }
         }
         println!(
-            "{name} res {res}: {} -> {} faces (MC {}), {} collapses, refused {:?}, {dt:.2} s, {:.2} us/collapse, fingerprint {h:016x}",
+            "{name} res {res}: {} -> {} faces (MC {}), {} collapses, refused {:?}, {} relocated ({} refused), {dt:.2} s, {:.2} us/collapse, fingerprint {h:016x}",
             s.stats.faces_before,
             s.stats.faces_after,
             surface.marching_cubes,
             s.stats.collapses,
             s.stats.refused,
+            s.stats.relocated,
+            s.stats.relocations_refused,
             dt * 1e6 / s.stats.collapses.max(1) as f64
         );
         if check {

@@ -356,13 +356,15 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
                     * band.marching_cubes_triangles as f64) as usize,
             );
             stats.simplify = s.stats;
-            let keep = |v: &u32| *v as usize;
+            // From the fixed point, as `place` does (exact dyadic steps: the same `f64` for a
+            // vertex that was not relocated).
+            let ticks = placed.ticks_per_cell as f64;
             (
-                s.vertices
+                s.points
                     .iter()
-                    .map(|v| placed.positions[keep(v)])
+                    .map(|p| lattice.position(p.map(|c| c as f64 / ticks)))
                     .collect(),
-                s.vertices.iter().map(|v| placed.fixed[keep(v)]).collect(),
+                s.points,
                 s.triangles,
             )
         }

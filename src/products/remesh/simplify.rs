@@ -59,6 +59,15 @@ pub const DEFAULT_TARGET_FRACTION: f64 = 0.45;
 /// regions, where the quadric is 0 for every target, short edges collapse first (rounder faces).
 const LENGTH_WEIGHT: f64 = 1e-3;
 
+/// Weight of `|p − p_v|²` (lattice units) against the area-normalised quadric in
+/// [`Simplifier::relocate`]: directions along which the planes vary less than this stay put.
+/// Chosen on the bunny at res 64 (occupancy agreement 99.897 % at 0.05, 99.908 % at 0.01,
+/// 99.904 % at 0.003, one sweep).
+const RELOCATION_STIFFNESS: f64 = 0.01;
+
+/// Sweeps of [`Simplifier::relocate`] after the collapses.
+const RELOCATION_SWEEPS: usize = 2;
+
 /// Most collapses planned together (in parallel) in one round of [`Simplifier::run`]. A
 /// constant, so that the result does not depend on the thread count; small enough that a
 /// round stays close to the global cost order.
@@ -77,6 +86,13 @@ pub struct SimplifyOptions {
     /// cheapest first, so stopping early keeps the flattest regions simplified and the curved
     /// ones closest to the marching-tetrahedra surface.
     pub target_fraction_of_marching_cubes: f64,
+    /// After the collapses, move each kept vertex towards the minimum of its quadric (the planes
+    /// of the marching-tetrahedra faces merged into it), by at most half of
+    /// [`SimplifyOptions::max_distance`] per sweep (two sweeps), rounded to the fixed-point
+    /// grid, where every check still passes ([`Simplifier::relocate`]): faces are chords, and
+    /// this moves them back towards the surface instead of inside convex parts and outside
+    /// concave ones.
+    pub relocate: bool,
 }
 
 impl Default for SimplifyOptions {
@@ -85,6 +101,7 @@ impl Default for SimplifyOptions {
             max_distance: DEFAULT_MAX_DISTANCE,
             max_face_extent: DEFAULT_MAX_FACE_EXTENT,
             target_fraction_of_marching_cubes: DEFAULT_TARGET_FRACTION,
+            relocate: true,
         }
     }
 }
@@ -115,6 +132,10 @@ pub struct SimplifyStats {
     pub faces_after: usize,
     /// Collapses made.
     pub collapses: usize,
+    /// Vertices moved by the relocation.
+    pub relocated: usize,
+    /// Relocations refused by the checks (flip, size, distance or intersection).
+    pub relocations_refused: usize,
     /// Collapses refused, by reason: link, face size, flip, distance, intersection.
     pub refused: [usize; 5],
     /// The input was not a closed oriented manifold without collinear faces: left unchanged.
@@ -128,6 +149,8 @@ pub struct Simplified {
     pub triangles: Vec<[u32; 3]>,
     /// For each kept vertex, its index in the input.
     pub vertices: Vec<u32>,
+    /// For each kept vertex, its fixed-point position (the input's unless relocated).
+    pub points: Vec<P>,
     /// Counters.
     pub stats: SimplifyStats,
 }
@@ -146,11 +169,19 @@ pub fn simplify(
     match Simplifier::new(points, triangles, ticks_per_cell, options) {
         Some(mut s) => {
             s.run(target_faces);
+            if options.relocate {
+                // The second sweep goes on from the first's positions (up to `max_distance` in
+                // all) and retries the moves that a neighbour's position refused.
+                for _ in 0..RELOCATION_SWEEPS {
+                    s.relocate();
+                }
+            }
             s.finish()
         }
         None => Simplified {
             triangles: triangles.to_vec(),
             vertices: (0..points.len() as u32).collect(),
+            points: points.to_vec(),
             stats: SimplifyStats {
                 faces_before: triangles.len(),
                 faces_after: triangles.len(),
@@ -164,8 +195,9 @@ pub fn simplify(
 /// The state of a simplification: a face list with removed faces marked dead, vertex-to-face
 /// lists, the removed vertices each face answers for, quadrics, and a spatial index of the faces.
 #[derive(Debug)]
-pub struct Simplifier<'a> {
-    points: &'a [P],
+pub struct Simplifier {
+    /// The vertices now (moved by [`Simplifier::relocate`]).
+    points: Vec<P>,
     /// `points` in lattice units.
     at: Vec<[f64; 3]>,
     faces: Vec<[u32; 3]>,
@@ -207,16 +239,16 @@ struct Plan {
     ring: Vec<u32>,
 }
 
-impl<'a> Simplifier<'a> {
+impl Simplifier {
     /// The state for `triangles` over `points`; `None` when the input is not a closed, edge- and
     /// vertex-manifold, consistently oriented surface without collinear faces, or has a
     /// coordinate the exact predicates cannot take.
     pub fn new(
-        points: &'a [P],
+        points: &[P],
         triangles: &[[u32; 3]],
         ticks_per_cell: i64,
         options: &SimplifyOptions,
-    ) -> Option<Simplifier<'a>> {
+    ) -> Option<Simplifier> {
         if ticks_per_cell <= 0
             || !(options.max_distance.is_finite() && options.max_distance >= 0.0)
             || points
@@ -259,7 +291,7 @@ impl<'a> Simplifier<'a> {
         let shift = (64 - largest.leading_zeros()).saturating_sub(30);
         let max_extent = i64::from(options.max_face_extent.max(1)).saturating_mul(ticks_per_cell);
         let mut s = Simplifier {
-            points,
+            points: points.to_vec(),
             at,
             faces: triangles.to_vec(),
             alive: vec![true; triangles.len()],
@@ -426,6 +458,190 @@ impl<'a> Simplifier<'a> {
         (lo, hi)
     }
 
+    /// Moves each kept vertex `v`, in index order, towards the minimum of its quadric (the
+    /// planes merged into it) plus `RELOCATION_STIFFNESS·|p − p_v|²` (which keeps it put along
+    /// the directions the planes leave free), by at most half of `max_distance`, rounded to the
+    /// fixed-point grid; the move is made only if `v`'s faces pass the checks of a collapse
+    /// (size, flip against their present normals, every removed vertex they answer for within
+    /// `max_distance`, no intersection with each other or any other face). Same rounds as
+    /// [`Simplifier::run`]: vertices with disjoint ring boxes (the new position included) are
+    /// planned in parallel and moved in index order.
+    pub fn relocate(&mut self) {
+        let mut pending: Vec<u32> = (0..self.points.len() as u32)
+            .filter(|&v| !self.removed[v as usize] && !self.vertex_faces[v as usize].is_empty())
+            .collect();
+        let mut taken = KeySet::<u64>::default();
+        let mut selected: Vec<(u32, P)> = Vec::with_capacity(ROUND);
+        let mut deferred: Vec<u32> = Vec::new();
+        let bucket = 2 * self.ticks;
+        while !pending.is_empty() {
+            taken.clear();
+            selected.clear();
+            deferred.clear();
+            let mut rest = pending.iter();
+            for &v in rest.by_ref() {
+                let Some(target) = self.relocation_target(v) else {
+                    continue;
+                };
+                let (mut lo, mut hi) = self.ring_box(v);
+                for a in 0..3 {
+                    lo[a] = lo[a].min(target[a]);
+                    hi[a] = hi[a].max(target[a]);
+                }
+                let mut free = true;
+                for_buckets(lo, hi, bucket, |key| free &= !taken.contains(&key));
+                if !free {
+                    deferred.push(v);
+                    continue;
+                }
+                for_buckets(lo, hi, bucket, |key| {
+                    taken.insert(key);
+                });
+                selected.push((v, target));
+                if selected.len() == ROUND {
+                    break;
+                }
+            }
+            deferred.extend(rest.copied());
+            std::mem::swap(&mut pending, &mut deferred);
+            let plans: Vec<Option<Vec<Vec<u32>>>> = selected
+                .par_iter()
+                .map(|&(v, target)| self.plan_move(v, target))
+                .collect();
+            for (&(v, target), plan) in selected.iter().zip(plans) {
+                match plan {
+                    Some(support) => self.apply_move(v, target, support),
+                    None => self.stats.relocations_refused += 1,
+                }
+            }
+        }
+    }
+
+    /// Where [`Simplifier::relocate`] would move `v` (fixed point), if anywhere.
+    fn relocation_target(&self, v: u32) -> Option<P> {
+        let q = &self.quadric[v as usize];
+        let w = q[10];
+        if !(w > 0.0) || self.removed[v as usize] {
+            return None;
+        }
+        let p0 = self.at[v as usize];
+        let k = RELOCATION_STIFFNESS;
+        // (A/w + k I) p = −b/w + k p0, by Cramer's rule (the matrix is positive definite).
+        let m = [
+            [q[0] / w + k, q[1] / w, q[2] / w],
+            [q[1] / w, q[4] / w + k, q[5] / w],
+            [q[2] / w, q[5] / w, q[7] / w + k],
+        ];
+        let r = [
+            -q[3] / w + k * p0[0],
+            -q[6] / w + k * p0[1],
+            -q[8] / w + k * p0[2],
+        ];
+        let det3 = |m: [[f64; 3]; 3]| {
+            m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+                - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+                + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+        };
+        let d = det3(m);
+        if !(d.abs() > 0.0) {
+            return None;
+        }
+        let mut p = [0.0; 3];
+        for (c, x) in p.iter_mut().enumerate() {
+            let mut mc = m;
+            for row in 0..3 {
+                mc[row][c] = r[row];
+            }
+            *x = det3(mc) / d;
+        }
+        let mut step = [p[0] - p0[0], p[1] - p0[1], p[2] - p0[2]];
+        let len = (step[0] * step[0] + step[1] * step[1] + step[2] * step[2]).sqrt();
+        if !len.is_finite() {
+            return None;
+        }
+        let limit = 0.5 * self.max_distance2.sqrt();
+        if len > limit {
+            step = step.map(|x| x * limit / len);
+        }
+        let origin = self.points[v as usize];
+        let target: P =
+            std::array::from_fn(|a| origin[a] + (step[a] * self.ticks as f64).round() as i64);
+        (target != origin
+            && target
+                .iter()
+                .all(|c| c.unsigned_abs() < (1u64 << (30 + self.shift)).min(MAX_COORDINATE as u64)))
+        .then_some(target)
+    }
+
+    /// The faces of `v` with `v` at `target`, if they pass every check: per face, the removed
+    /// vertices it will answer for.
+    fn plan_move(&self, v: u32, target: P) -> Option<Vec<Vec<u32>>> {
+        let old = &self.vertex_faces[v as usize];
+        let p = |x: u32| {
+            if x == v {
+                target
+            } else {
+                self.points[x as usize]
+            }
+        };
+        let mut exact: Vec<[P; 3]> = Vec::with_capacity(old.len());
+        for &f in old {
+            let t = self.faces[f as usize];
+            let moved = t.map(p);
+            let (lo, hi) = face_box(moved);
+            if (0..3).any(|a| hi[a] - lo[a] > self.max_extent) {
+                return None;
+            }
+            let after = normal(moved);
+            if after == [0; 3] || dot_sign(normal(t.map(|x| self.points[x as usize])), after) <= 0 {
+                return None;
+            }
+            exact.push(moved);
+        }
+        let scale = 1.0 / self.ticks as f64;
+        let triangles: Vec<[[f64; 3]; 3]> = exact
+            .iter()
+            .map(|t| t.map(|q| q.map(|c| c as f64 * scale)))
+            .collect();
+        let mut support = vec![Vec::new(); old.len()];
+        for x in old
+            .iter()
+            .flat_map(|&f| self.support[f as usize].iter().copied())
+        {
+            let q = self.at[x as usize];
+            let (best, d2) = triangles
+                .iter()
+                .enumerate()
+                .map(|(k, t)| (k, point_triangle_distance2(q, t)))
+                .fold((0, f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
+            if d2.is_nan() || d2 > self.max_distance2 {
+                return None;
+            }
+            support[best].push(x);
+        }
+        if self.meets_other_faces(&exact, old) {
+            return None;
+        }
+        Some(support)
+    }
+
+    /// Moves `v` to `target` (planned by [`Simplifier::plan_move`] on the current surface).
+    fn apply_move(&mut self, v: u32, target: P, support: Vec<Vec<u32>>) {
+        let faces = std::mem::take(&mut self.vertex_faces[v as usize]);
+        for &f in &faces {
+            self.index(f, false);
+        }
+        self.points[v as usize] = target;
+        let scale = 1.0 / self.ticks as f64;
+        self.at[v as usize] = target.map(|c| c as f64 * scale);
+        for (&f, s) in faces.iter().zip(support) {
+            self.index(f, true);
+            self.support[f as usize] = s;
+        }
+        self.vertex_faces[v as usize] = faces;
+        self.stats.relocated += 1;
+    }
+
     /// The surface: kept vertices renumbered in input order, live faces in creation order.
     pub fn finish(mut self) -> Simplified {
         let mut index = vec![u32::MAX; self.points.len()];
@@ -446,6 +662,7 @@ impl<'a> Simplifier<'a> {
         self.stats.faces_after = triangles.len();
         Simplified {
             triangles,
+            points: vertices.iter().map(|&v| self.points[v as usize]).collect(),
             vertices,
             stats: self.stats,
         }
@@ -591,18 +808,34 @@ impl<'a> Simplifier<'a> {
         }
         // Intersections: new faces against each other and against the live faces near them.
         let exact: Vec<[P; 3]> = new.iter().map(|t| t.map(p)).collect();
+        if self.meets_other_faces(&exact, &old) {
+            return Err(Refusal::Intersection);
+        }
+        Ok(Plan {
+            old,
+            new,
+            support,
+            v,
+            ring: Vec::new(),
+        })
+    }
+
+    /// Whether the faces `exact` (replacing the faces `old`) meet each other or any other live
+    /// face outside what they share.
+    fn meets_other_faces(&self, exact: &[[P; 3]], old: &[u32]) -> bool {
+        let p = |x: u32| self.points[x as usize];
         for i in 0..exact.len() {
             for j in i + 1..exact.len() {
                 if boxes_overlap(face_box(exact[i]), face_box(exact[j]))
                     && faces_intersect(exact[i], exact[j])
                 {
-                    return Err(Refusal::Intersection);
+                    return true;
                 }
             }
         }
         let mut lo = [i64::MAX; 3];
         let mut hi = [i64::MIN; 3];
-        for t in &exact {
+        for t in exact {
             let (l, h) = face_box(*t);
             for a in 0..3 {
                 lo[a] = lo[a].min(l[a]);
@@ -629,19 +862,13 @@ impl<'a> Simplifier<'a> {
         for &g in &near {
             let tg = self.faces[g as usize].map(p);
             let bg = face_box(tg);
-            for t in &exact {
+            for t in exact {
                 if boxes_overlap(face_box(*t), bg) && faces_intersect(*t, tg) {
-                    return Err(Refusal::Intersection);
+                    return true;
                 }
             }
         }
-        Ok(Plan {
-            old,
-            new,
-            support,
-            v,
-            ring: Vec::new(),
-        })
+        false
     }
 
     /// Sorted distinct neighbours of `x`.
