@@ -72,8 +72,8 @@ fn simplified_closed_forms_keep_every_guarantee() {
             before.triangles.len()
         );
         // Every vertex is a vertex of the marching-tetrahedra surface, moved by the relocation
-        // by at most `max_distance` (two sweeps of half of it, each rounded to the fixed point:
-        // √3/2 tick), and the relocation does move vertices.
+        // by at most `max_distance` (0.5 cell) and rounded to the fixed point (√3/2 tick), and
+        // the relocation does move vertices.
         let t = after.ticks_per_cell as f64;
         let reach = 0.5 * t + 2.0;
         let moved: Vec<f64> = after

@@ -62,11 +62,8 @@ const LENGTH_WEIGHT: f64 = 1e-3;
 /// Weight of `|p − p_v|²` (lattice units) against the area-normalised quadric in
 /// [`Simplifier::relocate`]: directions along which the planes vary less than this stay put.
 /// Chosen on the bunny at res 64 (occupancy agreement 99.897 % at 0.05, 99.908 % at 0.01,
-/// 99.904 % at 0.003, one sweep).
+/// 99.904 % at 0.003, moves of at most a quarter cell).
 const RELOCATION_STIFFNESS: f64 = 0.01;
-
-/// Sweeps of [`Simplifier::relocate`] after the collapses.
-const RELOCATION_SWEEPS: usize = 2;
 
 /// Most collapses planned together (in parallel) in one round of [`Simplifier::run`]. A
 /// constant, so that the result does not depend on the thread count; small enough that a
@@ -87,11 +84,10 @@ pub struct SimplifyOptions {
     /// ones closest to the marching-tetrahedra surface.
     pub target_fraction_of_marching_cubes: f64,
     /// After the collapses, move each kept vertex towards the minimum of its quadric (the planes
-    /// of the marching-tetrahedra faces merged into it), by at most half of
-    /// [`SimplifyOptions::max_distance`] per sweep (two sweeps), rounded to the fixed-point
-    /// grid, where every check still passes ([`Simplifier::relocate`]): faces are chords, and
-    /// this moves them back towards the surface instead of inside convex parts and outside
-    /// concave ones.
+    /// of the marching-tetrahedra faces merged into it), by at most
+    /// [`SimplifyOptions::max_distance`], rounded to the fixed-point grid, where every check
+    /// still passes ([`Simplifier::relocate`]): faces are chords, and this moves them back
+    /// towards the surface instead of inside convex parts and outside concave ones.
     pub relocate: bool,
 }
 
@@ -170,11 +166,7 @@ pub fn simplify(
         Some(mut s) => {
             s.run(target_faces);
             if options.relocate {
-                // The second sweep goes on from the first's positions (up to `max_distance` in
-                // all) and retries the moves that a neighbour's position refused.
-                for _ in 0..RELOCATION_SWEEPS {
-                    s.relocate();
-                }
+                s.relocate();
             }
             s.finish()
         }
@@ -460,7 +452,7 @@ impl Simplifier {
 
     /// Moves each kept vertex `v`, in index order, towards the minimum of its quadric (the
     /// planes merged into it) plus `RELOCATION_STIFFNESS·|p − p_v|²` (which keeps it put along
-    /// the directions the planes leave free), by at most half of `max_distance`, rounded to the
+    /// the directions the planes leave free), by at most `max_distance`, rounded to the
     /// fixed-point grid; the move is made only if `v`'s faces pass the checks of a collapse
     /// (size, flip against their present normals, every removed vertex they answer for within
     /// `max_distance`, no intersection with each other or any other face). Same rounds as
@@ -559,7 +551,7 @@ impl Simplifier {
         if !len.is_finite() {
             return None;
         }
-        let limit = 0.5 * self.max_distance2.sqrt();
+        let limit = self.max_distance2.sqrt();
         if len > limit {
             step = step.map(|x| x * limit / len);
         }
