@@ -3,7 +3,7 @@
 //! surface), so that changes to `simplify.rs` can be timed and compared side by side.
 //!
 //! ```text
-//! cargo run --release --features examples --example simplify_bench -- MESH RES [--repeat N] [--check]
+//! cargo run --release --features examples --example simplify_bench -- MESH RES [--repeat N] [--check] [--no-relocate]
 //! ```
 //! The surface before simplification (exact evaluator, guided placement) is computed once and
 //! cached in `$TMPDIR` (`gwn-simplify-<mesh>-<res>.bin`). `--check` also counts exact
@@ -109,10 +109,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .parse()?;
     let mut repeat = 1;
     let mut check = false;
+    let mut relocate = true;
     while let Some(a) = args.next() {
         match a.as_str() {
             "--repeat" => repeat = args.next().ok_or("--repeat N")?.parse()?,
             "--check" => check = true,
+            "--no-relocate" => relocate = false,
             _ => return Err(format!("unknown argument {a}").into()),
         }
     }
@@ -129,7 +131,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             s
         }
     };
-    let options = simplify::SimplifyOptions::default();
+    let options = simplify::SimplifyOptions {
+        relocate,
+        ..simplify::SimplifyOptions::default()
+    };
     let target =
         (options.target_fraction_of_marching_cubes * surface.marching_cubes as f64) as usize;
     for _ in 0..repeat {
