@@ -59,6 +59,14 @@ pub const DEFAULT_TARGET_FRACTION: f64 = 0.45;
 /// regions, where the quadric is 0 for every target, short edges collapse first (rounder faces).
 const LENGTH_WEIGHT: f64 = 1e-3;
 
+/// A round of [`Simplifier::run`] also ends once this many popped vertices had to wait for
+/// the next one (their ring box meets a selected one's). Where cheap collapses cluster, popping
+/// on would pay a heap push and pop per waiting vertex and take collapses far out of cost
+/// order: without the bound the bunny at res 128 took 1.3 waits per collapse and 25 % more CPU
+/// than one collapse at a time (4 × as much with rounds of 4096); with it, about the same CPU
+/// as one at a time (`examples/simplify_bench.rs`, docs/benchmarks.md).
+const MAX_DEFERRED: usize = 32;
+
 /// Weight of `|p − p_v|²` (lattice units) against the area-normalised quadric in
 /// [`Simplifier::relocate`]: directions along which the planes vary less than this stay put.
 /// Chosen on the bunny at res 64 (occupancy agreement 99.897 % at 0.05, 99.908 % at 0.01,
@@ -309,8 +317,9 @@ impl Simplifier {
 
     /// Greedy collapses in quadric-error order until none is allowed or at most `target_faces`
     /// faces are left, in rounds: each round takes the cheapest vertices whose neighbourhoods
-    /// are pairwise disjoint in space ([`ROUND`] at most), plans their collapses in parallel
-    /// against the surface at the start of the round, and makes them in cost order.
+    /// are pairwise disjoint in space ([`ROUND`] at most, until [`MAX_DEFERRED`] popped
+    /// vertices had to wait), plans their collapses in parallel against the surface at the start
+    /// of the round, and makes them in cost order.
     ///
     /// Why the plans stay valid: a plan for `u` reads only the faces and vertex lists of `u`'s
     /// closed 1-ring and the faces meeting the box of that ring (every new face lies in it);
@@ -344,7 +353,10 @@ impl Simplifier {
             let faces_now = self.stats.faces_before - 2 * self.stats.collapses;
             taken.clear();
             selected.clear();
-            while selected.len() < ROUND && faces_now - 2 * selected.len() > target_faces {
+            while selected.len() < ROUND
+                && deferred.len() < MAX_DEFERRED
+                && faces_now - 2 * selected.len() > target_faces
+            {
                 let Some(Reverse(entry)) = heap.pop() else {
                     break;
                 };
