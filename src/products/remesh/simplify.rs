@@ -1,12 +1,20 @@
 //! Simplification of the extracted surface by half-edge collapses on the fixed-point vertices.
 //!
 //! A collapse `u → v` removes the vertex `u` and moves its faces to `v`, which keeps its exact
-//! fixed-point position: every vertex of the result is a vertex of the marching-tetrahedra
-//! surface, so the exact predicates of [`super::intersect`] apply to it unchanged. Collapses run
-//! in the order of a quadric error (the area-weighted mean squared distance of `v` to the planes
-//! of the faces merged into `u`, plus a small length term so that flat regions collapse short
-//! edges first), from a priority queue with lazy invalidation, one at a time: the result is the
-//! same on every run and for every thread count.
+//! fixed-point position, so the exact predicates of [`super::intersect`] apply unchanged.
+//! Collapses run in the order of a quadric error (the area-weighted mean squared distance of `v`
+//! to the planes of the faces merged into `u`, plus a small length term so that flat regions
+//! collapse short edges first), from a priority queue with lazy invalidation, in rounds: the
+//! cheapest vertices whose closed 1-rings have disjoint boxes are planned in parallel and
+//! collapsed in cost order ([`Simplifier::run`] says why the plans stay valid). The selection
+//! is serial and the round size a constant: the result is the same on every run and for every
+//! thread count.
+//!
+//! Faces are chords of the surface, so a simplified convex part lies inside the input and a
+//! concave one outside. After the collapses, [`Simplifier::relocate`] moves each kept vertex
+//! towards the minimum of its quadric (the planes of the marching-tetrahedra faces merged into
+//! it), rounded to the fixed-point grid and by at most `max_distance`, where the moved faces pass
+//! the same checks (flip, size, distance, intersection); the topology does not change.
 //!
 //! A collapse is made only if it keeps every guarantee of the surface; it is refused when
 //! - **link** ([`Refusal::Link`]): `u` and `v` have other common neighbours than the two
@@ -469,11 +477,15 @@ impl Simplifier {
     /// (size, flip against their present normals, every removed vertex they answer for within
     /// `max_distance`, no intersection with each other or any other face). Same rounds as
     /// [`Simplifier::run`]: vertices with disjoint ring boxes (the new position included) are
-    /// planned in parallel and moved in index order.
+    /// planned in parallel and moved in a fixed scattered order of their indices.
     pub fn relocate(&mut self) {
+        // Vertices that need a move, in a scattered order: consecutive indices are neighbours
+        // (extraction order), so index order would make most of a round wait for a conflict.
         let mut pending: Vec<u32> = (0..self.points.len() as u32)
-            .filter(|&v| !self.removed[v as usize] && !self.vertex_faces[v as usize].is_empty())
+            .into_par_iter()
+            .filter(|&v| self.relocation_target(v).is_some())
             .collect();
+        pending.sort_unstable_by_key(|&v| (v.wrapping_mul(0x9e37_79b1), v));
         let mut taken = KeySet::<u64>::default();
         let mut selected: Vec<(u32, P)> = Vec::with_capacity(ROUND);
         let mut deferred: Vec<u32> = Vec::new();
@@ -484,6 +496,7 @@ impl Simplifier {
             deferred.clear();
             let mut rest = pending.iter();
             for &v in rest.by_ref() {
+                // Moves made this round do not change `v`'s target (its quadric and position).
                 let Some(target) = self.relocation_target(v) else {
                     continue;
                 };
@@ -496,6 +509,9 @@ impl Simplifier {
                 for_buckets(lo, hi, bucket, |key| free &= !taken.contains(&key));
                 if !free {
                     deferred.push(v);
+                    if deferred.len() == ROUND {
+                        break;
+                    }
                     continue;
                 }
                 for_buckets(lo, hi, bucket, |key| {
