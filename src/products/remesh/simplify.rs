@@ -470,7 +470,7 @@ impl Simplifier {
         (lo, hi)
     }
 
-    /// Moves each kept vertex `v`, in index order, towards the minimum of its quadric (the
+    /// Moves each kept vertex `v` towards the minimum of its quadric (the
     /// planes merged into it) plus `RELOCATION_STIFFNESS·|p − p_v|²` (which keeps it put along
     /// the directions the planes leave free), by at most `max_distance`, rounded to the
     /// fixed-point grid; the move is made only if `v`'s faces pass the checks of a collapse
