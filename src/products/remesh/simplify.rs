@@ -541,7 +541,7 @@ impl Simplifier {
     fn relocation_target(&self, v: u32) -> Option<P> {
         let q = &self.quadric[v as usize];
         let w = q[10];
-        if !(w > 0.0) || self.removed[v as usize] {
+        if w.is_nan() || w <= 0.0 || self.removed[v as usize] {
             return None;
         }
         let p0 = self.at[v as usize];
@@ -563,7 +563,7 @@ impl Simplifier {
                 + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
         };
         let d = det3(m);
-        if !(d.abs() > 0.0) {
+        if d.is_nan() || d == 0.0 {
             return None;
         }
         let mut p = [0.0; 3];
