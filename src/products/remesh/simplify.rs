@@ -70,9 +70,9 @@ const LENGTH_WEIGHT: f64 = 1e-3;
 /// A round of [`Simplifier::run`] also ends once this many popped vertices had to wait for
 /// the next one (their ring box meets a selected one's). Where cheap collapses cluster, popping
 /// on would pay a heap push and pop per waiting vertex and take collapses far out of cost
-/// order: without the bound the bunny at res 128 took 1.3 waits per collapse and 25 % more CPU
-/// than one collapse at a time (4 × as much with rounds of 4096); with it, about the same CPU
-/// as one at a time (`examples/simplify_bench.rs`, docs/benchmarks.md).
+/// order: without the bound the bunny at res 128 took 1.3 waits per collapse and ~30 % more
+/// CPU than one collapse at a time (4 × with rounds of 4096 and 4-cell conflict buckets); with
+/// it, 7–15 % more (`examples/simplify_bench.rs`, docs/benchmarks.md).
 const MAX_DEFERRED: usize = 32;
 
 /// Weight of `|p − p_v|²` (lattice units) against the area-normalised quadric in
