@@ -65,6 +65,10 @@ pub struct Args {
     /// the tolerance allows).
     #[arg(long, default_value_t = gwn::products::remesh::simplify::DEFAULT_TARGET_FRACTION)]
     pub simplify_target: f64,
+    /// Keep every simplified vertex on its marching-tetrahedra position (no move towards the
+    /// quadric minimum after the collapses).
+    #[arg(long)]
+    pub no_relocate: bool,
     #[command(flatten)]
     pub method: MethodArgs,
     #[command(flatten)]
@@ -127,6 +131,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         simplify: (!args.no_simplify).then_some(SimplifyOptions {
             max_distance: args.simplify_distance,
             target_fraction_of_marching_cubes: args.simplify_target,
+            relocate: !args.no_relocate,
             ..SimplifyOptions::default()
         }),
     };
@@ -205,6 +210,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
             s.marching_cubes_faces,
             100.0 * topology.faces as f64 / s.marching_cubes_faces.max(1) as f64
         )?;
+        outln!(
+            "vertices moved towards their quadric minimum: {} ({} moves refused by the checks)",
+            s.simplify.relocated,
+            s.simplify.relocations_refused
+        )?;
     } else {
         outln!(
             "faces: {} marching tetrahedra (not simplified); a dense marching cubes would have {}",
@@ -267,6 +277,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             ("marching_tetrahedra_faces", s.extracted_faces.to_string()),
             ("marching_cubes_faces", s.marching_cubes_faces.to_string()),
             ("collapses", s.simplify.collapses.to_string()),
+            ("relocated_vertices", s.simplify.relocated.to_string()),
         ];
         match &intersections {
             Ok(r) => {

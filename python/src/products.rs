@@ -414,7 +414,8 @@ pub fn filter_tets<'py>(
 /// placement precision (each vertex within ``cell / 2**(bisect+1)`` of where ``w`` crosses 1/2
 /// along its lattice edge); ``simplify`` (default on) reduces the marching-tetrahedra surface by
 /// edge collapses that keep every guarantee (each removed vertex within half a cell of the
-/// result; ``False``: the raw surface). Every solid is kept, double walls and inner faces vanish where ``w``
+/// result, each kept vertex then moved by at most half a cell towards the planes it replaces;
+/// ``False``: the raw surface). Every solid is kept, double walls and inner faces vanish where ``w``
 /// says so, holes close where ``w`` decides. Returns ``(V, F)``: float64 (n, 3) and int64
 /// (m, 3), triangles counter-clockwise seen from outside. ``method``/``beta``/``order``/
 /// ``tolerance`` as in :func:`voxelize`; refused (``ValueError``) when the surface would not fit

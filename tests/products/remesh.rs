@@ -132,6 +132,20 @@ pub(crate) fn signed_volume(out: &Remeshed, keep: impl Fn([f64; 3]) -> bool) -> 
     vol
 }
 
+/// Volume enclosed by a closed, outward-oriented mesh.
+pub(crate) fn mesh_volume(mesh: &Mesh) -> f64 {
+    let v = mesh.positions();
+    mesh.triangles()
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| v[i as usize]);
+            (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                + a[2] * (b[0] * c[1] - b[1] * c[0]))
+                / 6.0
+        })
+        .sum()
+}
+
 /// Fraction of `n` random points in the input's box (grown by 10 %) farther than `cells` cells
 /// from the output surface where input and output agree on `w > ½`; also the number compared.
 pub(crate) fn occupancy_agreement(

@@ -21,10 +21,12 @@
 //!    once two evaluations confirm it, else by bisection (a fixed number of steps); `w` jumps
 //!    across a sheet, so linear interpolation of `w` would misplace it. Vertices stay strictly
 //!    inside their edges, which is all the no-self-intersection argument needs.
-//! 5. [`simplify`] (on by default, [`RemeshOptions::simplify`]): half-edge collapses that keep
-//!    every vertex on its exact fixed-point position and refuse any collapse that would break the
-//!    manifold (link condition), flip a face, move a removed vertex farther than a tolerance, or
-//!    make two faces meet (exact test), down to a fraction of a dense marching cubes' face count.
+//! 5. [`simplify`] (on by default, [`RemeshOptions::simplify`]): half-edge collapses on the
+//!    exact fixed-point vertices that refuse any collapse that would break the manifold (link
+//!    condition), flip a face, move a removed vertex farther than a tolerance, or make two faces
+//!    meet (exact test), down to a fraction of a dense marching cubes' face count; then each kept
+//!    vertex moves towards its quadric minimum (on the fixed-point grid) where the same checks
+//!    pass. Both run in rounds planned in parallel, with a result independent of the threads.
 //! 6. [`report`], [`intersect`]: closed, edge- and vertex-manifold, oriented, Euler
 //!    characteristic, components, the exact self-intersection count (on the fixed-point
 //!    vertices), the sampled Hausdorff distance, printed and as JSON.
@@ -356,13 +358,15 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
                     * band.marching_cubes_triangles as f64) as usize,
             );
             stats.simplify = s.stats;
-            let keep = |v: &u32| *v as usize;
+            // From the fixed point, as `place` does (exact dyadic steps: the same `f64` for a
+            // vertex that was not relocated).
+            let ticks = placed.ticks_per_cell as f64;
             (
-                s.vertices
+                s.points
                     .iter()
-                    .map(|v| placed.positions[keep(v)])
+                    .map(|p| lattice.position(p.map(|c| c as f64 / ticks)))
                     .collect(),
-                s.vertices.iter().map(|v| placed.fixed[keep(v)]).collect(),
+                s.points,
                 s.triangles,
             )
         }

@@ -1,0 +1,194 @@
+//! The edge collapses of `gwn remesh` alone, on the marching-tetrahedra surface of one mesh at
+//! one resolution: time, counters, and a fingerprint of the output (equal fingerprints: the same
+//! surface), so that changes to `simplify.rs` can be timed and compared side by side.
+//!
+//! ```text
+//! cargo run --release --features examples --example simplify_bench -- MESH RES [--repeat N] [--check] [--no-relocate]
+//! ```
+//! The surface before simplification (exact evaluator, guided placement) is computed once and
+//! cached in `$TMPDIR` (`gwn-simplify-<mesh>-<res>.bin`). `--check` also counts exact
+//! self-intersections and checks the topology of the output. The thread count is rayon's
+//! (`RAYON_NUM_THREADS`).
+
+use std::io::{Read, Write};
+use std::path::PathBuf;
+use std::time::Instant;
+
+use gwn::eval::antipodal::WindingNumber;
+use gwn::products::remesh::lattice::Lattice;
+use gwn::products::remesh::report::TopologyReport;
+use gwn::products::remesh::{
+    DEFAULT_BISECTION_STEPS, crossings, extract, intersect, octree, place, simplify,
+};
+
+struct Surface {
+    fixed: Vec<[i64; 3]>,
+    triangles: Vec<[u32; 3]>,
+    ticks: i64,
+    marching_cubes: usize,
+}
+
+fn build(mesh_path: &PathBuf, res: usize) -> Result<Surface, Box<dyn std::error::Error>> {
+    let mesh = gwn::io::load_mesh(mesh_path)?.mesh;
+    let wn = WindingNumber::new(&mesh)?;
+    let bounds = mesh.bounding_box().ok_or("empty mesh")?;
+    let lattice = Lattice::new(bounds, res).ok_or("bad bounds")?;
+    let guide = crossings::SegmentBvh::of_mesh(&mesh);
+    let classified =
+        octree::classify(&wn, &lattice, Some(&guide), usize::MAX).ok_or("too large")?;
+    let band = extract::extract(&lattice, &classified);
+    let placed = place::place_vertices(
+        &wn,
+        &lattice,
+        &band.edges,
+        DEFAULT_BISECTION_STEPS,
+        Some(&guide),
+    );
+    Ok(Surface {
+        fixed: placed.fixed,
+        triangles: band.triangles,
+        ticks: placed.ticks_per_cell,
+        marching_cubes: band.marching_cubes_triangles,
+    })
+}
+
+fn save(s: &Surface, path: &PathBuf) -> std::io::Result<()> {
+    let mut out = Vec::new();
+    for x in [
+        s.fixed.len() as u64,
+        s.triangles.len() as u64,
+        s.ticks as u64,
+        s.marching_cubes as u64,
+    ] {
+        out.extend_from_slice(&x.to_le_bytes());
+    }
+    for p in &s.fixed {
+        for c in p {
+            out.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    for t in &s.triangles {
+        for v in t {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    std::fs::File::create(path)?.write_all(&out)
+}
+
+fn load(path: &PathBuf) -> std::io::Result<Surface> {
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)?.read_to_end(&mut bytes)?;
+    let mut at = 0;
+    let mut take = |n: usize| {
+        let s = &bytes[at..at + n];
+        at += n;
+        s.to_vec()
+    };
+    let mut u64_ = || u64::from_le_bytes(take(8).try_into().unwrap_or([0; 8]));
+    let (nv, nt, ticks, mc) = (u64_(), u64_(), u64_(), u64_());
+    let fixed = (0..nv)
+        .map(|_| [0; 3].map(|_: i64| u64_() as i64))
+        .collect();
+    let triangles = (0..nt)
+        .map(|_| [0; 3].map(|_: u32| u32::from_le_bytes(take(4).try_into().unwrap_or([0; 4]))))
+        .collect();
+    Ok(Surface {
+        fixed,
+        triangles,
+        ticks: ticks as i64,
+        marching_cubes: mc as usize,
+    })
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut args = std::env::args().skip(1);
+    let mesh_path = PathBuf::from(args.next().ok_or("usage: simplify_bench MESH RES")?);
+    let res: usize = args
+        .next()
+        .ok_or("usage: simplify_bench MESH RES")?
+        .parse()?;
+    let mut repeat = 1;
+    let mut check = false;
+    let mut relocate = true;
+    while let Some(a) = args.next() {
+        match a.as_str() {
+            "--repeat" => repeat = args.next().ok_or("--repeat N")?.parse()?,
+            "--check" => check = true,
+            "--no-relocate" => relocate = false,
+            _ => return Err(format!("unknown argument {a}").into()),
+        }
+    }
+    let name = mesh_path
+        .file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or("mesh");
+    let cache = std::env::temp_dir().join(format!("gwn-simplify-{name}-{res}.bin"));
+    let surface = match load(&cache) {
+        Ok(s) => s,
+        Err(_) => {
+            let s = build(&mesh_path, res)?;
+            save(&s, &cache)?;
+            s
+        }
+    };
+    let options = simplify::SimplifyOptions {
+        relocate,
+        ..simplify::SimplifyOptions::default()
+    };
+    let target =
+        (options.target_fraction_of_marching_cubes * surface.marching_cubes as f64) as usize;
+    for _ in 0..repeat {
+        let t0 = Instant::now();
+        let s = simplify::simplify(
+            &surface.fixed,
+            &surface.triangles,
+            surface.ticks,
+            &options,
+            target,
+        );
+        let dt = t0.elapsed().as_secs_f64();
+        // FNV-1a over the output: equal surfaces, equal fingerprints.
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        for t in &s.triangles {
+            for &v in t {
+                h = (h ^ u64::from(s.vertices[v as usize])).wrapping_mul(0x100_0000_01b3);
+                for c in s.points[v as usize] {
+                    h = (h ^ c as u64).wrapping_mul(0x100_0000_01b3);
+                }
+            }
+        }
+        println!(
+            "{name} res {res}: {} -> {} faces (MC {}), {} collapses, refused {:?}, {} relocated ({} refused), {dt:.2} s, {:.2} us/collapse, fingerprint {h:016x}",
+            s.stats.faces_before,
+            s.stats.faces_after,
+            surface.marching_cubes,
+            s.stats.collapses,
+            s.stats.refused,
+            s.stats.relocated,
+            s.stats.relocations_refused,
+            dt * 1e6 / s.stats.collapses.max(1) as f64
+        );
+        if check {
+            let fixed: Vec<[i64; 3]> = s
+                .vertices
+                .iter()
+                .map(|&v| surface.fixed[v as usize])
+                .collect();
+            let at: Vec<[f64; 3]> = fixed.iter().map(|p| p.map(|c| c as f64)).collect();
+            let rep = TopologyReport::of(&at, &s.triangles);
+            let si = intersect::self_intersections(&fixed, &s.triangles, u64::MAX)
+                .map_err(|e| e.to_string())?;
+            println!(
+                "  closed {} edge-manifold {} vertex-manifold {} oriented {} euler {} components {} self-intersections {}",
+                rep.closed,
+                rep.edge_manifold,
+                rep.vertex_manifold,
+                rep.oriented,
+                rep.euler_characteristic,
+                rep.components,
+                si.pairs
+            );
+        }
+    }
+    Ok(())
+}
