@@ -198,6 +198,7 @@ def main() -> int:
     ap.add_argument("--gwn", default=str(Path(__file__).resolve().parents[2] / "target/release/gwn"))
     ap.add_argument("--json", type=Path, help="write every row here too")
     ap.add_argument("--timeout", type=float, default=120, help="seconds per tool and mesh before it counts as a hang")
+    ap.add_argument("--tools", default="gwn,pymeshfix,pcu", help="which of gwn, pymeshfix, pcu to run")
     args = ap.parse_args()
 
     import point_cloud_utils as pcu
@@ -210,7 +211,10 @@ def main() -> int:
         files = [f for f in files if f.name in only]
 
     rows = []
-    tools = ["gwn", "pymeshfix", "pcu"]
+    tools = [t for t in args.tools.split(",") if t]
+    unknown = set(tools) - {"gwn", "pymeshfix", "pcu"}
+    if unknown:
+        ap.error(f"unknown tools: {', '.join(sorted(unknown))}")
     print(f"| mesh | faces | tool | out faces | closed | edge-manifold | oriented | manifold3d | agreement % | wall s | cpu s |")
     print("|---|---:|---|---:|---|---|---|---|---:|---:|---:|")
     for path in files:
