@@ -160,6 +160,18 @@ impl AngleSumAvx2 {
         }
     }
 
+    /// `sum` in registers.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub(crate) fn load(sum: &AngleSum) -> Self {
+        AngleSumAvx2 {
+            re: bytemuck::cast(sum.re),
+            im: bytemuck::cast(sum.im),
+            up: bytemuck::cast(sum.turns_up),
+            down: bytemuck::cast(sum.turns_down),
+        }
+    }
+
     /// [`AngleSum::push`].
     #[target_feature(enable = "avx2")]
     #[inline]

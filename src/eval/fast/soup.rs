@@ -133,9 +133,9 @@ impl FastWindingNumber {
     pub fn eval_with(&self, q: [f64; 3], params: FastParams) -> f64 {
         let q = self.scale.query(q);
         let mut angles = AngleSum::new();
-        let far_and_rare = self
-            .hierarchy
-            .eval(q, &params, self.leaf_terms(q, &mut angles));
+        let far_and_rare =
+            self.hierarchy
+                .eval(q, &params, self.leaf_terms(q, &mut angles, Simd::detect()));
         // Σ 2·atan2(det, den) / (4π).
         far_and_rare + angles.total() * (2.0 * INV_4PI)
     }
@@ -145,9 +145,9 @@ impl FastWindingNumber {
     fn eval_portable(&self, q: [f64; 3], params: FastParams) -> f64 {
         let q = self.scale.query(q);
         let mut angles = AngleSum::new();
-        let far_and_rare = self
-            .hierarchy
-            .eval_lanes(q, &params, self.leaf_terms(q, &mut angles));
+        let far_and_rare =
+            self.hierarchy
+                .eval_lanes(q, &params, self.leaf_terms(q, &mut angles, Simd::PORTABLE));
         far_and_rare + angles.total() * (2.0 * INV_4PI)
     }
 
@@ -158,21 +158,23 @@ impl FastWindingNumber {
         &'a self,
         q: [f64; 3],
         angles: &'a mut AngleSum,
+        simd: Simd,
     ) -> impl FnMut(usize, std::ops::Range<usize>, &mut f64) + 'a {
-        move |k, range, sum| self.add_leaf_terms(angles, q, k, range, sum)
+        move |k, range, sum| self.add_leaf_terms(simd, angles, q, k, range, sum)
     }
 
     /// The body of [`Self::leaf_terms`], shared with the packets of [`Self::eval_batch_with`].
     #[inline(always)]
     fn add_leaf_terms(
         &self,
+        simd: Simd,
         angles: &mut AngleSum,
         q: [f64; 3],
         k: usize,
         range: std::ops::Range<usize>,
         sum: &mut f64,
     ) {
-        let ok = push_solid_angles(angles, &self.leaves[k], q);
+        let ok = simd.push_solid_angles(angles, &self.leaves[k], q);
         if ok != 0b1111 {
             for (l, t) in self.triangles[range].iter().enumerate() {
                 if ok & (1 << l) == 0 {
@@ -230,8 +232,13 @@ impl FastWindingNumber {
         eval_in_packets(points, |packet, active| {
             let q = packet.map(|p| self.scale.query(p));
             let mut angles: [AngleSum; PACKET] = std::array::from_fn(|_| AngleSum::new());
+            let simd = if portable {
+                Simd::PORTABLE
+            } else {
+                Simd::detect()
+            };
             let leaf = |i: usize, k, range, sum: &mut f64| {
-                self.add_leaf_terms(&mut angles[i], q[i], k, range, sum)
+                self.add_leaf_terms(simd, &mut angles[i], q[i], k, range, sum)
             };
             let far_and_rare = if portable {
                 self.hierarchy.eval_packet_lanes::<super::packet::Lanes8>(
@@ -294,6 +301,160 @@ impl FastWindingNumber {
             max: n.max,
         }
     }
+}
+
+/// Which instructions the near leaves' solid angles run on: AVX2 registers where the CPU has
+/// them (the walks run compiled for AVX2, but `wide`'s `f64x4` is two SSE halves in a portable
+/// build), else `wide`. Both do the same IEEE operations in the same order: the same bits.
+#[derive(Clone, Copy, Debug)]
+struct Simd {
+    #[cfg(target_arch = "x86_64")]
+    avx2: Option<super::packet::Avx2>,
+}
+
+impl Simd {
+    /// `wide` only (the portable path, and the test of the dispatch).
+    const PORTABLE: Simd = Simd {
+        #[cfg(target_arch = "x86_64")]
+        avx2: None,
+    };
+
+    #[inline]
+    fn detect() -> Simd {
+        Simd {
+            #[cfg(target_arch = "x86_64")]
+            avx2: super::packet::Avx2::detect(),
+        }
+    }
+
+    /// [`push_solid_angles`] on this instruction set.
+    #[inline(always)]
+    fn push_solid_angles(self, angles: &mut AngleSum, t: &[f64x4; 9], q: [f64; 3]) -> u32 {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2.is_some() {
+            // SAFETY: the token proves the CPU has AVX2.
+            #[allow(unsafe_code)]
+            return unsafe { push_solid_angles_avx2(angles, t, q) };
+        }
+        push_solid_angles(angles, t, q)
+    }
+}
+
+/// [`push_solid_angles`] in AVX2 registers: the same operations in the same order, `wide`'s
+/// `min`/`max` NaN rule included, so the same bits (tested through the dispatch).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn push_solid_angles_avx2(angles: &mut AngleSum, t: &[f64x4; 9], q: [f64; 3]) -> u32 {
+    use crate::kernel::angle_sum::AngleSumAvx2;
+    use std::arch::x86_64::*;
+    // Macros, not closures: the intrinsics are safe to call only in this AVX2 function's body.
+    macro_rules! dot {
+        ($x0:expr, $y0:expr, $z0:expr, $x1:expr, $y1:expr, $z1:expr) => {
+            _mm256_add_pd(
+                _mm256_add_pd(_mm256_mul_pd($x0, $x1), _mm256_mul_pd($y0, $y1)),
+                _mm256_mul_pd($z0, $z1),
+            )
+        };
+    }
+    // `wide`'s min/max: the left operand where the right one is NaN.
+    macro_rules! min_max {
+        ($op:ident, $a:expr, $b:expr) => {{
+            let (a, b) = ($a, $b);
+            _mm256_blendv_pd($op(a, b), a, _mm256_cmp_pd::<_CMP_UNORD_Q>(b, b))
+        }};
+    }
+    let v: [__m256d; 9] = std::array::from_fn(|i| bytemuck::cast(t[i]));
+    let (qx, qy, qz) = (
+        _mm256_set1_pd(q[0]),
+        _mm256_set1_pd(q[1]),
+        _mm256_set1_pd(q[2]),
+    );
+    let (ax, ay, az) = (
+        _mm256_sub_pd(v[0], qx),
+        _mm256_sub_pd(v[1], qy),
+        _mm256_sub_pd(v[2], qz),
+    );
+    let (bx, by, bz) = (
+        _mm256_sub_pd(v[3], qx),
+        _mm256_sub_pd(v[4], qy),
+        _mm256_sub_pd(v[5], qz),
+    );
+    let (cx, cy, cz) = (
+        _mm256_sub_pd(v[6], qx),
+        _mm256_sub_pd(v[7], qy),
+        _mm256_sub_pd(v[8], qz),
+    );
+    let la2 = dot!(ax, ay, az, ax, ay, az);
+    let lb2 = dot!(bx, by, bz, bx, by, bz);
+    let lc2 = dot!(cx, cy, cz, cx, cy, cz);
+    let (la, lb, lc) = (
+        _mm256_sqrt_pd(la2),
+        _mm256_sqrt_pd(lb2),
+        _mm256_sqrt_pd(lc2),
+    );
+    let det = _mm256_add_pd(
+        _mm256_add_pd(
+            _mm256_mul_pd(
+                ax,
+                _mm256_sub_pd(_mm256_mul_pd(by, cz), _mm256_mul_pd(bz, cy)),
+            ),
+            _mm256_mul_pd(
+                ay,
+                _mm256_sub_pd(_mm256_mul_pd(bz, cx), _mm256_mul_pd(bx, cz)),
+            ),
+        ),
+        _mm256_mul_pd(
+            az,
+            _mm256_sub_pd(_mm256_mul_pd(bx, cy), _mm256_mul_pd(by, cx)),
+        ),
+    );
+    let labc = _mm256_mul_pd(_mm256_mul_pd(la, lb), lc);
+    let den = _mm256_add_pd(
+        _mm256_add_pd(
+            _mm256_add_pd(labc, _mm256_mul_pd(dot!(ax, ay, az, bx, by, bz), lc)),
+            _mm256_mul_pd(dot!(bx, by, bz, cx, cy, cz), la),
+        ),
+        _mm256_mul_pd(dot!(cx, cy, cz, ax, ay, az), lb),
+    );
+    let cond = _mm256_mul_pd(_mm256_set1_pd(SOLID_ANGLE_CONDITION), labc);
+    let sign = _mm256_set1_pd(-0.0);
+    let ok = _mm256_and_pd(
+        _mm256_and_pd(
+            _mm256_and_pd(
+                _mm256_and_pd(
+                    _mm256_cmp_pd::<_CMP_GT_OQ>(
+                        _mm256_andnot_pd(sign, det),
+                        _mm256_mul_pd(_mm256_set1_pd(1e-12), labc),
+                    ),
+                    _mm256_cmp_pd::<_CMP_LT_OQ>(
+                        _mm256_andnot_pd(sign, den),
+                        _mm256_set1_pd(f64::INFINITY),
+                    ),
+                ),
+                _mm256_cmp_pd::<_CMP_GT_OQ>(
+                    min_max!(_mm256_min_pd, min_max!(_mm256_min_pd, la2, lb2), lc2),
+                    _mm256_set1_pd(1e-180),
+                ),
+            ),
+            _mm256_cmp_pd::<_CMP_LT_OQ>(
+                min_max!(_mm256_max_pd, min_max!(_mm256_max_pd, la2, lb2), lc2),
+                _mm256_set1_pd(1e180),
+            ),
+        ),
+        _mm256_cmp_pd::<_CMP_GE_OQ>(
+            _mm256_add_pd(_mm256_mul_pd(det, det), _mm256_mul_pd(den, den)),
+            _mm256_mul_pd(cond, cond),
+        ),
+    );
+    let mut acc = AngleSumAvx2::load(angles);
+    acc.push(
+        _mm256_blendv_pd(_mm256_set1_pd(1.0), den, ok),
+        _mm256_blendv_pd(_mm256_setzero_pd(), det, ok),
+    );
+    acc.rescale();
+    *angles = acc.finish();
+    _mm256_movemask_pd(ok) as u32
 }
 
 /// Pushes `atan2(det, den)` of the Van Oosterom–Strackee formula (half the solid angle; see
