@@ -628,12 +628,7 @@ impl Simplifier {
             .iter()
             .flat_map(|&f| self.support[f as usize].iter().copied())
         {
-            let q = self.at[x as usize];
-            let (best, d2) = triangles
-                .iter()
-                .enumerate()
-                .map(|(k, t)| (k, point_triangle_distance2(q, t)))
-                .fold((0, f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
+            let (best, d2) = nearest_triangle(self.at[x as usize], &triangles);
             if d2.is_nan() || d2 > self.max_distance2 {
                 return None;
             }
@@ -815,12 +810,7 @@ impl Simplifier {
                 .flat_map(|&f| self.support[f as usize].iter().copied()),
         );
         for x in points {
-            let q = self.at[x as usize];
-            let (best, d2) = triangles
-                .iter()
-                .enumerate()
-                .map(|(k, t)| (k, point_triangle_distance2(q, t)))
-                .fold((0, f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
+            let (best, d2) = nearest_triangle(self.at[x as usize], &triangles);
             if d2.is_nan() || d2 > self.max_distance2 {
                 return Err(Refusal::Distance);
             }
@@ -1062,6 +1052,16 @@ fn plane_quadric(t: [[f64; 3]; 3]) -> [f64; 11] {
         w * d * d,
         w,
     ]
+}
+
+/// The triangle of `triangles` nearest to `q` (the first of equals) and its squared distance
+/// (`∞` when there is none, or when every distance is NaN).
+fn nearest_triangle(q: [f64; 3], triangles: &[[[f64; 3]; 3]]) -> (usize, f64) {
+    triangles
+        .iter()
+        .enumerate()
+        .map(|(k, t)| (k, point_triangle_distance2(q, t)))
+        .fold((0, f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a })
 }
 
 /// Squared distance from `p` to the closed triangle `t` (Ericson, "Real-Time Collision
