@@ -90,20 +90,24 @@ pub fn shared_mesh_files() -> Option<(std::path::PathBuf, Vec<String>)> {
     Some((dir, files))
 }
 
-/// Deterministic pseudo-random numbers (SplitMix64) so tests need no RNG dependency.
+/// Deterministic pseudo-random numbers: the crate's SplitMix64 (`gwn::testing::SplitMix64`) with
+/// the state in the open, so tests need no RNG dependency.
 pub struct Rng(pub u64);
 
 impl Rng {
     pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E3779B97F4A7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58476D1CE4E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D049BB133111EB);
-        z ^ (z >> 31)
+        let mut g = gwn::testing::SplitMix64(self.0);
+        let v = g.next_u64();
+        self.0 = g.0;
+        v
     }
-    /// Uniform in [0, 1).
+    /// Uniform in [0, 1) (53 random bits; dividing by 2^53 and multiplying by 2^-53 are the
+    /// same exact operation).
     pub fn f64(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+        let mut g = gwn::testing::SplitMix64(self.0);
+        let v = g.unit();
+        self.0 = g.0;
+        v
     }
     pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
         lo + (hi - lo) * self.f64()
