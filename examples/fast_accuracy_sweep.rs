@@ -54,12 +54,8 @@ fn main() {
     while let Some(a) = args.next() {
         match a.as_str() {
             "--rule" => {
-                rule = match args.next().as_deref() {
-                    Some("radius") => Admissibility::Radius,
-                    Some("box-corner") => Admissibility::BoxCorner,
-                    Some("box-diagonal") => Admissibility::BoxDiagonal,
-                    r => panic!("--rule radius|box-corner|box-diagonal, not {r:?}"),
-                }
+                let name = args.next().unwrap_or_default();
+                rule = name.parse().unwrap_or_else(|e| panic!("--rule: {e}"));
             }
             "--betas" => {
                 betas = args

@@ -40,7 +40,7 @@
 //! threads gives the same bits as one built on one thread.
 //!
 //! `cargo run --release --features examples --example fast_speed -- [--beta B] [--order K]
-//! [--rule radius|box-corner] [--reps N] [--threads T] [--points grid|random] [--count N]
+//! [--rule radius|box-corner|box-diagonal|radius-or-box-corner] [--reps N] [--threads T] [--points grid|random] [--count N]
 //! [--seed S] [--dump-points FILE.npy] [--dump-mesh FILE.off] [--cloud N] [--dump-cloud FILE.npy] [--accuracy K] [--build-only] MESH...`
 
 use gwn::eval::direct::winding_number_direct;
@@ -242,11 +242,8 @@ fn main() {
             "--reps" => reps = value::<usize>(&mut args, "--reps N").max(1),
             "--threads" => threads = value::<usize>(&mut args, "--threads T").max(1),
             "--rule" => {
-                rule = match args.next().as_deref() {
-                    Some("radius") => Admissibility::Radius,
-                    Some("box-corner") => Admissibility::BoxCorner,
-                    r => panic!("--rule radius|box-corner, not {r:?}"),
-                }
+                let name = args.next().unwrap_or_default();
+                rule = name.parse().unwrap_or_else(|e| panic!("--rule: {e}"));
             }
             "--points" => {
                 random = match args.next().as_deref() {

@@ -40,7 +40,7 @@ use std::str::FromStr;
 use crate::eval::Evaluator;
 use crate::eval::antipodal::{BoundaryBy, BuildError, DEFAULT_TOLERANCE, Options, WindingNumber};
 use crate::eval::direct::DirectWindingNumber;
-use crate::eval::fast::{FastParams, FastWindingNumber, PointCloudWindingNumber};
+use crate::eval::fast::{Admissibility, FastParams, FastWindingNumber, PointCloudWindingNumber};
 use crate::input::{Input, InputKind};
 use crate::kernel::frame::RayAxis;
 use crate::kernel::quantize::Precision;
@@ -106,6 +106,8 @@ pub enum SpecOption {
     Beta,
     /// [`EvaluatorSpec::order`].
     Order,
+    /// [`EvaluatorSpec::rule`].
+    Rule,
 }
 
 impl SpecOption {
@@ -118,6 +120,7 @@ impl SpecOption {
             SpecOption::Tolerance => "tolerance",
             SpecOption::Beta => "beta",
             SpecOption::Order => "order",
+            SpecOption::Rule => "rule",
         }
     }
 
@@ -130,6 +133,9 @@ impl SpecOption {
             SpecOption::Tolerance => "a finite number >= 0",
             SpecOption::Beta => "a positive finite number",
             SpecOption::Order => "0, 1 or 2",
+            SpecOption::Rule => {
+                "\"radius\", \"box-diagonal\", \"box-corner\" or \"radius-or-box-corner\""
+            }
         }
     }
 
@@ -138,7 +144,7 @@ impl SpecOption {
         match self {
             SpecOption::Ray | SpecOption::Precision => "the exact method",
             SpecOption::Tolerance => "the exact method, and of the direct method on patch sets",
-            SpecOption::Beta | SpecOption::Order => "the fast method",
+            SpecOption::Beta | SpecOption::Order | SpecOption::Rule => "the fast method",
             SpecOption::Method => "every method",
         }
     }
@@ -182,6 +188,27 @@ impl FromStr for Method {
             .find(|m| m.name() == s)
             .ok_or_else(|| ParseError {
                 option: SpecOption::Method,
+                given: format!("{s:?}"),
+            })
+    }
+}
+
+impl FromStr for Admissibility {
+    type Err = ParseError;
+    /// [`Admissibility::name`]: `"radius"`, `"box-diagonal"`, `"box-corner"`,
+    /// `"radius-or-box-corner"`.
+    ///
+    /// ```
+    /// use gwn::eval::fast::Admissibility;
+    /// assert_eq!("box-corner".parse(), Ok(Admissibility::BoxCorner));
+    /// assert!("corner".parse::<Admissibility>().is_err());
+    /// ```
+    fn from_str(s: &str) -> Result<Self, ParseError> {
+        Admissibility::ALL
+            .into_iter()
+            .find(|a| a.name() == s)
+            .ok_or_else(|| ParseError {
+                option: SpecOption::Rule,
                 given: format!("{s:?}"),
             })
     }
@@ -396,6 +423,8 @@ pub struct EvaluatorSpec {
     pub beta: Option<f64>,
     /// Fast method: the expansion order 0, 1 or 2 (default 2).
     pub order: Option<u8>,
+    /// Fast method: which node size β multiplies (default [`Admissibility::Radius`], Barill's).
+    pub rule: Option<Admissibility>,
     /// Exact method on meshes: how boundary edges are matched (by position unless the front
     /// end keeps the file's vertices as they are); values do not depend on it.
     pub boundary: BoundaryBy,
@@ -435,6 +464,7 @@ impl EvaluatorSpec {
             (self.tolerance.is_some(), SpecOption::Tolerance),
             (self.beta.is_some(), SpecOption::Beta),
             (self.order.is_some(), SpecOption::Order),
+            (self.rule.is_some(), SpecOption::Rule),
         ]
         .into_iter()
         .filter_map(|(given, o)| given.then_some(o))
@@ -446,7 +476,7 @@ impl EvaluatorSpec {
             let used = match option {
                 SpecOption::Ray | SpecOption::Precision => method == Method::Exact,
                 SpecOption::Tolerance => method != Method::Fast,
-                SpecOption::Beta | SpecOption::Order => method == Method::Fast,
+                SpecOption::Beta | SpecOption::Order | SpecOption::Rule => method == Method::Fast,
                 SpecOption::Method => true,
             };
             if !used {
@@ -505,13 +535,15 @@ impl EvaluatorSpec {
         }
     }
 
-    /// The fast method's parameters (defaults for what is not given: β = 2, order 2).
+    /// The fast method's parameters (defaults for what is not given: β = 2, order 2, Barill's
+    /// radius rule).
     pub fn fast_params(&self) -> FastParams {
         let default = FastParams::default();
-        FastParams::barill(
-            self.beta.unwrap_or(default.beta),
-            self.order.unwrap_or(default.order),
-        )
+        FastParams {
+            beta: self.beta.unwrap_or(default.beta),
+            order: self.order.unwrap_or(default.order),
+            admissibility: self.rule.unwrap_or(default.admissibility),
+        }
     }
 
     /// The patch evaluator's options.
@@ -610,6 +642,14 @@ mod tests {
         );
         assert!("Exact".parse::<Method>().is_err());
         assert!("".parse::<RayAxis>().is_err());
+        for a in Admissibility::ALL {
+            assert_eq!(a.to_string().parse::<Admissibility>(), Ok(a));
+        }
+        assert_eq!(
+            "corner".parse::<Admissibility>().unwrap_err().to_string(),
+            "rule must be \"radius\", \"box-diagonal\", \"box-corner\" or \
+             \"radius-or-box-corner\", got \"corner\""
+        );
     }
 
     #[test]
@@ -840,5 +880,25 @@ mod tests {
             ..spec()
         };
         assert_eq!(f.fast_params(), FastParams::barill(3.5, 1));
+        let r = EvaluatorSpec {
+            rule: Some(Admissibility::RadiusOrBoxCorner),
+            ..f
+        };
+        assert_eq!(
+            r.fast_params().admissibility,
+            Admissibility::RadiusOrBoxCorner
+        );
+        let exact_rule = EvaluatorSpec {
+            method: Some(Method::Exact),
+            rule: Some(Admissibility::BoxCorner),
+            ..spec()
+        };
+        assert_eq!(
+            exact_rule.validate(),
+            Err(SpecError::OptionForMethod {
+                option: SpecOption::Rule,
+                method: Method::Exact
+            })
+        );
     }
 }

@@ -42,6 +42,9 @@ pub struct Args {
     /// Expansion order of the fast method (0, 1 or 2).
     #[arg(long, default_value_t = 2)]
     pub order: u8,
+    /// Which node size beta multiplies in the fast method (as in `gwn eval --rule`).
+    #[arg(long, value_parser = crate::method::parse_option::<gwn::eval::fast::Admissibility>, default_value = "radius")]
+    pub rule: gwn::eval::fast::Admissibility,
     /// Leave out the `exact` columns (for timing `fast` alone, e.g. on soups, where the exact
     /// method costs O(faces) per query).
     #[arg(long)]
@@ -87,6 +90,7 @@ pub fn run(mut args: Args) -> Result<(), CliError> {
     gwn::spec::EvaluatorSpec {
         beta: Some(args.beta),
         order: Some(args.order),
+        rule: Some(args.rule),
         ..args.method_spec()
     }
     .validate()?;
@@ -178,7 +182,12 @@ fn bench_mesh(mesh: &Mesh, args: &Args) -> Result<Option<String>, CliError> {
     std::hint::black_box(wn.eval(outside));
     let pre = t0.elapsed().as_secs_f64() * 1e3;
     let t0 = Instant::now();
-    let fast = FastWindingNumber::with_params(mesh, FastParams::barill(args.beta, args.order));
+    let params = FastParams {
+        beta: args.beta,
+        order: args.order,
+        admissibility: args.rule,
+    };
+    let fast = FastWindingNumber::with_params(mesh, params);
     let build = t0.elapsed().as_secs_f64() * 1e3;
     let mut row = format!(
         "{} | {} | {pre:.1} | {build:.1}",

@@ -7,6 +7,7 @@ use std::path::Path;
 
 use clap::Args as ClapArgs;
 use gwn::eval::Evaluator;
+use gwn::eval::fast::Admissibility;
 use gwn::input::{Input, InputKind};
 use gwn::mesh::Mesh;
 use gwn::spec::{EvaluatorSpec, Method, SpecError};
@@ -39,6 +40,12 @@ pub struct MethodArgs {
     /// Expansion order of the fast method (0, 1 or 2) [default: 2].
     #[arg(long)]
     pub order: Option<u8>,
+    /// Which node size beta multiplies in the fast method: radius (Barill et al.), box-corner
+    /// (libigl), box-diagonal (FOSSIL) or radius-or-box-corner (admit by whichever of radius
+    /// at beta and box-corner at 6/7 beta admits first; at beta 2.8 as accurate as libigl's
+    /// default on the shared corpus, and faster: docs/fast.md) [default: radius].
+    #[arg(long, value_parser = parse_option::<Admissibility>)]
+    pub rule: Option<Admissibility>,
 }
 
 /// `--tolerance`, shared by every subcommand that evaluates `w`.
@@ -59,6 +66,7 @@ impl MethodArgs {
             method: self.method,
             beta: self.beta,
             order: self.order,
+            rule: self.rule,
             tolerance: tolerance.tolerance,
             boundary: weld.boundary(),
             ..Default::default()

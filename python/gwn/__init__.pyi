@@ -17,6 +17,7 @@ _F64 = npt.NDArray[np.float64]
 _I64 = npt.NDArray[np.int64]
 _Method = Literal["exact", "direct", "fast"]
 _Ray = Literal["+x", "-x", "+y", "-y", "+z", "-z"]
+_Rule = Literal["radius", "box-diagonal", "box-corner", "radius-or-box-corner"]
 _Grid = Tuple[_F64, _F64, _F64]
 
 class StepModel:
@@ -64,10 +65,16 @@ class WindingNumber:
         precision: Optional[int] = None,
         ray: Optional[_Ray] = None,
         tolerance: Optional[float] = None,
+        rule: Optional[_Rule] = None,
     ) -> None: ...
     @staticmethod
     def from_point_cloud(
-        P: _Floats, N: _Floats, A: Optional[_Floats] = None, beta: float = 2.3, order: int = 2
+        P: _Floats,
+        N: _Floats,
+        A: Optional[_Floats] = None,
+        beta: float = 2.3,
+        order: int = 2,
+        rule: Optional[_Rule] = None,
     ) -> "WindingNumber":
         """Barnes-Hut evaluator of an oriented point cloud; areas estimated when ``A`` is None."""
     @overload
@@ -134,6 +141,7 @@ def fast_winding_number(
     order: Optional[int] = None,
     expansion_order: Optional[int] = None,
     threads: Optional[int] = None,
+    rule: Optional[_Rule] = None,
 ) -> _F64: ...
 @overload
 def fast_winding_number(
@@ -149,6 +157,7 @@ def fast_winding_number(
     order: Optional[int] = None,
     expansion_order: Optional[int] = None,
     threads: Optional[int] = None,
+    rule: Optional[_Rule] = None,
 ) -> _F64:
     """Barnes-Hut winding numbers of a mesh (V, F, Q) or point cloud (P, N, A, Q); libigl's forms,
     with libigl's positional ``expansion_order, beta`` (default 2, 2.0) after the arrays."""

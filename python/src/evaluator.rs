@@ -6,7 +6,7 @@ use std::sync::Arc;
 use gwn::Mesh;
 use gwn::eval::antipodal::{DEFAULT_TOLERANCE, WindingNumber};
 use gwn::eval::direct::{winding_number_direct_batch, winding_number_gradient_direct};
-use gwn::eval::fast::{FastWindingNumber, PointCloudWindingNumber};
+use gwn::eval::fast::{Admissibility, FastWindingNumber, PointCloudWindingNumber};
 use gwn::input::InputKind;
 use gwn::patch::step::{StepEvaluation, StepModel, StepWindingNumber};
 use gwn::spec::{EvaluatorSpec, Method, SpecError};
@@ -28,6 +28,8 @@ pub struct SpecArgs<'a> {
     pub beta: Option<f64>,
     /// `order=`.
     pub order: Option<u8>,
+    /// `rule=` (the fast method's admissibility rule).
+    pub rule: Option<&'a str>,
     /// `precision=` (bits).
     pub precision: Option<u32>,
     /// `ray=`.
@@ -43,6 +45,7 @@ impl SpecArgs<'_> {
             method: self.method.map(str::parse::<Method>).transpose()?,
             beta: self.beta,
             order: self.order,
+            rule: self.rule.map(str::parse::<Admissibility>).transpose()?,
             precision: self.precision.map(Precision::try_from).transpose()?,
             ray: self.ray.map(str::parse::<RayAxis>).transpose()?,
             tolerance: self.tolerance,

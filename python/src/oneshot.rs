@@ -70,10 +70,13 @@ pub fn winding_number<'py>(
 ///
 /// As in libigl, the expansion order and ``beta`` may follow the arrays positionally
 /// (``fast_winding_number(P, N, A, Q, 2, 2.0)``); ``order=`` is accepted as a shorter name of
-/// ``expansion_order``. Defaults: order 2, ``beta`` 2.0. Returns float64 (k,). Ctrl-C
-/// interrupts a long call (``KeyboardInterrupt``).
+/// ``expansion_order``. Defaults: order 2, ``beta`` 2.0. ``rule`` is the admissibility rule
+/// (``"radius"``, Barill's, the default; ``"box-corner"``, libigl's; ``"box-diagonal"``;
+/// ``"radius-or-box-corner"``: at ``beta=2.8`` as accurate as libigl's default on the shared
+/// corpus, and faster; docs/fast.md). Returns float64 (k,). Ctrl-C interrupts a long call
+/// (``KeyboardInterrupt``).
 #[pyfunction]
-#[pyo3(signature = (*arrays, beta = None, order = None, expansion_order = None, threads = None))]
+#[pyo3(signature = (*arrays, beta = None, order = None, expansion_order = None, threads = None, rule = None))]
 pub fn fast_winding_number<'py>(
     py: Python<'py>,
     arrays: &Bound<'py, PyTuple>,
@@ -81,6 +84,7 @@ pub fn fast_winding_number<'py>(
     order: Option<u8>,
     expansion_order: Option<u8>,
     threads: Option<Threads>,
+    rule: Option<&str>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let mut items: Vec<Bound<'py, PyAny>> = arrays.iter().collect();
     // libigl's trailing positional `expansion_order, beta`: at most two numbers after the arrays
@@ -111,6 +115,10 @@ pub fn fast_winding_number<'py>(
         method: Some(gwn::spec::Method::Fast),
         beta: Some(beta),
         order: Some(order),
+        rule: rule
+            .map(str::parse::<gwn::eval::fast::Admissibility>)
+            .transpose()
+            .map_err(value_error)?,
         ..Default::default()
     };
     spec.validate().map_err(value_error)?;

@@ -38,6 +38,7 @@ fn spec_of(
         method: Some(method),
         beta,
         order,
+        rule: None,
         precision: None,
         ray: None,
         tolerance,

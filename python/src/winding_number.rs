@@ -117,6 +117,7 @@ impl PyWindingNumber {
         Option<u32>,
         Option<String>,
         Option<f64>,
+        Option<&'static str>,
     ) {
         let exact = self.spec.exact_options();
         let fast = self.spec.fast_params();
@@ -128,9 +129,18 @@ impl PyWindingNumber {
                 Some(exact.precision.bits()),
                 Some(exact.ray.to_string()),
                 Some(exact.tolerance),
+                None,
             ),
-            Method::Direct => ("direct", None, None, None, None, None),
-            Method::Fast => ("fast", Some(fast.beta), Some(fast.order), None, None, None),
+            Method::Direct => ("direct", None, None, None, None, None, None),
+            Method::Fast => (
+                "fast",
+                Some(fast.beta),
+                Some(fast.order),
+                None,
+                None,
+                None,
+                Some(fast.admissibility.name()),
+            ),
         }
     }
 
@@ -183,7 +193,7 @@ impl PyWindingNumber {
 #[pymethods]
 impl PyWindingNumber {
     #[new]
-    #[pyo3(signature = (V, F = None, method = "exact", beta = None, order = None, precision = None, ray = None, tolerance = None))]
+    #[pyo3(signature = (V, F = None, method = "exact", beta = None, order = None, precision = None, ray = None, tolerance = None, rule = None))]
     #[allow(non_snake_case, clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -195,11 +205,13 @@ impl PyWindingNumber {
         precision: Option<u32>,
         ray: Option<&str>,
         tolerance: Option<f64>,
+        rule: Option<&str>,
     ) -> PyResult<Self> {
         let args = SpecArgs {
             method: Some(method),
             beta,
             order,
+            rule,
             precision,
             ray,
             tolerance,
@@ -217,9 +229,11 @@ impl PyWindingNumber {
 
     /// Barnes-Hut evaluator of an oriented point cloud: positions ``P`` (n, 3), normals ``N``
     /// (n, 3; their length is ignored) and areas ``A`` (n,), estimated from the 20 nearest
-    /// neighbours when ``None``. ``beta`` defaults to 2.3 (Barill et al. for points).
+    /// neighbours when ``None``. ``beta`` defaults to 2.3 (Barill et al. for points); ``rule``
+    /// is the admissibility rule (``"radius"``, the default, ``"box-corner"``, ``"box-diagonal"``
+    /// or ``"radius-or-box-corner"``).
     #[staticmethod]
-    #[pyo3(signature = (P, N, A = None, beta = 2.3, order = 2))]
+    #[pyo3(signature = (P, N, A = None, beta = 2.3, order = 2, rule = None))]
     #[allow(non_snake_case)]
     fn from_point_cloud(
         py: Python<'_>,
@@ -228,10 +242,15 @@ impl PyWindingNumber {
         A: Option<&Bound<'_, PyAny>>,
         beta: f64,
         order: u8,
+        rule: Option<&str>,
     ) -> PyResult<Self> {
         let spec = EvaluatorSpec {
             beta: Some(beta),
             order: Some(order),
+            rule: rule
+                .map(str::parse::<gwn::eval::fast::Admissibility>)
+                .transpose()
+                .map_err(value_error)?,
             ..Default::default()
         };
         spec.check(InputKind::Cloud).map_err(value_error)?;
@@ -448,7 +467,7 @@ impl PyWindingNumber {
         match &self.source {
             Source::Mesh(m) => {
                 let cls = py.get_type::<PyWindingNumber>().into_any();
-                let (method, beta, order, precision, ray, tolerance) = self.rebuild_options();
+                let (method, beta, order, precision, ray, tolerance, rule) = self.rebuild_options();
                 let args = (
                     array2(py, m.positions().to_vec())?,
                     array2(py, m.triangles().to_vec())?,
@@ -458,6 +477,7 @@ impl PyWindingNumber {
                     precision,
                     ray,
                     tolerance,
+                    rule,
                 )
                     .into_pyobject(py)?;
                 Ok((cls, args))
@@ -476,6 +496,7 @@ impl PyWindingNumber {
                     array1(py, areas.clone()),
                     self.spec.fast_params().beta,
                     self.spec.fast_params().order,
+                    self.spec.fast_params().admissibility.name(),
                 )
                     .into_pyobject(py)?;
                 Ok((rebuild, args))
@@ -492,6 +513,7 @@ impl PyWindingNumber {
                     None::<u32>,
                     None::<String>,
                     self.spec.step_options().tolerance,
+                    None::<String>,
                 )
                     .into_pyobject(py)?;
                 Ok((cls, args))

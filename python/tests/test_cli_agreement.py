@@ -32,6 +32,9 @@ def queries(tmp_path_factory, lion):
         ("exact", ["--tolerance", "0"], {"tolerance": 0.0}),
         ("direct", [], {}),
         ("fast", ["--beta", "2.5", "--order", "1"], {"beta": 2.5, "order": 1}),
+        ("fast", ["--beta", "2.8", "--rule", "radius-or-box-corner"],
+         {"beta": 2.8, "rule": "radius-or-box-corner"}),
+        ("fast", ["--beta", "2.4", "--rule", "box-corner"], {"beta": 2.4, "rule": "box-corner"}),
     ],
 )
 def test_eval(cli, tmp_path, lion, queries, method, cli_args, kwargs):
@@ -48,6 +51,12 @@ def test_one_shot_calls_equal_cli(cli, tmp_path, lion, queries):
     run(cli, "eval", LION_HEAD, "--points", qpath, "--out", tmp_path / "f.npy", "--method", "fast")
     np.testing.assert_array_equal(gwn.winding_number(*lion, q), np.load(tmp_path / "e.npy"))
     np.testing.assert_array_equal(gwn.fast_winding_number(*lion, q), np.load(tmp_path / "f.npy"))
+    run(cli, "eval", LION_HEAD, "--points", qpath, "--out", tmp_path / "r.npy", "--method", "fast",
+        "--beta", "2.8", "--rule", "radius-or-box-corner")
+    np.testing.assert_array_equal(
+        gwn.fast_winding_number(*lion, q, beta=2.8, rule="radius-or-box-corner"),
+        np.load(tmp_path / "r.npy"),
+    )
 
 
 @pytest.mark.parametrize("method", ["exact", "direct"])

@@ -80,6 +80,8 @@ def test_inputs_are_not_modified():
         (lambda: gwn.WindingNumber(CUBE_V, CUBE_F, ray="+w"), ValueError, "ray must be one of"),
         (lambda: gwn.WindingNumber(CUBE_V, CUBE_F, method="fast", beta=float("nan")), ValueError, "beta must be"),
         (lambda: gwn.fast_winding_number(CUBE_V, CUBE_F, Q, order=3), ValueError, "order must be 0, 1 or 2"),
+        (lambda: gwn.fast_winding_number(CUBE_V, CUBE_F, Q, rule="corner"), ValueError, "rule must be \"radius\""),
+        (lambda: gwn.WindingNumber(CUBE_V, CUBE_F, rule="box-corner"), ValueError, "rule does not apply to the exact method"),
         (lambda: gwn.fast_winding_number(CUBE_V, CUBE_F, Q, order=1, expansion_order=1), TypeError, "not both"),
         (lambda: gwn.fast_winding_number(CUBE_V, Q), TypeError, "takes (V, F, Q) or (P, N, A, Q)"),
         (lambda: gwn.fast_winding_number(CUBE_V, CUBE_V, np.ones(7), Q), ValueError, "A must have shape (8,)"),

@@ -75,7 +75,7 @@ def test_gil_is_released_during_evaluation(lion):
 
 @pytest.mark.parametrize("method", ["exact", "direct", "fast"])
 def test_pickle_round_trip_is_bit_identical(method):
-    fast_options = {"beta": 3.0, "order": 1} if method == "fast" else {}
+    fast_options = {"beta": 3.0, "order": 1, "rule": "box-corner"} if method == "fast" else {}
     wn = gwn.WindingNumber(CUBE_V, OPEN_BOX_F, method=method, **fast_options)
     q = random_points(500, seed=21)
     back = pickle.loads(pickle.dumps(wn))
@@ -88,7 +88,16 @@ def test_pickle_keeps_exact_options():
     back = pickle.loads(pickle.dumps(wn))
     q = np.array([[0.5, 0.5, 0.0]])  # on the bottom face: the value depends on the ray frame
     np.testing.assert_array_equal(back(q), wn(q))
-    assert back.__reduce__()[1][5:] == (30, "-x", 1e-10)
+    assert back.__reduce__()[1][5:] == (30, "-x", 1e-10, None)
+
+
+def test_pickle_keeps_the_fast_rule():
+    wn = gwn.WindingNumber(CUBE_V, OPEN_BOX_F, method="fast", beta=2.8, rule="radius-or-box-corner")
+    back = pickle.loads(pickle.dumps(wn))
+    assert back.__reduce__()[1][2:5] == ("fast", 2.8, 2)
+    assert back.__reduce__()[1][8] == "radius-or-box-corner"
+    cloud = gwn.WindingNumber.from_point_cloud(CUBE_V, CUBE_V, beta=2.5, rule="box-corner")
+    assert pickle.loads(pickle.dumps(cloud)).__reduce__()[1][3:] == (2.5, 2, "box-corner")
 
 
 def test_pickle_point_cloud_keeps_estimated_areas():

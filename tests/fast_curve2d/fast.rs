@@ -520,6 +520,35 @@ fn libigl_box_corner_rule_tracks_the_direct_sum() {
 }
 
 #[test]
+fn radius_or_box_corner_rule_tracks_the_direct_sum() {
+    // It admits a node when either Barill's test at β or libigl's at 6β/7 does, so it expands
+    // nodes earlier than the radius rule; still within Barill's 1e-3 at the documented β, and
+    // exact when nothing is admitted.
+    let Some(mesh) = shared_mesh("cgal-hand.off") else {
+        return;
+    };
+    let qs = queries(&mesh, 300, 17);
+    let exact = winding_number_direct_batch(&mesh, &qs);
+    let fast = FastWindingNumber::new(&mesh);
+    let either = |beta| FastParams {
+        beta,
+        order: 2,
+        admissibility: Admissibility::RadiusOrBoxCorner,
+    };
+    let (rms_e, max_e) = errors(&fast.eval_batch_with(&qs, either(2.8)), &exact);
+    let (rms_r, _) = errors(
+        &fast.eval_batch_with(&qs, FastParams::barill(2.8, 2)),
+        &exact,
+    );
+    println!(
+        "beta 2.8: radius or box corner rms {rms_e:.2e} max {max_e:.2e}, radius rms {rms_r:.2e}"
+    );
+    assert!(rms_e < 1e-3 && max_e < 1e-2, "rms {rms_e}, max {max_e}");
+    let (_, max) = errors(&fast.eval_batch_with(&qs, either(1e9)), &exact);
+    assert!(max <= 1e-12, "{max:e}");
+}
+
+#[test]
 fn near_field_keeps_the_scalar_semantics_on_degenerate_and_remote_triangles() {
     // Leaves mixing zero-area triangles (collinear, repeated corners), tiny and huge ones, far
     // from the origin: the four-lane near field must agree with the scalar direct sum, including

@@ -23,7 +23,47 @@ pub enum Admissibility {
     /// libigl / Houdini (`UT_SolidAngle`): `size` = the distance from `p̃` to the farthest corner
     /// of the node's bounding box (always `≥ r`).
     BoxCorner,
+    /// Whichever of Barill's and libigl's tests admits the node first: `size =
+    /// min(r, BOX_CORNER_SCALE · ρ)`, `ρ` the [`Admissibility::BoxCorner`] size. At β it admits
+    /// what `Radius` admits at β or `BoxCorner` admits at `6β/7`; at β = 2.8 that is the union
+    /// of the two settings that each match libigl's accuracy on the corpus (2.8 and 2.4), and
+    /// it does too (docs/fast.md, "β: FOSSIL vs Barill"). Why it pays: `ρ ≥ r`, and
+    /// `6ρ/7 < r` on the nodes whose elements reach into their box's corners, which are
+    /// common in CAD and scans; there the box test admits earlier.
+    RadiusOrBoxCorner,
 }
+
+impl Admissibility {
+    /// Every rule, in declaration order.
+    pub const ALL: [Admissibility; 4] = [
+        Admissibility::Radius,
+        Admissibility::BoxDiagonal,
+        Admissibility::BoxCorner,
+        Admissibility::RadiusOrBoxCorner,
+    ];
+
+    /// The rule's name on the command line and in Python (`--rule`, `rule=`; parsed by
+    /// `str::parse`, see [`crate::spec`]): `radius`, `box-diagonal`, `box-corner`,
+    /// `radius-or-box-corner`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Admissibility::Radius => "radius",
+            Admissibility::BoxDiagonal => "box-diagonal",
+            Admissibility::BoxCorner => "box-corner",
+            Admissibility::RadiusOrBoxCorner => "radius-or-box-corner",
+        }
+    }
+}
+
+impl std::fmt::Display for Admissibility {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// `RadiusOrBoxCorner`'s scale of the box-corner size: 2.4 / 2.8, the ratio of the two rules'
+/// βs that match libigl's max error on the shared corpus (`tests/fast_curve2d/fast_vs_libigl.rs`).
+pub const BOX_CORNER_SCALE: f64 = 6.0 / 7.0;
 
 /// Parameters of the fast evaluation: the accuracy parameter `β` and the expansion order.
 ///
@@ -121,7 +161,7 @@ pub(crate) struct Hierarchy {
     wide: Vec<WideNode>,
     /// Per query-tree node, the lanes' admissibility sizes, one vector per [`Admissibility`]
     /// (`as usize`): a query reads only the one it uses.
-    wide_size: [Vec<f32x4>; 3],
+    wide_size: [Vec<f32x4>; 4],
     wide_far: Vec<FarField<f32x4>>,
     /// Per query-tree node, the binary node of each lane (`EMPTY` when unused): the gradient
     /// differentiates the `f64` [`Moments`] of exactly the nodes the value expands.
@@ -263,10 +303,17 @@ impl Hierarchy {
                 .map(|(_, lanes)| lanes_of(lanes.get(), f))
                 .collect()
         };
-        self.wide_size = [sizes(&radius), sizes(&diag), sizes(&corner)];
+        let radius_or_corner = |b: usize| radius(b).min(BOX_CORNER_SCALE * corner(b));
+        self.wide_size = [
+            sizes(&radius),
+            sizes(&diag),
+            sizes(&corner),
+            sizes(&radius_or_corner),
+        ];
         debug_assert_eq!(Admissibility::Radius as usize, 0);
         debug_assert_eq!(Admissibility::BoxDiagonal as usize, 1);
         debug_assert_eq!(Admissibility::BoxCorner as usize, 2);
+        debug_assert_eq!(Admissibility::RadiusOrBoxCorner as usize, 3);
         self.wide_far = shape
             .par_iter()
             .map(|(_, lanes)| {
@@ -307,6 +354,21 @@ impl Hierarchy {
     fn lane_offsets(&self, id: usize, q: [f64; 3]) -> [f32x4; 3] {
         let node = &self.wide[id];
         std::array::from_fn(|k| node.offset[k] + f32x4::splat((node.anchor[k] - q[k]) as f32))
+    }
+
+    /// Every used lane's admissibility size under `rule`, node by node (for tests).
+    #[cfg(test)]
+    pub(crate) fn lane_sizes(&self, rule: Admissibility) -> Vec<f32> {
+        self.wide
+            .iter()
+            .zip(&self.wide_size[rule as usize])
+            .flat_map(|(node, size)| {
+                let size = size.to_array();
+                (0..WIDTH)
+                    .filter(move |&l| node.child[l] != EMPTY)
+                    .map(move |l| size[l])
+            })
+            .collect()
     }
 
     /// The lanes of query-tree node `id` whose expansion is admissible (bit `l` for lane `l`):

@@ -72,7 +72,7 @@ mod soup;
 mod tree;
 
 pub use area::estimate_areas;
-pub use barnes_hut::{Admissibility, FastParams};
+pub use barnes_hut::{Admissibility, BOX_CORNER_SCALE, FastParams};
 pub use cloud::{
     DEFAULT_AREA_NEIGHBOURS, POINT_LEAF_SIZE, PointCloudWindingNumber, winding_number_points_direct,
 };

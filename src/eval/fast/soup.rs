@@ -585,6 +585,37 @@ mod tests {
         assert!(fast.is_empty());
     }
 
+    /// `RadiusOrBoxCorner`'s size is, lane by lane, the smaller of the radius and 6/7 of the box
+    /// corner distance: it admits exactly what either test admits (at β and 6β/7).
+    #[test]
+    fn radius_or_box_corner_size_is_the_smaller_of_the_two() {
+        use super::super::{Admissibility, BOX_CORNER_SCALE};
+        let fast = FastWindingNumber::new(&subdivided(3));
+        let h = &fast.hierarchy;
+        let radius = h.lane_sizes(Admissibility::Radius);
+        let corner = h.lane_sizes(Admissibility::BoxCorner);
+        let either = h.lane_sizes(Admissibility::RadiusOrBoxCorner);
+        assert_eq!(radius.len(), either.len());
+        assert!(radius.len() > 100);
+        let (mut by_radius, mut by_corner) = (0, 0);
+        for ((&r, &c), &e) in radius.iter().zip(&corner).zip(&either) {
+            assert!(r <= c, "the corner distance bounds the radius: {r} {c}");
+            let scaled = (BOX_CORNER_SCALE * f64::from(c)) as f32;
+            // `f32` rounding of the `f64` sizes: within an ulp or two of the `f32` inputs.
+            assert!(
+                e <= r && (e - r.min(scaled)).abs() <= 2e-7 * r,
+                "{e} {r} {c}"
+            );
+            if e == r {
+                by_radius += 1;
+            } else {
+                by_corner += 1;
+            }
+        }
+        // Both tests decide somewhere, or the rule would be one of the two.
+        assert!(by_radius > 0 && by_corner > 0, "{by_radius} {by_corner}");
+    }
+
     /// The AVX2 instantiation of the traversal (taken on this machine when it has AVX2) and the
     /// portable one give the same bits, near and far, at every order and rule.
     #[test]
@@ -656,6 +687,11 @@ mod tests {
                 beta: 2.4,
                 order: 2,
                 admissibility: super::super::Admissibility::BoxCorner,
+            },
+            FastParams {
+                beta: 2.8,
+                order: 2,
+                admissibility: super::super::Admissibility::RadiusOrBoxCorner,
             },
             FastParams::barill(0.0, 2),
             FastParams::barill(-1.0, 2),
