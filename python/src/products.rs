@@ -473,6 +473,11 @@ pub fn remesh<'py>(
         let out = match thicken {
             Some(eps) => {
                 let thick = ThickenedSheets::new(&mesh, &wn, eps)?;
+                // The slabs reach `eps` past the input's box (as in `gwn remesh`).
+                let bounds = gwn::BoundingBox {
+                    min: bounds.min.map(|x| x - eps),
+                    max: bounds.max.map(|x| x + eps),
+                };
                 remesh_guided(&thick, Some(&guide), bounds, &options, &|_| {})?
             }
             None => remesh_guided(&wn, Some(&guide), bounds, &options, &|_| {})?,
