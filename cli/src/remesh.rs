@@ -66,6 +66,10 @@ pub struct Args {
     /// the tolerance allows).
     #[arg(long, default_value_t = gwn::products::remesh::simplify::DEFAULT_TARGET_FRACTION)]
     pub simplify_target: f64,
+    /// After the target, keep collapsing where the quadric error is at most this many finest
+    /// cells (flat regions end with few faces; 0: stop at the target).
+    #[arg(long, default_value_t = gwn::products::remesh::simplify::DEFAULT_FLAT_TOLERANCE)]
+    pub simplify_flat: f64,
     /// Keep every simplified vertex on its marching-tetrahedra position (no move towards the
     /// quadric minimum after the collapses).
     #[arg(long)]
@@ -139,6 +143,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             max_distance: args.simplify_distance,
             target_fraction_of_marching_cubes: args.simplify_target,
             relocate: !args.no_relocate,
+            flat_tolerance: args.simplify_flat,
             ..SimplifyOptions::default()
         }),
     };

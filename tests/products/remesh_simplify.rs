@@ -272,6 +272,7 @@ fn generous() -> SimplifyOptions {
         max_face_extent: 16,
         target_fraction_of_marching_cubes: 0.0,
         relocate: true,
+        flat_tolerance: 0.0,
     }
 }
 

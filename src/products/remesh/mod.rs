@@ -297,6 +297,7 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
         let bad = |x: f64| !(x.is_finite() && x >= 0.0);
         for (option, value, wrong) in [
             ("max_distance", s.max_distance, bad(s.max_distance)),
+            ("flat_tolerance", s.flat_tolerance, bad(s.flat_tolerance)),
             (
                 "target_fraction_of_marching_cubes",
                 s.target_fraction_of_marching_cubes,
