@@ -410,7 +410,8 @@ pub fn filter_tets<'py>(
 /// (no self-intersections) of the solid where the winding number (exact by default) is above
 /// 1/2, as ``gwn remesh`` writes it.
 ///
-/// ``res`` is the finest resolution (cells of edge longest extent / ``res``); ``bisect`` the
+/// ``res`` is the finest resolution (cells of edge longest extent / ``res``, and at least
+/// ``res / 4`` cells across every axis of the box, so that a thin plate is kept); ``bisect`` the
 /// placement precision (each vertex within ``cell / 2**(bisect+1)`` of where ``w`` crosses 1/2
 /// along its lattice edge); ``simplify`` (default on) reduces the marching-tetrahedra surface by
 /// edge collapses that keep every guarantee (each removed vertex within half a cell of the
