@@ -25,7 +25,7 @@ pub const COARSE_TARGET: usize = 64;
 pub const THIN_AXIS_DIVISOR: f64 = 4.0;
 
 /// Cells are at most this many times finer along a thin axis than along the longest one: below
-/// it the cell edge would approach the rounding of the coordinates (a box flat to `1e-300`),
+/// it the cell edge would approach the rounding of the coordinates (a box flat to `1e-12`),
 /// and a part that thin is a sheet, not a solid.
 pub const MAX_ANISOTROPY: f64 = (1u64 << 20) as f64;
 
@@ -168,3 +168,43 @@ pub type KeyHash = std::hash::BuildHasherDefault<KeyHasher>;
 pub type KeyMap<V> = std::collections::HashMap<u64, V, KeyHash>;
 /// A set of packed lattice keys.
 pub type KeySet<K> = std::collections::HashSet<K, KeyHash>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lattice(extent: [f64; 3], res: usize) -> Lattice {
+        let bounds = BoundingBox {
+            min: [-1.0, 2.0, 3.0],
+            max: [-1.0 + extent[0], 2.0 + extent[1], 3.0 + extent[2]],
+        };
+        Lattice::new(bounds, res).unwrap()
+    }
+
+    #[test]
+    fn thin_axes_get_res_over_four_cells_and_the_others_cubes() {
+        let cube = 100.0 / 64.0;
+        // Not thin (extent ≥ longest / 4): cubes, as before.
+        assert_eq!(lattice([100.0, 60.0, 25.0], 64).h, [cube; 3]);
+        // A plate: 16 cells across its thickness, plus the margin (one coarse cell each side).
+        let plate = lattice([100.0, 100.0, 1.0], 64);
+        assert_eq!(plate.h, [cube, cube, 4.0 / 64.0]);
+        assert_eq!(plate.cells[2], 16 + 2);
+        // Continuous at the threshold: just below it, the cell is just below the cube.
+        let edge = lattice([100.0, 100.0, 24.999], 64).h[2];
+        assert!(edge < cube && edge > 0.9999 * cube, "{edge}");
+        // A flat box (no volume) keeps cubes; a nearly flat one stops at MAX_ANISOTROPY.
+        assert_eq!(lattice([100.0, 100.0, 0.0], 64).h[2], cube);
+        assert_eq!(
+            lattice([100.0, 100.0, 1e-12], 64).h[2],
+            cube / MAX_ANISOTROPY
+        );
+        // Positions follow each axis's cell edge.
+        let p = plate.position([1.0, 2.0, 3.0]);
+        for a in 0..3 {
+            assert_eq!(p[a], plate.origin[a] + [1.0, 2.0, 3.0][a] * plate.h[a]);
+        }
+        assert_eq!(plate.largest_cell(), cube);
+        assert_eq!(plate.smallest_cell(), 4.0 / 64.0);
+    }
+}
