@@ -8,7 +8,9 @@
 //! cheapest vertices whose closed 1-rings have disjoint boxes are planned in parallel and
 //! collapsed in cost order ([`Simplifier::run`] says why the plans stay valid). The selection
 //! is serial and the round size a constant: the result is the same on every run and for every
-//! thread count.
+//! thread count. Collapses stop at a face target, except those of (near) zero quadric error,
+//! which go on past it ([`Simplifier::run_flat`]): a flat region's collapses all cost 0, and the
+//! target alone left flat regions as dense as curved ones.
 //!
 //! Faces are chords of the surface, so a simplified convex part lies inside the input and a
 //! concave one outside. After the collapses, [`Simplifier::relocate`] moves each kept vertex
