@@ -93,7 +93,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .unwrap_or_else(|e| e.to_string());
         clean += usize::from(si == "0");
         let cell = out.cell_size;
-        let guided = 100.0 * out.stats.guided_vertices as f64 / out.positions.len().max(1) as f64;
+        // Of the marching-tetrahedra vertices, which the guide places (the output's are fewer).
+        let guided =
+            100.0 * out.stats.guided_vertices as f64 / out.stats.extracted_vertices.max(1) as f64;
         let out_mesh = gwn::Mesh::new(out.positions, out.triangles)?;
         if out_mesh.is_empty() {
             empty += 1;

@@ -3,10 +3,11 @@
 //! surface), so that changes to `simplify.rs` can be timed and compared side by side.
 //!
 //! ```text
-//! cargo run --release --features examples --example simplify_bench -- MESH RES [--repeat N] [--check] [--no-relocate]
+//! cargo run --release --features examples --example simplify_bench -- MESH RES [--repeat N] [--check] [--no-relocate] [--flat TOL]
 //! ```
 //! The surface before simplification (exact evaluator, guided placement) is computed once and
-//! cached in `$TMPDIR` (`gwn-simplify-<mesh>-<res>.bin`). `--check` also counts exact
+//! cached in `$TMPDIR` (`gwn-simplify-<mesh>-<res>-<lattice cells>.bin`). `--flat TOL`: the
+//! flat tolerance in cells (`SimplifyOptions::flat_tolerance`; 0: stop at the target). `--check` also counts exact
 //! self-intersections and checks the topology of the output. The thread count is rayon's
 //! (`RAYON_NUM_THREADS`).
 
@@ -110,11 +111,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut repeat = 1;
     let mut check = false;
     let mut relocate = true;
+    let mut flat = simplify::DEFAULT_FLAT_TOLERANCE;
     while let Some(a) = args.next() {
         match a.as_str() {
             "--repeat" => repeat = args.next().ok_or("--repeat N")?.parse()?,
             "--check" => check = true,
             "--no-relocate" => relocate = false,
+            "--flat" => flat = args.next().ok_or("--flat TOL")?.parse()?,
             _ => return Err(format!("unknown argument {a}").into()),
         }
     }
@@ -122,7 +125,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .file_name()
         .and_then(|n| n.to_str())
         .unwrap_or("mesh");
-    let cache = std::env::temp_dir().join(format!("gwn-simplify-{name}-{res}.bin"));
+    // The lattice's cell counts in the name: a cache from another lattice rule is not reused.
+    let bounds = gwn::io::load_mesh(&mesh_path)?
+        .mesh
+        .bounding_box()
+        .ok_or("empty mesh")?;
+    let cells = Lattice::new(bounds, res).ok_or("bad bounds")?.cells;
+    let cache = std::env::temp_dir().join(format!(
+        "gwn-simplify-{name}-{res}-{}x{}x{}.bin",
+        cells[0], cells[1], cells[2]
+    ));
     let surface = match load(&cache) {
         Ok(s) => s,
         Err(_) => {
@@ -133,6 +145,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let options = simplify::SimplifyOptions {
         relocate,
+        flat_tolerance: flat,
         ..simplify::SimplifyOptions::default()
     };
     let target =
@@ -158,22 +171,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
         }
         println!(
-            "{name} res {res}: {} -> {} faces (MC {}), {} collapses, refused {:?}, {} relocated ({} refused), {dt:.2} s, {:.2} us/collapse, fingerprint {h:016x}",
+            "{name} res {res}: {} -> {} faces (MC {}), {} collapses in {} rounds, refused {:?}, {} relocated ({} refused), {dt:.2} s, {:.2} us/collapse, fingerprint {h:016x}",
             s.stats.faces_before,
             s.stats.faces_after,
             surface.marching_cubes,
             s.stats.collapses,
+            s.stats.rounds,
             s.stats.refused,
             s.stats.relocated,
             s.stats.relocations_refused,
             dt * 1e6 / s.stats.collapses.max(1) as f64
         );
         if check {
-            let fixed: Vec<[i64; 3]> = s
-                .vertices
-                .iter()
-                .map(|&v| surface.fixed[v as usize])
-                .collect();
+            // The output's own points: relocated vertices are not where the input had them.
+            let fixed = s.points.clone();
             let at: Vec<[f64; 3]> = fixed.iter().map(|p| p.map(|c| c as f64)).collect();
             let rep = TopologyReport::of(&at, &s.triangles);
             let si = intersect::self_intersections(&fixed, &s.triangles, u64::MAX)

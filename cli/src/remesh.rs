@@ -18,17 +18,18 @@ use crate::method::{MethodArgs, ToleranceArgs};
 /// solid where the winding number (exact by default) is above 1/2.
 ///
 /// Every solid is kept (nested and disjoint parts), double walls and inner faces vanish where w
-/// says so, holes close where w decides. Corners of a lattice of cell edge `extent / res` are
-/// classified (ray reuse on a coarse level, an octree only where classes differ), the surface is
-/// extracted by marching tetrahedra and each vertex placed on its lattice edge where w crosses 1/2
-/// (at the edge's crossing with the input triangles once two evaluations confirm it, else by
-/// bisection). The report counts self-intersections with exact predicates and gives a sampled
+/// says so, holes close where w decides. Corners of a lattice of cell edge `extent / res` (finer
+/// across a thin axis) are classified (ray reuse on a coarse level, an octree only where classes
+/// differ), the surface is extracted by marching tetrahedra and each vertex placed on its lattice
+/// edge where w crosses 1/2 (at the edge's crossing with the input triangles once two evaluations
+/// confirm it, else by bisection). The report counts self-intersections with exact predicates and gives a sampled
 /// Hausdorff distance to the input. See docs/remesh.md.
 #[derive(ClapArgs, Debug)]
 pub struct Args {
     /// Mesh file (OBJ, STL, OFF, PLY, glTF/GLB) or oriented point cloud (.xyz, .csv, .pts, .ply).
     pub mesh: PathBuf,
-    /// Finest equivalent resolution: cells of edge (longest extent of the box) / res.
+    /// Finest equivalent resolution: cells of edge (longest extent of the box) / res, and at
+    /// least res/4 cells across every axis (finer cells across a thin plate).
     #[arg(long, default_value_t = 128)]
     pub res: usize,
     /// Output surface: `.obj`, `.ply` (binary), `.stl` (binary) or `.glb` (binary glTF).
@@ -65,6 +66,10 @@ pub struct Args {
     /// the tolerance allows).
     #[arg(long, default_value_t = gwn::products::remesh::simplify::DEFAULT_TARGET_FRACTION)]
     pub simplify_target: f64,
+    /// After the target, keep collapsing where the quadric error is at most this many finest
+    /// cells (flat regions end with few faces; 0: stop at the target).
+    #[arg(long, default_value_t = gwn::products::remesh::simplify::DEFAULT_FLAT_TOLERANCE)]
+    pub simplify_flat: f64,
     /// Keep every simplified vertex on its marching-tetrahedra position (no move towards the
     /// quadric minimum after the collapses).
     #[arg(long)]
@@ -120,6 +125,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
             )
         }
     };
+    // The slabs reach EPS past the input's box: the lattice must hold them, or they are capped
+    // by the box (and squashed flat where the box is thin on one axis).
+    let bounds = match &thickened {
+        Some(t) => grown(bounds, t.eps()),
+        None => bounds,
+    };
     let wn: &dyn gwn::eval::Evaluator = match &thickened {
         Some(t) => t,
         None => &*built,
@@ -132,6 +143,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             max_distance: args.simplify_distance,
             target_fraction_of_marching_cubes: args.simplify_target,
             relocate: !args.no_relocate,
+            flat_tolerance: args.simplify_flat,
             ..SimplifyOptions::default()
         }),
     };
@@ -186,11 +198,17 @@ pub fn run(args: Args) -> Result<(), CliError> {
     bar.finish_and_clear();
     let s = out.stats;
     let cell_size = out.cell_size;
+    // Cells are cubes unless the box is thin along an axis (finer cells across it).
+    let cells = if out.cell_sizes.iter().all(|&h| h == cell_size) {
+        format!("cell {cell_size:.4e}")
+    } else {
+        let [x, y, z] = out.cell_sizes;
+        format!("cells {x:.4e} x {y:.4e} x {z:.4e}")
+    };
     outln!(
-        "{}: res {} (cell {:.4e}, lattice {}x{}x{}), {:.2} s, {} points classified, {} band cells",
+        "{}: res {} ({cells}, lattice {}x{}x{}), {:.2} s, {} points classified, {} band cells",
         args.out.display(),
         args.res,
-        cell_size,
         s.lattice_cells[0],
         s.lattice_cells[1],
         s.lattice_cells[2],
@@ -267,6 +285,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
         let mut extra = vec![
             ("resolution", args.res.to_string()),
             ("cell_size", format!("{:?}", cell_size)),
+            (
+                "cell_sizes",
+                format!(
+                    "[{:?}, {:?}, {:?}]",
+                    out.cell_sizes[0], out.cell_sizes[1], out.cell_sizes[2]
+                ),
+            ),
             ("seconds", format!("{secs:.3}")),
             ("classified_points", s.classified_points.to_string()),
             ("band_cells", s.band_cells.to_string()),
@@ -301,4 +326,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
             .map_err(|e| CliError(format!("{}: {e}", path.display())))?;
     }
     Ok(())
+}
+
+/// `bounds` grown by `d` on every side.
+fn grown(bounds: gwn::BoundingBox, d: f64) -> gwn::BoundingBox {
+    gwn::BoundingBox {
+        min: bounds.min.map(|x| x - d),
+        max: bounds.max.map(|x| x + d),
+    }
 }

@@ -411,7 +411,8 @@ pub fn filter_tets<'py>(
 /// (no self-intersections) of the solid where the winding number (exact by default) is above
 /// 1/2, as ``gwn remesh`` writes it.
 ///
-/// ``res`` is the finest resolution (cells of edge longest extent / ``res``); ``bisect`` the
+/// ``res`` is the finest resolution (cells of edge longest extent / ``res``, and at least
+/// ``res / 4`` cells across every axis of the box, so that a thin plate is kept); ``bisect`` the
 /// placement precision (each vertex within ``cell / 2**(bisect+1)`` of where ``w`` crosses 1/2
 /// along its lattice edge); ``simplify`` (default on) reduces the marching-tetrahedra surface by
 /// edge collapses that keep every guarantee (each removed vertex within half a cell of the
@@ -474,6 +475,11 @@ pub fn remesh<'py>(
         let out = match thicken {
             Some(eps) => {
                 let thick = ThickenedSheets::new(&mesh, &wn, eps)?;
+                // The slabs reach `eps` past the input's box (as in `gwn remesh`).
+                let bounds = gwn::BoundingBox {
+                    min: bounds.min.map(|x| x - eps),
+                    max: bounds.max.map(|x| x + eps),
+                };
                 remesh_guided(&thick, Some(&guide), bounds, &options, &|_| {})?
             }
             None => remesh_guided(&wn, Some(&guide), bounds, &options, &|_| {})?,

@@ -94,6 +94,18 @@ impl Width for W128 {
         if v < -bound {
             return -1;
         }
+        // Below 2^53 every step was exact (a nonzero integer `x_k` bounds its products by the
+        // permanent; `x_k = 0` zeroes its term whatever the rounding): `v` is the determinant.
+        // Coplanar points (v = 0) land here, and the remesher's flat regions test thousands.
+        if permanent < EXACT_F64_INTEGER {
+            return if v > 0.0 {
+                1
+            } else if v < 0.0 {
+                -1
+            } else {
+                0
+            };
+        }
         exact_dot3_sign(d, cross_exact(e1, e2))
     }
 }
@@ -103,15 +115,34 @@ impl Width for W128 {
 /// error of `d = p1 − p2` by `4u·(|p1| + |p2|)`; the filter tests twice that, `8u`.
 pub const DET2_FILTER_RELATIVE: f64 = 8.0 * (f64::EPSILON * 0.5);
 
+/// `2^53`: integers below it, and sums and products of them that stay below it, are exact in
+/// `f64`.
+const EXACT_F64_INTEGER: f64 = 9_007_199_254_740_992.0;
+
 /// Relative bound of the 60-bit `orient3d` filter on the permanent
 /// `Σ |d_k|·(|e1_i e2_j| + |e1_j e2_i|)`: each difference (`< 2^61`) is rounded once on
 /// conversion, relative error `≤ u = 2^-53`, which is the error model of Shewchuk's orient3d, whose
 /// first-stage bound `(7 + 56u)·u·permanent` therefore holds; the filter tests `8u·permanent`.
 pub const ORIENT3D_FILTER_RELATIVE: f64 = 8.0 * (f64::EPSILON * 0.5);
 
-/// Exact sign of `d·n` in arbitrary precision (the rare fallback of the 60-bit depth test).
-#[cold]
+/// Exact sign of `d·n` (the fallback of the 60-bit depth test): in `i128` when no product or
+/// sum overflows, else in arbitrary precision. The fallback is rare on general inputs, but not
+/// on coplanar ones (the remesher's flat regions test coplanar faces by the thousand), whose
+/// small coordinates fit `i128`.
 pub fn exact_dot3_sign(d: [i64; 3], n: [i128; 3]) -> i32 {
+    let small = (0..3).try_fold(0i128, |sum, k| {
+        i128::from(d[k])
+            .checked_mul(n[k])
+            .and_then(|p| sum.checked_add(p))
+    });
+    if let Some(v) = small {
+        return v.signum() as i32;
+    }
+    exact_dot3_sign_big(d, n)
+}
+
+#[cold]
+fn exact_dot3_sign_big(d: [i64; 3], n: [i128; 3]) -> i32 {
     let v: BigInt = (0..3)
         .map(|k| BigInt::from(d[k]) * BigInt::from(n[k]))
         .sum();
@@ -608,6 +639,15 @@ mod tests {
             0,
         ];
         assert_eq!(exact_dot3_sign(d, n), 1);
+        assert_eq!(exact_dot3_sign_big(d, n), 1);
+        // Products beyond i128 take the arbitrary-precision path:
+        // 2^62·2^123 + 2^62·(1 − 2^123) = 2^62.
+        let (d, n) = (
+            [1_i64 << 62, 1 << 62, 0],
+            [1_i128 << 123, 1 - (1_i128 << 123), 0],
+        );
+        assert_eq!(exact_dot3_sign(d, n), 1);
+        assert_eq!(exact_dot3_sign([-(1_i64 << 62), -(1 << 62), 0], n), -1);
         // orient3d: e1 × e2 = (0, 0, 2^60 − (2^60 − 1)) = (0, 0, 1), but in f64 2^60 − 1 rounds to
         // 2^60 and the filtered value is 0: only the exact fallback can answer.
         let e1 = [big, 1, 0];
@@ -628,6 +668,7 @@ mod tests {
             let e1 = [next(), next(), next()];
             let e2 = [next(), next(), next()];
             let want = exact_dot3_sign(d, cross_exact(e1, e2));
+            assert_eq!(exact_dot3_sign_big(d, cross_exact(e1, e2)), want);
             assert_eq!(W64::orient3d_sign(d, e1, e2), want);
             assert_eq!(W128::orient3d_sign(d, e1, e2), want);
         }

@@ -290,7 +290,8 @@ fn plate_thinner_than_a_coarse_cell_is_kept() {
     let res = 256;
     let lattice = Lattice::new(bounds, res).unwrap();
     assert_eq!(lattice.levels, 2);
-    let h = lattice.h;
+    let h = lattice.h[0];
+    assert_eq!(lattice.h, [h; 3], "a cube box has cubic cells");
     let coarse = 4.0 * h;
     // Coarse planes sit at origin + k·coarse on every axis; the plate spans (0.75 h, 3.25 h)
     // past one of them in z, and starts and ends off the lattice in x and y.
@@ -329,6 +330,50 @@ fn plate_thinner_than_a_coarse_cell_is_kept() {
         "{:?}",
         out.stats
     );
+}
+
+/// A closed plate of 100 × 100 × 1 at res 64: cubes of `100 / 64` would put no lattice plane
+/// inside it (the lattice is centred on the box, so its planes nearest the middle are ±0.78 off
+/// it) and the output would be empty; the thin axis gets `64 / 4` cells across instead.
+#[test]
+fn plate_thinner_than_a_cube_cell_is_kept() {
+    use gwn::products::remesh::lattice::{Lattice, THIN_AXIS_DIVISOR};
+    use gwn::products::remesh::report::occupancy_agreement;
+    let size = [100.0, 100.0, 1.0];
+    let cube = common::unit_cube();
+    let positions: Vec<[f64; 3]> = cube
+        .positions()
+        .iter()
+        .map(|p| std::array::from_fn(|a| 3.0 + (p[a] - 0.5) * size[a]))
+        .collect();
+    let plate = Mesh::new(positions, cube.triangles().to_vec()).unwrap();
+    let bounds = plate.bounding_box().unwrap();
+    let res = 64;
+    let lattice = Lattice::new(bounds, res).unwrap();
+    assert_eq!(lattice.h[0], 100.0 / 64.0);
+    assert_eq!(lattice.h[1], 100.0 / 64.0);
+    assert_eq!(lattice.h[2], THIN_AXIS_DIVISOR / 64.0);
+    for simplify in [false, true] {
+        let options = if simplify {
+            RemeshOptions::with_resolution(res)
+        } else {
+            raw(res)
+        };
+        let (out, r) = run_with(&plate, &options);
+        assert_closed_manifold(&r);
+        assert_eq!((r.euler_characteristic, r.components), (2, 1), "{r}");
+        assert_eq!(out.cell_size, 100.0 / 64.0);
+        let vol = signed_volume(&out, |_| true);
+        assert!((vol / 1e4 - 1.0).abs() < 0.02, "volume {vol}");
+        let wn = WindingNumber::new(&plate).unwrap();
+        let out_mesh = Mesh::new(out.positions.clone(), out.triangles.clone()).unwrap();
+        let output = WindingNumber::new(&out_mesh).unwrap();
+        let agreement = occupancy_agreement(&wn, &output, bounds, 20_000, 7).unwrap();
+        assert!(
+            agreement >= 0.99,
+            "simplify {simplify}: agreement {agreement}"
+        );
+    }
 }
 
 #[test]

@@ -257,3 +257,52 @@ fn remesh_reads_step_models() {
     }
     std::fs::remove_dir_all(&out_dir).unwrap();
 }
+
+/// A printer part thinner than a cube cell of `extent / res` (`prusa-helper_disk.stl` of the
+/// shared corpus: a disk 15 mm across and 0.2 mm thick, cubes of 0.47 mm at res 32) was empty;
+/// with cells sized for the thin axis it is a closed, manifold disk that agrees with the input.
+#[test]
+fn remesh_keeps_a_printer_plate_thinner_than_a_cube_cell() {
+    let Some(input) = crate::common::shared_file("meshes/prusa-helper_disk.stl") else {
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("gwn-cli-remesh-plate-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (out, report) = (dir.join("o.ply"), dir.join("r.json"));
+    let (ok, stdout, stderr) = gwn(&[
+        "remesh",
+        input.to_str().unwrap(),
+        "--res",
+        "32",
+        "--samples",
+        "20000",
+        "--out",
+        out.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("closed: yes"), "{stdout}");
+    let json = std::fs::read_to_string(&report).unwrap();
+    for member in [
+        "\"closed\": true",
+        "\"edge_manifold\": true",
+        "\"vertex_manifold\": true",
+        "\"oriented\": true",
+        "\"components\": 1",
+        "\"self_intersections\": 0",
+    ] {
+        assert!(json.contains(member), "{member} not in {json}");
+    }
+    let number = |key: &str| -> f64 {
+        json.split(&format!("\"{key}\": "))
+            .nth(1)
+            .and_then(|s| s.split([',', '\n', '}']).next())
+            .and_then(|s| s.trim().parse().ok())
+            .unwrap_or_else(|| panic!("no {key} in {json}"))
+    };
+    assert!(number("faces") > 0.0, "{json}");
+    let agreement = number("occupancy_agreement");
+    assert!(agreement >= 0.99, "agreement {agreement}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

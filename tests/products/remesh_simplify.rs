@@ -123,6 +123,63 @@ fn simplified_closed_forms_keep_every_guarantee() {
     }
 }
 
+/// Flat regions: a box's sides have quadric error 0 everywhere, and the target alone (a fraction
+/// of marching cubes' faces) left them as dense as curved regions. The collapses within the flat
+/// tolerance go on past it: far fewer faces, the same guarantees, the same solid. A sphere has
+/// nothing flat at res 16: the flat phase leaves it (almost) as it was.
+#[test]
+fn flat_regions_collapse_past_the_target() {
+    let with = |mesh: &Mesh, res: usize, flat_tolerance: f64| {
+        run_with(
+            mesh,
+            &RemeshOptions {
+                simplify: Some(SimplifyOptions {
+                    flat_tolerance,
+                    ..SimplifyOptions::default()
+                }),
+                ..RemeshOptions::with_resolution(res)
+            },
+        )
+    };
+    // A box off the lattice planes on every axis (its sides are not on lattice planes).
+    let cube = common::unit_cube().translated([0.013, -0.021, 0.007]);
+    let (at_target, r0) = with(&cube, 32, 0.0);
+    let (flat, r1) = with(&cube, 32, 0.01);
+    for r in [&r0, &r1] {
+        assert_closed_manifold(r);
+        assert_eq!((r.euler_characteristic, r.components), (2, 1), "{r}");
+    }
+    let target = (DEFAULT_TARGET_FRACTION * at_target.stats.marching_cubes_faces as f64) as usize;
+    assert!(
+        at_target.triangles.len() > target / 2,
+        "{}",
+        at_target.triangles.len()
+    );
+    assert!(
+        flat.triangles.len() * 4 < at_target.triangles.len(),
+        "{} faces with the flat phase, {} without",
+        flat.triangles.len(),
+        at_target.triangles.len()
+    );
+    let volume = crate::remesh::signed_volume(&flat, |_| true);
+    assert!((volume - 1.0).abs() < 0.01, "volume {volume}");
+    let (agreement, compared) = occupancy_agreement(&cube, &flat, 1000, 1.0);
+    assert!(
+        compared > 250 && agreement == 1.0,
+        "{agreement} of {compared}"
+    );
+    let ball = sphere([0.1, -0.2, 0.3], 1.0, 24, false);
+    let (curved_target, _) = with(&ball, 16, 0.0);
+    let (curved_flat, r) = with(&ball, 16, 0.01);
+    assert_closed_manifold(&r);
+    assert!(
+        curved_flat.triangles.len() * 10 >= curved_target.triangles.len() * 9,
+        "{} of {}",
+        curved_flat.triangles.len(),
+        curved_target.triangles.len()
+    );
+}
+
 /// The collapses and the relocation run in rounds planned in parallel: the surface must not
 /// depend on the thread count (a torus at res 32 takes several rounds of collapses).
 #[test]
@@ -203,6 +260,10 @@ fn simplification_options_are_checked_and_zero_tolerance_keeps_flat_collapses_on
             max_face_extent: 0,
             ..SimplifyOptions::default()
         },
+        SimplifyOptions {
+            flat_tolerance: f64::NAN,
+            ..SimplifyOptions::default()
+        },
     ] {
         let options = RemeshOptions {
             simplify: Some(bad),
@@ -272,6 +333,7 @@ fn generous() -> SimplifyOptions {
         max_face_extent: 16,
         target_fraction_of_marching_cubes: 0.0,
         relocate: true,
+        flat_tolerance: 0.0,
     }
 }
 

@@ -264,6 +264,16 @@ pub fn faces_intersect(s: [P; 3], t: [P; 3]) -> bool {
             if side.iter().all(|&x| x > 0) || side.iter().all(|&x| x < 0) {
                 return false;
             }
+            if side == [0; 3] {
+                // Coplanar (a flat region of the remesher's output: most pairs the
+                // simplification tests there): the coplanar branch of `segment_meets_triangle`
+                // for all six edges, without its 24 orientation tests that would all say 0.
+                let axes = plane_axes(projection_axis(normal(s[0], s[1], s[2])));
+                return (0..3)
+                    .any(|k| coplanar_segment_meets_triangle(s[k], s[(k + 1) % 3], t, axes))
+                    || (0..3)
+                        .any(|k| coplanar_segment_meets_triangle(t[k], t[(k + 1) % 3], s, axes));
+            }
             let side = s.map(|p| orient(t[0], t[1], t[2], p));
             if side.iter().all(|&x| x > 0) || side.iter().all(|&x| x < 0) {
                 return false;
@@ -299,9 +309,7 @@ fn segment_meets_triangle(p: P, q: P, t: [P; 3]) -> bool {
     }
     if op == 0 && oq == 0 {
         let axes = plane_axes(projection_axis(normal(t[0], t[1], t[2])));
-        return point_in_triangle_2d(p, t, axes)
-            || point_in_triangle_2d(q, t, axes)
-            || (0..3).any(|k| segments_meet_2d(p, q, t[k], t[(k + 1) % 3], axes));
+        return coplanar_segment_meets_triangle(p, q, t, axes);
     }
     // The segment meets the plane in one point; the line through it passes through the closed
     // triangle iff the three edge volumes have no two opposite strict signs.
@@ -311,6 +319,14 @@ fn segment_meets_triangle(p: P, q: P, t: [P; 3]) -> bool {
         orient(p, q, t[2], t[0]),
     ];
     !(s.contains(&1) && s.contains(&-1))
+}
+
+/// Whether the closed segment `p q` meets the closed triangle `t`, all in one plane, projected on
+/// `axes` (a plane of projection along which the triangle's normal is nonzero).
+fn coplanar_segment_meets_triangle(p: P, q: P, t: [P; 3], axes: (usize, usize)) -> bool {
+    point_in_triangle_2d(p, t, axes)
+        || point_in_triangle_2d(q, t, axes)
+        || (0..3).any(|k| segments_meet_2d(p, q, t[k], t[(k + 1) % 3], axes))
 }
 
 fn point_in_triangle_2d(p: P, t: [P; 3], axes: (usize, usize)) -> bool {

@@ -1,5 +1,13 @@
-//! The finest lattice: cubic cells of edge `h`, integer corner coordinates, the coarse level and
-//! the margin whose outermost corners are declared outside.
+//! The finest lattice: box-shaped cells of edge `h[a]` along axis `a`, integer corner
+//! coordinates, the coarse level and the margin whose outermost corners are declared outside.
+//!
+//! Cells are cubes of edge `longest extent / res`, except along an axis whose extent is below
+//! `longest / THIN_AXIS_DIVISOR`: there `res / THIN_AXIS_DIVISOR` cells span the extent. A plate
+//! thinner than a cube cell (a printer bed: 235 × 235 × 3 mm at `res 64` has 3.7 mm cubes) would
+//! otherwise fall between two lattice planes and hold no lattice point, and a part that holds no
+//! lattice point is lost. Everything downstream works in lattice units (integer corners,
+//! fixed-point vertices), and a positive scaling of each axis keeps incidences, orientations and
+//! intersections, so the guarantees do not depend on the cells being cubes.
 
 use crate::base::bounding_box::BoundingBox;
 
@@ -7,6 +15,19 @@ use crate::base::bounding_box::BoundingBox;
 /// enough that a thin part is rarely missed by every coarse corner, coarse enough that its
 /// `(COARSE_TARGET + 3)³` corners cost little with ray reuse.
 pub const COARSE_TARGET: usize = 64;
+
+/// An axis whose extent is below `longest / THIN_AXIS_DIVISOR` gets `res / THIN_AXIS_DIVISOR`
+/// cells across (finer cells than the cubes); the others keep cubic cells. 4: at `res 64` a
+/// whole-model plate is 16 cells thick, enough for its top and bottom (placed within a tick
+/// like every vertex) and its rim, while a model whose box is not flat (the bunny, 1 : 1 : 0.8)
+/// keeps the lattice it had with cubes. The side walls of a plate cost about
+/// `perimeter · res / THIN_AXIS_DIVISOR` band cells, a fraction of its top and bottom.
+pub const THIN_AXIS_DIVISOR: f64 = 4.0;
+
+/// Cells are at most this many times finer along a thin axis than along the longest one: below
+/// it the cell edge would approach the rounding of the coordinates (a box flat to `1e-12`),
+/// and a part that thin is a sheet, not a solid.
+pub const MAX_ANISOTROPY: f64 = (1u64 << 20) as f64;
 
 /// A lattice corner, in finest-cell units from the lattice origin.
 pub type Corner = [u32; 3];
@@ -16,8 +37,8 @@ pub type Corner = [u32; 3];
 pub struct Lattice {
     /// Position of corner `[0, 0, 0]`.
     pub origin: [f64; 3],
-    /// Cell edge.
-    pub h: f64,
+    /// Cell edge along each axis (the longest axis's is `longest extent / res`, the largest).
+    pub h: [f64; 3],
     /// Finest cells per axis; corners run over `0..=cells[a]`.
     pub cells: [usize; 3],
     /// Octree levels: a coarse cell is `2^levels` finest cells wide.
@@ -25,8 +46,9 @@ pub struct Lattice {
 }
 
 impl Lattice {
-    /// The lattice of cell edge `longest extent / res` around `bounds`, with one coarse cell of
-    /// margin on every side; `None` when `bounds` is not finite or inverted.
+    /// The lattice of cell edge `longest extent / res` around `bounds` (finer along thin axes,
+    /// see the [module documentation](self)), with one coarse cell of margin on every side;
+    /// `None` when `bounds` is not finite or inverted.
     pub fn new(bounds: BoundingBox, res: usize) -> Option<Lattice> {
         let ok = (0..3).all(|a| {
             bounds.min[a].is_finite() && bounds.max[a].is_finite() && bounds.min[a] <= bounds.max[a]
@@ -37,20 +59,28 @@ impl Lattice {
         let extent = [0, 1, 2].map(|a| bounds.max[a] - bounds.min[a]);
         let longest = extent[0].max(extent[1]).max(extent[2]);
         // A single point: any positive cell edge shows it (as nothing, w ≤ ½ everywhere).
-        let h = if longest > 0.0 {
+        let cube = if longest > 0.0 {
             longest / res as f64
         } else {
             1.0
         };
+        // A flat axis (extent 0: a planar sheet, no volume) keeps the cube edge.
+        let h = extent.map(|e| {
+            if e > 0.0 {
+                (THIN_AXIS_DIVISOR * e / res as f64).clamp(cube / MAX_ANISOTROPY, cube)
+            } else {
+                cube
+            }
+        });
         let mut levels = 0;
         while res >> (levels + 1) >= COARSE_TARGET {
             levels += 1;
         }
         let coarse = 1usize << levels;
-        let coarse_edge = h * coarse as f64;
         let mut cells = [0; 3];
         let mut origin = [0.0; 3];
         for a in 0..3 {
+            let coarse_edge = h[a] * coarse as f64;
             let inner = ((extent[a] / coarse_edge).ceil() as usize).max(1);
             let c = inner + 2;
             cells[a] = c * coarse;
@@ -72,7 +102,18 @@ impl Lattice {
 
     /// Position of a point given in (possibly fractional) lattice units.
     pub fn position(&self, p: [f64; 3]) -> [f64; 3] {
-        [0, 1, 2].map(|a| self.origin[a] + p[a] * self.h)
+        [0, 1, 2].map(|a| self.origin[a] + p[a] * self.h[a])
+    }
+
+    /// The largest cell edge (along the longest axis of the box): the unit of the reports'
+    /// distances in cells.
+    pub fn largest_cell(&self) -> f64 {
+        self.h[0].max(self.h[1]).max(self.h[2])
+    }
+
+    /// The smallest cell edge.
+    pub fn smallest_cell(&self) -> f64 {
+        self.h[0].min(self.h[1]).min(self.h[2])
     }
 
     /// Position of a corner.
@@ -127,3 +168,43 @@ pub type KeyHash = std::hash::BuildHasherDefault<KeyHasher>;
 pub type KeyMap<V> = std::collections::HashMap<u64, V, KeyHash>;
 /// A set of packed lattice keys.
 pub type KeySet<K> = std::collections::HashSet<K, KeyHash>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lattice(extent: [f64; 3], res: usize) -> Lattice {
+        let bounds = BoundingBox {
+            min: [-1.0, 2.0, 3.0],
+            max: [-1.0 + extent[0], 2.0 + extent[1], 3.0 + extent[2]],
+        };
+        Lattice::new(bounds, res).unwrap()
+    }
+
+    #[test]
+    fn thin_axes_get_res_over_four_cells_and_the_others_cubes() {
+        let cube = 100.0 / 64.0;
+        // Not thin (extent ≥ longest / 4): cubes, as before.
+        assert_eq!(lattice([100.0, 60.0, 25.0], 64).h, [cube; 3]);
+        // A plate: 16 cells across its thickness, plus the margin (one coarse cell each side).
+        let plate = lattice([100.0, 100.0, 1.0], 64);
+        assert_eq!(plate.h, [cube, cube, 4.0 / 64.0]);
+        assert_eq!(plate.cells[2], 16 + 2);
+        // Continuous at the threshold: just below it, the cell is just below the cube.
+        let edge = lattice([100.0, 100.0, 24.999], 64).h[2];
+        assert!(edge < cube && edge > 0.9999 * cube, "{edge}");
+        // A flat box (no volume) keeps cubes; a nearly flat one stops at MAX_ANISOTROPY.
+        assert_eq!(lattice([100.0, 100.0, 0.0], 64).h[2], cube);
+        assert_eq!(
+            lattice([100.0, 100.0, 1e-12], 64).h[2],
+            cube / MAX_ANISOTROPY
+        );
+        // Positions follow each axis's cell edge.
+        let p = plate.position([1.0, 2.0, 3.0]);
+        for a in 0..3 {
+            assert_eq!(p[a], plate.origin[a] + [1.0, 2.0, 3.0][a] * plate.h[a]);
+        }
+        assert_eq!(plate.largest_cell(), cube);
+        assert_eq!(plate.smallest_cell(), 4.0 / 64.0);
+    }
+}

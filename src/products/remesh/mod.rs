@@ -3,7 +3,8 @@
 //! triangle meshes and soups, the fast evaluator for oriented point clouds).
 //!
 //! The pipeline (each step in its own file; the why is in `docs/remesh.md`):
-//! 1. [`lattice`]: a cubic lattice of spacing `h = extent / res` around the input, with one
+//! 1. [`lattice`]: a lattice of cubes of edge `h = longest extent / res` around the input (finer
+//!    along an axis on which the box is thin, so that a plate holds lattice points), with one
 //!    coarse cell of margin whose outermost corners are *declared* outside (so the output is
 //!    closed even when `w > ½` reaches the box).
 //! 2. [`octree`]: corners of a coarse level are classified with [`crate::grid::evaluate`] (ray
@@ -81,7 +82,8 @@ pub const BYTES_PER_CLASSIFIED_POINT: u64 = 512;
 /// Options of [`remesh`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RemeshOptions {
-    /// Finest equivalent resolution: cells of edge `h = longest extent / res`.
+    /// Finest equivalent resolution: cells of edge `h = longest extent / res`, and at least
+    /// `res / 4` cells across every axis of the box ([`lattice::THIN_AXIS_DIVISOR`]).
     pub resolution: usize,
     /// Bisection steps per output vertex (0: the midpoint of the lattice edge).
     pub bisection_steps: u32,
@@ -213,14 +215,18 @@ pub struct Remeshed {
     pub fixed: Vec<[i64; 3]>,
     /// Fixed-point units per lattice cell edge (`2^(bisection_steps + 1)`).
     pub ticks_per_cell: i64,
-    /// Lattice spacing `h`.
+    /// The largest lattice spacing (cells are cubes of this edge, finer along an axis on which
+    /// the box is thin: [`Remeshed::cell_sizes`]); the unit of distances "in cells".
     pub cell_size: f64,
+    /// The lattice spacing along each axis.
+    pub cell_sizes: [f64; 3],
     /// Work counters.
     pub stats: RemeshStats,
 }
 
 /// The surface of `{w > ½}` inside `bounds` (grown by a margin), at finest cell size
-/// `longest extent of bounds / options.resolution`.
+/// `longest extent of bounds / options.resolution` (finer along a thin axis of the box: at least
+/// `resolution / 4` cells across it, see [`lattice`]).
 ///
 /// Output guarantees, whatever the evaluator returns: closed, edge- and vertex-manifold,
 /// consistently oriented (outward from `w > ½`). Without the input triangles (this function;
@@ -291,6 +297,7 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
         let bad = |x: f64| !(x.is_finite() && x >= 0.0);
         for (option, value, wrong) in [
             ("max_distance", s.max_distance, bad(s.max_distance)),
+            ("flat_tolerance", s.flat_tolerance, bad(s.flat_tolerance)),
             (
                 "target_fraction_of_marching_cubes",
                 s.target_fraction_of_marching_cubes,
@@ -376,7 +383,8 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
         triangles,
         fixed,
         ticks_per_cell: placed.ticks_per_cell,
-        cell_size: lattice.h,
+        cell_size: lattice.largest_cell(),
+        cell_sizes: lattice.h,
         stats,
     })
 }

@@ -115,7 +115,7 @@ fn touched(guide: Option<&SegmentBvh>, lattice: &Lattice, level: u32, m: Corner)
     // most MAX_RESOLUTION cells from the box); a millionth of a cell does, and a triangle that
     // close to the box costs one needless split at worst.
     let scale = (0..3).fold(0.0f64, |s, a| s.max(lo[a].abs()).max(hi[a].abs()));
-    let pad = 1e-6 * lattice.h + 1e-12 * scale;
+    let pad = 1e-6 * lattice.smallest_cell() + 1e-12 * scale;
     guide.meets_box(lo, hi, pad)
 }
 
@@ -134,10 +134,10 @@ pub fn classify<E: Evaluator + ?Sized>(
     let cc = lattice.coarse_cells();
     // The coarse corners as a grid of cell-centre samples: a box half a coarse cell larger on
     // every side puts the sample centres on the corners.
-    let ch = lattice.h * f64::from(coarse);
+    let ch = lattice.h.map(|h| h * f64::from(coarse));
     let bounds = crate::base::bounding_box::BoundingBox {
-        min: [0, 1, 2].map(|a| lattice.origin[a] - 0.5 * ch),
-        max: [0, 1, 2].map(|a| lattice.origin[a] + (cc[a] as f64 + 0.5) * ch),
+        min: [0, 1, 2].map(|a| lattice.origin[a] - 0.5 * ch[a]),
+        max: [0, 1, 2].map(|a| lattice.origin[a] + (cc[a] as f64 + 0.5) * ch[a]),
     };
     let dims = cc.map(|n| n + 1);
     // The lattice is at most MAX_RESOLUTION-ish per axis and the coarse level ~COARSE_TARGET

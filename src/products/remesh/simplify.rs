@@ -8,7 +8,9 @@
 //! cheapest vertices whose closed 1-rings have disjoint boxes are planned in parallel and
 //! collapsed in cost order ([`Simplifier::run`] says why the plans stay valid). The selection
 //! is serial and the round size a constant: the result is the same on every run and for every
-//! thread count.
+//! thread count. Collapses stop at a face target, except those of (near) zero quadric error,
+//! which go on past it ([`Simplifier::run_flat`]): a flat region's collapses all cost 0, and the
+//! target alone left flat regions as dense as curved ones.
 //!
 //! Faces are chords of the surface, so a simplified convex part lies inside the input and a
 //! concave one outside. After the collapses, [`Simplifier::relocate`] moves each kept vertex
@@ -63,6 +65,9 @@ pub const DEFAULT_MAX_FACE_EXTENT: u32 = 6;
 /// Default [`SimplifyOptions::target_fraction_of_marching_cubes`].
 pub const DEFAULT_TARGET_FRACTION: f64 = 0.45;
 
+/// Default [`SimplifyOptions::flat_tolerance`], in finest cells.
+pub const DEFAULT_FLAT_TOLERANCE: f64 = 0.01;
+
 /// Weight of the squared edge length (lattice units) added to the quadric error: in flat
 /// regions, where the quadric is 0 for every target, short edges collapse first (rounder faces).
 const LENGTH_WEIGHT: f64 = 1e-3;
@@ -105,6 +110,12 @@ pub struct SimplifyOptions {
     /// still passes ([`Simplifier::relocate`]): faces are chords, and this moves them back
     /// towards the surface instead of inside convex parts and outside concave ones.
     pub relocate: bool,
+    /// Once the target is reached, collapses whose quadric error (the root of the area-weighted
+    /// mean squared distance of the kept vertex to the planes merged into the removed one) is at
+    /// most this many finest cells go on, cheapest first, until none is left: flat regions
+    /// (a box's sides, a printer bed) keep only the faces the other bounds need, where the
+    /// target alone would leave them as dense as curved ones. 0: stop at the target.
+    pub flat_tolerance: f64,
 }
 
 impl Default for SimplifyOptions {
@@ -114,6 +125,7 @@ impl Default for SimplifyOptions {
             max_face_extent: DEFAULT_MAX_FACE_EXTENT,
             target_fraction_of_marching_cubes: DEFAULT_TARGET_FRACTION,
             relocate: true,
+            flat_tolerance: DEFAULT_FLAT_TOLERANCE,
         }
     }
 }
@@ -144,6 +156,8 @@ pub struct SimplifyStats {
     pub faces_after: usize,
     /// Collapses made.
     pub collapses: usize,
+    /// Rounds of collapses planned together ([`Simplifier::run`]).
+    pub rounds: usize,
     /// Vertices moved by the relocation.
     pub relocated: usize,
     /// Relocations refused by the checks (flip, size, distance or intersection).
@@ -181,6 +195,9 @@ pub fn simplify(
     match Simplifier::new(points, triangles, ticks_per_cell, options) {
         Some(mut s) => {
             s.run(target_faces);
+            if target_faces > 0 && options.flat_tolerance > 0.0 {
+                s.run_flat(options.flat_tolerance);
+            }
             if options.relocate {
                 s.relocate();
             }
@@ -229,6 +246,9 @@ pub struct Simplifier {
     max_extent: i64,
     /// Squared distance bound, lattice units.
     max_distance2: f64,
+    /// While set ([`Simplifier::run_flat`]): the largest quadric error (squared, lattice units)
+    /// of a collapse that may be made.
+    flat_limit: Option<f64>,
     stats: SimplifyStats,
 }
 
@@ -312,6 +332,7 @@ impl Simplifier {
             ticks: ticks_per_cell,
             max_extent,
             max_distance2: (options.max_distance * options.max_distance),
+            flat_limit: None,
             stats: SimplifyStats {
                 faces_before: triangles.len(),
                 ..SimplifyStats::default()
@@ -336,6 +357,23 @@ impl Simplifier {
     /// other's changes. The selection and the order of the changes are serial, so the result
     /// does not depend on the thread count.
     pub fn run(&mut self, target_faces: usize) {
+        self.collapse_rounds(target_faces);
+    }
+
+    /// More collapses after [`Simplifier::run`], in the same rounds and order, restricted to
+    /// those whose quadric error is at most `tolerance` cells (see
+    /// [`SimplifyOptions::flat_tolerance`]), until none is left. Every check applies as in
+    /// [`Simplifier::run`].
+    pub fn run_flat(&mut self, tolerance: f64) {
+        if !(tolerance.is_finite() && tolerance > 0.0) {
+            return;
+        }
+        self.flat_limit = Some(tolerance * tolerance);
+        self.collapse_rounds(0);
+        self.flat_limit = None;
+    }
+
+    fn collapse_rounds(&mut self, target_faces: usize) {
         let n = self.points.len();
         // Lazy invalidation: an entry counts only if its version is the vertex's. `queued` is the
         // cost of the vertex's valid entry, if any: a vertex whose best cost did not change keeps
@@ -389,6 +427,7 @@ impl Simplifier {
             if selected.is_empty() {
                 break;
             }
+            self.stats.rounds += 1;
             let plans: Vec<(Option<Plan>, [usize; 5])> =
                 selected.par_iter().map(|&u| self.plan_best(u)).collect();
             touched.clear();
@@ -427,6 +466,7 @@ impl Simplifier {
         let ring = self.neighbours(u);
         let mut candidates: Vec<(u64, u32)> = ring
             .iter()
+            .filter(|&&v| self.flat_enough(u, v))
             .map(|&v| (self.cost(u, v), v))
             .filter(|&(c, _)| c <= self.max_distance2)
             .map(|(c, v)| (c.to_bits(), v))
@@ -893,12 +933,27 @@ impl Simplifier {
         n
     }
 
-    /// The ordering error of `u → v`: the area-weighted mean squared distance of `v` to the
-    /// planes merged into `u` (lattice units²), plus the length term.
+    /// The ordering error of `u → v`: the quadric error ([`Simplifier::quadric_error`]) plus
+    /// the length term.
     fn cost(&self, u: u32, v: u32) -> f64 {
-        let q = &self.quadric[u as usize];
         let [x, y, z] = self.at[v as usize];
         let pu = self.at[u as usize];
+        let len2 = (x - pu[0]).powi(2) + (y - pu[1]).powi(2) + (z - pu[2]).powi(2);
+        self.quadric_error(u, v) + LENGTH_WEIGHT * len2
+    }
+
+    /// Whether `u → v` may be made now: always, except in [`Simplifier::run_flat`], where its
+    /// quadric error must be within the flat tolerance.
+    fn flat_enough(&self, u: u32, v: u32) -> bool {
+        self.flat_limit
+            .is_none_or(|limit| self.quadric_error(u, v) <= limit)
+    }
+
+    /// The area-weighted mean squared distance of `v` to the planes merged into `u` (lattice
+    /// units²).
+    fn quadric_error(&self, u: u32, v: u32) -> f64 {
+        let q = &self.quadric[u as usize];
+        let [x, y, z] = self.at[v as usize];
         let e = q[0] * x * x
             + 2.0 * q[1] * x * y
             + 2.0 * q[2] * x * z
@@ -909,8 +964,7 @@ impl Simplifier {
             + q[7] * z * z
             + 2.0 * q[8] * z
             + q[9];
-        let len2 = (x - pu[0]).powi(2) + (y - pu[1]).powi(2) + (z - pu[2]).powi(2);
-        (e / q[10].max(f64::MIN_POSITIVE)).max(0.0) + LENGTH_WEIGHT * len2
+        (e / q[10].max(f64::MIN_POSITIVE)).max(0.0)
     }
 
     fn best_cost(&self, u: u32) -> Option<f64> {
@@ -922,7 +976,7 @@ impl Simplifier {
         self.vertex_faces[u as usize]
             .iter()
             .flat_map(|&f| self.faces[f as usize])
-            .filter(|&v| v != u)
+            .filter(|&v| v != u && self.flat_enough(u, v))
             .map(|v| self.cost(u, v))
             .filter(|&c| c <= self.max_distance2)
             .min_by(f64::total_cmp)
@@ -999,6 +1053,14 @@ fn dot_sign(a: [i128; 3], b: [i128; 3]) -> i32 {
     }
     if sum < -bound {
         return -1;
+    }
+    // Exact: in `i128` when it does not overflow (small coordinates, the common case), else in
+    // arbitrary precision.
+    let small = (0..3).try_fold(0i128, |s, k| {
+        a[k].checked_mul(b[k]).and_then(|p| s.checked_add(p))
+    });
+    if let Some(v) = small {
+        return v.signum() as i32;
     }
     use num_bigint::BigInt;
     let exact: BigInt = (0..3)
