@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# libigl's fast winding number against gwn fast under three admissibility rules at matched
+# accuracy (radius 2.8, radius-or-box-corner 2.8, box-corner 2.4), 1 thread, process CPU time,
+# the 32³ grid of `gwn bench`, one table row per mesh (docs/benchmarks.md, "Either admissibility
+# test"). Needs the peers venv (benches/peers/run.sh creates it).
+#
+#   benches/peers/fast_rules.sh MESH...
+set -euo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+repo="$(cd "$here/../.." && pwd)"
+cd "$repo"
+cargo build --release --features examples --example fast_speed --quiet
+bin="${CARGO_TARGET_DIR:-$repo/target}/release/examples/fast_speed"
+py="$here/.venv/bin/python"
+rate() { tail -1 | cut -d'|' -f6 | tr -d ' '; }
+echo "| mesh | libigl q/s | radius 2.8 | radius-or-box-corner 2.8 | box-corner 2.4 | load |"
+echo "|---|---:|---:|---:|---:|---|"
+for m in "$@"; do
+  igl=$(IGL_NUM_THREADS=1 OMP_NUM_THREADS=1 "$py" "$here/igl_fast_cpu.py" --reps 5 "$m" 2>&1 | rate)
+  r=$("$bin" --reps 5 --beta 2.8 "$m" 2>&1 | rate)
+  e=$("$bin" --reps 5 --beta 2.8 --rule radius-or-box-corner "$m" 2>&1 | rate)
+  c=$("$bin" --reps 5 --beta 2.4 --rule box-corner "$m" 2>&1 | rate)
+  echo "| $(basename "$m") | $igl | $r | $e | $c | $(cut -d' ' -f1 /proc/loadavg) |"
+done
