@@ -473,7 +473,7 @@ impl Simplifier {
             .collect();
         candidates.sort_unstable();
         for &(_, v) in &candidates {
-            match self.plan(u, v) {
+            match self.plan_with_ring(u, v, &ring) {
                 Ok(mut plan) => {
                     plan.ring = ring;
                     return (Some(plan), refused);
@@ -785,6 +785,14 @@ impl Simplifier {
     }
 
     fn plan(&self, u: u32, v: u32) -> Result<Plan, Refusal> {
+        if u as usize >= self.points.len() {
+            return Err(Refusal::NotAnEdge);
+        }
+        self.plan_with_ring(u, v, &self.neighbours(u))
+    }
+
+    /// [`Simplifier::plan`] with `nu`, the sorted distinct neighbours of `u`, already known.
+    fn plan_with_ring(&self, u: u32, v: u32, nu: &[u32]) -> Result<Plan, Refusal> {
         if u == v
             || self.removed[u as usize]
             || self.removed[v as usize]
@@ -806,7 +814,6 @@ impl Simplifier {
         }
         // Link condition: the common neighbours are exactly the two opposite vertices, and the
         // edge between them is not in both links (the tetrahedron).
-        let nu = self.neighbours(u);
         let nv = self.neighbours(v);
         let common = nu.iter().filter(|x| nv.binary_search(x).is_ok()).count();
         if common != 2 {
@@ -873,49 +880,54 @@ impl Simplifier {
     /// Whether the faces `exact` (replacing the faces `old`) meet each other or any other live
     /// face outside what they share.
     fn meets_other_faces(&self, exact: &[[P; 3]], old: &[u32]) -> bool {
-        let p = |x: u32| self.points[x as usize];
+        let boxes: Vec<(P, P)> = exact.iter().map(|t| face_box(*t)).collect();
         for i in 0..exact.len() {
             for j in i + 1..exact.len() {
-                if boxes_overlap(face_box(exact[i]), face_box(exact[j]))
-                    && faces_intersect(exact[i], exact[j])
-                {
+                if boxes_overlap(boxes[i], boxes[j]) && faces_intersect(exact[i], exact[j]) {
                     return true;
                 }
             }
         }
         let mut lo = [i64::MAX; 3];
         let mut hi = [i64::MIN; 3];
-        for t in exact {
-            let (l, h) = face_box(*t);
+        for (l, h) in &boxes {
             for a in 0..3 {
                 lo[a] = lo[a].min(l[a]);
                 hi[a] = hi[a].max(h[a]);
             }
         }
-        let mut near: Vec<u32> = Vec::new();
         let (qlo, qhi) = coarse((lo, hi), self.shift);
+        let p = |x: u32| self.points[x as usize];
+        let mut meets = false;
         for (k, grid) in self.grids.iter().enumerate() {
             let reach = lo.map(|c| c - (self.ticks << k));
             let bucket = self.ticks << (k + 1);
             for_buckets(reach, hi, bucket, |key| {
-                if let Some(list) = grid.get(&key) {
-                    near.extend(
-                        list.iter()
-                            .filter(|(g, l, h)| {
-                                (0..3).all(|a| l[a] <= qhi[a] && qlo[a] <= h[a]) && !old.contains(g)
-                            })
-                            .map(|e| e.0),
-                    );
+                if meets {
+                    return;
+                }
+                let Some(list) = grid.get(&key) else {
+                    return;
+                };
+                for (g, l, h) in list {
+                    // Tested where they are found, with an early exit: no candidate list.
+                    if !(0..3).all(|a| l[a] <= qhi[a] && qlo[a] <= h[a]) || old.contains(g) {
+                        continue;
+                    }
+                    let tg = self.faces[*g as usize].map(p);
+                    let bg = face_box(tg);
+                    if exact
+                        .iter()
+                        .zip(&boxes)
+                        .any(|(t, b)| boxes_overlap(*b, bg) && faces_intersect(*t, tg))
+                    {
+                        meets = true;
+                        return;
+                    }
                 }
             });
-        }
-        for &g in &near {
-            let tg = self.faces[g as usize].map(p);
-            let bg = face_box(tg);
-            for t in exact {
-                if boxes_overlap(face_box(*t), bg) && faces_intersect(*t, tg) {
-                    return true;
-                }
+            if meets {
+                return true;
             }
         }
         false
@@ -972,10 +984,16 @@ impl Simplifier {
             return None;
         }
         // Over the faces rather than the sorted ring (no allocation: this runs for every
-        // neighbour of every collapse); each neighbour is seen twice, which leaves the minimum.
+        // neighbour of every collapse).
+        // On the closed oriented manifold the simplifier keeps, each neighbour follows `u` in
+        // exactly one of its faces: one term per neighbour.
         self.vertex_faces[u as usize]
             .iter()
-            .flat_map(|&f| self.faces[f as usize])
+            .map(|&f| {
+                let t = self.faces[f as usize];
+                let i = t.iter().position(|&x| x == u).unwrap_or(0);
+                t[(i + 1) % 3]
+            })
             .filter(|&v| v != u && self.flat_enough(u, v))
             .map(|v| self.cost(u, v))
             .filter(|&c| c <= self.max_distance2)
