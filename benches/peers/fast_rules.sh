@@ -12,13 +12,15 @@ cd "$repo"
 cargo build --release --features examples --example fast_speed --quiet
 bin="${CARGO_TARGET_DIR:-$repo/target}/release/examples/fast_speed"
 py="$here/.venv/bin/python"
-rate() { tail -1 | cut -d'|' -f6 | tr -d ' '; }
+# The sixth column of the last table row (libigl's script and fast_speed print the same columns);
+# "-" when the tool failed on the mesh (the loop goes on).
+rate() { local r; r=$(tail -1 | cut -d'|' -f6 | tr -d ' '); echo "${r:--}"; }
 echo "| mesh | libigl q/s | radius 2.8 | radius-or-box-corner 2.8 | box-corner 2.4 | load |"
 echo "|---|---:|---:|---:|---:|---|"
 for m in "$@"; do
-  igl=$(IGL_NUM_THREADS=1 OMP_NUM_THREADS=1 "$py" "$here/igl_fast_cpu.py" --reps 5 "$m" 2>&1 | rate)
-  r=$("$bin" --reps 5 --beta 2.8 "$m" 2>&1 | rate)
-  e=$("$bin" --reps 5 --beta 2.8 --rule radius-or-box-corner "$m" 2>&1 | rate)
-  c=$("$bin" --reps 5 --beta 2.4 --rule box-corner "$m" 2>&1 | rate)
+  igl=$( (IGL_NUM_THREADS=1 OMP_NUM_THREADS=1 "$py" "$here/igl_fast_cpu.py" --reps 5 "$m" 2>&1 || true) | rate)
+  r=$( ("$bin" --reps 5 --beta 2.8 "$m" 2>&1 || true) | rate)
+  e=$( ("$bin" --reps 5 --beta 2.8 --rule radius-or-box-corner "$m" 2>&1 || true) | rate)
+  c=$( ("$bin" --reps 5 --beta 2.4 --rule box-corner "$m" 2>&1 || true) | rate)
   echo "| $(basename "$m") | $igl | $r | $e | $c | $(cut -d' ' -f1 /proc/loadavg) |"
 done

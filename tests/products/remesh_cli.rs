@@ -213,49 +213,16 @@ fn remesh_reads_step_models() {
     let Some(dir) = crate::common::shared_file("parametric/step") else {
         return;
     };
-    let out_dir = std::env::temp_dir().join(format!("gwn-cli-remesh-step-{}", std::process::id()));
-    std::fs::create_dir_all(&out_dir).unwrap();
     for (model, min_agreement) in [("tet.step", 0.995), ("sliced_cylinder.step", 0.98)] {
-        let (input, out, report) = (
-            dir.join(model),
-            out_dir.join("o.ply"),
-            out_dir.join("r.json"),
-        );
-        let (ok, stdout, stderr) = gwn(&[
-            "remesh",
-            input.to_str().unwrap(),
-            "--res",
+        let json = remesh_report(
+            &dir.join(model),
             "16",
-            "--samples",
             "2000",
-            "--out",
-            out.to_str().unwrap(),
-            "--report",
-            report.to_str().unwrap(),
-        ]);
-        assert!(ok, "{model}: {stderr}");
-        assert!(stdout.contains("closed: yes"), "{model}: {stdout}");
-        let json = std::fs::read_to_string(&report).unwrap();
-        for member in [
-            "\"closed\": true",
-            "\"edge_manifold\": true",
-            "\"vertex_manifold\": true",
-            "\"oriented\": true",
-            "\"euler_characteristic\": 2",
-            "\"components\": 1",
-            "\"self_intersections\": 0",
-        ] {
-            assert!(json.contains(member), "{model}: {member} not in {json}");
-        }
-        let agreement: f64 = json
-            .split("\"occupancy_agreement\": ")
-            .nth(1)
-            .and_then(|s| s.split([',', '\n', '}']).next())
-            .and_then(|s| s.trim().parse().ok())
-            .unwrap_or_else(|| panic!("{model}: no agreement in {json}"));
+            &["\"euler_characteristic\": 2"],
+        );
+        let agreement = report_number(&json, "occupancy_agreement");
         assert!(agreement >= min_agreement, "{model}: agreement {agreement}");
     }
-    std::fs::remove_dir_all(&out_dir).unwrap();
 }
 
 /// A printer part thinner than a cube cell of `extent / res` (`prusa-helper_disk.stl` of the
@@ -266,24 +233,36 @@ fn remesh_keeps_a_printer_plate_thinner_than_a_cube_cell() {
     let Some(input) = crate::common::shared_file("meshes/prusa-helper_disk.stl") else {
         return;
     };
-    let dir = std::env::temp_dir().join(format!("gwn-cli-remesh-plate-{}", std::process::id()));
+    let json = remesh_report(&input, "32", "20000", &[]);
+    assert!(report_number(&json, "faces") > 0.0, "{json}");
+    let agreement = report_number(&json, "occupancy_agreement");
+    assert!(agreement >= 0.99, "agreement {agreement}");
+}
+
+/// Runs `gwn remesh INPUT --res RES --samples SAMPLES` and returns its JSON report, after
+/// checking that the run succeeded and that the report says closed, manifold, oriented, one
+/// component, no self-intersection, and every member of `also`.
+fn remesh_report(input: &std::path::Path, res: &str, samples: &str, also: &[&str]) -> String {
+    let name = input.file_name().unwrap().to_string_lossy().into_owned();
+    let dir = std::env::temp_dir().join(format!("gwn-cli-remesh-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let (out, report) = (dir.join("o.ply"), dir.join("r.json"));
     let (ok, stdout, stderr) = gwn(&[
         "remesh",
         input.to_str().unwrap(),
         "--res",
-        "32",
+        res,
         "--samples",
-        "20000",
+        samples,
         "--out",
         out.to_str().unwrap(),
         "--report",
         report.to_str().unwrap(),
     ]);
-    assert!(ok, "{stderr}");
-    assert!(stdout.contains("closed: yes"), "{stdout}");
+    assert!(ok, "{name}: {stderr}");
+    assert!(stdout.contains("closed: yes"), "{name}: {stdout}");
     let json = std::fs::read_to_string(&report).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
     for member in [
         "\"closed\": true",
         "\"edge_manifold\": true",
@@ -291,18 +270,20 @@ fn remesh_keeps_a_printer_plate_thinner_than_a_cube_cell() {
         "\"oriented\": true",
         "\"components\": 1",
         "\"self_intersections\": 0",
-    ] {
-        assert!(json.contains(member), "{member} not in {json}");
+    ]
+    .iter()
+    .chain(also)
+    {
+        assert!(json.contains(member), "{name}: {member} not in {json}");
     }
-    let number = |key: &str| -> f64 {
-        json.split(&format!("\"{key}\": "))
-            .nth(1)
-            .and_then(|s| s.split([',', '\n', '}']).next())
-            .and_then(|s| s.trim().parse().ok())
-            .unwrap_or_else(|| panic!("no {key} in {json}"))
-    };
-    assert!(number("faces") > 0.0, "{json}");
-    let agreement = number("occupancy_agreement");
-    assert!(agreement >= 0.99, "agreement {agreement}");
-    std::fs::remove_dir_all(&dir).unwrap();
+    json
+}
+
+/// The number after `"key": ` in a JSON report.
+fn report_number(json: &str, key: &str) -> f64 {
+    json.split(&format!("\"{key}\": "))
+        .nth(1)
+        .and_then(|s| s.split([',', '\n', '}']).next())
+        .and_then(|s| s.trim().parse().ok())
+        .unwrap_or_else(|| panic!("no {key} in {json}"))
 }
