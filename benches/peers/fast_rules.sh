@@ -15,7 +15,7 @@ py="$here/.venv/bin/python"
 reps="${REPS:-5}"   # best of this many timings per tool and mesh
 # The sixth column of the last table row (libigl's script and fast_speed print the same columns);
 # "-" when the tool failed on the mesh (the loop goes on).
-rate() { local r; r=$(tail -1 | cut -d'|' -f6 | tr -d ' '); echo "${r:--}"; }
+rate() { local r; r=$(grep '^| ' | tail -1 | cut -d'|' -f6 | tr -d ' '); echo "${r:--}"; }
 echo "| mesh | libigl q/s | radius 2.8 | radius-or-box-corner 2.8 | box-corner 2.4 | load |"
 echo "|---|---:|---:|---:|---:|---|"
 for m in "$@"; do
