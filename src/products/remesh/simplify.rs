@@ -984,9 +984,8 @@ impl Simplifier {
             return None;
         }
         // Over the faces rather than the sorted ring (no allocation: this runs for every
-        // neighbour of every collapse).
-        // On the closed oriented manifold the simplifier keeps, each neighbour follows `u` in
-        // exactly one of its faces: one term per neighbour.
+        // neighbour of every collapse): on the closed oriented manifold the simplifier keeps,
+        // each neighbour follows `u` in exactly one of its faces, so one term per neighbour.
         self.vertex_faces[u as usize]
             .iter()
             .map(|&f| {
