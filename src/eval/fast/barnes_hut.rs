@@ -480,24 +480,25 @@ impl Hierarchy {
     /// [`Hierarchy::eval`] for a packet of neighbouring queries (bit `i` of `active` set for
     /// the queries to evaluate), walking the tree once for all of them: per node and lane, the
     /// admissibility of every query at once, and the lane's expansion evaluated for every query
-    /// that admits it in one pass (the queries in the lanes of [`Lanes8`]). `leaf(query,
-    /// number, range, sum)` adds a near leaf's exact terms for one query. Each query gets
-    /// exactly the value [`Hierarchy::eval`] gives it (module `packet`); inactive queries get 0.
+    /// that admits it in one pass (the queries in the lanes of [`Lanes8`]). `near.add(query,
+    /// number, sum)` adds a near leaf's exact terms for one query ([`NearLeaf`]). Each query
+    /// gets exactly the value [`Hierarchy::eval`] gives it (module `packet`); inactive queries
+    /// get 0.
     #[inline]
     pub fn eval_packet(
         &self,
         q: &[[f64; 3]; PACKET],
         active: u32,
         params: &FastParams,
-        leaf: impl FnMut(usize, usize, std::ops::Range<usize>, &mut f64),
+        near: impl NearLeaf,
     ) -> [f64; PACKET] {
         #[cfg(target_arch = "x86_64")]
         if let Some(avx2) = Avx2::detect() {
             // SAFETY: as in `eval`: compiled for AVX2, and the CPU was just checked to have it.
             #[allow(unsafe_code)]
-            return unsafe { self.eval_packet_avx2(avx2, q, active, params, leaf) };
+            return unsafe { self.eval_packet_avx2(avx2, q, active, params, near) };
         }
-        self.eval_packet_lanes::<Lanes8>((), q, active, params, leaf)
+        self.eval_packet_lanes::<Lanes8>((), q, active, params, near)
     }
 
     /// The packet walk with the eight lanes in one AVX register ([`Avx8`]): the same IEEE
@@ -510,15 +511,23 @@ impl Hierarchy {
         q: &[[f64; 3]; PACKET],
         active: u32,
         params: &FastParams,
-        leaf: impl FnMut(usize, usize, std::ops::Range<usize>, &mut f64),
+        near: impl NearLeaf,
     ) -> [f64; PACKET] {
-        self.eval_packet_lanes::<Avx8>(avx2, q, active, params, leaf)
+        self.eval_packet_lanes::<Avx8>(avx2, q, active, params, near)
     }
 
     /// The traversal of [`Hierarchy::eval_packet`]. Per query it makes the decisions of
     /// [`Hierarchy::eval_lanes`] with the same `f32` operations (`r`, `d²`, `β·size` and the
     /// comparisons of [`Hierarchy::admit`]) and adds the same terms to the same sums in the same
     /// order.
+    ///
+    /// The near leaves are not summed where the walk meets them but listed (with the queries
+    /// that need them) and summed in the order met once the list is full or the walk is done:
+    /// each query's near leaves are still added to its own sums in its own walk order (the
+    /// far-field sums are apart), so the bits do not change, and the list lets the walk
+    /// [`NearLeaf::prefetch`] each leaf's elements a few hundred nodes before they are read. A
+    /// near leaf was the walk's costliest step on large meshes, mostly waiting for its
+    /// elements (288 bytes per triangle leaf) to come from memory (docs/benchmarks.md).
     #[inline(always)]
     pub(crate) fn eval_packet_lanes<L: EightLanes>(
         &self,
@@ -526,7 +535,7 @@ impl Hierarchy {
         q: &[[f64; 3]; PACKET],
         active: u32,
         params: &FastParams,
-        mut leaf: impl FnMut(usize, usize, std::ops::Range<usize>, &mut f64),
+        mut near: impl NearLeaf,
     ) -> [f64; PACKET] {
         let mut sum = [0.0f64; PACKET];
         if self.wide.is_empty() || active == 0 {
@@ -539,6 +548,9 @@ impl Hierarchy {
         let mut far = [[0.0f64; PACKET]; WIDTH];
         let mut stack = [(0u32, 0u32); WIDE_STACK];
         let mut top = 0usize;
+        // (leaf number, the queries it is near to), in the order the walk met them.
+        let mut listed = [(0u32, 0u32); NEAR_LIST];
+        let mut len = 0usize;
         let (mut id, mut mask) = (0usize, active);
         loop {
             let node = &self.wide[id];
@@ -576,11 +588,13 @@ impl Hierarchy {
                     continue;
                 }
                 if c & LEAF != 0 {
-                    let k = (c & !LEAF) as usize;
-                    for (i, sum) in sum.iter_mut().enumerate() {
-                        if rest & (1 << i) != 0 {
-                            leaf(i, k, self.leaves[k].clone(), sum);
-                        }
+                    let k = c & !LEAF;
+                    near.prefetch(k as usize);
+                    listed[len] = (k, rest);
+                    len += 1;
+                    if len == NEAR_LIST {
+                        add_near_leaves(&listed, &mut sum, &mut near);
+                        len = 0;
                     }
                 } else {
                     stack[top] = (c, rest);
@@ -593,6 +607,7 @@ impl Hierarchy {
             top -= 1;
             (id, mask) = (stack[top].0 as usize, stack[top].1);
         }
+        add_near_leaves(&listed[..len], &mut sum, &mut near);
         std::array::from_fn(|i| sum[i] + (far[0][i] + far[1][i] + far[2][i] + far[3][i]))
     }
 }
@@ -643,6 +658,30 @@ impl Hierarchy {
             id = stack[top] as usize;
         }
         g
+    }
+}
+
+/// The exact terms of the elements of a near leaf, for [`Hierarchy::eval_packet`].
+pub(crate) trait NearLeaf {
+    /// A hint that leaf `leaf`'s elements will soon be read ([`super::packet::prefetch`]).
+    fn prefetch(&self, leaf: usize);
+    /// Adds the exact terms of leaf `leaf`'s elements at query `query` of the packet to `sum`.
+    fn add(&mut self, query: usize, leaf: usize, sum: &mut f64);
+}
+
+/// Near leaves a packet's walk lists before it sums them ([`Hierarchy::eval_packet_lanes`]):
+/// 32 triangle leaves are 9 KiB, well inside the first-level cache with the walk's own data.
+const NEAR_LIST: usize = 32;
+
+/// Sums the listed near leaves, in order, for the queries listed with each.
+#[inline(always)]
+fn add_near_leaves(listed: &[(u32, u32)], sum: &mut [f64; PACKET], near: &mut impl NearLeaf) {
+    for &(k, queries) in listed {
+        for (i, sum) in sum.iter_mut().enumerate() {
+            if queries & (1 << i) != 0 {
+                near.add(i, k as usize, sum);
+            }
+        }
     }
 }
 

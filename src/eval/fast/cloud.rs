@@ -4,9 +4,9 @@
 
 use super::InputScale;
 use super::area::estimate_areas;
-use super::barnes_hut::{FastParams, Hierarchy};
+use super::barnes_hut::{FastParams, Hierarchy, NearLeaf};
 use super::moments::Moments;
-use super::packet::eval_in_packets;
+use super::packet::{PACKET, eval_in_packets, prefetch};
 use super::soup::dist2;
 use super::tree::Tree;
 use crate::base::bounding_box::BoundingBox;
@@ -214,15 +214,10 @@ impl PointCloudWindingNumber {
     /// bit for bit, and faster, as neighbouring points walk the tree together in packets of
     /// eight (see `docs/fast.md`).
     pub fn eval_batch_with(&self, points: &[[f64; 3]], params: FastParams) -> Vec<f64> {
-        let (p, an) = (&self.positions, &self.weighted_normals);
         eval_in_packets(points, |packet, active| {
             let q = packet.map(|x| self.scale.query(x));
-            self.hierarchy
-                .eval_packet(&q, active, &params, |i, _, range, sum| {
-                    for e in range {
-                        *sum += dipole(p[e], an[e], q[i]);
-                    }
-                })
+            let near = NearPoints { cloud: self, q: &q };
+            self.hierarchy.eval_packet(&q, active, &params, near)
         })
     }
 
@@ -240,6 +235,29 @@ impl PointCloudWindingNumber {
     pub fn node_children(&self, id: usize) -> Option<[usize; 2]> {
         let node = &self.hierarchy.tree.nodes[id];
         (!node.is_leaf()).then(|| [node.left as usize, node.left as usize + 1])
+    }
+}
+
+/// The near leaves of a packet ([`Hierarchy::eval_packet`]): their exact dipoles.
+struct NearPoints<'a> {
+    cloud: &'a PointCloudWindingNumber,
+    q: &'a [[f64; 3]; PACKET],
+}
+
+impl NearLeaf for NearPoints<'_> {
+    #[inline(always)]
+    fn prefetch(&self, leaf: usize) {
+        let start = self.cloud.hierarchy.leaves[leaf].start;
+        prefetch(&self.cloud.positions[start]);
+        prefetch(&self.cloud.weighted_normals[start]);
+    }
+
+    #[inline(always)]
+    fn add(&mut self, query: usize, leaf: usize, sum: &mut f64) {
+        let (p, an) = (&self.cloud.positions, &self.cloud.weighted_normals);
+        for e in self.cloud.hierarchy.leaves[leaf].clone() {
+            *sum += dipole(p[e], an[e], self.q[query]);
+        }
     }
 }
 
@@ -319,3 +337,4 @@ mod tests {
         }
     }
 }
+

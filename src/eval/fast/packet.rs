@@ -226,6 +226,29 @@ mod avx {
     }
 }
 
+/// Asks the CPU to bring every cache line of `value` towards the first-level cache, without
+/// waiting for it (no-op off x86-64).
+#[inline(always)]
+pub(crate) fn prefetch<T>(value: &T) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        const LINE: usize = 64;
+        let start = std::ptr::from_ref(value).cast::<i8>();
+        for offset in (0..std::mem::size_of::<T>()).step_by(LINE) {
+            // SAFETY: a prefetch is a hint: it reads nothing into the program and never faults,
+            // whatever the address; every address here is inside `value` anyway. (SSE, which
+            // every x86-64 CPU has.) Why it is here: docs/benchmarks.md, "near leaves listed".
+            #[allow(unsafe_code)]
+            unsafe {
+                _mm_prefetch::<_MM_HINT_T0>(start.wrapping_add(offset));
+            }
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = value;
+}
+
 /// Evaluates `points` packet by packet on rayon and returns the values in input order.
 ///
 /// `eval_packet(points, active)` evaluates one packet: `active` has bit `i` set for the real

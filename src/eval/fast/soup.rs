@@ -1,9 +1,9 @@
 //! The fast winding number of a triangle mesh or soup (Barill et al. 2018, Section 3.3).
 
 use super::InputScale;
-use super::barnes_hut::{FastParams, Hierarchy};
+use super::barnes_hut::{FastParams, Hierarchy, NearLeaf};
 use super::moments::Moments;
-use super::packet::{PACKET, eval_in_packets};
+use super::packet::{PACKET, eval_in_packets, prefetch};
 use super::tree::Tree;
 use wide::{CmpGe, CmpGt, CmpLt, f64x4};
 
@@ -43,6 +43,10 @@ pub struct FastWindingNumber {
     /// The same corners leaf by leaf, one triangle per lane (`x, y, z` of `a`, `b`, `c`);
     /// unused lanes are zero, a triangle with `det = 0` that adds nothing.
     leaves: Vec<[f64x4; 9]>,
+    /// Per leaf, the mask of its used lanes (`0b111` for three triangles): a leaf whose used
+    /// lanes all took the fast path needs nothing else. (Its element range, 16 bytes per leaf
+    /// in a second array, cost a cache miss per near leaf of fewer than four triangles.)
+    used_lanes: Vec<u8>,
     params: FastParams,
     /// World → the scaled coordinates everything above is stored in.
     scale: InputScale,
@@ -104,10 +108,16 @@ impl FastWindingNumber {
                 })
             })
             .collect();
+        let used_lanes = hierarchy
+            .leaves
+            .iter()
+            .map(|range| ((1u32 << range.len().min(4)) - 1) as u8)
+            .collect();
         FastWindingNumber {
             hierarchy,
             triangles,
             leaves,
+            used_lanes,
             params,
             scale,
         }
@@ -160,7 +170,7 @@ impl FastWindingNumber {
         angles: &'a mut AngleSum,
         simd: Simd,
     ) -> impl FnMut(usize, std::ops::Range<usize>, &mut f64) + 'a {
-        move |k, range, sum| self.add_leaf_terms(simd, angles, q, k, range, sum)
+        move |k, _, sum| self.add_leaf_terms(simd, angles, q, k, sum)
     }
 
     /// The body of [`Self::leaf_terms`], shared with the packets of [`Self::eval_batch_with`].
@@ -171,11 +181,11 @@ impl FastWindingNumber {
         angles: &mut AngleSum,
         q: [f64; 3],
         k: usize,
-        range: std::ops::Range<usize>,
         sum: &mut f64,
     ) {
         let ok = simd.push_solid_angles(angles, &self.leaves[k], q);
-        if ok != 0b1111 {
+        if ok & u32::from(self.used_lanes[k]) != u32::from(self.used_lanes[k]) {
+            let range = self.hierarchy.leaves[k].clone();
             for (l, t) in self.triangles[range].iter().enumerate() {
                 if ok & (1 << l) == 0 {
                     // The direct sum's term: exact offsets and double-double where the f64
@@ -237,8 +247,11 @@ impl FastWindingNumber {
             } else {
                 Simd::detect()
             };
-            let leaf = |i: usize, k, range, sum: &mut f64| {
-                self.add_leaf_terms(simd, &mut angles[i], q[i], k, range, sum)
+            let leaf = NearTriangles {
+                fast: self,
+                simd,
+                angles: &mut angles,
+                q: &q,
             };
             let far_and_rare = if portable {
                 self.hierarchy.eval_packet_lanes::<super::packet::Lanes8>(
@@ -300,6 +313,28 @@ impl FastWindingNumber {
             min: n.min,
             max: n.max,
         }
+    }
+}
+
+/// The near leaves of a packet ([`Hierarchy::eval_packet`]): their exact solid angles.
+struct NearTriangles<'a> {
+    fast: &'a FastWindingNumber,
+    simd: Simd,
+    angles: &'a mut [AngleSum; PACKET],
+    q: &'a [[f64; 3]; PACKET],
+}
+
+impl NearLeaf for NearTriangles<'_> {
+    #[inline(always)]
+    fn prefetch(&self, leaf: usize) {
+        prefetch(&self.fast.leaves[leaf]);
+    }
+
+    #[inline(always)]
+    fn add(&mut self, query: usize, leaf: usize, sum: &mut f64) {
+        let q = self.q[query];
+        self.fast
+            .add_leaf_terms(self.simd, &mut self.angles[query], q, leaf, sum);
     }
 }
 
