@@ -422,8 +422,9 @@ impl Hierarchy {
     }
 
     /// The traversal of [`Hierarchy::eval`], inlined into each instantiation. The expansions
-    /// are summed in `f64`, one sum per lane position in traversal order, then the four sums;
-    /// [`Hierarchy::eval_packet_lanes`] sums in exactly this order.
+    /// are added to one `f64` sum in traversal order, a node's lanes in lane order (one sum, so
+    /// that a packet keeps its eight in two registers); [`Hierarchy::eval_packet_lanes`] sums in
+    /// exactly this order.
     #[inline(always)]
     pub(crate) fn eval_lanes(
         &self,
@@ -437,7 +438,7 @@ impl Hierarchy {
         let beta = params.beta as f32;
         let order = params.order;
         let which = params.admissibility as usize;
-        let mut far = [0.0f64; WIDTH];
+        let mut far = 0.0f64;
         let mut sum = 0.0;
         let mut stack = [0u32; WIDE_STACK];
         let mut top = 0usize;
@@ -447,9 +448,9 @@ impl Hierarchy {
             let mask = self.admit(id, &r, beta, which);
             if mask != 0 {
                 let w = self.wide_far[id].eval(r, order).to_array();
-                for l in 0..WIDTH {
+                for (l, w) in w.into_iter().enumerate() {
                     if mask & (1 << l) != 0 {
-                        far[l] += f64::from(w[l]);
+                        far += f64::from(w);
                     }
                 }
             }
@@ -474,7 +475,7 @@ impl Hierarchy {
             top -= 1;
             id = stack[top] as usize;
         }
-        sum + (far[0] + far[1] + far[2] + far[3])
+        sum + far
     }
 
     /// [`Hierarchy::eval`] for a packet of neighbouring queries (bit `i` of `active` set for
@@ -545,7 +546,7 @@ impl Hierarchy {
         let order = params.order;
         let which = params.admissibility as usize;
         let qk: [[f64; PACKET]; 3] = std::array::from_fn(|k| q.map(|p| p[k]));
-        let mut far = [[0.0f64; PACKET]; WIDTH];
+        let mut far = L::zero_sums(token);
         let mut stack = [(0u32, 0u32); WIDE_STACK];
         let mut top = 0usize;
         // (leaf number, the queries it is near to), in the order the walk met them.
@@ -570,18 +571,8 @@ impl Hierarchy {
                 if admitted != 0 {
                     let w = self.wide_far[id]
                         .lane(l, |v| L::splat(token, v))
-                        .eval(r, order)
-                        .to_array();
-                    // Adding 0.0 leaves a sum unchanged (a sum that starts at +0.0 is never
-                    // −0.0 in round-to-nearest), so this branch-free form adds exactly what
-                    // `eval_lanes` adds.
-                    for (i, (acc, &w)) in far[l].iter_mut().zip(&w).enumerate() {
-                        *acc += if admitted & (1 << i) != 0 {
-                            f64::from(w)
-                        } else {
-                            0.0
-                        };
-                    }
+                        .eval(r, order);
+                    far = w.add_where(far, admitted);
                 }
                 let rest = mask & !admitted;
                 if rest == 0 {
@@ -608,7 +599,8 @@ impl Hierarchy {
             (id, mask) = (stack[top].0 as usize, stack[top].1);
         }
         add_near_leaves(&listed[..len], &mut sum, &mut near);
-        std::array::from_fn(|i| sum[i] + (far[0][i] + far[1][i] + far[2][i] + far[3][i]))
+        let far = L::sums_to_array(far);
+        std::array::from_fn(|i| sum[i] + far[i])
     }
 }
 

@@ -48,6 +48,14 @@ pub(crate) trait EightLanes:
     fn sqrt(self) -> Self;
     /// Bit `i` set where lane `i` is `> 0` and (`bs < 0` or `> bs²`): the admissibility test.
     fn admissible(self, bs: f32) -> u32;
+    /// Eight `f64` sums, one per query of a packet (the far-field sums: kept in registers).
+    type Sums: Copy;
+    fn zero_sums(token: Self::Token) -> Self::Sums;
+    /// `sums[i] += f64::from(self[i])` where bit `i` of `bits` is set, `+= 0.0` elsewhere,
+    /// which leaves the sum as it was: a sum that starts at `+0.0` is never `−0.0` in
+    /// round-to-nearest, and `x + 0.0 = x` for every other `x`.
+    fn add_where(self, sums: Self::Sums, bits: u32) -> Self::Sums;
+    fn sums_to_array(sums: Self::Sums) -> [f64; PACKET];
 }
 
 /// The portable eight lanes, `wide::f32x8` (one AVX register where the build targets AVX, two
@@ -84,6 +92,30 @@ impl EightLanes for Lanes8 {
         let admit = self.0.cmp_gt(zero) & (bs.cmp_lt(zero) | self.0.cmp_gt(bs * bs));
         admit.move_mask() as u32
     }
+
+    type Sums = [f64; PACKET];
+
+    #[inline(always)]
+    fn zero_sums((): ()) -> [f64; PACKET] {
+        [0.0; PACKET]
+    }
+
+    #[inline(always)]
+    fn add_where(self, mut sums: [f64; PACKET], bits: u32) -> [f64; PACKET] {
+        for (i, (s, w)) in sums.iter_mut().zip(self.to_array()).enumerate() {
+            *s += if bits & (1 << i) != 0 {
+                f64::from(w)
+            } else {
+                0.0
+            };
+        }
+        sums
+    }
+
+    #[inline(always)]
+    fn sums_to_array(sums: [f64; PACKET]) -> [f64; PACKET] {
+        sums
+    }
 }
 
 macro_rules! lanes8_op {
@@ -119,10 +151,13 @@ pub(crate) use avx::{Avx2, Avx8};
 mod avx {
     use super::{EightLanes, PACKET};
     use std::arch::x86_64::{
-        __m256, _CMP_GT_OQ, _CMP_LT_OQ, _mm256_add_ps, _mm256_and_ps, _mm256_cmp_ps,
-        _mm256_cvtpd_ps, _mm256_div_ps, _mm256_loadu_pd, _mm256_loadu_ps, _mm256_movemask_ps,
-        _mm256_mul_ps, _mm256_or_ps, _mm256_set_m128, _mm256_set1_pd, _mm256_set1_ps,
-        _mm256_setzero_ps, _mm256_sqrt_ps, _mm256_storeu_ps, _mm256_sub_pd, _mm256_sub_ps,
+        __m256, __m256d, _CMP_GT_OQ, _CMP_LT_OQ, _mm256_add_pd, _mm256_add_ps, _mm256_and_ps,
+        _mm256_and_si256, _mm256_castps256_ps128, _mm256_castsi256_ps, _mm256_cmp_ps,
+        _mm256_cmpeq_epi32, _mm256_cvtpd_ps, _mm256_cvtps_pd, _mm256_div_ps,
+        _mm256_extractf128_ps, _mm256_loadu_pd, _mm256_loadu_ps, _mm256_movemask_ps,
+        _mm256_mul_ps, _mm256_or_ps, _mm256_set_m128, _mm256_set1_epi32, _mm256_set1_pd,
+        _mm256_set1_ps, _mm256_setr_epi32, _mm256_setzero_pd, _mm256_setzero_ps,
+        _mm256_sqrt_ps, _mm256_storeu_pd, _mm256_storeu_ps, _mm256_sub_pd, _mm256_sub_ps,
     };
 
     /// Proof that the CPU has AVX2 (and so AVX): made only by [`Avx2::detect`].
@@ -213,6 +248,43 @@ mod avx {
                 let admit = _mm256_and_ps(_mm256_cmp_ps::<_CMP_GT_OQ>(self.0, zero), far);
                 _mm256_movemask_ps(admit) as u32
             }
+        }
+
+        /// Two `f64x4` registers (queries 0–3, 4–7).
+        type Sums = (__m256d, __m256d);
+
+        #[inline(always)]
+        fn zero_sums(_: Avx2) -> Self::Sums {
+            // SAFETY: the token proves AVX2.
+            unsafe { (_mm256_setzero_pd(), _mm256_setzero_pd()) }
+        }
+
+        /// The bits become a lane mask (lane `i` all ones where bit `i` is set) that zeroes the
+        /// other lanes in `f32` (`+0.0`, which converts to `+0.0`), then both halves are widened
+        /// and added: what the portable `Lanes8` adds, lane by lane.
+        #[inline(always)]
+        fn add_where(self, sums: Self::Sums, bits: u32) -> Self::Sums {
+            // SAFETY: `self` proves AVX2.
+            unsafe {
+                let bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+                let set = _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(bits as i32), bit), bit);
+                let w = _mm256_and_ps(self.0, _mm256_castsi256_ps(set));
+                let lo = _mm256_cvtps_pd(_mm256_castps256_ps128(w));
+                let hi = _mm256_cvtps_pd(_mm256_extractf128_ps::<1>(w));
+                (_mm256_add_pd(sums.0, lo), _mm256_add_pd(sums.1, hi))
+            }
+        }
+
+        #[inline(always)]
+        fn sums_to_array(sums: Self::Sums) -> [f64; PACKET] {
+            let mut out = [0.0; PACKET];
+            // SAFETY: the sums exist, so the CPU has AVX; the stores write the eight `f64` of
+            // `out`.
+            unsafe {
+                _mm256_storeu_pd(out.as_mut_ptr(), sums.0);
+                _mm256_storeu_pd(out.as_mut_ptr().add(4), sums.1);
+            }
+            out
         }
     }
 
