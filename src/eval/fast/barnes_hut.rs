@@ -435,14 +435,32 @@ impl Hierarchy {
         if self.wide.is_empty() {
             return 0.0;
         }
+        let (mut far, mut sum) = (0.0f64, 0.0);
+        self.walk_one(0, q, params, &mut far, |k| {
+            leaf(k, self.leaves[k].clone(), &mut sum);
+        });
+        sum + far
+    }
+
+    /// One query's walk of the subtree of query-tree node `start`: adds the admitted
+    /// expansions to `far` in traversal order (a node's lanes in lane order) and calls
+    /// `near(leaf number)` for every near leaf, in traversal order. The packets walk one
+    /// query's subtrees with it too ([`Hierarchy::eval_packet_lanes`]).
+    #[inline(always)]
+    fn walk_one(
+        &self,
+        start: usize,
+        q: [f64; 3],
+        params: &FastParams,
+        far: &mut f64,
+        mut near: impl FnMut(usize),
+    ) {
         let beta = params.beta as f32;
         let order = params.order;
         let which = params.admissibility as usize;
-        let mut far = 0.0f64;
-        let mut sum = 0.0;
         let mut stack = [0u32; WIDE_STACK];
         let mut top = 0usize;
-        let mut id = 0usize;
+        let mut id = start;
         loop {
             let r = self.lane_offsets(id, q);
             let mask = self.admit(id, &r, beta, which);
@@ -450,7 +468,7 @@ impl Hierarchy {
                 let w = self.wide_far[id].eval(r, order).to_array();
                 for (l, w) in w.into_iter().enumerate() {
                     if mask & (1 << l) != 0 {
-                        far += f64::from(w);
+                        *far += f64::from(w);
                     }
                 }
             }
@@ -462,8 +480,7 @@ impl Hierarchy {
                     continue;
                 }
                 if c & LEAF != 0 {
-                    let k = (c & !LEAF) as usize;
-                    leaf(k, self.leaves[k].clone(), &mut sum);
+                    near((c & !LEAF) as usize);
                 } else {
                     stack[top] = c;
                     top += 1;
@@ -475,7 +492,6 @@ impl Hierarchy {
             top -= 1;
             id = stack[top] as usize;
         }
-        sum + far
     }
 
     /// [`Hierarchy::eval`] for a packet of neighbouring queries (bit `i` of `active` set for
@@ -548,12 +564,33 @@ impl Hierarchy {
         let qk: [[f64; PACKET]; 3] = std::array::from_fn(|k| q.map(|p| p[k]));
         let mut far = L::zero_sums(token);
         let mut stack = [(0u32, 0u32); WIDE_STACK];
-        let mut top = 0usize;
+        stack[0] = (0, active);
+        let mut top = 1usize;
         // (leaf number, the queries it is near to), in the order the walk met them.
         let mut listed = [(0u32, 0u32); NEAR_LIST];
         let mut len = 0usize;
-        let (mut id, mut mask) = (0usize, active);
-        loop {
+        while top > 0 {
+            top -= 1;
+            let (id, mask) = (stack[top].0 as usize, stack[top].1);
+            if mask.is_power_of_two() {
+                // One query left below this node (a sixth of the visits on the large scans):
+                // its own walk tests and evaluates a node's four lanes at once, where the
+                // packet would take one eight-query pass per lane for one query. Same
+                // operations per lane, same order of the sums, so the same bits.
+                let i = mask.trailing_zeros() as usize;
+                let mut sums = L::sums_to_array(far);
+                self.walk_one(id, q[i], params, &mut sums[i], |k| {
+                    near.prefetch(k);
+                    listed[len] = (k as u32, mask);
+                    len += 1;
+                    if len == NEAR_LIST {
+                        add_near_leaves(&listed, &mut sum, &mut near);
+                        len = 0;
+                    }
+                });
+                far = L::sums_from_array(token, sums);
+                continue;
+            }
             let node = &self.wide[id];
             let dq: [L; 3] = std::array::from_fn(|k| L::difference(token, node.anchor[k], &qk[k]));
             let size = self.wide_size[which][id].as_array_ref();
@@ -592,11 +629,6 @@ impl Hierarchy {
                     top += 1;
                 }
             }
-            if top == 0 {
-                break;
-            }
-            top -= 1;
-            (id, mask) = (stack[top].0 as usize, stack[top].1);
         }
         add_near_leaves(&listed[..len], &mut sum, &mut near);
         let far = L::sums_to_array(far);

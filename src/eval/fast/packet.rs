@@ -56,6 +56,7 @@ pub(crate) trait EightLanes:
     /// round-to-nearest, and `x + 0.0 = x` for every other `x`.
     fn add_where(self, sums: Self::Sums, bits: u32) -> Self::Sums;
     fn sums_to_array(sums: Self::Sums) -> [f64; PACKET];
+    fn sums_from_array(token: Self::Token, sums: [f64; PACKET]) -> Self::Sums;
 }
 
 /// The portable eight lanes, `wide::f32x8` (one AVX register where the build targets AVX, two
@@ -114,6 +115,11 @@ impl EightLanes for Lanes8 {
 
     #[inline(always)]
     fn sums_to_array(sums: [f64; PACKET]) -> [f64; PACKET] {
+        sums
+    }
+
+    #[inline(always)]
+    fn sums_from_array((): (), sums: [f64; PACKET]) -> [f64; PACKET] {
         sums
     }
 }
@@ -285,6 +291,17 @@ mod avx {
                 _mm256_storeu_pd(out.as_mut_ptr().add(4), sums.1);
             }
             out
+        }
+
+        #[inline(always)]
+        fn sums_from_array(_: Avx2, sums: [f64; PACKET]) -> Self::Sums {
+            // SAFETY: the token proves AVX2; the loads read the eight `f64` of `sums`.
+            unsafe {
+                (
+                    _mm256_loadu_pd(sums.as_ptr()),
+                    _mm256_loadu_pd(sums.as_ptr().add(4)),
+                )
+            }
         }
     }
 
