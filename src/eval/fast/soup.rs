@@ -247,11 +247,13 @@ impl FastWindingNumber {
             } else {
                 Simd::detect()
             };
+            let mut touched = 0u32;
             let leaf = NearTriangles {
                 fast: self,
                 simd,
                 angles: &mut angles,
                 q: &q,
+                touched: &mut touched,
             };
             let far_and_rare = if portable {
                 self.hierarchy.eval_packet_lanes::<super::packet::Lanes8>(
@@ -264,7 +266,15 @@ impl FastWindingNumber {
             } else {
                 self.hierarchy.eval_packet(&q, active, &params, leaf)
             };
-            std::array::from_fn(|i| far_and_rare[i] + angles[i].total() * (2.0 * INV_4PI))
+            // A query that met no near leaf has an empty angle sum, whose total is +0.0: adding
+            // it changes nothing (`far_and_rare` is never −0.0), so its `atan2` is skipped.
+            std::array::from_fn(|i| {
+                if touched & (1 << i) != 0 {
+                    far_and_rare[i] + angles[i].total() * (2.0 * INV_4PI)
+                } else {
+                    far_and_rare[i]
+                }
+            })
         })
     }
 
@@ -322,6 +332,8 @@ struct NearTriangles<'a> {
     simd: Simd,
     angles: &'a mut [AngleSum; PACKET],
     q: &'a [[f64; 3]; PACKET],
+    /// Bit `i` set once query `i` met a near leaf.
+    touched: &'a mut u32,
 }
 
 impl NearLeaf for NearTriangles<'_> {
@@ -333,6 +345,7 @@ impl NearLeaf for NearTriangles<'_> {
     #[inline(always)]
     fn add(&mut self, query: usize, leaf: usize, sum: &mut f64) {
         let q = self.q[query];
+        *self.touched |= 1 << query;
         self.fast
             .add_leaf_terms(self.simd, &mut self.angles[query], q, leaf, sum);
     }
