@@ -566,9 +566,7 @@ impl Hierarchy {
         let mut stack = [(0u32, 0u32); WIDE_STACK];
         stack[0] = (0, active);
         let mut top = 1usize;
-        // (leaf number, the queries it is near to), in the order the walk met them.
-        let mut listed = [(0u32, 0u32); NEAR_LIST];
-        let mut len = 0usize;
+        let mut listed = NearList::default();
         while top > 0 {
             top -= 1;
             let (id, mask) = (stack[top].0 as usize, stack[top].1);
@@ -580,13 +578,7 @@ impl Hierarchy {
                 let i = mask.trailing_zeros() as usize;
                 let mut sums = L::sums_to_array(far);
                 self.walk_one(id, q[i], params, &mut sums[i], |k| {
-                    near.prefetch(k);
-                    listed[len] = (k as u32, mask);
-                    len += 1;
-                    if len == NEAR_LIST {
-                        add_near_leaves(&listed, &mut sum, &mut near);
-                        len = 0;
-                    }
+                    listed.push(k, mask, &mut sum, &mut near);
                 });
                 far = L::sums_from_array(token, sums);
                 continue;
@@ -616,21 +608,14 @@ impl Hierarchy {
                     continue;
                 }
                 if c & LEAF != 0 {
-                    let k = c & !LEAF;
-                    near.prefetch(k as usize);
-                    listed[len] = (k, rest);
-                    len += 1;
-                    if len == NEAR_LIST {
-                        add_near_leaves(&listed, &mut sum, &mut near);
-                        len = 0;
-                    }
+                    listed.push((c & !LEAF) as usize, rest, &mut sum, &mut near);
                 } else {
                     stack[top] = (c, rest);
                     top += 1;
                 }
             }
         }
-        add_near_leaves(&listed[..len], &mut sum, &mut near);
+        listed.add(&mut sum, &mut near);
         let far = L::sums_to_array(far);
         std::array::from_fn(|i| sum[i] + far[i])
     }
@@ -694,18 +679,37 @@ pub(crate) trait NearLeaf {
 }
 
 /// Near leaves a packet's walk lists before it sums them ([`Hierarchy::eval_packet_lanes`]):
-/// 32 triangle leaves are 9 KiB, well inside the first-level cache with the walk's own data.
-const NEAR_LIST: usize = 32;
+/// `(leaf number, the queries it is near to)` in the order the walk met them. 32 triangle
+/// leaves are 9 KiB, well inside the first-level cache with the walk's own data.
+#[derive(Default)]
+struct NearList {
+    listed: [(u32, u32); 32],
+    len: usize,
+}
 
-/// Sums the listed near leaves, in order, for the queries listed with each.
-#[inline(always)]
-fn add_near_leaves(listed: &[(u32, u32)], sum: &mut [f64; PACKET], near: &mut impl NearLeaf) {
-    for &(k, queries) in listed {
-        for (i, sum) in sum.iter_mut().enumerate() {
-            if queries & (1 << i) != 0 {
-                near.add(i, k as usize, sum);
+impl NearList {
+    /// Lists leaf `k` for `queries` and prefetches it; sums the list when it is full.
+    #[inline(always)]
+    fn push(&mut self, k: usize, queries: u32, sum: &mut [f64; PACKET], near: &mut impl NearLeaf) {
+        near.prefetch(k);
+        self.listed[self.len] = (k as u32, queries);
+        self.len += 1;
+        if self.len == self.listed.len() {
+            self.add(sum, near);
+        }
+    }
+
+    /// Sums the listed leaves, in order, for the queries listed with each, and empties the list.
+    #[inline(always)]
+    fn add(&mut self, sum: &mut [f64; PACKET], near: &mut impl NearLeaf) {
+        for &(k, queries) in &self.listed[..self.len] {
+            for (i, sum) in sum.iter_mut().enumerate() {
+                if queries & (1 << i) != 0 {
+                    near.add(i, k as usize, sum);
+                }
             }
         }
+        self.len = 0;
     }
 }
 
