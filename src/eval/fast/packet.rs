@@ -159,11 +159,11 @@ mod avx {
     use std::arch::x86_64::{
         __m256, __m256d, _CMP_GT_OQ, _CMP_LT_OQ, _mm256_add_pd, _mm256_add_ps, _mm256_and_ps,
         _mm256_and_si256, _mm256_castps256_ps128, _mm256_castsi256_ps, _mm256_cmp_ps,
-        _mm256_cmpeq_epi32, _mm256_cvtpd_ps, _mm256_cvtps_pd, _mm256_div_ps,
-        _mm256_extractf128_ps, _mm256_loadu_pd, _mm256_loadu_ps, _mm256_movemask_ps,
-        _mm256_mul_ps, _mm256_or_ps, _mm256_set_m128, _mm256_set1_epi32, _mm256_set1_pd,
-        _mm256_set1_ps, _mm256_setr_epi32, _mm256_setzero_pd, _mm256_setzero_ps,
-        _mm256_sqrt_ps, _mm256_storeu_pd, _mm256_storeu_ps, _mm256_sub_pd, _mm256_sub_ps,
+        _mm256_cmpeq_epi32, _mm256_cvtpd_ps, _mm256_cvtps_pd, _mm256_div_ps, _mm256_extractf128_ps,
+        _mm256_loadu_pd, _mm256_loadu_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_ps,
+        _mm256_set_m128, _mm256_set1_epi32, _mm256_set1_pd, _mm256_set1_ps, _mm256_setr_epi32,
+        _mm256_setzero_pd, _mm256_setzero_ps, _mm256_sqrt_ps, _mm256_storeu_pd, _mm256_storeu_ps,
+        _mm256_sub_pd, _mm256_sub_ps,
     };
 
     /// Proof that the CPU has AVX2 (and so AVX): made only by [`Avx2::detect`].
@@ -273,7 +273,8 @@ mod avx {
             // SAFETY: `self` proves AVX2.
             unsafe {
                 let bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
-                let set = _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(bits as i32), bit), bit);
+                let set =
+                    _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(bits as i32), bit), bit);
                 let w = _mm256_and_ps(self.0, _mm256_castsi256_ps(set));
                 let lo = _mm256_cvtps_pd(_mm256_castps256_ps128(w));
                 let hi = _mm256_cvtps_pd(_mm256_extractf128_ps::<1>(w));
