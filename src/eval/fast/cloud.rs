@@ -248,8 +248,13 @@ impl NearLeaf for NearPoints<'_> {
     #[inline(always)]
     fn prefetch(&self, leaf: usize) {
         let start = self.cloud.hierarchy.leaves[leaf].start;
-        prefetch(&self.cloud.positions[start]);
-        prefetch(&self.cloud.weighted_normals[start]);
+        if let (Some(p), Some(n)) = (
+            self.cloud.positions.get(start),
+            self.cloud.weighted_normals.get(start),
+        ) {
+            prefetch(p);
+            prefetch(n);
+        }
     }
 
     #[inline(always)]
