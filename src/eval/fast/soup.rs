@@ -18,6 +18,8 @@ use crate::kernel::spherical::INV_4PI;
 
 /// Largest number of triangles in a leaf (summed exactly when the leaf is near the query).
 pub const TRIANGLE_LEAF_SIZE: usize = 4;
+// A leaf is one `f64x4` per coordinate, and `used_lanes` one bit per lane in a `u8`.
+const _: () = assert!(TRIANGLE_LEAF_SIZE == 4);
 
 /// Barnes–Hut evaluator of the generalized winding number of a triangle mesh (connectivity is
 /// ignored: soups, open and non-manifold meshes are all fine). Owns a copy of the triangles, so it
@@ -111,7 +113,7 @@ impl FastWindingNumber {
         let used_lanes = hierarchy
             .leaves
             .iter()
-            .map(|range| ((1u32 << range.len().min(4)) - 1) as u8)
+            .map(|range| ((1u32 << range.len().min(TRIANGLE_LEAF_SIZE)) - 1) as u8)
             .collect();
         FastWindingNumber {
             hierarchy,
