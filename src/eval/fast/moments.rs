@@ -461,13 +461,36 @@ impl FarField<f32x4> {
     #[inline(always)]
     pub fn lane<T: Copy>(&self, l: usize, splat: impl Fn(f32) -> T) -> FarField<T> {
         let get = |v: &f32x4| splat(v.as_array_ref()[l]);
+        // Element by element, not `array::map`: this runs inside the packet walks' AVX2
+        // instantiations, and when the inliner left `map`'s closure out of line (which a change
+        // elsewhere in the crate could decide), the splats in it ran as calls compiled without
+        // AVX: the walk took 2.3× as long (docs/benchmarks.md, "Radix-sorted packets").
+        let (n, q, v, c) = (&self.n, &self.q, &self.v, &self.c);
         FarField {
             inv_s: get(&self.inv_s),
-            n: self.n.each_ref().map(get),
+            n: [get(&n[0]), get(&n[1]), get(&n[2])],
             tr: get(&self.tr),
-            q: self.q.each_ref().map(get),
-            v: self.v.each_ref().map(get),
-            c: self.c.each_ref().map(get),
+            q: [
+                get(&q[0]),
+                get(&q[1]),
+                get(&q[2]),
+                get(&q[3]),
+                get(&q[4]),
+                get(&q[5]),
+            ],
+            v: [get(&v[0]), get(&v[1]), get(&v[2])],
+            c: [
+                get(&c[0]),
+                get(&c[1]),
+                get(&c[2]),
+                get(&c[3]),
+                get(&c[4]),
+                get(&c[5]),
+                get(&c[6]),
+                get(&c[7]),
+                get(&c[8]),
+                get(&c[9]),
+            ],
         }
     }
 }

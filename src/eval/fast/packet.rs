@@ -22,6 +22,7 @@
 //! the sort or the number of threads (tested).
 
 use rayon::prelude::*;
+use rdst::RadixSort;
 use wide::{CmpGt, CmpLt, f32x8};
 
 /// Queries per packet.
@@ -375,6 +376,25 @@ const MORTON_BITS: u32 = 21;
 /// The point indices sorted by the Morton code of their position in the box of the finite
 /// points (non-finite points last), ties by index: deterministic.
 fn morton_order(points: &[[f64; 3]]) -> Vec<u32> {
+    let mut keys = morton_keys(points);
+    // A radix sort (rdst, which obvhs already brings): the comparison sort took a tenth of a
+    // batch of 32k queries on a 10k-face mesh (docs/benchmarks.md, "Radix-sorted packets").
+    // Rayon's tasks pay off only on large batches.
+    if keys.len() < PARALLEL_SORT {
+        keys.radix_sort_builder()
+            .with_parallel(false)
+            .with_single_threaded_tuner()
+            .sort();
+    } else {
+        keys.radix_sort_unstable();
+    }
+    keys.into_iter().map(|k| k as u32).collect()
+}
+
+/// Per point, its sort key: the top 32 bits of its Morton code (about 11 per axis: the packets
+/// need neighbours, not an exact order) above its index, so the keys are distinct and any
+/// sort of them gives one order.
+fn morton_keys(points: &[[f64; 3]]) -> Vec<u64> {
     assert!(
         points.len() <= u32::MAX as usize,
         "too many points for one batch"
@@ -408,7 +428,7 @@ fn morton_order(points: &[[f64; 3]]) -> Vec<u32> {
         let s = cells / (hi[k] - lo[k]);
         if s.is_finite() { s } else { 0.0 }
     });
-    let mut keys: Vec<(u64, u32)> = points
+    points
         .par_iter()
         .enumerate()
         .map(|(i, p)| {
@@ -421,17 +441,9 @@ fn morton_order(points: &[[f64; 3]]) -> Vec<u32> {
             } else {
                 u64::MAX
             };
-            (code, i as u32)
+            ((code >> (3 * MORTON_BITS - 32)) << 32) | i as u64
         })
-        .collect();
-    // Rayon's sort pays for its tasks below a few hundred thousand keys (a tenth of a batch of
-    // 32k queries on small meshes); the order is the same either way (the keys are distinct).
-    if keys.len() < PARALLEL_SORT {
-        keys.sort_unstable();
-    } else {
-        keys.par_sort_unstable();
-    }
-    keys.into_iter().map(|(_, i)| i).collect()
+        .collect()
 }
 
 /// The low 21 bits of `v`, two zero bits inserted after each.
@@ -501,5 +513,25 @@ mod tests {
             }
         }
         assert!(morton_order(&[]).is_empty());
+    }
+
+    #[test]
+    fn morton_order_is_the_order_of_the_keys_on_every_sort_path() {
+        // Below rdst's comparison-sort size, its one-thread radix path, and the parallel one;
+        // duplicated and non-finite points give equal codes, which the index separates.
+        let mut rng = crate::base::splitmix::SplitMix64(7);
+        for n in [100, 5_000, PARALLEL_SORT + 3] {
+            let points: Vec<[f64; 3]> = (0..n)
+                .map(|i| match i % 97 {
+                    0 => [f64::NAN, 0.0, 1.0],
+                    1 | 2 => [0.25, 0.5, 0.75],
+                    _ => [rng.unit(), rng.unit(), rng.unit() * 1e-3],
+                })
+                .collect();
+            let mut keys = morton_keys(&points);
+            keys.sort_unstable();
+            let want: Vec<u32> = keys.iter().map(|&k| k as u32).collect();
+            assert_eq!(morton_order(&points), want, "{n} points");
+        }
     }
 }
