@@ -584,15 +584,20 @@ impl Hierarchy {
                 continue;
             }
             let node = &self.wide[id];
-            let dq: [L; 3] = std::array::from_fn(|k| L::difference(token, node.anchor[k], &qk[k]));
+            // Element by element, not `array::from_fn`: a closure the inliner leaves out of
+            // line runs without AVX (see `FarField::lane`).
+            let dq: [L; 3] = [
+                L::difference(token, node.anchor[0], &qk[0]),
+                L::difference(token, node.anchor[1], &qk[1]),
+                L::difference(token, node.anchor[2], &qk[2]),
+            ];
             let size = self.wide_size[which][id].as_array_ref();
             for (l, &c) in node.child.iter().enumerate() {
                 if c == EMPTY {
                     break;
                 }
-                let r: [L; 3] = std::array::from_fn(|k| {
-                    L::splat(token, node.offset[k].as_array_ref()[l]) + dq[k]
-                });
+                let offset = |k: usize| L::splat(token, node.offset[k].as_array_ref()[l]);
+                let r: [L; 3] = [offset(0) + dq[0], offset(1) + dq[1], offset(2) + dq[2]];
                 let d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
                 let bs = beta * size[l];
                 let mut admitted = d2.admissible(bs);

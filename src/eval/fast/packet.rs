@@ -353,6 +353,7 @@ pub(crate) fn eval_in_packets(
     sorted
         .par_chunks_mut(PACKET)
         .zip(order.par_chunks(PACKET))
+        .with_max_len(PACKETS_PER_TASK)
         .for_each(|(out, ids)| {
             let packet: [[f64; 3]; PACKET] =
                 std::array::from_fn(|i| points[ids[i.min(ids.len() - 1)] as usize]);
@@ -366,6 +367,13 @@ pub(crate) fn eval_in_packets(
     }
     values
 }
+
+/// Most packets one rayon task evaluates. Rayon's adaptive split leaves a few long ranges that
+/// cannot be split once started: where the cost is concentrated in one part of the space (a
+/// grid around a thin part), one thread idled for a fifth of a 2-thread batch (2-thread
+/// scaling 1.6× on a grid, 1.9× on uniform points; docs/benchmarks.md, "Two threads").
+/// Sixteen packets are tens of microseconds of work or more, against ~1 µs per task.
+const PACKETS_PER_TASK: usize = 16;
 
 /// Fewest keys [`morton_order`] sorts in parallel.
 const PARALLEL_SORT: usize = 1 << 18;
