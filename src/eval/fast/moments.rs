@@ -499,31 +499,31 @@ impl<T: Lanes> FarField<T> {
     /// The same value as [`Moments::far_field`] at `q = p̃ − r` (per lane).
     #[inline(always)]
     pub fn eval(&self, r: [T; 3], order: u8) -> T {
-        let r = [r[0] * self.inv_s, r[1] * self.inv_s, r[2] * self.inv_s];
-        let d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-        let inv_d = d2.rsqrt();
+        let (x, y, z) = (r[0] * self.inv_s, r[1] * self.inv_s, r[2] * self.inv_s);
+        let (xx, yy, zz) = (x * x, y * y, z * z);
+        let inv_d = (xx + yy + zz).rsqrt();
         let inv_d2 = inv_d * inv_d;
         let inv_d3 = inv_d * inv_d2;
-        let mut w3 = self.n[0] * r[0] + self.n[1] * r[1] + self.n[2] * r[2];
+        let mut w3 = self.n[0] * x + self.n[1] * y + self.n[2] * z;
         if order == 0 {
             return w3 * inv_d3;
         }
-        let (x, y, z) = (r[0], r[1], r[2]);
-        let (xx, yy, zz) = (x * x, y * y, z * z);
+        // The products of two coordinates once, shared by the quadrupole and octupole terms,
+        // and the powers of 1/d by Horner: the far field is most of a walk on the meshes where
+        // it is cheap for libigl (docs/benchmarks.md, "Radix-sorted packets").
+        let (xy, xz, yz) = (x * y, x * z, y * z);
         let q = &self.q;
         w3 = w3 + self.tr;
-        let mut w5 = q[0] * xx + q[1] * yy + q[2] * zz + q[3] * x * y + q[4] * x * z + q[5] * y * z;
-        let inv_d5 = inv_d3 * inv_d2;
+        let mut w5 = q[0] * xx + q[1] * yy + q[2] * zz + q[3] * xy + q[4] * xz + q[5] * yz;
         if order == 1 {
-            return w3 * inv_d3 + w5 * inv_d5;
+            return (w3 + w5 * inv_d2) * inv_d3;
         }
         w5 = w5 + self.v[0] * x + self.v[1] * y + self.v[2] * z;
         let c = &self.c;
-        let w7 = x * (c[0] * xx + c[3] * x * y + c[4] * x * z + c[5] * yy + c[7] * zz)
-            + y * (c[1] * yy + c[6] * y * z + c[8] * zz)
-            + z * (c[2] * zz + c[9] * x * y);
-        let inv_d7 = inv_d5 * inv_d2;
-        w3 * inv_d3 + w5 * inv_d5 + w7 * inv_d7
+        let w7 = x * (c[0] * xx + c[3] * xy + c[4] * xz + c[5] * yy + c[7] * zz)
+            + y * (c[1] * yy + c[6] * yz + c[8] * zz)
+            + z * (c[2] * zz + c[9] * xy);
+        (w3 + (w5 + w7 * inv_d2) * inv_d2) * inv_d3
     }
 }
 
