@@ -592,23 +592,41 @@ impl Hierarchy {
                 L::difference(token, node.anchor[2], &qk[2]),
             ];
             let size = self.wide_size[which][id].as_array_ref();
+            let far_lanes = &self.wide_far[id];
+            let inv_s = far_lanes.inv_s().as_array_ref();
+            // Two passes over the lanes: the tests and every admitted lane's square root and
+            // division first, independent of each other, then the expansions and the sums in
+            // lane order (the order of the sums, so the bits, are those of one pass). In one
+            // pass each lane's expansion waited on its own division (docs/benchmarks.md,
+            // "Square roots first").
+            let zero = L::splat(token, 0.0);
+            let mut admitted = [0u32; 4];
+            let mut scaled = [([zero; 3], zero); 4];
+            let mut lanes = 0;
             for (l, &c) in node.child.iter().enumerate() {
                 if c == EMPTY {
                     break;
                 }
+                lanes = l + 1;
                 let offset = |k: usize| L::splat(token, node.offset[k].as_array_ref()[l]);
                 let r: [L; 3] = [offset(0) + dq[0], offset(1) + dq[1], offset(2) + dq[2]];
                 let d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
                 let bs = beta * size[l];
-                let mut admitted = d2.admissible(bs);
-                admitted &= mask;
-                if admitted != 0 {
-                    let w = self.wide_far[id]
-                        .lane(l, |v| L::splat(token, v))
-                        .eval(r, order);
-                    far = w.add_where(far, admitted);
+                admitted[l] = d2.admissible(bs) & mask;
+                if admitted[l] != 0 {
+                    scaled[l] = FarField::scale(r, L::splat(token, inv_s[l]));
                 }
-                let rest = mask & !admitted;
+            }
+            for l in 0..lanes {
+                let c = node.child[l];
+                if admitted[l] != 0 {
+                    let (s, inv_d) = scaled[l];
+                    let w = far_lanes
+                        .lane(l, |v| L::splat(token, v))
+                        .eval_scaled(s, inv_d, order);
+                    far = w.add_where(far, admitted[l]);
+                }
+                let rest = mask & !admitted[l];
                 if rest == 0 {
                     continue;
                 }

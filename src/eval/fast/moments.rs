@@ -457,6 +457,12 @@ impl FarField<f32x4> {
         }
     }
 
+    /// `1/s` of each lane.
+    #[inline(always)]
+    pub fn inv_s(&self) -> &f32x4 {
+        &self.inv_s
+    }
+
     /// Lane `l` of the record, the same coefficients in every lane of `T`.
     #[inline(always)]
     pub fn lane<T: Copy>(&self, l: usize, splat: impl Fn(f32) -> T) -> FarField<T> {
@@ -499,9 +505,25 @@ impl<T: Lanes> FarField<T> {
     /// The same value as [`Moments::far_field`] at `q = p̃ − r` (per lane).
     #[inline(always)]
     pub fn eval(&self, r: [T; 3], order: u8) -> T {
-        let (x, y, z) = (r[0] * self.inv_s, r[1] * self.inv_s, r[2] * self.inv_s);
+        let (scaled, inv_d) = Self::scale(r, self.inv_s);
+        self.eval_scaled(scaled, inv_d, order)
+    }
+
+    /// The first half of [`FarField::eval`]: `r/s` and `s/|r|`, given `1/s`. Apart from the
+    /// polynomial so that the packet walk can start every lane's square root and division
+    /// before it needs the first: the walk was waiting on them (docs/benchmarks.md, "Square
+    /// roots first").
+    #[inline(always)]
+    pub fn scale(r: [T; 3], inv_s: T) -> ([T; 3], T) {
+        let (x, y, z) = (r[0] * inv_s, r[1] * inv_s, r[2] * inv_s);
+        let inv_d = (x * x + y * y + z * z).rsqrt();
+        ([x, y, z], inv_d)
+    }
+
+    /// The second half of [`FarField::eval`], from [`FarField::scale`]'s values.
+    #[inline(always)]
+    pub fn eval_scaled(&self, [x, y, z]: [T; 3], inv_d: T, order: u8) -> T {
         let (xx, yy, zz) = (x * x, y * y, z * z);
-        let inv_d = (xx + yy + zz).rsqrt();
         let inv_d2 = inv_d * inv_d;
         let inv_d3 = inv_d * inv_d2;
         let mut w3 = self.n[0] * x + self.n[1] * y + self.n[2] * z;
