@@ -494,6 +494,12 @@ impl Hierarchy {
         }
     }
 
+    /// Whether a batch gains from Morton-ordered packets: not with a single query-tree node,
+    /// which every query visits and nothing else ([`super::packet::eval_in_packets`]).
+    pub fn packets_need_order(&self) -> bool {
+        self.wide.len() > 1
+    }
+
     /// [`Hierarchy::eval`] for a packet of neighbouring queries (bit `i` of `active` set for
     /// the queries to evaluate), walking the tree once for all of them: per node and lane, the
     /// admissibility of every query at once, and the lane's expansion evaluated for every query

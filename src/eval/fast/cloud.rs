@@ -214,11 +214,15 @@ impl PointCloudWindingNumber {
     /// bit for bit, and faster, as neighbouring points walk the tree together in packets of
     /// eight (see `docs/fast.md`).
     pub fn eval_batch_with(&self, points: &[[f64; 3]], params: FastParams) -> Vec<f64> {
-        eval_in_packets(points, |packet, active| {
-            let q = packet.map(|x| self.scale.query(x));
-            let near = NearPoints { cloud: self, q: &q };
-            self.hierarchy.eval_packet(&q, active, &params, near)
-        })
+        eval_in_packets(
+            points,
+            self.hierarchy.packets_need_order(),
+            |packet, active| {
+                let q = packet.map(|x| self.scale.query(x));
+                let near = NearPoints { cloud: self, q: &q };
+                self.hierarchy.eval_packet(&q, active, &params, near)
+            },
+        )
     }
 
     /// Number of tree nodes (node 0 is the root).

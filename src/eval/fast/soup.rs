@@ -241,43 +241,47 @@ impl FastWindingNumber {
     /// [`Self::eval_batch_with`], on the portable instantiation of the packet walk when
     /// `portable` (the test of the run-time dispatch).
     fn eval_in_packets(&self, points: &[[f64; 3]], params: FastParams, portable: bool) -> Vec<f64> {
-        eval_in_packets(points, |packet, active| {
-            let q = packet.map(|p| self.scale.query(p));
-            let mut angles: [AngleSum; PACKET] = std::array::from_fn(|_| AngleSum::new());
-            let simd = if portable {
-                Simd::PORTABLE
-            } else {
-                Simd::detect()
-            };
-            let mut touched = 0u32;
-            let leaf = NearTriangles {
-                fast: self,
-                simd,
-                angles: &mut angles,
-                q: &q,
-                touched: &mut touched,
-            };
-            let far_and_rare = if portable {
-                self.hierarchy.eval_packet_lanes::<super::packet::Lanes8>(
-                    (),
-                    &q,
-                    active,
-                    &params,
-                    leaf,
-                )
-            } else {
-                self.hierarchy.eval_packet(&q, active, &params, leaf)
-            };
-            // A query that met no near leaf has an empty angle sum, whose total is +0.0: adding
-            // it changes nothing (`far_and_rare` is never −0.0), so its `atan2` is skipped.
-            std::array::from_fn(|i| {
-                if touched & (1 << i) != 0 {
-                    far_and_rare[i] + angles[i].total() * (2.0 * INV_4PI)
+        eval_in_packets(
+            points,
+            self.hierarchy.packets_need_order(),
+            |packet, active| {
+                let q = packet.map(|p| self.scale.query(p));
+                let mut angles: [AngleSum; PACKET] = std::array::from_fn(|_| AngleSum::new());
+                let simd = if portable {
+                    Simd::PORTABLE
                 } else {
-                    far_and_rare[i]
-                }
-            })
-        })
+                    Simd::detect()
+                };
+                let mut touched = 0u32;
+                let leaf = NearTriangles {
+                    fast: self,
+                    simd,
+                    angles: &mut angles,
+                    q: &q,
+                    touched: &mut touched,
+                };
+                let far_and_rare = if portable {
+                    self.hierarchy.eval_packet_lanes::<super::packet::Lanes8>(
+                        (),
+                        &q,
+                        active,
+                        &params,
+                        leaf,
+                    )
+                } else {
+                    self.hierarchy.eval_packet(&q, active, &params, leaf)
+                };
+                // A query that met no near leaf has an empty angle sum, whose total is +0.0: adding
+                // it changes nothing (`far_and_rare` is never −0.0), so its `atan2` is skipped.
+                std::array::from_fn(|i| {
+                    if touched & (1 << i) != 0 {
+                        far_and_rare[i] + angles[i].total() * (2.0 * INV_4PI)
+                    } else {
+                        far_and_rare[i]
+                    }
+                })
+            },
+        )
     }
 
     /// A world point in the coordinates of [`Self::node_box`] and [`Self::node_moments`]: the
