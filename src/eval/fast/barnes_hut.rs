@@ -602,9 +602,9 @@ impl Hierarchy {
             let inv_s = far_lanes.inv_s().as_array_ref();
             // Two passes over the lanes: the tests and every admitted lane's square root and
             // division first, independent of each other, then the expansions and the sums in
-            // lane order (the order of the sums, so the bits, are those of one pass). In one
-            // pass each lane's expansion waited on its own division (docs/benchmarks.md,
-            // "Square roots first").
+            // lane order (the order of the sums, and so the bits, is that of one pass). In one
+            // pass each lane's expansion waited on its own division (docs/benchmarks.md, "Far
+            // field by Horner, square roots first").
             let zero = L::splat(token, 0.0);
             let mut admitted = [0u32; 4];
             let mut scaled = [([zero; 3], zero); 4];

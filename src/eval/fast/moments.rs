@@ -511,8 +511,8 @@ impl<T: Lanes> FarField<T> {
 
     /// The first half of [`FarField::eval`]: `r/s` and `s/|r|`, given `1/s`. Apart from the
     /// polynomial so that the packet walk can start every lane's square root and division
-    /// before it needs the first: the walk was waiting on them (docs/benchmarks.md, "Square
-    /// roots first").
+    /// before it needs the first: the walk was waiting on them (docs/benchmarks.md, "Far field
+    /// by Horner, square roots first").
     #[inline(always)]
     pub fn scale(r: [T; 3], inv_s: T) -> ([T; 3], T) {
         let (x, y, z) = (r[0] * inv_s, r[1] * inv_s, r[2] * inv_s);
@@ -532,7 +532,7 @@ impl<T: Lanes> FarField<T> {
         }
         // The products of two coordinates once, shared by the quadrupole and octupole terms,
         // and the powers of 1/d by Horner: the far field is most of a walk on the meshes where
-        // it is cheap for libigl (docs/benchmarks.md, "Radix-sorted packets").
+        // it is cheap for libigl (docs/benchmarks.md, "Far field by Horner").
         let (xy, xz, yz) = (x * y, x * z, y * z);
         let q = &self.q;
         w3 = w3 + self.tr;
