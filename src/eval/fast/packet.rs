@@ -389,11 +389,36 @@ const PACKETS_PER_TASK: usize = 16;
 /// Fewest keys [`morton_order`] sorts in parallel.
 const PARALLEL_SORT: usize = 1 << 18;
 
-/// Bits per axis of the Morton code (three axes in a `u64`).
-const MORTON_BITS: u32 = 21;
+/// Points per rayon task of [`morton_keys`]: a few microseconds of work.
+const KEYS_PER_TASK: usize = 4096;
+
+/// Bits per axis of the Morton code: 33 in all, of which the key keeps the top 32.
+const MORTON_BITS: u32 = 11;
+
+/// A point's place in the packets' order: the top 32 bits of its Morton code (11 bits per
+/// axis: the packets need neighbours, not an exact order), which is all the sort looks at, and
+/// its index.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct MortonKey {
+    code: u32,
+    index: u32,
+}
+
+impl rdst::RadixKey for MortonKey {
+    // Four byte passes, not the eight a `u64` of code and index needed: ties may come out in
+    // any order, which changes no value (a query's value does not depend on its packet; see
+    // the module's comment), and the sort took half of the keys-and-sort time that did not
+    // scale with threads (docs/benchmarks.md, "Two threads on armadillo").
+    const LEVELS: usize = 4;
+
+    #[inline]
+    fn get_level(&self, level: usize) -> u8 {
+        (self.code >> (8 * level)) as u8
+    }
+}
 
 /// The point indices sorted by the Morton code of their position in the box of the finite
-/// points (non-finite points last), ties by index: deterministic.
+/// points (non-finite points last).
 fn morton_order(points: &[[f64; 3]]) -> Vec<u32> {
     let mut keys = morton_keys(points);
     // A radix sort (rdst, which obvhs already brings): the comparison sort took a tenth of a
@@ -407,39 +432,24 @@ fn morton_order(points: &[[f64; 3]]) -> Vec<u32> {
     } else {
         keys.radix_sort_unstable();
     }
-    keys.into_iter().map(|k| k as u32).collect()
+    keys.into_iter().map(|k| k.index).collect()
 }
 
-/// Per point, its sort key: the top 32 bits of its Morton code (about 11 per axis: the packets
-/// need neighbours, not an exact order) above its index, so the keys are distinct and any
-/// sort of them gives one order.
-fn morton_keys(points: &[[f64; 3]]) -> Vec<u64> {
+/// Per point, its [`MortonKey`].
+fn morton_keys(points: &[[f64; 3]]) -> Vec<MortonKey> {
     assert!(
         points.len() <= u32::MAX as usize,
         "too many points for one batch"
     );
-    let finite = |p: &[f64; 3]| p.iter().all(|c| c.is_finite());
-    let (lo, hi) = points
-        .par_iter()
-        .filter(|p| finite(p))
-        .fold(
-            || ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
-            |(lo, hi), p| {
-                (
-                    std::array::from_fn(|k| lo[k].min(p[k])),
-                    std::array::from_fn(|k| hi[k].max(p[k])),
-                )
-            },
-        )
-        .reduce(
-            || ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
-            |(a, b), (c, d)| {
-                (
-                    std::array::from_fn(|k| a[k].min(c[k])),
-                    std::array::from_fn(|k| b[k].max(d[k])),
-                )
-            },
-        );
+    let (lo, hi) = points.par_chunks(KEYS_PER_TASK).map(finite_bounds).reduce(
+        empty_bounds,
+        |(a, b), (c, d)| {
+            (
+                [a[0].min(c[0]), a[1].min(c[1]), a[2].min(c[2])],
+                [b[0].max(d[0]), b[1].max(d[1]), b[2].max(d[2])],
+            )
+        },
+    );
     let cells = f64::from(1u32 << MORTON_BITS);
     // Per axis: cells per unit length (0 for a flat or empty axis; the extent may overflow to
     // +∞ for points near ±f64::MAX, which gives 0 too, and only a worse order).
@@ -447,35 +457,72 @@ fn morton_keys(points: &[[f64; 3]]) -> Vec<u64> {
         let s = cells / (hi[k] - lo[k]);
         if s.is_finite() { s } else { 0.0 }
     });
-    points
-        .par_iter()
+    let mut keys = vec![MortonKey::default(); points.len()];
+    keys.par_chunks_mut(KEYS_PER_TASK)
+        .zip(points.par_chunks(KEYS_PER_TASK))
         .enumerate()
-        .map(|(i, p)| {
-            let code = if finite(p) {
-                let cell = |k: usize| {
-                    // `as` saturates, and NaN (0 · ∞ cannot occur: the scale is finite) maps to 0.
-                    (((p[k] - lo[k]) * scale[k]) as u64).min((1 << MORTON_BITS) - 1)
+        .for_each(|(task, (keys, points))| {
+            // Written as a loop over plain values with the bits spread by a table: the earlier
+            // `par_iter().map().collect()` with array closures and shifted masks over 21 bits
+            // per axis took 13 ns per point.
+            let first = task * KEYS_PER_TASK;
+            for (i, (key, p)) in keys.iter_mut().zip(points).enumerate() {
+                let code = if is_finite(p) {
+                    // `as` saturates, and NaN (0 · ∞ cannot occur: the scale is finite) maps
+                    // to 0.
+                    let cell = |k: usize| {
+                        let cell = ((p[k] - lo[k]) * scale[k]) as usize;
+                        SPREAD[cell.min(SPREAD.len() - 1)]
+                    };
+                    cell(0) | (cell(1) << 1) | (cell(2) << 2)
+                } else {
+                    u64::MAX
                 };
-                spread(cell(0)) | (spread(cell(1)) << 1) | (spread(cell(2)) << 2)
-            } else {
-                u64::MAX
-            };
-            ((code >> (3 * MORTON_BITS - 32)) << 32) | i as u64
-        })
-        .collect()
+                *key = MortonKey {
+                    code: (code >> (3 * MORTON_BITS - 32)) as u32,
+                    index: (first + i) as u32,
+                };
+            }
+        });
+    keys
 }
 
-/// The low 21 bits of `v`, two zero bits inserted after each.
-#[inline]
-fn spread(v: u64) -> u64 {
-    let mut x = v & 0x1f_ffff;
-    x = (x | (x << 32)) & 0x1f00000000ffff;
-    x = (x | (x << 16)) & 0x1f0000ff0000ff;
-    x = (x | (x << 8)) & 0x100f00f00f00f00f;
-    x = (x | (x << 4)) & 0x10c30c30c30c30c3;
-    x = (x | (x << 2)) & 0x1249249249249249;
-    x
+/// The bounds of nothing: the identity of the bounds' union.
+fn empty_bounds() -> ([f64; 3], [f64; 3]) {
+    ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3])
 }
+
+fn is_finite(p: &[f64; 3]) -> bool {
+    p[0].is_finite() && p[1].is_finite() && p[2].is_finite()
+}
+
+/// The bounding box of the finite points of `points` ([`empty_bounds`] if none).
+fn finite_bounds(points: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
+    let (mut lo, mut hi) = empty_bounds();
+    for p in points.iter().filter(|p| is_finite(p)) {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    (lo, hi)
+}
+
+/// Per cell coordinate `v` below 2^[`MORTON_BITS`], the bits of `v` with two zero bits
+/// inserted after each: one axis's share of the Morton code.
+static SPREAD: [u64; 1 << MORTON_BITS] = {
+    let mut table = [0; 1 << MORTON_BITS];
+    let mut v = 0;
+    while v < table.len() {
+        let mut bit = 0;
+        while bit < MORTON_BITS {
+            table[v] |= ((v as u64 >> bit) & 1) << (3 * bit);
+            bit += 1;
+        }
+        v += 1;
+    }
+    table
+};
 
 #[cfg(test)]
 mod tests {
@@ -483,10 +530,10 @@ mod tests {
 
     #[test]
     fn spread_interleaves_bits() {
-        for v in [0u64, 1, 2, 3, 0x1f_ffff, 0b1011] {
-            let s = spread(v);
+        for v in [0usize, 1, 2, 3, 0x7ff, 0b1011, 0x555] {
+            let s = SPREAD[v];
             for b in 0..MORTON_BITS {
-                assert_eq!((s >> (3 * b)) & 1, (v >> b) & 1, "v {v:#x} bit {b}");
+                assert_eq!((s >> (3 * b)) & 1, (v as u64 >> b) & 1, "v {v:#x} bit {b}");
             }
             assert_eq!(s & !0x1249249249249249, 0);
         }
@@ -537,9 +584,10 @@ mod tests {
     }
 
     #[test]
-    fn morton_order_is_the_order_of_the_keys_on_every_sort_path() {
+    fn morton_order_is_the_order_of_the_codes_on_every_sort_path() {
         // Below rdst's comparison-sort size, its one-thread radix path, and the parallel one;
-        // duplicated and non-finite points give equal codes, which the index separates.
+        // duplicated and non-finite points give equal codes, whose indices may come in any
+        // order.
         let mut rng = crate::base::splitmix::SplitMix64(7);
         for n in [100, 5_000, PARALLEL_SORT + 3] {
             let points: Vec<[f64; 3]> = (0..n)
@@ -549,10 +597,20 @@ mod tests {
                     _ => [rng.unit(), rng.unit(), rng.unit() * 1e-3],
                 })
                 .collect();
-            let mut keys = morton_keys(&points);
-            keys.sort_unstable();
-            let want: Vec<u32> = keys.iter().map(|&k| k as u32).collect();
-            assert_eq!(morton_order(&points), want, "{n} points");
+            let keys = morton_keys(&points);
+            assert!(keys.iter().enumerate().all(|(i, k)| k.index as usize == i));
+            let order = morton_order(&points);
+            let mut seen = vec![false; n];
+            for &i in &order {
+                assert!(
+                    !std::mem::replace(&mut seen[i as usize], true),
+                    "{n}: {i} twice"
+                );
+            }
+            assert!(seen.iter().all(|&s| s), "{n}: a point missing");
+            let codes: Vec<u32> = order.iter().map(|&i| keys[i as usize].code).collect();
+            assert!(codes.is_sorted(), "{n} points: codes out of order");
+            assert_eq!(codes.last(), Some(&u32::MAX), "{n}: non-finite points last");
         }
     }
 }
