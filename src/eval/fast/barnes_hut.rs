@@ -215,8 +215,19 @@ impl Hierarchy {
             return;
         }
         let mut leaf_of = vec![u32::MAX; nodes.len()];
-        let mut leaves: Vec<usize> = (0..nodes.len()).filter(|&i| nodes[i].is_leaf()).collect();
-        leaves.sort_by_key(|&i| nodes[i].start);
+        // The leaves in element order: a depth-first walk, left child first (children split
+        // their parent's range in order), in place of a sort by start.
+        let mut leaves: Vec<usize> = Vec::with_capacity(nodes.len() / 2 + 1);
+        let mut stack = vec![0usize];
+        while let Some(i) = stack.pop() {
+            let left = nodes[i].left as usize;
+            if nodes[i].is_leaf() {
+                leaves.push(i);
+            } else {
+                stack.extend([left + 1, left]);
+            }
+        }
+        debug_assert!(leaves.is_sorted_by_key(|&i| nodes[i].start));
         assert!(
             leaves.len() < LEAF as usize,
             "too many leaves for the query tree"
@@ -276,74 +287,70 @@ impl Hierarchy {
             child[parent][lane] = id;
         }
         let anchor = |a: Option<usize>| a.map_or(m[0].center, |b| m[b].center);
-        let corner = |b: usize| {
+        // Every admissibility size of binary node `b`, in `Admissibility` order.
+        let sizes_of = |b: usize| -> [f64; 4] {
             let (n, c) = (&nodes[b], m[b].center);
-            (0..3)
-                .map(|k| (c[k] - n.min[k]).max(n.max[k] - c[k]).powi(2))
-                .sum::<f64>()
-                .sqrt()
+            let (mut corner2, mut diag2) = (0.0, 0.0);
+            for ((&c, &lo), &hi) in c.iter().zip(&n.min).zip(&n.max) {
+                corner2 += (c - lo).max(hi - c).powi(2);
+                diag2 += (hi - lo).powi(2);
+            }
+            let (radius, corner) = (m[b].radius, corner2.sqrt());
+            [
+                radius,
+                diag2.sqrt(),
+                corner,
+                radius.min(BOX_CORNER_SCALE * corner),
+            ]
         };
-        let diag = |b: usize| {
-            let n = &nodes[b];
-            (0..3)
-                .map(|k| (n.max[k] - n.min[k]).powi(2))
-                .sum::<f64>()
-                .sqrt()
-        };
-        let radius = |b: usize| m[b].radius;
-        // One `f32` per lane (NaN in unused lanes: never admissible).
-        let lanes_of = |lanes: &[usize], f: &(dyn Fn(usize) -> f64 + Sync)| {
-            f32x4::from(std::array::from_fn::<f32, WIDTH, _>(|l| {
-                lanes.get(l).map_or(f32::NAN, |&b| f(b) as f32)
-            }))
-        };
-        let sizes = |f: &(dyn Fn(usize) -> f64 + Sync)| -> Vec<f32x4> {
-            shape
-                .par_iter()
-                .map(|(_, lanes)| lanes_of(lanes.get(), f))
-                .collect()
-        };
-        let radius_or_corner = |b: usize| radius(b).min(BOX_CORNER_SCALE * corner(b));
-        self.wide_size = [
-            sizes(&radius),
-            sizes(&diag),
-            sizes(&corner),
-            sizes(&radius_or_corner),
-        ];
         debug_assert_eq!(Admissibility::Radius as usize, 0);
         debug_assert_eq!(Admissibility::BoxDiagonal as usize, 1);
         debug_assert_eq!(Admissibility::BoxCorner as usize, 2);
         debug_assert_eq!(Admissibility::RadiusOrBoxCorner as usize, 3);
-        self.wide_far = shape
+        // All of a query-tree node's data in one pass: each lane's 280-byte moments and its box
+        // are read once (in a pass per size and per record this step took 186 ms at 0.8M
+        // triangles, the four size passes 52 of them; in one, ~137: docs/benchmarks.md, "The
+        // tree build at 0.8M triangles"). Unused lanes: NaN sizes (never admissible) and
+        // offsets, zero far fields.
+        let (sizes, (far, wide)): (Vec<_>, (Vec<_>, Vec<_>)) = shape
             .par_iter()
-            .map(|(_, lanes)| {
-                let far: [FarField; WIDTH] = std::array::from_fn(|l| {
-                    lanes
-                        .get()
-                        .get(l)
-                        .map_or_else(FarField::default, |&b| FarField::new(&m[b]))
-                });
+            .zip(&child)
+            .map(|((a, lanes), &child)| {
+                let lanes = lanes.get();
+                let mut sizes = [[f32::NAN; WIDTH]; 4];
+                let mut far = [FarField::default(); WIDTH];
+                let mut offset = [[f32::NAN; WIDTH]; 3];
+                let anchor = anchor(*a);
+                for (l, &b) in lanes.iter().enumerate() {
+                    for (rule, size) in sizes_of(b).into_iter().enumerate() {
+                        sizes[rule][l] = size as f32;
+                    }
+                    far[l] = FarField::new(&m[b]);
+                    for k in 0..3 {
+                        offset[k][l] = (m[b].center[k] - anchor[k]) as f32;
+                    }
+                }
                 let refs: [&FarField; WIDTH] = std::array::from_fn(|l| &far[l]);
-                FarField::lanes(&refs[..lanes.len])
+                (
+                    sizes.map(f32x4::from),
+                    (
+                        FarField::lanes(&refs[..lanes.len()]),
+                        WideNode {
+                            anchor,
+                            offset: offset.map(f32x4::from),
+                            child,
+                        },
+                    ),
+                )
             })
-            .collect();
+            .unzip();
+        self.wide_size = std::array::from_fn(|rule| sizes.iter().map(|s| s[rule]).collect());
+        self.wide_far = far;
+        self.wide = wide;
         self.wide_binary = shape
             .iter()
             .map(|(_, lanes)| {
                 std::array::from_fn(|l| lanes.get().get(l).map_or(EMPTY, |&b| b as u32))
-            })
-            .collect();
-        self.wide = shape
-            .par_iter()
-            .zip(&child)
-            .map(|((a, lanes), &child)| {
-                let anchor = anchor(*a);
-                WideNode {
-                    anchor,
-                    offset: [0, 1, 2]
-                        .map(|k| lanes_of(lanes.get(), &|b| m[b].center[k] - anchor[k])),
-                    child,
-                }
             })
             .collect();
     }

@@ -367,6 +367,44 @@ impl Lanes for Lanes8 {
     }
 }
 
+/// The slot in [`FarField`]'s cubic coefficients `c` of the term `xᵢ xⱼ x_k`: the slot of the
+/// sorted triple, in the order `xxx, yyy, zzz, xxy, xxz, xyy, yyz, xzz, yzz, xyz`. A table
+/// because [`FarField::new`] looked it up by sorting the triple 27 times per node, a tenth of
+/// a 0.8M-triangle build (docs/benchmarks.md, "The tree build at 0.8M triangles").
+const CUBIC_INDEX: [[[usize; 3]; 3]; 3] = {
+    let mut table = [[[0; 3]; 3]; 3];
+    let mut i = 0;
+    while i < 3 {
+        let mut j = 0;
+        while j < 3 {
+            let mut k = 0;
+            while k < 3 {
+                // The counts of 0s, 1s and 2s name the monomial.
+                let mut count = [0; 3];
+                count[i] += 1;
+                count[j] += 1;
+                count[k] += 1;
+                table[i][j][k] = match count {
+                    [3, 0, 0] => 0,
+                    [0, 3, 0] => 1,
+                    [0, 0, 3] => 2,
+                    [2, 1, 0] => 3,
+                    [2, 0, 1] => 4,
+                    [1, 2, 0] => 5,
+                    [0, 2, 1] => 6,
+                    [1, 0, 2] => 7,
+                    [0, 1, 2] => 8,
+                    _ => 9,
+                };
+                k += 1;
+            }
+            j += 1;
+        }
+        i += 1;
+    }
+    table
+};
+
 impl FarField {
     pub fn new(m: &Moments) -> Self {
         let s = INV_4PI;
@@ -397,20 +435,7 @@ impl FarField {
         for i in 0..3 {
             for j in 0..3 {
                 for k in 0..3 {
-                    let mut t = [i, j, k];
-                    t.sort_unstable();
-                    let idx = match t {
-                        [0, 0, 0] => 0,
-                        [1, 1, 1] => 1,
-                        [2, 2, 2] => 2,
-                        [0, 0, 1] => 3,
-                        [0, 0, 2] => 4,
-                        [0, 1, 1] => 5,
-                        [1, 1, 2] => 6,
-                        [0, 2, 2] => 7,
-                        [1, 2, 2] => 8,
-                        _ => 9,
-                    };
+                    let idx = CUBIC_INDEX[i][j][k];
                     c[idx] += row(i, j)[k];
                 }
             }

@@ -79,11 +79,21 @@ pub(crate) fn inner_nodes(count: usize, leaf_size: usize) -> usize {
     pair(count, leaf_size.max(1)).0
 }
 
-/// What a subtree build reads: the elements' centroids and boxes, and the leaf size.
+/// What a subtree build reads: the elements' boxes and the leaf size.
 struct Split<'a> {
-    centroids: &'a [[f64; 3]],
     boxes: &'a [([f64; 3], [f64; 3])],
     leaf_size: usize,
+}
+
+/// An element as the splits move it: its centroid travels with its id, so that the median
+/// selections read memory in order. With ids alone each comparison read the centroid array at
+/// random, a cache miss on large inputs: the tree was a third of a 0.8M-triangle build
+/// (docs/benchmarks.md, "The tree build at 0.8M triangles"). The comparisons, and so the
+/// permutation, are the same.
+#[derive(Clone, Copy)]
+struct Element {
+    centroid: [f64; 3],
+    id: u32,
 }
 
 impl Split<'_> {
@@ -97,7 +107,7 @@ impl Split<'_> {
     /// left child first. So the tree is the same bit for bit at any thread count.
     fn subtree(
         &self,
-        order: &mut [u32],
+        order: &mut [Element],
         start: usize,
         below: &mut [Node],
         first: usize,
@@ -106,8 +116,8 @@ impl Split<'_> {
         if count <= self.leaf_size {
             debug_assert!(below.is_empty());
             let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-            for &e in order.iter() {
-                let (bmin, bmax) = self.boxes[e as usize];
+            for e in order.iter() {
+                let (bmin, bmax) = self.boxes[e.id as usize];
                 for k in 0..3 {
                     lo[k] = lo[k].min(bmin[k]);
                     hi[k] = hi[k].max(bmax[k]);
@@ -116,12 +126,9 @@ impl Split<'_> {
             return (lo, hi);
         }
         // The centroids' box picks the split; the element boxes are merged bottom-up below.
-        let axis = split_axis(self.centroids, order);
+        let axis = split_axis(order);
         let half = count / 2;
-        let centroids = self.centroids;
-        order.select_nth_unstable_by(half, |&a, &b| {
-            centroids[a as usize][axis].total_cmp(&centroids[b as usize][axis])
-        });
+        order.select_nth_unstable_by(half, |a, b| a.centroid[axis].total_cmp(&b.centroid[axis]));
         let (left_order, right_order) = order.split_at_mut(half);
         let left_inner = inner_nodes(half, self.leaf_size);
         let right_inner = inner_nodes(count - half, self.leaf_size);
@@ -177,7 +184,14 @@ impl Tree {
             return Tree::default();
         }
         let leaf_size = leaf_size.max(1);
-        let mut order: Vec<u32> = (0..n as u32).collect();
+        let mut order: Vec<Element> = centroids
+            .iter()
+            .enumerate()
+            .map(|(id, &centroid)| Element {
+                centroid,
+                id: id as u32,
+            })
+            .collect();
         let inner = inner_nodes(n, leaf_size);
         let empty = Node {
             start: 0,
@@ -187,11 +201,7 @@ impl Tree {
             max: [0.0; 3],
         };
         let mut nodes = vec![empty; 1 + 2 * inner];
-        let split = Split {
-            centroids,
-            boxes,
-            leaf_size,
-        };
+        let split = Split { boxes, leaf_size };
         let (min, max) = split.subtree(&mut order, 0, &mut nodes[1..], 1);
         nodes[0] = Node {
             start: 0,
@@ -200,6 +210,7 @@ impl Tree {
             min,
             max,
         };
+        let order = order.into_iter().map(|e| e.id).collect();
         Tree { nodes, order }
     }
 
@@ -222,13 +233,12 @@ pub(crate) fn box_dist2(q: [f64; 3], min: [f64; 3], max: [f64; 3]) -> f64 {
 }
 
 /// The longest axis of the box of the centroids of `elems` (ties: the lower axis).
-fn split_axis(centroids: &[[f64; 3]], elems: &[u32]) -> usize {
+fn split_axis(elems: &[Element]) -> usize {
     let (mut clo, mut chi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for &e in elems {
-        let c = centroids[e as usize];
+    for e in elems {
         for k in 0..3 {
-            clo[k] = clo[k].min(c[k]);
-            chi[k] = chi[k].max(c[k]);
+            clo[k] = clo[k].min(e.centroid[k]);
+            chi[k] = chi[k].max(e.centroid[k]);
         }
     }
     let ext = [0, 1, 2].map(|k| chi[k] - clo[k]);
@@ -271,7 +281,15 @@ mod tests {
             if count <= leaf_size {
                 continue;
             }
-            let axis = split_axis(centroids, slice);
+            // The longest axis of the centroids' box, ties to the lower axis (as the build).
+            let elems: Vec<Element> = slice
+                .iter()
+                .map(|&e| Element {
+                    centroid: centroids[e as usize],
+                    id: e,
+                })
+                .collect();
+            let axis = split_axis(&elems);
             let half = count / 2;
             slice.select_nth_unstable_by(half, |&a, &b| {
                 centroids[a as usize][axis].total_cmp(&centroids[b as usize][axis])
