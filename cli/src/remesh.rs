@@ -188,12 +188,16 @@ pub fn run(args: Args) -> Result<(), CliError> {
     };
     bar.inc(1);
     bar.set_message("occupancy agreement");
-    // The agreement compares against the written surface's own exact winding number.
-    let agreement = if args.samples > 0 && !mesh.is_empty() {
+    // The agreement compares against the written surface's own exact winding number; an empty
+    // output's is 0 everywhere, and its agreement says whether empty was right (an open sheet:
+    // 100 %) or a solid was lost.
+    let agreement = if args.samples == 0 {
+        None
+    } else if mesh.is_empty() {
+        occupancy_agreement(wn, &NoSurface, bounds, args.samples, 0x9e57)
+    } else {
         let output = gwn::eval::antipodal::WindingNumber::new(&mesh)?;
         occupancy_agreement(wn, &output, bounds, args.samples, 0x9e57)
-    } else {
-        None
     };
     bar.finish_and_clear();
     let s = out.stats;
@@ -333,5 +337,14 @@ fn grown(bounds: gwn::BoundingBox, d: f64) -> gwn::BoundingBox {
     gwn::BoundingBox {
         min: bounds.min.map(|x| x - d),
         max: bounds.max.map(|x| x + d),
+    }
+}
+
+/// The winding number of an empty surface: 0 everywhere.
+struct NoSurface;
+
+impl gwn::eval::Evaluator for NoSurface {
+    fn eval(&self, _: [f64; 3]) -> f64 {
+        0.0
     }
 }

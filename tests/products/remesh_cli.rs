@@ -175,6 +175,15 @@ fn remesh_thickens_an_open_sheet_on_request() {
         a.iter().map(|s| s.to_string()).collect::<Vec<_>>()
     };
     let call = |a: Vec<String>| gwn(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    // Without --thicken the sheet has no volume (|w| < ½ everywhere off it): the output is
+    // empty, and the report says that empty agrees with the input at every sample.
+    let mut plain = args(&["--report"]);
+    plain.push(report.clone());
+    let (ok, _, stderr) = call(plain);
+    assert!(ok, "{stderr}");
+    let json = std::fs::read_to_string(&report).unwrap();
+    assert!(json.contains("\"faces\": 0,"), "{json}");
+    assert!(json.contains("\"occupancy_agreement\": 1.0"), "{json}");
     let mut with_report = args(&["--thicken", "0.08", "--report"]);
     with_report.push(report.clone());
     let (ok, stdout, stderr) = call(with_report);
