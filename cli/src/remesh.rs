@@ -5,7 +5,9 @@ use std::path::PathBuf;
 use clap::Args as ClapArgs;
 use gwn::products::remesh::crossings::SegmentBvh;
 use gwn::products::remesh::intersect::self_intersections;
-use gwn::products::remesh::report::{TopologyReport, hausdorff_distance, occupancy_agreement};
+use gwn::products::remesh::report::{
+    NoSurface, TopologyReport, hausdorff_distance, occupancy_agreement,
+};
 use gwn::products::remesh::simplify::SimplifyOptions;
 use gwn::products::remesh::thicken::ThickenedSheets;
 use gwn::products::remesh::write::{SurfaceFormat, write_surface};
@@ -337,14 +339,5 @@ fn grown(bounds: gwn::BoundingBox, d: f64) -> gwn::BoundingBox {
     gwn::BoundingBox {
         min: bounds.min.map(|x| x - d),
         max: bounds.max.map(|x| x + d),
-    }
-}
-
-/// The winding number of an empty surface: 0 everywhere.
-struct NoSurface;
-
-impl gwn::eval::Evaluator for NoSurface {
-    fn eval(&self, _: [f64; 3]) -> f64 {
-        0.0
     }
 }

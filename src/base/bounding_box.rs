@@ -27,6 +27,14 @@ impl BoundingBox {
         Some(b)
     }
 
+    /// The smallest box holding both boxes.
+    pub fn union(&self, other: &Self) -> Self {
+        BoundingBox {
+            min: std::array::from_fn(|k| self.min[k].min(other.min[k])),
+            max: std::array::from_fn(|k| self.max[k].max(other.max[k])),
+        }
+    }
+
     /// Length of the diagonal, also for boxes of extent 1e-300 or 1e300 (where the squared
     /// lengths under- or overflow; `gwn info` printed `diagonal 0` for a cube of side 1e-300).
     pub fn diagonal(&self) -> f64 {
@@ -58,5 +66,20 @@ impl BoundingBox {
             min: [self.min[0] - pad, self.min[1] - pad, self.min[2] - pad],
             max: [self.max[0] + pad, self.max[1] + pad, self.max[2] + pad],
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn union_holds_both_boxes() {
+        let a = BoundingBox::of_points(&[[0.0, -1.0, 2.0], [1.0, 0.0, 3.0]]).unwrap();
+        let b = BoundingBox::of_points(&[[-2.0, 0.5, 2.5]]).unwrap();
+        let u = a.union(&b);
+        assert_eq!(u.min, [-2.0, -1.0, 2.0]);
+        assert_eq!(u.max, [1.0, 0.5, 3.0]);
+        assert_eq!(b.union(&a), u);
     }
 }

@@ -21,6 +21,7 @@
 //! stack). So a batch equals the points evaluated one by one, bit for bit, whatever the packets,
 //! the sort or the number of threads (tested).
 
+use crate::base::bounding_box::BoundingBox;
 use rayon::prelude::*;
 use rdst::RadixSort;
 use wide::{CmpGt, CmpLt, f32x8};
@@ -398,7 +399,7 @@ const MORTON_BITS: u32 = 11;
 /// A point's place in the packets' order: the top 32 bits of its Morton code (11 bits per
 /// axis: the packets need neighbours, not an exact order), which is all the sort looks at, and
 /// its index.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default)]
 struct MortonKey {
     code: u32,
     index: u32,
@@ -441,15 +442,12 @@ fn morton_keys(points: &[[f64; 3]]) -> Vec<MortonKey> {
         points.len() <= u32::MAX as usize,
         "too many points for one batch"
     );
-    let (lo, hi) = points.par_chunks(KEYS_PER_TASK).map(finite_bounds).reduce(
-        empty_bounds,
-        |(a, b), (c, d)| {
-            (
-                [a[0].min(c[0]), a[1].min(c[1]), a[2].min(c[2])],
-                [b[0].max(d[0]), b[1].max(d[1]), b[2].max(d[2])],
-            )
-        },
-    );
+    // With no finite point nothing below reads the bounds.
+    let (lo, hi) = points
+        .par_chunks(KEYS_PER_TASK)
+        .filter_map(|chunk| BoundingBox::of_points(chunk.iter().filter(|p| is_finite(p))))
+        .reduce_with(|a, b| a.union(&b))
+        .map_or(([0.0; 3], [0.0; 3]), |b| (b.min, b.max));
     let cells = f64::from(1u32 << MORTON_BITS);
     // Per axis: cells per unit length (0 for a flat or empty axis; the extent may overflow to
     // +∞ for points near ±f64::MAX, which gives 0 too, and only a worse order).
@@ -487,25 +485,8 @@ fn morton_keys(points: &[[f64; 3]]) -> Vec<MortonKey> {
     keys
 }
 
-/// The bounds of nothing: the identity of the bounds' union.
-fn empty_bounds() -> ([f64; 3], [f64; 3]) {
-    ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3])
-}
-
 fn is_finite(p: &[f64; 3]) -> bool {
     p[0].is_finite() && p[1].is_finite() && p[2].is_finite()
-}
-
-/// The bounding box of the finite points of `points` ([`empty_bounds`] if none).
-fn finite_bounds(points: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
-    let (mut lo, mut hi) = empty_bounds();
-    for p in points.iter().filter(|p| is_finite(p)) {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    (lo, hi)
 }
 
 /// Per cell coordinate `v` below 2^[`MORTON_BITS`], the bits of `v` with two zero bits

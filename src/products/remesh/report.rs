@@ -254,11 +254,13 @@ where
     Some(agree as f64 / samples as f64)
 }
 
-/// An evaluator that is never asked: [`SignedDistance`](crate::products::sdf::SignedDistance)
-/// needs one, the unsigned distance of [`hausdorff_distance`] does not use it.
-struct Unused;
+/// The winding number of an empty surface: 0 everywhere. The output side of
+/// [`occupancy_agreement`] when a remesh is empty, and the evaluator that
+/// [`SignedDistance`](crate::products::sdf::SignedDistance) needs and the unsigned distance of
+/// [`hausdorff_distance`] never asks.
+pub struct NoSurface;
 
-impl crate::eval::Evaluator for Unused {
+impl crate::eval::Evaluator for NoSurface {
     fn eval(&self, _q: [f64; 3]) -> f64 {
         0.0
     }
@@ -279,7 +281,7 @@ pub fn hausdorff_distance(
         return None;
     }
     let one_sided = |from: &crate::Mesh, to: &crate::Mesh, seed: u64| -> f64 {
-        let distance = crate::products::sdf::SignedDistance::with_evaluator(to, Unused);
+        let distance = crate::products::sdf::SignedDistance::with_evaluator(to, NoSurface);
         let triangles: Vec<[[f64; 3]; 3]> = (0..from.triangles().len())
             .map(|f| from.triangle_positions(f))
             .collect();
