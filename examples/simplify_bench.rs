@@ -3,11 +3,12 @@
 //! surface), so that changes to `simplify.rs` can be timed and compared side by side.
 //!
 //! ```text
-//! cargo run --release --features examples --example simplify_bench -- MESH RES [--repeat N] [--check] [--no-relocate] [--flat TOL]
+//! cargo run --release --features examples --example simplify_bench -- MESH RES [--repeat N] [--check] [--no-relocate] [--flat TOL] [--no-diagonals]
 //! ```
 //! The surface before simplification (exact evaluator, guided placement) is computed once and
 //! cached in `$TMPDIR` (`gwn-simplify-<mesh>-<res>-<lattice cells>.bin`). `--flat TOL`: the
-//! flat tolerance in cells (`SimplifyOptions::flat_tolerance`; 0: stop at the target). `--check` also counts exact
+//! flat tolerance in cells (`SimplifyOptions::flat_tolerance`; 0: stop at the target). `--no-diagonals`: no cube-by-cube pass over the diagonal vertices
+//! (`SimplifyOptions::lattice_diagonals`). `--check` also counts exact
 //! self-intersections and checks the topology of the output. The thread count is rayon's
 //! (`RAYON_NUM_THREADS`).
 
@@ -111,12 +112,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut repeat = 1;
     let mut check = false;
     let mut relocate = true;
+    let mut diagonals = true;
     let mut flat = simplify::DEFAULT_FLAT_TOLERANCE;
     while let Some(a) = args.next() {
         match a.as_str() {
             "--repeat" => repeat = args.next().ok_or("--repeat N")?.parse()?,
             "--check" => check = true,
             "--no-relocate" => relocate = false,
+            "--no-diagonals" => diagonals = false,
             "--flat" => flat = args.next().ok_or("--flat TOL")?.parse()?,
             _ => return Err(format!("unknown argument {a}").into()),
         }
@@ -146,6 +149,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let options = simplify::SimplifyOptions {
         relocate,
         flat_tolerance: flat,
+        lattice_diagonals: diagonals,
         ..simplify::SimplifyOptions::default()
     };
     let target =
@@ -171,11 +175,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
         }
         println!(
-            "{name} res {res}: {} -> {} faces (MC {}), {} collapses in {} rounds, refused {:?}, {} relocated ({} refused), {dt:.2} s, {:.2} us/collapse, fingerprint {h:016x}",
+            "{name} res {res}: {} -> {} faces (MC {}), {} collapses ({} of diagonal vertices, {} kept) in {} rounds, refused {:?}, {} relocated ({} refused), {dt:.2} s, {:.2} us/collapse, fingerprint {h:016x}",
             s.stats.faces_before,
             s.stats.faces_after,
             surface.marching_cubes,
             s.stats.collapses,
+            s.stats.diagonal_collapses,
+            s.stats.diagonals_left,
             s.stats.rounds,
             s.stats.refused,
             s.stats.relocated,

@@ -51,6 +51,8 @@ use super::intersect::{MAX_COORDINATE, faces_intersect};
 use rayon::prelude::*;
 
 use super::lattice::{KeyMap, KeySet};
+
+mod lattice_diagonals;
 use crate::kernel::predicates::cross_exact;
 
 type P = [i64; 3];
@@ -116,6 +118,12 @@ pub struct SimplifyOptions {
     /// (a box's sides, a printer bed) keep only the faces the other bounds need, where the
     /// target alone would leave them as dense as curved ones. 0: stop at the target.
     pub flat_tolerance: f64,
+    /// Before the quadric-ordered collapses, remove the vertices that lie on the face and body
+    /// diagonals of the lattice's cubes (where the marching-tetrahedra surface of
+    /// [`super::extract`] has 70 % of its vertices and marching cubes has none) by collapses
+    /// whose checks stay inside one or two cubes ([`lattice_diagonals`]). Same guarantees, a
+    /// fraction of the time; skipped when the input is not such a surface.
+    pub lattice_diagonals: bool,
 }
 
 impl Default for SimplifyOptions {
@@ -126,6 +134,7 @@ impl Default for SimplifyOptions {
             target_fraction_of_marching_cubes: DEFAULT_TARGET_FRACTION,
             relocate: true,
             flat_tolerance: DEFAULT_FLAT_TOLERANCE,
+            lattice_diagonals: true,
         }
     }
 }
@@ -158,6 +167,12 @@ pub struct SimplifyStats {
     pub collapses: usize,
     /// Rounds of collapses planned together ([`Simplifier::run`]).
     pub rounds: usize,
+    /// Of [`SimplifyStats::collapses`], those of lattice-diagonal vertices made cube by cube
+    /// before the others ([`SimplifyOptions::lattice_diagonals`]).
+    pub diagonal_collapses: usize,
+    /// Lattice-diagonal vertices that the cube-by-cube pass had to leave (every local collapse
+    /// refused); the quadric-ordered collapses may still remove them.
+    pub diagonals_left: usize,
     /// Vertices moved by the relocation.
     pub relocated: usize,
     /// Relocations refused by the checks (flip, size, distance or intersection).
@@ -192,8 +207,11 @@ pub fn simplify(
     options: &SimplifyOptions,
     target_faces: usize,
 ) -> Simplified {
-    match Simplifier::new(points, triangles, ticks_per_cell, options) {
+    match Simplifier::new_unindexed(points, triangles, ticks_per_cell, options) {
         Some(mut s) => {
+            if options.lattice_diagonals {
+                s.collapse_lattice_diagonals();
+            }
             s.run(target_faces);
             if target_faces > 0 && options.flat_tolerance > 0.0 {
                 s.run_flat(options.flat_tolerance);
@@ -241,6 +259,10 @@ pub struct Simplifier {
     /// to `i32` (half the bytes to scan; exact when `shift` is 0, as for every remesher
     /// output below 2^30 ticks): a prefilter, the exact box test follows.
     grids: Vec<KeyMap<Vec<(u32, Q, Q)>>>,
+    /// Whether `grids` holds every live face: built on first need
+    /// ([`Simplifier::build_index`]), since the pass over the lattice diagonals needs none and
+    /// removes 70 % of the faces first.
+    indexed: bool,
     shift: u32,
     ticks: i64,
     max_extent: i64,
@@ -272,6 +294,18 @@ impl Simplifier {
     /// vertex-manifold, consistently oriented surface without collinear faces, or has a
     /// coordinate the exact predicates cannot take.
     pub fn new(
+        points: &[P],
+        triangles: &[[u32; 3]],
+        ticks_per_cell: i64,
+        options: &SimplifyOptions,
+    ) -> Option<Simplifier> {
+        let mut s = Simplifier::new_unindexed(points, triangles, ticks_per_cell, options)?;
+        s.build_index();
+        Some(s)
+    }
+
+    /// [`Simplifier::new`] without the spatial index (built by [`Simplifier::build_index`]).
+    fn new_unindexed(
         points: &[P],
         triangles: &[[u32; 3]],
         ticks_per_cell: i64,
@@ -318,7 +352,7 @@ impl Simplifier {
             .unwrap_or(0);
         let shift = (64 - largest.leading_zeros()).saturating_sub(30);
         let max_extent = i64::from(options.max_face_extent.max(1)).saturating_mul(ticks_per_cell);
-        let mut s = Simplifier {
+        Some(Simplifier {
             points: points.to_vec(),
             at,
             faces: triangles.to_vec(),
@@ -328,6 +362,7 @@ impl Simplifier {
             support: vec![Vec::new(); triangles.len()],
             quadric,
             grids: Vec::new(),
+            indexed: false,
             shift,
             ticks: ticks_per_cell,
             max_extent,
@@ -337,11 +372,19 @@ impl Simplifier {
                 faces_before: triangles.len(),
                 ..SimplifyStats::default()
             },
-        };
-        for f in 0..s.faces.len() {
-            s.index(f as u32, true);
+        })
+    }
+
+    /// Indexes every live face, once.
+    fn build_index(&mut self) {
+        if !self.indexed {
+            self.indexed = true;
+            for f in 0..self.faces.len() as u32 {
+                if self.alive[f as usize] {
+                    self.index(f, true);
+                }
+            }
         }
-        Some(s)
     }
 
     /// Greedy collapses in quadric-error order until none is allowed or at most `target_faces`
@@ -374,6 +417,7 @@ impl Simplifier {
     }
 
     fn collapse_rounds(&mut self, target_faces: usize) {
+        self.build_index();
         let n = self.points.len();
         // Lazy invalidation: an entry counts only if its version is the vertex's. `queued` is the
         // cost of the vertex's valid entry, if any: a vertex whose best cost did not change keeps
@@ -473,7 +517,7 @@ impl Simplifier {
             .collect();
         candidates.sort_unstable();
         for &(_, v) in &candidates {
-            match self.plan_with_ring(u, v, &ring) {
+            match self.plan_with_ring(u, v, &ring, None) {
                 Ok(mut plan) => {
                     plan.ring = ring;
                     return (Some(plan), refused);
@@ -519,6 +563,7 @@ impl Simplifier {
     /// [`Simplifier::run`]: vertices with disjoint ring boxes (the new position included) are
     /// planned in parallel and moved in a fixed scattered order of their indices.
     pub fn relocate(&mut self) {
+        self.build_index();
         // Vertices that need a move, in a scattered order: consecutive indices are neighbours
         // (extraction order), so index order would make most of a round wait for a conflict.
         let mut pending: Vec<u32> = (0..self.points.len() as u32)
@@ -788,11 +833,19 @@ impl Simplifier {
         if u as usize >= self.points.len() {
             return Err(Refusal::NotAnEdge);
         }
-        self.plan_with_ring(u, v, &self.neighbours(u))
+        self.plan_with_ring(u, v, &self.neighbours(u), None)
     }
 
     /// [`Simplifier::plan`] with `nu`, the sorted distinct neighbours of `u`, already known.
-    fn plan_with_ring(&self, u: u32, v: u32, nu: &[u32]) -> Result<Plan, Refusal> {
+    /// With `cubes`, the intersection check is the cube-local one of [`lattice_diagonals`]
+    /// (only for the lattice-diagonal vertices of a marching-tetrahedra surface).
+    fn plan_with_ring(
+        &self,
+        u: u32,
+        v: u32,
+        nu: &[u32],
+        cubes: Option<&lattice_diagonals::CubeFaces>,
+    ) -> Result<Plan, Refusal> {
         if u == v
             || self.removed[u as usize]
             || self.removed[v as usize]
@@ -865,7 +918,11 @@ impl Simplifier {
         }
         // Intersections: new faces against each other and against the live faces near them.
         let exact: Vec<[P; 3]> = new.iter().map(|t| t.map(p)).collect();
-        if self.meets_other_faces(&exact, &old) {
+        let meets = match cubes {
+            None => self.meets_other_faces(&exact, &old),
+            Some(cubes) => cubes.refuses(self, u, &new, &exact, &old),
+        };
+        if meets {
             return Err(Refusal::Intersection);
         }
         Ok(Plan {
@@ -880,6 +937,10 @@ impl Simplifier {
     /// Whether the faces `exact` (replacing the faces `old`) meet each other or any other live
     /// face outside what they share.
     fn meets_other_faces(&self, exact: &[[P; 3]], old: &[u32]) -> bool {
+        debug_assert!(
+            self.indexed,
+            "the spatial index is built before any global check"
+        );
         let boxes: Vec<(P, P)> = exact.iter().map(|t| face_box(*t)).collect();
         for i in 0..exact.len() {
             for j in i + 1..exact.len() {
@@ -1001,6 +1062,9 @@ impl Simplifier {
 
     /// Adds face `f` to (or removes it from) the spatial index.
     fn index(&mut self, f: u32, insert: bool) {
+        if !self.indexed {
+            return;
+        }
         let (lo, hi) = face_box(self.faces[f as usize].map(|x| self.points[x as usize]));
         let extent = (0..3).map(|a| hi[a] - lo[a]).max().unwrap_or(0);
         let mut k = 0;

@@ -1,0 +1,347 @@
+//! The vertices on the lattice's face and body diagonals, removed cube by cube before the
+//! quadric-ordered collapses ([`super::SimplifyOptions::lattice_diagonals`]).
+//!
+//! The marching-tetrahedra surface of the Freudenthal split has a vertex on every crossed edge of
+//! every tetrahedron: on the bunny at res 256, 224k on the cubes' axis edges (where marching
+//! cubes has its vertices), 341k on face diagonals and 146k on body diagonals. The general
+//! collapses remove them one by one, each with a search of a spatial index for faces that a new
+//! face could meet. Here each diagonal vertex `u` is collapsed first, with the same checks
+//! (link, flip, size, distance: [`Simplifier::plan_with_ring`]) except that the intersection
+//! check only looks inside the cube of each new face, which the following argument allows.
+//!
+//! **Invariants** (in lattice units; *cube*: a closed unit cube of the lattice; *facet*: a
+//! closed unit square of a lattice plane):
+//! 1. every vertex lies strictly inside a lattice segment — an axis edge, a face diagonal or a
+//!    body diagonal of a cube, in the direction `+e_a (+e_b (+e_c))` of the Freudenthal split —
+//!    and no two vertices lie on the same segment;
+//! 2. every face lies in a cube, its *owner* (the per-axis minimum of its vertices' cells), and
+//!    not in a facet of it;
+//! 3. the surface has no self-intersection.
+//!
+//! [`CubeFaces::new`] checks 1 and 2 on the input (a marching-tetrahedra triangle lies in its
+//! tetrahedron, its vertices on the tetrahedron's edges, and never in a facet: a facet triangle
+//! has 0 or 2 crossed edges); 3 is the simplifier's own precondition.
+//!
+//! **Lemma.** Let `T` and `G` be faces with owners `C ≠ E`. Then `T ∩ G ⊆ C ∩ E = S`, a facet,
+//! a lattice edge or a corner. As `T ⊂ C` and `S` is a face of the convex cube, `T ∩ S` is the
+//! convex hull of `T`'s vertices in `S`; so is `G ∩ S`. A corner holds no vertex and a lattice
+//! edge at most one (invariant 1), so there `T ∩ G` is empty or a common vertex. On a facet `F`
+//! the hulls are vertices or segments of the planar graph that the surface's vertices and edges
+//! in `F` form, and that graph has no crossing and no vertex inside an edge (invariant 3): two
+//! of its elements meet in common vertices or are the same edge, which `T` and `G` then share.
+//! So **a face can only meet a face of another owner properly**, and a new face needs testing
+//! only against the other new faces and the faces of its own owner — if the collapse keeps the
+//! invariants, which these rules make sure of ([`CubeFaces::refuses`]):
+//! - every new face lies in its owner and not in a facet (invariant 2; invariant 1 holds since
+//!   no vertex moves);
+//! - two vertices of a new face on a common facet `F` of its owner are joined by an edge of the
+//!   surface already (so the graph of `F` does not change), except one: when `u` is a face
+//!   diagonal's vertex, the surface in its facet `F` is the path `t₁ u t₂` (checked: no other
+//!   vertex of the two cubes on `F` lies in `F`), and the collapse `u → t₁` replaces it by the
+//!   edge `t₁ t₂`, whose interior lies inside `F` (its ends are on two different sides of the
+//!   square), where no other vertex or edge is. The graph stays free of crossings.
+//!
+//! A body diagonal's vertex has all its faces in its own cube (the six tetrahedra around the
+//! diagonal each hold one piece through it), so its collapse onto a vertex of its link only
+//! changes that cube; a face diagonal's collapse onto `t₁` or `t₂` changes the two cubes of its
+//! facet. Axis-edge vertices are left to the quadric-ordered collapses (their faces lie in four
+//! cubes, and no vertex lies in all four), which also get the diagonal vertices that this pass
+//! had to keep.
+
+use super::super::lattice::KeyMap;
+use super::{P, Plan, Refusal, Simplifier, bucket_key, face_box, faces_intersect};
+
+/// The lattice segment a vertex lies strictly inside: from the corner `base` (cells) along the
+/// axes whose bits are set in `axes`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+struct Segment {
+    base: P,
+    axes: u8,
+}
+
+impl Segment {
+    /// The segment of the fixed-point `p` (`ticks` per cell), if `p` is strictly inside a
+    /// segment of the Freudenthal split: its non-integer coordinates all have the same
+    /// fractional part.
+    fn of(p: P, ticks: i64) -> Option<Segment> {
+        let mut axes = 0;
+        let mut fraction = 0;
+        let mut base = [0; 3];
+        for a in 0..3 {
+            base[a] = p[a].div_euclid(ticks);
+            let r = p[a].rem_euclid(ticks);
+            if r != 0 {
+                if fraction != 0 && r != fraction {
+                    return None;
+                }
+                fraction = r;
+                axes |= 1 << a;
+            }
+        }
+        (axes != 0).then_some(Segment { base, axes })
+    }
+
+    /// For a face diagonal: the axis across its facet.
+    fn facet_axis(self) -> Option<usize> {
+        (self.axes.count_ones() == 2).then(|| (0..3).find(|&a| self.axes & (1 << a) == 0))?
+    }
+}
+
+/// The cube holding the face `t` (fixed point), if it lies in one and not in one of its facets.
+fn owner(t: [P; 3], ticks: i64) -> Option<P> {
+    let m: P = std::array::from_fn(|a| t.iter().map(|p| p[a].div_euclid(ticks)).min().unwrap_or(0));
+    for a in 0..3 {
+        let (lo, hi) = (m[a] * ticks, (m[a] + 1) * ticks);
+        if t.iter().any(|p| p[a] > hi)
+            || t.iter().all(|p| p[a] == lo)
+            || t.iter().all(|p| p[a] == hi)
+        {
+            return None;
+        }
+    }
+    Some(m)
+}
+
+/// The live faces of each cube, by owner.
+pub(super) struct CubeFaces {
+    /// Keyed by the owner's [`bucket_key`] (keys wrap beyond 2²¹ cells: far cubes may share a
+    /// list, which costs box tests, never a miss).
+    faces: KeyMap<Vec<u32>>,
+}
+
+impl CubeFaces {
+    /// The faces of `s` by cube, if `s` satisfies invariants 1 and 2 of the module
+    /// documentation.
+    fn new(s: &Simplifier) -> Option<CubeFaces> {
+        let mut segments: Vec<Segment> = Vec::with_capacity(s.points.len());
+        for (x, p) in s.points.iter().enumerate() {
+            if !s.removed[x] && !s.vertex_faces[x].is_empty() {
+                segments.push(Segment::of(*p, s.ticks)?);
+            }
+        }
+        segments.sort_unstable();
+        if segments.windows(2).any(|w| w[0] == w[1]) {
+            return None;
+        }
+        let mut faces: KeyMap<Vec<u32>> = KeyMap::default();
+        for (f, t) in s.faces.iter().enumerate() {
+            if s.alive[f] {
+                let m = owner(t.map(|x| s.points[x as usize]), s.ticks)?;
+                faces.entry(bucket_key(m)).or_default().push(f as u32);
+            }
+        }
+        Some(CubeFaces { faces })
+    }
+
+    fn of(&self, m: P) -> &[u32] {
+        self.faces.get(&bucket_key(m)).map_or(&[], Vec::as_slice)
+    }
+
+    /// Whether the collapse of `u` into the faces `new` (vertex indices, and `exact` their
+    /// points; replacing `old`) breaks a rule of the module documentation, or a new face meets
+    /// another new face or a face of its owner.
+    pub(super) fn refuses(
+        &self,
+        s: &Simplifier,
+        u: u32,
+        new: &[[u32; 3]],
+        exact: &[[P; 3]],
+        old: &[u32],
+    ) -> bool {
+        let ticks = s.ticks;
+        let pu = s.points[u as usize];
+        let Some(segment) = Segment::of(pu, ticks) else {
+            return true;
+        };
+        let mut owners = Vec::with_capacity(new.len());
+        for (t, e) in new.iter().zip(exact) {
+            let Some(m) = owner(*e, ticks) else {
+                return true;
+            };
+            for a in 0..3 {
+                for side in [m[a] * ticks, (m[a] + 1) * ticks] {
+                    let on: Vec<usize> = (0..3).filter(|&i| e[i][a] == side).collect();
+                    if on.len() < 2 {
+                        continue;
+                    }
+                    let (x, y) = (t[on[0]], t[on[1]]);
+                    if s.vertex_faces[x as usize]
+                        .iter()
+                        .any(|&f| s.faces[f as usize].contains(&y))
+                    {
+                        continue;
+                    }
+                    let own_facet = segment.facet_axis() == Some(a) && pu[a] == side;
+                    if !(own_facet && self.facet_is_path(s, u, segment, a, [x, y])) {
+                        return true;
+                    }
+                }
+            }
+            owners.push(m);
+        }
+        let boxes: Vec<(P, P)> = exact.iter().map(|t| face_box(*t)).collect();
+        for i in 0..exact.len() {
+            for j in i + 1..exact.len() {
+                if super::boxes_overlap(boxes[i], boxes[j]) && faces_intersect(exact[i], exact[j]) {
+                    return true;
+                }
+            }
+        }
+        let p = |x: u32| s.points[x as usize];
+        for ((t, b), m) in exact.iter().zip(&boxes).zip(&owners) {
+            for &g in self.of(*m) {
+                if old.contains(&g) {
+                    continue;
+                }
+                let tg = s.faces[g as usize].map(p);
+                if super::boxes_overlap(*b, face_box(tg)) && faces_intersect(*t, tg) {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+
+    /// Whether `ends` lie in the facet of the face diagonal `segment` (of `u`, across axis
+    /// `a`), and the only vertices in that facet among the faces of its two cubes are `u` and
+    /// `ends`.
+    fn facet_is_path(
+        &self,
+        s: &Simplifier,
+        u: u32,
+        segment: Segment,
+        a: usize,
+        ends: [u32; 2],
+    ) -> bool {
+        let side = s.points[u as usize][a];
+        let in_facet = |q: P| {
+            q[a] == side
+                && (0..3).all(|b| {
+                    b == a
+                        || (segment.base[b] * s.ticks..=(segment.base[b] + 1) * s.ticks)
+                            .contains(&q[b])
+                })
+        };
+        if !ends.iter().all(|&x| in_facet(s.points[x as usize])) {
+            return false;
+        }
+        let mut below = segment.base;
+        below[a] -= 1;
+        [segment.base, below].iter().all(|&m| {
+            self.of(m).iter().all(|&f| {
+                s.faces[f as usize]
+                    .iter()
+                    .all(|&x| x == u || ends.contains(&x) || !in_facet(s.points[x as usize]))
+            })
+        })
+    }
+
+    fn remove(&mut self, m: P, f: u32) {
+        if let Some(list) = self.faces.get_mut(&bucket_key(m))
+            && let Some(i) = list.iter().position(|&g| g == f)
+        {
+            list.swap_remove(i);
+        }
+    }
+}
+
+impl Simplifier {
+    /// Collapses the vertices on body diagonals, then those on face diagonals, each into the
+    /// cheapest neighbour (quadric error) that passes the checks, with the cube-local
+    /// intersection check of the module documentation. Does nothing when the surface is not a
+    /// marching-tetrahedra surface of the lattice (invariants 1 and 2).
+    ///
+    /// One at a time, in index order (the extraction's: by `z`, then `y`, then `x`, so
+    /// neighbours follow each other in memory). Tried and slower: planning the collapses of
+    /// cubes a cube apart in parallel (classes of equal coordinate parities) visits memory in a
+    /// scattered order, 4.5 s on two threads against 2.4 s for this on one (bunny at res 256);
+    /// planning the next vertex of the lower and of the upper half of the order together
+    /// (`rayon::join` per pair) gained nothing on two threads (2.9–3.0 s).
+    pub(super) fn collapse_lattice_diagonals(&mut self) {
+        let Some(mut cubes) = CubeFaces::new(self) else {
+            return;
+        };
+        let ticks = self.ticks;
+        for axes in [3, 2] {
+            for u in 0..self.points.len() as u32 {
+                if !self.removed[u as usize]
+                    && !self.vertex_faces[u as usize].is_empty()
+                    && Segment::of(self.points[u as usize], ticks)
+                        .is_some_and(|s| s.axes.count_ones() == axes)
+                {
+                    let plan = self.plan_diagonal(u, &cubes);
+                    self.make_diagonal_collapse(u, plan, &mut cubes);
+                }
+            }
+        }
+    }
+
+    /// Makes the planned collapse of the diagonal vertex `u`, if any, and counts it.
+    fn make_diagonal_collapse(
+        &mut self,
+        u: u32,
+        (plan, refused): (Option<Plan>, [usize; 5]),
+        cubes: &mut CubeFaces,
+    ) {
+        for (a, b) in self.stats.refused.iter_mut().zip(refused) {
+            *a += b;
+        }
+        let Some(plan) = plan else {
+            self.stats.diagonals_left += 1;
+            return;
+        };
+        let ticks = self.ticks;
+        let p = |s: &Simplifier, f: u32| s.faces[f as usize].map(|x| s.points[x as usize]);
+        for &f in &plan.old {
+            if let Some(m) = owner(p(self, f), ticks) {
+                cubes.remove(m, f);
+            }
+        }
+        let first = self.faces.len() as u32;
+        self.apply(u, plan);
+        for f in first..self.faces.len() as u32 {
+            // Every new face passed `refuses`, so it has an owner.
+            if let Some(m) = owner(p(self, f), ticks) {
+                cubes.faces.entry(bucket_key(m)).or_default().push(f);
+            }
+        }
+        self.stats.diagonal_collapses += 1;
+    }
+
+    /// The collapse of the diagonal vertex `u` into its cheapest neighbour that passes the
+    /// checks, and the refusals on the way (link, face size, flip, distance, intersection).
+    fn plan_diagonal(&self, u: u32, cubes: &CubeFaces) -> (Option<Plan>, [usize; 5]) {
+        let mut refused = [0; 5];
+        let facet = Segment::of(self.points[u as usize], self.ticks)
+            .and_then(|s| s.facet_axis())
+            .map(|a| (a, self.points[u as usize][a]));
+        let ring = self.neighbours(u);
+        let mut candidates: Vec<(u64, u32)> = ring
+            .iter()
+            // A face diagonal's faces lie in the two cubes of its facet: only a target in the
+            // facet keeps each of them in its cube.
+            .filter(|&&v| facet.is_none_or(|(a, side)| self.points[v as usize][a] == side))
+            .map(|&v| (self.cost(u, v), v))
+            .filter(|&(c, _)| c <= self.max_distance2)
+            .map(|(c, v)| (c.to_bits(), v))
+            .collect();
+        candidates.sort_unstable();
+        for &(_, v) in &candidates {
+            match self.plan_with_ring(u, v, &ring, Some(cubes)) {
+                Ok(plan) => return (Some(plan), refused),
+                Err(r) => {
+                    let k = match r {
+                        Refusal::NotAnEdge => continue,
+                        Refusal::Link => 0,
+                        Refusal::FaceTooLarge => 1,
+                        Refusal::Flip => 2,
+                        Refusal::Distance => 3,
+                        Refusal::Intersection => 4,
+                    };
+                    refused[k] += 1;
+                }
+            }
+        }
+        (None, refused)
+    }
+}
