@@ -1,6 +1,6 @@
 //! The edge collapses of `gwn remesh` alone, on the marching-tetrahedra surface of one mesh at
 //! one resolution: time, counters, and a fingerprint of the output (equal fingerprints: the same
-//! surface), so that changes to `simplify.rs` can be timed and compared side by side.
+//! surface), so that changes to `simplify/` can be timed and compared side by side.
 //!
 //! ```text
 //! cargo run --release --features examples --example simplify_bench -- MESH RES [--repeat N] [--check] [--no-relocate] [--flat TOL] [--no-diagonals]

@@ -235,6 +235,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
             100.0 * topology.faces as f64 / s.marching_cubes_faces.max(1) as f64
         )?;
         outln!(
+            "vertices on cube face and body diagonals collapsed cube by cube first: {} ({} kept)",
+            s.simplify.diagonal_collapses,
+            s.simplify.diagonals_left
+        )?;
+        outln!(
             "vertices moved towards their quadric minimum: {} ({} moves refused by the checks)",
             s.simplify.relocated,
             s.simplify.relocations_refused
@@ -308,6 +313,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
             ("marching_tetrahedra_faces", s.extracted_faces.to_string()),
             ("marching_cubes_faces", s.marching_cubes_faces.to_string()),
             ("collapses", s.simplify.collapses.to_string()),
+            (
+                "diagonal_collapses",
+                s.simplify.diagonal_collapses.to_string(),
+            ),
+            ("diagonals_kept", s.simplify.diagonals_left.to_string()),
             ("relocated_vertices", s.simplify.relocated.to_string()),
         ];
         match &intersections {

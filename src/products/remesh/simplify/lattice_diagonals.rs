@@ -345,3 +345,44 @@ impl Simplifier {
         (None, refused)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const T: i64 = 8;
+
+    #[test]
+    fn segments_are_freudenthal_edges_only() {
+        // An axis edge, a face diagonal and the body diagonal of the cube at (1, 2, 3).
+        assert_eq!(
+            Segment::of([8 + 3, 16, 24], T),
+            Some(Segment {
+                base: [1, 2, 3],
+                axes: 1
+            })
+        );
+        let face = Segment::of([8 + 5, 16, 24 + 5], T).unwrap();
+        assert_eq!((face.axes, face.facet_axis()), (0b101, Some(1)));
+        let body = Segment::of([8 + 2, 16 + 2, 24 + 2], T).unwrap();
+        assert_eq!((body.axes, body.facet_axis()), (7, None));
+        // Negative coordinates floor to the cell below.
+        assert_eq!(Segment::of([-3, 0, 0], T).unwrap().base, [-1, 0, 0]);
+        // A lattice corner, and a point of a square off its `+e_a + e_b` diagonal.
+        assert_eq!(Segment::of([8, 16, 24], T), None);
+        assert_eq!(Segment::of([8 + 5, 16 + 3, 24], T), None);
+    }
+
+    #[test]
+    fn owners_hold_their_faces_outside_their_facets() {
+        // In the cube at the origin, touching its facets x = 0 and x = 1 at one vertex each.
+        let inside = [[0, 3, 3], [8, 3, 5], [4, 4, 4]];
+        assert_eq!(owner(inside, T), Some([0, 0, 0]));
+        // The same face's owner does not depend on where the vertices start.
+        assert_eq!(owner([inside[2], inside[0], inside[1]], T), Some([0, 0, 0]));
+        // In the facet x = 8 of the cube at the origin (and of the one beyond): no owner.
+        assert_eq!(owner([[8, 1, 1], [8, 5, 1], [8, 1, 5]], T), None);
+        // Across two cubes: no owner.
+        assert_eq!(owner([[1, 1, 1], [12, 1, 1], [4, 5, 1]], T), None);
+    }
+}

@@ -88,6 +88,14 @@ const MAX_DEFERRED: usize = 32;
 /// 99.904 % at 0.003, moves of at most a quarter cell).
 const RELOCATION_STIFFNESS: f64 = 0.01;
 
+/// Shortest move, in finest cells, that [`Simplifier::relocate`] makes: a shorter one changes the
+/// surface by less than this, and is not worth its intersection check. On the bunny at res 256,
+/// 35k of the 76k moves were below 0.01 cells (20k below 0.005). Not more: on a convex surface
+/// every move is outward, so skipped moves add up to a bias; at 0.01 the sphere's volume after
+/// relocation at res 16 is the same as with every move (2.609e-2 lost against 2.608e-2; at 0.02,
+/// 2.735e-2), and the bunny's occupancy agreement at res 128 is within 10⁻⁴.
+const MIN_RELOCATION: f64 = 0.01;
+
 /// Most collapses planned together (in parallel) in one round of [`Simplifier::run`]. A
 /// constant, so that the result does not depend on the thread count; small enough that a
 /// round stays close to the global cost order.
@@ -661,7 +669,7 @@ impl Simplifier {
         }
         let mut step = [p[0] - p0[0], p[1] - p0[1], p[2] - p0[2]];
         let len = (step[0] * step[0] + step[1] * step[1] + step[2] * step[2]).sqrt();
-        if !len.is_finite() {
+        if !len.is_finite() || len < MIN_RELOCATION {
             return None;
         }
         let limit = self.max_distance2.sqrt();
