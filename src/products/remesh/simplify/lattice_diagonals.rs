@@ -160,11 +160,15 @@ impl CubeFaces {
             };
             for a in 0..3 {
                 for side in [m[a] * ticks, (m[a] + 1) * ticks] {
-                    let on: Vec<usize> = (0..3).filter(|&i| e[i][a] == side).collect();
-                    if on.len() < 2 {
-                        continue;
-                    }
-                    let (x, y) = (t[on[0]], t[on[1]]);
+                    // The owner's facets never hold all three vertices: at most one pair.
+                    let on = [0, 1, 2].map(|i| e[i][a] == side);
+                    let (x, y) = match on {
+                        [true, true, true] => return true,
+                        [true, true, _] => (t[0], t[1]),
+                        [true, false, true] => (t[0], t[2]),
+                        [false, true, true] => (t[1], t[2]),
+                        _ => continue,
+                    };
                     if s.vertex_faces[x as usize]
                         .iter()
                         .any(|&f| s.faces[f as usize].contains(&y))

@@ -332,27 +332,47 @@ impl Simplifier {
         }
         let scale = 1.0 / ticks_per_cell as f64;
         let at: Vec<[f64; 3]> = points.iter().map(|p| p.map(|c| c as f64 * scale)).collect();
-        let report = super::report::TopologyReport::of(&at, triangles);
+        // The topology check alongside the face lists and quadrics (two threads: it is the
+        // larger half of the set-up).
+        let (report, lists) = rayon::join(
+            || super::report::TopologyReport::of(&at, triangles),
+            || {
+                if triangles.par_iter().any(|t| {
+                    let p = t.map(|v| points[v as usize]);
+                    cross_exact(sub(p[1], p[0]), sub(p[2], p[0])) == [0; 3]
+                }) {
+                    return None;
+                }
+                let mut vertex_faces = vec![Vec::new(); points.len()];
+                for (f, t) in triangles.iter().enumerate() {
+                    for &v in t {
+                        vertex_faces[v as usize].push(f as u32);
+                    }
+                }
+                // Each vertex's planes summed in face order, as one pass over the faces would.
+                let quadric: Vec<[f64; 11]> = vertex_faces
+                    .par_iter()
+                    .map(|faces| {
+                        let mut q = [0.0; 11];
+                        for &f in faces {
+                            let t = triangles[f as usize];
+                            for (a, b) in q.iter_mut().zip(plane_quadric(t.map(|v| at[v as usize])))
+                            {
+                                *a += b;
+                            }
+                        }
+                        q
+                    })
+                    .collect();
+                Some((vertex_faces, quadric))
+            },
+        );
         if !(report.closed && report.edge_manifold && report.vertex_manifold && report.oriented)
             || report.degenerate_faces > 0
         {
             return None;
         }
-        let mut vertex_faces = vec![Vec::new(); points.len()];
-        let mut quadric = vec![[0.0; 11]; points.len()];
-        for (f, t) in triangles.iter().enumerate() {
-            let p = t.map(|v| points[v as usize]);
-            if cross_exact(sub(p[1], p[0]), sub(p[2], p[0])) == [0; 3] {
-                return None;
-            }
-            let q = plane_quadric(t.map(|v| at[v as usize]));
-            for &v in t {
-                vertex_faces[v as usize].push(f as u32);
-                for (a, b) in quadric[v as usize].iter_mut().zip(&q) {
-                    *a += b;
-                }
-            }
-        }
+        let (vertex_faces, quadric) = lists?;
         let largest = points
             .iter()
             .flat_map(|p| p.iter().map(|c| c.unsigned_abs()))
