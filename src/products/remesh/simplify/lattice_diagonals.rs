@@ -49,7 +49,7 @@
 //! had to keep.
 
 use super::super::lattice::KeyMap;
-use super::{P, Plan, Refusal, Simplifier, bucket_key, face_box, faces_intersect};
+use super::{P, Plan, Simplifier, bucket_key, face_box, faces_intersect};
 
 /// The lattice segment a vertex lies strictly inside: from the corner `base` (cells) along the
 /// axes whose bits are set in `axes`.
@@ -315,38 +315,16 @@ impl Simplifier {
     /// The collapse of the diagonal vertex `u` into its cheapest neighbour that passes the
     /// checks, and the refusals on the way (link, face size, flip, distance, intersection).
     fn plan_diagonal(&self, u: u32, cubes: &CubeFaces) -> (Option<Plan>, [usize; 5]) {
-        let mut refused = [0; 5];
         let facet = Segment::of(self.points[u as usize], self.ticks)
             .and_then(|s| s.facet_axis())
             .map(|a| (a, self.points[u as usize][a]));
-        let ring = self.neighbours(u);
-        let mut candidates: Vec<(u64, u32)> = ring
-            .iter()
-            // A face diagonal's faces lie in the two cubes of its facet: only a target in the
-            // facet keeps each of them in its cube.
-            .filter(|&&v| facet.is_none_or(|(a, side)| self.points[v as usize][a] == side))
-            .map(|&v| (self.cost(u, v), v))
-            .filter(|&(c, _)| c <= self.max_distance2)
-            .map(|(c, v)| (c.to_bits(), v))
-            .collect();
-        candidates.sort_unstable();
-        for &(_, v) in &candidates {
-            match self.plan_with_ring(u, v, &ring, Some(cubes)) {
-                Ok(plan) => return (Some(plan), refused),
-                Err(r) => {
-                    let k = match r {
-                        Refusal::NotAnEdge => continue,
-                        Refusal::Link => 0,
-                        Refusal::FaceTooLarge => 1,
-                        Refusal::Flip => 2,
-                        Refusal::Distance => 3,
-                        Refusal::Intersection => 4,
-                    };
-                    refused[k] += 1;
-                }
-            }
-        }
-        (None, refused)
+        // A face diagonal's faces lie in the two cubes of its facet: only a target in the facet
+        // keeps each of them in its cube.
+        self.plan_cheapest(
+            u,
+            |v| facet.is_none_or(|(a, side)| self.points[v as usize][a] == side),
+            Some(cubes),
+        )
     }
 }
 

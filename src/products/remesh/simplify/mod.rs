@@ -534,18 +534,31 @@ impl Simplifier {
     /// The first allowed collapse of `u` into a neighbour, cheapest first, and the refusals
     /// on the way (link, face size, flip, distance, intersection).
     fn plan_best(&self, u: u32) -> (Option<Plan>, [usize; 5]) {
+        self.plan_cheapest(u, |v| self.flat_enough(u, v), None)
+    }
+
+    /// The first collapse of `u` into a neighbour `v` with `admissible(v)` that passes the
+    /// checks (with `cubes`, the cube-local intersection check of [`lattice_diagonals`]),
+    /// cheapest first, and the refusals on the way (link, face size, flip, distance,
+    /// intersection).
+    fn plan_cheapest(
+        &self,
+        u: u32,
+        admissible: impl Fn(u32) -> bool,
+        cubes: Option<&lattice_diagonals::CubeFaces>,
+    ) -> (Option<Plan>, [usize; 5]) {
         let mut refused = [0; 5];
         let ring = self.neighbours(u);
         let mut candidates: Vec<(u64, u32)> = ring
             .iter()
-            .filter(|&&v| self.flat_enough(u, v))
+            .filter(|&&v| admissible(v))
             .map(|&v| (self.cost(u, v), v))
             .filter(|&(c, _)| c <= self.max_distance2)
             .map(|(c, v)| (c.to_bits(), v))
             .collect();
         candidates.sort_unstable();
         for &(_, v) in &candidates {
-            match self.plan_with_ring(u, v, &ring, None) {
+            match self.plan_with_ring(u, v, &ring, cubes) {
                 Ok(mut plan) => {
                     plan.ring = ring;
                     return (Some(plan), refused);
