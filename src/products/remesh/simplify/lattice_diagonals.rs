@@ -251,7 +251,8 @@ impl CubeFaces {
 
 impl Simplifier {
     /// Collapses the vertices on body diagonals, then those on face diagonals, each into the
-    /// cheapest neighbour (quadric error) that passes the checks, with the cube-local
+    /// cheapest neighbour (quadric error, at most `max_error` cells) that passes the checks,
+    /// with the cube-local
     /// intersection check of the module documentation. Does nothing when the surface is not a
     /// marching-tetrahedra surface of the lattice (invariants 1 and 2).
     ///
@@ -261,7 +262,7 @@ impl Simplifier {
     /// scattered order, 4.5 s on two threads against 2.4 s for this on one (bunny at res 256);
     /// planning the next vertex of the lower and of the upper half of the order together
     /// (`rayon::join` per pair) gained nothing on two threads (2.9–3.0 s).
-    pub(super) fn collapse_lattice_diagonals(&mut self) {
+    pub(super) fn collapse_lattice_diagonals(&mut self, max_error: f64) {
         let Some(mut cubes) = CubeFaces::new(self) else {
             return;
         };
@@ -273,7 +274,7 @@ impl Simplifier {
                     && Segment::of(self.points[u as usize], ticks)
                         .is_some_and(|s| s.axes.count_ones() == axes)
                 {
-                    let plan = self.plan_diagonal(u, &cubes);
+                    let plan = self.plan_diagonal(u, &cubes, max_error);
                     self.make_diagonal_collapse(u, plan, &mut cubes);
                 }
             }
@@ -312,9 +313,15 @@ impl Simplifier {
         self.stats.diagonal_collapses += 1;
     }
 
-    /// The collapse of the diagonal vertex `u` into its cheapest neighbour that passes the
-    /// checks, and the refusals on the way (link, face size, flip, distance, intersection).
-    fn plan_diagonal(&self, u: u32, cubes: &CubeFaces) -> (Option<Plan>, [usize; 5]) {
+    /// The collapse of the diagonal vertex `u` into its cheapest neighbour, among those within
+    /// `max_error` cells (quadric error), that passes the checks, and the refusals on the way
+    /// (link, face size, flip, distance, intersection).
+    fn plan_diagonal(
+        &self,
+        u: u32,
+        cubes: &CubeFaces,
+        max_error: f64,
+    ) -> (Option<Plan>, [usize; 5]) {
         let facet = Segment::of(self.points[u as usize], self.ticks)
             .and_then(|s| s.facet_axis())
             .map(|a| (a, self.points[u as usize][a]));
@@ -322,7 +329,10 @@ impl Simplifier {
         // keeps each of them in its cube.
         self.plan_cheapest(
             u,
-            |v| facet.is_none_or(|(a, side)| self.points[v as usize][a] == side),
+            |v| {
+                facet.is_none_or(|(a, side)| self.points[v as usize][a] == side)
+                    && self.quadric_error(u, v) <= max_error * max_error
+            },
             Some(cubes),
         )
     }
