@@ -298,14 +298,8 @@ pub fn hausdorff_distance(
 fn surface_samples(triangles: &[[[f64; 3]; 3]], samples: usize, seed: u64) -> Vec<[f64; 3]> {
     let mut points: Vec<[f64; 3]> = Vec::with_capacity(samples);
     let area = |t: &[[f64; 3]; 3]| {
-        let u = [0, 1, 2].map(|k| t[1][k] - t[0][k]);
-        let v = [0, 1, 2].map(|k| t[2][k] - t[0][k]);
-        let n = [
-            u[1] * v[2] - u[2] * v[1],
-            u[2] * v[0] - u[0] * v[2],
-            u[0] * v[1] - u[1] * v[0],
-        ];
-        0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
+        use crate::base::vec3::{cross, norm, sub};
+        0.5 * norm(cross(sub(t[1], t[0]), sub(t[2], t[0])))
     };
     let mut cumulative = Vec::with_capacity(triangles.len());
     let mut total = 0.0;

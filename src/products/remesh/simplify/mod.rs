@@ -1224,14 +1224,9 @@ fn boxes_overlap((alo, ahi): (P, P), (blo, bhi): (P, P)) -> bool {
 /// The area-weighted quadric of the plane of `t`: 10 coefficients of `(n·x + d)²` times the
 /// area, and the area.
 fn plane_quadric(t: [[f64; 3]; 3]) -> [f64; 11] {
-    let u = [0, 1, 2].map(|k| t[1][k] - t[0][k]);
-    let v = [0, 1, 2].map(|k| t[2][k] - t[0][k]);
-    let n = [
-        u[1] * v[2] - u[2] * v[1],
-        u[2] * v[0] - u[0] * v[2],
-        u[0] * v[1] - u[1] * v[0],
-    ];
-    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    use crate::base::vec3::{cross, norm, sub};
+    let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
+    let len = norm(n);
     if len == 0.0 || !len.is_finite() {
         return [0.0; 11];
     }
