@@ -3,12 +3,13 @@
 //! surface), so that changes to `simplify/` can be timed and compared side by side.
 //!
 //! ```text
-//! cargo run --release --features examples --example simplify_bench -- MESH RES [--repeat N] [--check] [--no-relocate] [--flat TOL] [--no-diagonals]
+//! cargo run --release --features examples --example simplify_bench -- MESH RES [--repeat N] [--check] [--no-relocate] [--flat TOL] [--no-diagonals] [--slab-cells N]
 //! ```
 //! The surface before simplification (exact evaluator, guided placement) is computed once and
 //! cached in `$TMPDIR` (`gwn-simplify-<mesh>-<res>-<lattice cells>.bin`). `--flat TOL`: the
 //! flat tolerance in cells (`SimplifyOptions::flat_tolerance`; 0: stop at the target). `--no-diagonals`: no cube-by-cube pass over the diagonal vertices
-//! (`SimplifyOptions::lattice_diagonals`). `--check` also counts exact
+//! (`SimplifyOptions::lattice_diagonals`). `--slab-cells N`: slab thickness of the parallel
+//! collapses (`SimplifyOptions::slab_cells`; 0: none). `--check` also counts exact
 //! self-intersections and checks the topology of the output. The thread count is rayon's
 //! (`RAYON_NUM_THREADS`).
 
@@ -114,6 +115,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut relocate = true;
     let mut diagonals = true;
     let mut flat = simplify::DEFAULT_FLAT_TOLERANCE;
+    let mut slab_cells = simplify::DEFAULT_SLAB_CELLS;
     while let Some(a) = args.next() {
         match a.as_str() {
             "--repeat" => repeat = args.next().ok_or("--repeat N")?.parse()?,
@@ -121,6 +123,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--no-relocate" => relocate = false,
             "--no-diagonals" => diagonals = false,
             "--flat" => flat = args.next().ok_or("--flat TOL")?.parse()?,
+            "--slab-cells" => slab_cells = args.next().ok_or("--slab-cells N")?.parse()?,
             _ => return Err(format!("unknown argument {a}").into()),
         }
     }
@@ -150,6 +153,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         relocate,
         flat_tolerance: flat,
         lattice_diagonals: diagonals,
+        slab_cells,
         ..simplify::SimplifyOptions::default()
     };
     let target =

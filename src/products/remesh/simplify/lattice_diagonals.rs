@@ -269,10 +269,13 @@ impl Simplifier {
         let ticks = self.ticks;
         for axes in [3, 2] {
             for u in 0..self.points.len() as u32 {
+                let p = self.points[u as usize];
+                // In a slab's simplifier, the slab's own vertices (those of a slab plane are
+                // left to the global collapses, uncounted).
                 if !self.removed[u as usize]
                     && !self.vertex_faces[u as usize].is_empty()
-                    && Segment::of(self.points[u as usize], ticks)
-                        .is_some_and(|s| s.axes.count_ones() == axes)
+                    && Segment::of(p, ticks).is_some_and(|s| s.axes.count_ones() == axes)
+                    && self.slab.is_none_or(|slab| slab.holds((p, p)))
                 {
                     let plan = self.plan_diagonal(u, &cubes, max_error);
                     self.make_diagonal_collapse(u, plan, &mut cubes);

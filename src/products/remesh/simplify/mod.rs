@@ -53,6 +53,7 @@ use rayon::prelude::*;
 use super::lattice::{KeyMap, KeySet};
 
 mod lattice_diagonals;
+mod slabs;
 use crate::kernel::predicates::cross_exact;
 
 type P = [i64; 3];
@@ -76,6 +77,9 @@ pub const DEFAULT_TARGET_FRACTION: f64 = 0.45;
 /// 99.918 %), and on curved parts at fine resolutions few are (the bunny at res 256: 16.8k of
 /// its 487k diagonal vertices left, time unchanged within the VM's spread).
 pub const DEFAULT_DIAGONAL_ERROR: f64 = 0.03;
+
+/// Default [`SimplifyOptions::slab_cells`].
+pub const DEFAULT_SLAB_CELLS: u32 = 32;
 
 /// Default [`SimplifyOptions::flat_tolerance`], in finest cells.
 pub const DEFAULT_FLAT_TOLERANCE: f64 = 0.01;
@@ -146,6 +150,12 @@ pub struct SimplifyOptions {
     /// planes, in finest cells) of a collapse in that pass; larger ones are left to the
     /// cost-ordered collapses ([`DEFAULT_DIAGONAL_ERROR`] says why).
     pub lattice_diagonal_error: f64,
+    /// Before the global collapses, cut the surface into slabs of at least this many finest
+    /// cells across its longest axis (at most 8, about equal in faces) and collapse inside each
+    /// slab, all slabs at once, each with its own simplifier ([`slabs`]): the same checks and
+    /// guarantees, the work of every slab in parallel and in a smaller memory. The result
+    /// depends on this, not on the thread count. 0: no slabs.
+    pub slab_cells: u32,
 }
 
 impl Default for SimplifyOptions {
@@ -158,6 +168,7 @@ impl Default for SimplifyOptions {
             flat_tolerance: DEFAULT_FLAT_TOLERANCE,
             lattice_diagonals: true,
             lattice_diagonal_error: DEFAULT_DIAGONAL_ERROR,
+            slab_cells: DEFAULT_SLAB_CELLS,
         }
     }
 }
@@ -196,6 +207,11 @@ pub struct SimplifyStats {
     /// Lattice-diagonal vertices that the cube-by-cube pass had to leave (every local collapse
     /// refused); the quadric-ordered collapses may still remove them.
     pub diagonals_left: usize,
+    /// Slabs the surface was cut into for the parallel collapses ([`SimplifyOptions::slab_cells`];
+    /// 0: none).
+    pub slabs: usize,
+    /// Of [`SimplifyStats::collapses`], those made inside the slabs.
+    pub slab_collapses: usize,
     /// Vertices moved by the relocation.
     pub relocated: usize,
     /// Relocations refused by the checks (flip, size, distance or intersection).
@@ -232,8 +248,13 @@ pub fn simplify(
 ) -> Simplified {
     match Simplifier::new_unindexed(points, triangles, ticks_per_cell, options) {
         Some(mut s) => {
-            if options.lattice_diagonals {
-                s.collapse_lattice_diagonals(options.lattice_diagonal_error);
+            let diagonals = options
+                .lattice_diagonals
+                .then_some(options.lattice_diagonal_error);
+            if !s.collapse_in_slabs(options.slab_cells, target_faces, diagonals)
+                && let Some(max_error) = diagonals
+            {
+                s.collapse_lattice_diagonals(max_error);
             }
             s.run(target_faces);
             if target_faces > 0 && options.flat_tolerance > 0.0 {
@@ -294,6 +315,8 @@ pub struct Simplifier {
     /// While set ([`Simplifier::run_flat`]): the largest quadric error (squared, lattice units)
     /// of a collapse that may be made.
     flat_limit: Option<f64>,
+    /// In a slab's simplifier ([`slabs`]): the open slab its collapses must stay inside.
+    slab: Option<slabs::Slab>,
     stats: SimplifyStats,
 }
 
@@ -411,6 +434,7 @@ impl Simplifier {
             max_extent,
             max_distance2: (options.max_distance * options.max_distance),
             flat_limit: None,
+            slab: None,
             stats: SimplifyStats {
                 faces_before: triangles.len(),
                 ..SimplifyStats::default()
@@ -903,10 +927,11 @@ impl Simplifier {
         cubes: Option<&lattice_diagonals::CubeFaces>,
     ) -> Result<Plan, Refusal> {
         if u == v
-            || self.removed[u as usize]
-            || self.removed[v as usize]
             || u as usize >= self.points.len()
             || v as usize >= self.points.len()
+            || self.removed[u as usize]
+            || self.removed[v as usize]
+            || !self.may_collapse(u)
         {
             return Err(Refusal::NotAnEdge);
         }
@@ -1097,7 +1122,7 @@ impl Simplifier {
     }
 
     fn best_cost(&self, u: u32) -> Option<f64> {
-        if self.removed[u as usize] {
+        if self.removed[u as usize] || !self.may_collapse(u) {
             return None;
         }
         // Over the faces rather than the sorted ring (no allocation: this runs for every

@@ -1,0 +1,331 @@
+//! The collapses planned and made in parallel slabs of space, each by its own simplifier, before
+//! the global, cost-ordered ones ([`super::SimplifyOptions::slab_cells`]).
+//!
+//! The surface is cut by lattice planes across its longest axis into slabs holding about equal
+//! numbers of faces. Each slab gets a simplifier of its own ([`Simplifier::slab`]) holding every
+//! face whose box meets the **open** slab `lo < x_a < hi`, and may collapse a vertex only if its
+//! ring's box lies inside the open slab ([`Slab::holds`]). Then the slabs cannot see each other's
+//! changes, so they run at once and the result is the same for every thread count:
+//! - every face a collapse in slab `A` kills or creates lies inside the open slab `A` (its
+//!   vertices are in the ring), and so does every face of a vertex inside it: the faces a
+//!   collapse reads (its own, its target's, their neighbours' lists) are all in `A`'s simplifier,
+//!   and no other slab writes them (the open slabs are disjoint);
+//! - a face that meets a new face of `A` has a point inside the open slab `A`, so it is in `A`'s
+//!   simplifier, and is either `A`'s own or a face no slab can change (one crossing a plane, or
+//!   a face of another slab that only reaches into `A`'s, which that slab may not change either).
+//!
+//! So every check of [`super`] — link, flip, size, distance and the exact intersection test —
+//! holds against the whole surface, as in the global collapses, and the pass over the lattice
+//! diagonals ([`super::lattice_diagonals`]) runs inside each slab as well (slab planes are
+//! lattice planes: a cube meeting the open slab lies in the closed one, and so do its faces).
+//! The slabs collapse, cheapest first, to their share of the target with [`SLAB_SLACK`] to
+//! spare; the global collapses ([`Simplifier::run`]) then finish in global cost order, which
+//! also takes the vertices within a ring of the planes.
+
+use super::{P, Simplifier, SimplifyStats};
+use rayon::prelude::*;
+
+/// Most slabs. Not the thread count: the result must not depend on it. Eight slabs keep two
+/// threads busy to the end (the slabs' collapse counts differ) and leave 7 seams.
+const MAX_SLABS: usize = 8;
+
+/// How far above its share of the target face count a slab stops: the global collapses make
+/// the rest, in one cost order over the whole surface, and reach the vertices along the seams
+/// that no slab could collapse.
+const SLAB_SLACK: f64 = 1.1;
+
+/// The open slab `lo < x[axis] < hi` (fixed point).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct Slab {
+    axis: usize,
+    lo: i64,
+    hi: i64,
+}
+
+impl Slab {
+    /// Whether the box `lo..=hi` lies inside the open slab.
+    pub(super) fn holds(&self, (lo, hi): (P, P)) -> bool {
+        self.lo < lo[self.axis] && hi[self.axis] < self.hi
+    }
+
+    /// Whether the span `lo..=hi` along the slab's axis meets the closed slab.
+    fn meets(&self, (lo, hi): (i64, i64)) -> bool {
+        lo <= self.hi && self.lo <= hi
+    }
+}
+
+/// A slab's simplifier and what it needs to give its work back.
+struct SlabWork {
+    s: Simplifier,
+    /// Global index of each local vertex.
+    global: Vec<u32>,
+    /// Per local face present at the start: whether this slab gives it back (the slab of the
+    /// face's lowest coordinate along the axis; faces no slab may change are given back by
+    /// that one too, unchanged).
+    owned: Vec<bool>,
+}
+
+/// What a slab gives back ([`SlabWork::result`]), in global indices: the rest of its simplifier
+/// is dropped as soon as it is done (at most one per thread is alive).
+struct SlabResult {
+    /// Its live faces, owned or new, and the removed vertices each answers for.
+    faces: Vec<([u32; 3], Vec<u32>)>,
+    /// Its vertices inside the open slab (the only ones that change): removed or not, quadric.
+    vertices: Vec<(u32, bool, [f64; 11])>,
+    stats: SimplifyStats,
+}
+
+impl SlabWork {
+    fn result(self) -> SlabResult {
+        let SlabWork { s, global, owned } = self;
+        let slab = s.slab;
+        let vertices = (0..global.len())
+            .filter(|&x| slab.is_some_and(|slab| slab.holds((s.points[x], s.points[x]))))
+            .map(|x| (global[x], s.removed[x], s.quadric[x]))
+            .collect();
+        let faces = (0..s.faces.len())
+            .filter(|&f| s.alive[f] && owned.get(f).is_none_or(|&o| o))
+            .map(|f| {
+                (
+                    s.faces[f].map(|x| global[x as usize]),
+                    s.support[f].iter().map(|&x| global[x as usize]).collect(),
+                )
+            })
+            .collect();
+        SlabResult {
+            faces,
+            vertices,
+            stats: s.stats,
+        }
+    }
+}
+
+impl Simplifier {
+    /// Whether the collapses of `u` may be made here: always, except in a slab's simplifier,
+    /// where `u`'s ring must lie inside the open slab.
+    pub(super) fn may_collapse(&self, u: u32) -> bool {
+        self.slab.is_none_or(|slab| slab.holds(self.ring_box(u)))
+    }
+
+    /// Collapses in slabs ([`super::SimplifyOptions::slab_cells`] cells thick at least, about
+    /// equal in faces), in parallel: first the lattice diagonals' pass with error bound
+    /// `diagonals` (if any), then the cost-ordered collapses down to each slab's share of
+    /// `target_faces`. Returns `false` (and does nothing) when the surface is too thin for two
+    /// slabs.
+    pub(super) fn collapse_in_slabs(
+        &mut self,
+        slab_cells: u32,
+        target_faces: usize,
+        diagonals: Option<f64>,
+    ) -> bool {
+        let slabs = self.slabs(slab_cells);
+        if slabs.len() < 2 {
+            return false;
+        }
+        let axis = slabs[0].axis;
+        let spans: Vec<(i64, i64)> = self
+            .faces
+            .par_iter()
+            .map(|t| {
+                let c = t.map(|x| self.points[x as usize][axis]);
+                (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]))
+            })
+            .collect();
+        let live = self.alive.iter().filter(|&&a| a).count();
+        let work: Vec<SlabResult> = slabs
+            .par_iter()
+            .map(|slab| {
+                let mut w = self.slab(*slab, &spans);
+                if let Some(max_error) = diagonals {
+                    w.s.collapse_lattice_diagonals(max_error);
+                }
+                // The slab's share of the target by the faces it gives back; the others (in
+                // its simplifier, not its own) count as they are.
+                let owned = w.owned.iter().filter(|&&o| o).count();
+                let target = if target_faces == 0 {
+                    0
+                } else {
+                    let share = target_faces as f64 * owned as f64 / live as f64;
+                    (share * SLAB_SLACK).ceil() as usize + (w.owned.len() - owned)
+                };
+                w.s.run(target);
+                w.result()
+            })
+            .collect();
+        self.merge(work);
+        self.stats.slabs = slabs.len();
+        true
+    }
+
+    /// The slabs for [`Simplifier::collapse_in_slabs`]: across the axis along which the live
+    /// vertices spread most, cut at lattice planes at quantiles of the faces' lowest cells.
+    fn slabs(&self, slab_cells: u32) -> Vec<Slab> {
+        if slab_cells == 0 {
+            return Vec::new();
+        }
+        let mut lo = [i64::MAX; 3];
+        let mut hi = [i64::MIN; 3];
+        for (x, p) in self.points.iter().enumerate() {
+            if !self.removed[x] && !self.vertex_faces[x].is_empty() {
+                for a in 0..3 {
+                    lo[a] = lo[a].min(p[a]);
+                    hi[a] = hi[a].max(p[a]);
+                }
+            }
+        }
+        let Some(axis) = (0..3)
+            .filter(|&a| lo[a] <= hi[a])
+            .max_by_key(|&a| hi[a] - lo[a])
+        else {
+            return Vec::new();
+        };
+        let cells = (hi[axis] - lo[axis]) / self.ticks;
+        let count = ((cells / i64::from(slab_cells)).max(1) as usize).min(MAX_SLABS);
+        if count < 2 {
+            return Vec::new();
+        }
+        let mut lowest: Vec<i64> = self
+            .faces
+            .iter()
+            .zip(&self.alive)
+            .filter(|(_, a)| **a)
+            .map(|(t, _)| {
+                t.iter()
+                    .map(|&x| self.points[x as usize][axis].div_euclid(self.ticks))
+                    .min()
+                    .unwrap_or(0)
+            })
+            .collect();
+        lowest.sort_unstable();
+        // Planes at lattice coordinates (ticks), strictly increasing, inside the surface's span.
+        let mut planes: Vec<i64> = (1..count)
+            .map(|k| lowest[k * lowest.len() / count] * self.ticks)
+            .filter(|&c| lo[axis] < c && c < hi[axis])
+            .collect();
+        planes.dedup();
+        let mut slabs = Vec::with_capacity(planes.len() + 1);
+        let mut below = i64::MIN;
+        for &c in planes.iter().chain(std::iter::once(&i64::MAX)) {
+            slabs.push(Slab {
+                axis,
+                lo: below,
+                hi: c,
+            });
+            below = c;
+        }
+        slabs
+    }
+
+    /// The simplifier of `slab`: the live faces whose spans (`spans`, per face) meet the closed
+    /// slab (a face in a slab plane is in both slabs' and no slab may change it), their vertices
+    /// and the removed vertices they answer for, renumbered in the global order (the
+    /// extraction's, which keeps neighbours near each other in memory).
+    fn slab(&self, slab: Slab, spans: &[(i64, i64)]) -> SlabWork {
+        let mine: Vec<u32> = (0..self.faces.len() as u32)
+            .filter(|&f| self.alive[f as usize] && slab.meets(spans[f as usize]))
+            .collect();
+        let mut local = vec![u32::MAX; self.points.len()];
+        for &f in &mine {
+            let f = f as usize;
+            for &x in self.faces[f].iter().chain(&self.support[f]) {
+                local[x as usize] = 0;
+            }
+        }
+        let mut global: Vec<u32> = Vec::new();
+        for (x, l) in local.iter_mut().enumerate() {
+            if *l == 0 {
+                *l = global.len() as u32;
+                global.push(x as u32);
+            }
+        }
+        let faces: Vec<[u32; 3]> = mine
+            .iter()
+            .map(|&f| self.faces[f as usize].map(|x| local[x as usize]))
+            .collect();
+        let support: Vec<Vec<u32>> = mine
+            .iter()
+            .map(|&f| {
+                self.support[f as usize]
+                    .iter()
+                    .map(|&x| local[x as usize])
+                    .collect()
+            })
+            .collect();
+        let owned: Vec<bool> = mine
+            .iter()
+            .map(|&f| {
+                let lowest = spans[f as usize].0;
+                slab.lo <= lowest && lowest < slab.hi
+            })
+            .collect();
+        let mut vertex_faces = vec![Vec::new(); global.len()];
+        for (f, t) in faces.iter().enumerate() {
+            for &x in t {
+                vertex_faces[x as usize].push(f as u32);
+            }
+        }
+        let s = Simplifier {
+            points: global.iter().map(|&x| self.points[x as usize]).collect(),
+            at: global.iter().map(|&x| self.at[x as usize]).collect(),
+            alive: vec![true; faces.len()],
+            removed: global.iter().map(|&x| self.removed[x as usize]).collect(),
+            quadric: global.iter().map(|&x| self.quadric[x as usize]).collect(),
+            vertex_faces,
+            support,
+            grids: Vec::new(),
+            indexed: false,
+            shift: self.shift,
+            ticks: self.ticks,
+            max_extent: self.max_extent,
+            max_distance2: self.max_distance2,
+            flat_limit: None,
+            slab: Some(slab),
+            stats: SimplifyStats {
+                faces_before: faces.len(),
+                ..SimplifyStats::default()
+            },
+            faces,
+        };
+        SlabWork { s, global, owned }
+    }
+
+    /// Takes back the slabs' work: their removed vertices and merged quadrics, the faces each
+    /// gives back, the counters; the face lists are rebuilt (the spatial index is built on
+    /// first need).
+    fn merge(&mut self, work: Vec<SlabResult>) {
+        let mut faces = Vec::new();
+        let mut support = Vec::new();
+        for w in work {
+            for (g, removed, quadric) in w.vertices {
+                self.removed[g as usize] = removed;
+                self.quadric[g as usize] = quadric;
+            }
+            for (t, s) in w.faces {
+                faces.push(t);
+                support.push(s);
+            }
+            let st = w.stats;
+            self.stats.collapses += st.collapses;
+            self.stats.slab_collapses += st.collapses;
+            self.stats.rounds += st.rounds;
+            self.stats.diagonal_collapses += st.diagonal_collapses;
+            self.stats.diagonals_left += st.diagonals_left;
+            for (a, b) in self.stats.refused.iter_mut().zip(st.refused) {
+                *a += b;
+            }
+        }
+        for list in &mut self.vertex_faces {
+            list.clear();
+        }
+        for (f, t) in faces.iter().enumerate() {
+            for &x in t {
+                self.vertex_faces[x as usize].push(f as u32);
+            }
+        }
+        self.alive = vec![true; faces.len()];
+        self.faces = faces;
+        self.support = support;
+        self.grids = Vec::new();
+        self.indexed = false;
+    }
+}
