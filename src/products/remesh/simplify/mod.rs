@@ -150,11 +150,12 @@ pub struct SimplifyOptions {
     /// planes, in finest cells) of a collapse in that pass; larger ones are left to the
     /// cost-ordered collapses ([`DEFAULT_DIAGONAL_ERROR`] says why).
     pub lattice_diagonal_error: f64,
-    /// Before the global collapses, cut the surface into slabs of at least this many finest
-    /// cells across its longest axis (at most 8, about equal in faces) and collapse inside each
-    /// slab, all slabs at once, each with its own simplifier ([`slabs`]): the same checks and
-    /// guarantees, the work of every slab in parallel and in a smaller memory. The result
-    /// depends on this, not on the thread count. 0: no slabs.
+    /// Before the global collapses, cut the surface across its longest axis into slabs about
+    /// this many finest cells thick (an even number of them, 2 to 8, about equal in faces; none
+    /// if the surface is less than two slabs thick) and collapse inside each slab, all slabs at
+    /// once, each with its own simplifier ([`slabs`]): the same checks and guarantees, the work
+    /// of the slabs in parallel and each in a smaller memory. The result depends on this, not
+    /// on the thread count. 0: no slabs.
     pub slab_cells: u32,
 }
 
@@ -251,13 +252,23 @@ pub fn simplify(
             let diagonals = options
                 .lattice_diagonals
                 .then_some(options.lattice_diagonal_error);
-            if !s.collapse_in_slabs(options.slab_cells, target_faces, diagonals)
+            let flat = target_faces > 0 && options.flat_tolerance > 0.0;
+            // The collapses first in slabs (when the surface is thick enough), then globally
+            // (`slabs` says why the checks are the same).
+            let slabs = s.slabs(options.slab_cells);
+            s.in_slabs(&slabs, |slab, share, foreign| {
+                if let Some(max_error) = diagonals {
+                    slab.collapse_lattice_diagonals(max_error);
+                }
+                slab.run(Simplifier::slab_target(target_faces, share, foreign));
+            });
+            if slabs.is_empty()
                 && let Some(max_error) = diagonals
             {
                 s.collapse_lattice_diagonals(max_error);
             }
             s.run(target_faces);
-            if target_faces > 0 && options.flat_tolerance > 0.0 {
+            if flat {
                 s.run_flat(options.flat_tolerance);
             }
             if options.relocate {

@@ -70,9 +70,15 @@ struct SlabWork {
 struct SlabResult {
     /// Its live faces, owned or new, and the removed vertices each answers for.
     faces: Vec<([u32; 3], Vec<u32>)>,
-    /// Its vertices inside the open slab (the only ones that change): removed or not, quadric.
-    vertices: Vec<(u32, bool, [f64; 11])>,
+    /// Its vertices inside the open slab (the only ones that change).
+    vertices: Vec<(u32, SlabVertex)>,
     stats: SimplifyStats,
+}
+
+/// What a slab may change of a vertex inside it.
+struct SlabVertex {
+    removed: bool,
+    quadric: [f64; 11],
 }
 
 impl SlabWork {
@@ -81,7 +87,13 @@ impl SlabWork {
         let slab = s.slab;
         let vertices = (0..global.len())
             .filter(|&x| slab.is_some_and(|slab| slab.holds((s.points[x], s.points[x]))))
-            .map(|x| (global[x], s.removed[x], s.quadric[x]))
+            .map(|x| {
+                let vertex = SlabVertex {
+                    removed: s.removed[x],
+                    quadric: s.quadric[x],
+                };
+                (global[x], vertex)
+            })
             .collect();
         let faces = (0..s.faces.len())
             .filter(|&f| s.alive[f] && owned.get(f).is_none_or(|&o| o))
@@ -107,22 +119,17 @@ impl Simplifier {
         self.slab.is_none_or(|slab| slab.holds(self.ring_box(u)))
     }
 
-    /// Collapses in slabs ([`super::SimplifyOptions::slab_cells`] cells thick at least, about
-    /// equal in faces), in parallel: first the lattice diagonals' pass with error bound
-    /// `diagonals` (if any), then the cost-ordered collapses down to each slab's share of
-    /// `target_faces`. Returns `false` (and does nothing) when the surface is too thin for two
-    /// slabs.
-    pub(super) fn collapse_in_slabs(
+    /// Runs `work` on every slab's simplifier, all at once, and takes their changes back.
+    /// `work` gets the slab's share of the live faces (those it gives back, over all) and the
+    /// number of faces in its simplifier that are not its own.
+    pub(super) fn in_slabs(
         &mut self,
-        slab_cells: u32,
-        target_faces: usize,
-        diagonals: Option<f64>,
-    ) -> bool {
-        let slabs = self.slabs(slab_cells);
-        if slabs.len() < 2 {
-            return false;
-        }
-        let axis = slabs[0].axis;
+        slabs: &[Slab],
+        work: impl Fn(&mut Simplifier, f64, usize) + Sync,
+    ) {
+        let Some(axis) = slabs.first().map(|s| s.axis) else {
+            return;
+        };
         let spans: Vec<(i64, i64)> = self
             .faces
             .par_iter()
@@ -131,35 +138,33 @@ impl Simplifier {
                 (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]))
             })
             .collect();
-        let live = self.alive.iter().filter(|&&a| a).count();
-        let work: Vec<SlabResult> = slabs
+        let live = self.alive.iter().filter(|&&a| a).count().max(1);
+        let results: Vec<SlabResult> = slabs
             .par_iter()
             .map(|slab| {
                 let mut w = self.slab(*slab, &spans);
-                if let Some(max_error) = diagonals {
-                    w.s.collapse_lattice_diagonals(max_error);
-                }
-                // The slab's share of the target by the faces it gives back; the others (in
-                // its simplifier, not its own) count as they are.
                 let owned = w.owned.iter().filter(|&&o| o).count();
-                let target = if target_faces == 0 {
-                    0
-                } else {
-                    let share = target_faces as f64 * owned as f64 / live as f64;
-                    (share * SLAB_SLACK).ceil() as usize + (w.owned.len() - owned)
-                };
-                w.s.run(target);
+                work(&mut w.s, owned as f64 / live as f64, w.owned.len() - owned);
                 w.result()
             })
             .collect();
-        self.merge(work);
+        self.merge(results);
         self.stats.slabs = slabs.len();
-        true
     }
 
-    /// The slabs for [`Simplifier::collapse_in_slabs`]: across the axis along which the live
+    /// A slab's target: its `share` of `target_faces` with [`SLAB_SLACK`] to spare, plus the
+    /// `foreign` faces it holds and cannot change (0: no target).
+    pub(super) fn slab_target(target_faces: usize, share: f64, foreign: usize) -> usize {
+        if target_faces == 0 {
+            0
+        } else {
+            (target_faces as f64 * share * SLAB_SLACK).ceil() as usize + foreign
+        }
+    }
+
+    /// The slabs for [`Simplifier::in_slabs`] (none if fewer than two): across the axis along which the live
     /// vertices spread most, cut at lattice planes at quantiles of the faces' lowest cells.
-    fn slabs(&self, slab_cells: u32) -> Vec<Slab> {
+    pub(super) fn slabs(&self, slab_cells: u32) -> Vec<Slab> {
         if slab_cells == 0 {
             return Vec::new();
         }
@@ -180,10 +185,13 @@ impl Simplifier {
             return Vec::new();
         };
         let cells = (hi[axis] - lo[axis]) / self.ticks;
-        let count = ((cells / i64::from(slab_cells)).max(1) as usize).min(MAX_SLABS);
-        if count < 2 {
+        // An even count: two threads (or four) end together when the slabs cost about the same
+        // (7 slabs on 2 threads take 4 slabs' time, 8 take 4 as well).
+        let fit = (cells / i64::from(slab_cells)).max(0) as usize;
+        if fit < 2 {
             return Vec::new();
         }
+        let count = (fit + fit % 2).min(MAX_SLABS);
         let mut lowest: Vec<i64> = self
             .faces
             .iter()
@@ -296,9 +304,10 @@ impl Simplifier {
         let mut faces = Vec::new();
         let mut support = Vec::new();
         for w in work {
-            for (g, removed, quadric) in w.vertices {
-                self.removed[g as usize] = removed;
-                self.quadric[g as usize] = quadric;
+            for (g, v) in w.vertices {
+                let g = g as usize;
+                self.removed[g] = v.removed;
+                self.quadric[g] = v.quadric;
             }
             for (t, s) in w.faces {
                 faces.push(t);
