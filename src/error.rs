@@ -188,9 +188,10 @@ impl fmt::Display for LoadErrorKind {
 impl fmt::Display for LoadError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let p = self.path.display();
-        match self.location {
-            Location::File => write!(f, "{p}: {}", self.kind),
-            ref l => write!(f, "{p}: {l}: {}", self.kind),
+        match (&self.location, &self.kind) {
+            // A mesh error names its face or vertex itself.
+            (Location::File, _) | (_, LoadErrorKind::Mesh(_)) => write!(f, "{p}: {}", self.kind),
+            (l, _) => write!(f, "{p}: {l}: {}", self.kind),
         }
     }
 }

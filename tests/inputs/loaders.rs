@@ -119,6 +119,11 @@ fn off_nan_coordinate() {
         "{e}"
     );
     assert_eq!(e.location, Location::Vertex(1));
+    // The file, the vertex, the axis, once each.
+    assert_eq!(
+        e.to_string().rsplit('/').next().unwrap(),
+        "broken_nan.off: vertex 1 has a non-finite coordinate NaN on axis y"
+    );
 }
 
 #[test]

@@ -143,7 +143,7 @@ pub struct SimplifyOptions {
     /// Before the quadric-ordered collapses, remove the vertices that lie on the face and body
     /// diagonals of the lattice's cubes (where the marching-tetrahedra surface of
     /// [`super::extract`] has 70 % of its vertices and marching cubes has none) by collapses
-    /// whose checks stay inside one or two cubes ([`lattice_diagonals`]). Same guarantees, a
+    /// whose checks stay inside one or two cubes (`simplify/lattice_diagonals.rs`). Same guarantees, a
     /// fraction of the time; skipped when the input is not such a surface.
     pub lattice_diagonals: bool,
     /// Largest quadric error (root mean square distance of the kept vertex to the removed one's
@@ -153,7 +153,7 @@ pub struct SimplifyOptions {
     /// Before the global collapses, cut the surface across its longest axis into slabs about
     /// this many finest cells thick (an even number of them, 2 to 8, about equal in faces; none
     /// if the surface is less than two slabs thick) and collapse inside each slab, all slabs at
-    /// once, each with its own simplifier ([`slabs`]): the same checks and guarantees, the work
+    /// once, each with its own simplifier (`simplify/slabs.rs`): the same checks and guarantees, the work
     /// of the slabs in parallel and each in a smaller memory. The result depends on this, not
     /// on the thread count. 0: no slabs.
     pub slab_cells: u32,

@@ -3,21 +3,25 @@
 //!
 //! The surface is cut by lattice planes across its longest axis into slabs holding about equal
 //! numbers of faces. Each slab gets a simplifier of its own ([`Simplifier::slab`]) holding every
-//! face whose box meets the **open** slab `lo < x_a < hi`, and may collapse a vertex only if its
-//! ring's box lies inside the open slab ([`Slab::holds`]). Then the slabs cannot see each other's
-//! changes, so they run at once and the result is the same for every thread count:
+//! face whose box meets the closed slab `lo ≤ x_a ≤ hi`, and may collapse a vertex only if its
+//! ring's box lies inside the **open** slab `lo < x_a < hi` ([`Slab::holds`]). Then the slabs
+//! cannot see each other's changes, so they run at once and the result is the same for every
+//! thread count:
 //! - every face a collapse in slab `A` kills or creates lies inside the open slab `A` (its
-//!   vertices are in the ring), and so does every face of a vertex inside it: the faces a
-//!   collapse reads (its own, its target's, their neighbours' lists) are all in `A`'s simplifier,
-//!   and no other slab writes them (the open slabs are disjoint);
+//!   vertices are in the ring), and every face of a vertex inside it meets it: the faces, lists
+//!   and quadrics a collapse reads (its own, its target's, their neighbours') are all in `A`'s
+//!   simplifier, and no other slab writes them (the open slabs are disjoint);
 //! - a face that meets a new face of `A` has a point inside the open slab `A`, so it is in `A`'s
-//!   simplifier, and is either `A`'s own or a face no slab can change (one crossing a plane, or
-//!   a face of another slab that only reaches into `A`'s, which that slab may not change either).
+//!   simplifier, and is either `A`'s own or a face no slab can change (one reaching outside
+//!   `A`, whose vertices outside no slab's ring may hold while it lies inside `A`).
 //!
 //! So every check of [`super`] — link, flip, size, distance and the exact intersection test —
-//! holds against the whole surface, as in the global collapses, and the pass over the lattice
-//! diagonals ([`super::lattice_diagonals`]) runs inside each slab as well (slab planes are
-//! lattice planes: a cube meeting the open slab lies in the closed one, and so do its faces).
+//! holds against the whole surface, as in the global collapses. The pass over the lattice
+//! diagonals ([`super::lattice_diagonals`]) runs inside each slab as well: slab planes are
+//! lattice planes, so a cube that meets the open slab lies in the closed one and all its faces
+//! are in the slab's simplifier; new faces never touch a slab plane, so the planar graphs the
+//! surface draws on the facets in those planes (the other slab's side of the argument) do not
+//! change; and every slab keeps the pass's invariants by the same rules.
 //! The slabs collapse, cheapest first, to their share of the target with [`SLAB_SLACK`] to
 //! spare; the global collapses ([`Simplifier::run`]) then finish in global cost order, which
 //! also takes the vertices within a ring of the planes.
