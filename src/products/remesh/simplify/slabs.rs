@@ -162,7 +162,7 @@ impl Simplifier {
         if target_faces == 0 {
             0
         } else {
-            (target_faces as f64 * share * SLAB_SLACK).ceil() as usize + foreign
+            ((target_faces as f64 * share * SLAB_SLACK).ceil() as usize).saturating_add(foreign)
         }
     }
 
@@ -340,5 +340,36 @@ impl Simplifier {
         self.support = support;
         self.grids = Vec::new();
         self.indexed = false;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn collapses_stay_inside_the_open_slab_and_faces_of_its_planes_belong_to_both() {
+        let slab = Slab {
+            axis: 1,
+            lo: 16,
+            hi: 32,
+        };
+        let at = |y: i64| [0, y, 0];
+        // Rings strictly inside may collapse; a ring touching a plane may not.
+        assert!(slab.holds((at(17), at(31))));
+        assert!(!slab.holds((at(16), at(20))));
+        assert!(!slab.holds((at(20), at(32))));
+        // Faces meeting the closed slab are in its simplifier, those in a plane included.
+        assert!(slab.meets((32, 32)) && slab.meets((8, 16)) && slab.meets((0, 40)));
+        assert!(!slab.meets((33, 40)) && !slab.meets((0, 15)));
+    }
+
+    #[test]
+    fn a_slab_target_is_its_share_with_slack_plus_what_it_cannot_change() {
+        assert_eq!(Simplifier::slab_target(0, 0.5, 7), 0);
+        assert_eq!(Simplifier::slab_target(1000, 0.25, 7), 275 + 7);
+        // No target (`usize::MAX`) stays out of reach, without overflow.
+        assert_eq!(Simplifier::slab_target(usize::MAX, 1.0, 7), usize::MAX);
+        assert!(Simplifier::slab_target(usize::MAX, 0.5, 7) > usize::MAX / 2);
     }
 }
