@@ -484,6 +484,27 @@ impl gwn::eval::Evaluator for Noise {
     }
 }
 
+/// The marching-tetrahedra surface (res 16, unit box) of noise `seed`: one of four scales and
+/// three bisection depths (vertices anywhere along their edges, at coarse and fine ticks).
+fn noise_surface(seed: i64) -> gwn::products::remesh::Remeshed {
+    let bounds = gwn::BoundingBox {
+        min: [0.0; 3],
+        max: [1.0, 1.0, 1.0],
+    };
+    let options = RemeshOptions {
+        bisection_steps: [8, 3, 5][seed as usize % 3],
+        ..raw(16)
+    };
+    let scale = [23.7, 41.3, 67.1, 97.9][seed as usize % 4];
+    gwn::products::remesh::remesh(&Noise(scale, seed), bounds, &options).unwrap()
+}
+
+/// The topology report of a simplified surface, on its fixed-point coordinates.
+fn report_of(s: &gwn::products::remesh::simplify::Simplified) -> TopologyReport {
+    let positions: Vec<[f64; 3]> = s.points.iter().map(|p| p.map(|c| c as f64)).collect();
+    TopologyReport::of(&positions, &s.triangles)
+}
+
 /// The pass over the lattice diagonals alone (`SimplifyOptions::lattice_diagonals`; no target,
 /// no flat phase, no relocation: nothing else runs) on marching-tetrahedra surfaces of noise
 /// finer than the lattice — every corner labelling, vertices anywhere along their edges, at
@@ -493,10 +514,6 @@ impl gwn::eval::Evaluator for Noise {
 /// nothing.
 #[test]
 fn the_pass_over_lattice_diagonals_keeps_every_guarantee_on_noise() {
-    let bounds = gwn::BoundingBox {
-        min: [0.0; 3],
-        max: [1.0, 1.0, 1.0],
-    };
     // Every collapse the checks allow (no error bound: noise at lattice scale is all sharp
     // edges, which the default bound leaves to the cost-ordered collapses).
     let only_the_pass = SimplifyOptions {
@@ -507,12 +524,7 @@ fn the_pass_over_lattice_diagonals_keeps_every_guarantee_on_noise() {
     };
     let (mut diagonals, mut removed) = (0, 0);
     for seed in 0..12 {
-        let scale = [23.7, 41.3, 67.1, 97.9][seed as usize % 4];
-        let options = RemeshOptions {
-            bisection_steps: [8, 3, 5][seed as usize % 3],
-            ..raw(16)
-        };
-        let out = gwn::products::remesh::remesh(&Noise(scale, seed), bounds, &options).unwrap();
+        let out = noise_surface(seed);
         let s = simplify(
             &out.fixed,
             &out.triangles,
@@ -522,13 +534,7 @@ fn the_pass_over_lattice_diagonals_keeps_every_guarantee_on_noise() {
         );
         assert_eq!(s.stats.collapses, s.stats.diagonal_collapses);
         assert!(is_clean(&s.points, &s.triangles), "seed {seed}");
-        let r = TopologyReport::of(
-            &s.points
-                .iter()
-                .map(|p| p.map(|c| c as f64))
-                .collect::<Vec<_>>(),
-            &s.triangles,
-        );
+        let r = report_of(&s);
         assert_closed_manifold(&r);
         diagonals += s.stats.diagonal_collapses + s.stats.diagonals_left;
         removed += s.stats.diagonal_collapses;
@@ -543,10 +549,6 @@ fn the_pass_over_lattice_diagonals_keeps_every_guarantee_on_noise() {
 /// this thin are within a ring of a plane), which the global ones finish.
 #[test]
 fn collapses_in_slabs_keep_every_guarantee_on_noise() {
-    let bounds = gwn::BoundingBox {
-        min: [0.0; 3],
-        max: [1.0, 1.0, 1.0],
-    };
     let options = SimplifyOptions {
         max_distance: 1.5,
         flat_tolerance: 0.0,
@@ -556,23 +558,12 @@ fn collapses_in_slabs_keep_every_guarantee_on_noise() {
     };
     let (mut collapses, mut in_slabs) = (0, 0);
     for seed in 0..8 {
-        let scale = [23.7, 41.3, 67.1, 97.9][seed as usize % 4];
-        let raw_options = RemeshOptions {
-            bisection_steps: [8, 3, 5][seed as usize % 3],
-            ..raw(16)
-        };
-        let out = gwn::products::remesh::remesh(&Noise(scale, seed), bounds, &raw_options).unwrap();
+        let out = noise_surface(seed);
         let before = TopologyReport::of(&out.positions, &out.triangles);
         let s = simplify(&out.fixed, &out.triangles, out.ticks_per_cell, &options, 0);
         assert!(s.stats.slabs >= 6, "seed {seed}: {:?}", s.stats);
         assert!(is_clean(&s.points, &s.triangles), "seed {seed}");
-        let r = TopologyReport::of(
-            &s.points
-                .iter()
-                .map(|p| p.map(|c| c as f64))
-                .collect::<Vec<_>>(),
-            &s.triangles,
-        );
+        let r = report_of(&s);
         assert_closed_manifold(&r);
         assert_eq!(
             (r.euler_characteristic, r.components),
