@@ -252,7 +252,6 @@ pub fn simplify(
             let diagonals = options
                 .lattice_diagonals
                 .then_some(options.lattice_diagonal_error);
-            let flat = target_faces > 0 && options.flat_tolerance > 0.0;
             // The collapses first in slabs (when the surface is thick enough), then globally
             // (`slabs` says why the checks are the same).
             let slabs = s.slabs(options.slab_cells);
@@ -268,7 +267,7 @@ pub fn simplify(
                 s.collapse_lattice_diagonals(max_error);
             }
             s.run(target_faces);
-            if flat {
+            if target_faces > 0 && options.flat_tolerance > 0.0 {
                 s.run_flat(options.flat_tolerance);
             }
             if options.relocate {
@@ -598,6 +597,10 @@ impl Simplifier {
         cubes: Option<&lattice_diagonals::CubeFaces>,
     ) -> (Option<Plan>, [usize; 5]) {
         let mut refused = [0; 5];
+        // Once per vertex, not per target: the ring does not depend on the target.
+        if !self.may_collapse(u) {
+            return (None, refused);
+        }
         let ring = self.neighbours(u);
         let mut candidates: Vec<(u64, u32)> = ring
             .iter()
@@ -921,7 +924,7 @@ impl Simplifier {
     }
 
     fn plan(&self, u: u32, v: u32) -> Result<Plan, Refusal> {
-        if u as usize >= self.points.len() {
+        if u as usize >= self.points.len() || !self.may_collapse(u) {
             return Err(Refusal::NotAnEdge);
         }
         self.plan_with_ring(u, v, &self.neighbours(u), None)
@@ -942,7 +945,6 @@ impl Simplifier {
             || v as usize >= self.points.len()
             || self.removed[u as usize]
             || self.removed[v as usize]
-            || !self.may_collapse(u)
         {
             return Err(Refusal::NotAnEdge);
         }
