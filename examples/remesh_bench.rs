@@ -82,6 +82,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 &wn,
                 &lattice,
                 &band.edges,
+                &classified.edge_values(&band.edges),
                 DEFAULT_BISECTION_STEPS,
                 if guided { Some(&guide) } else { None },
             );

@@ -44,6 +44,7 @@ fn build(mesh_path: &PathBuf, res: usize) -> Result<Surface, Box<dyn std::error:
         &wn,
         &lattice,
         &band.edges,
+        &classified.edge_values(&band.edges),
         DEFAULT_BISECTION_STEPS,
         Some(&guide),
     );

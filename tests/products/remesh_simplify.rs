@@ -539,7 +539,9 @@ fn the_pass_over_lattice_diagonals_keeps_every_guarantee_on_noise() {
         diagonals += s.stats.diagonal_collapses + s.stats.diagonals_left;
         removed += s.stats.diagonal_collapses;
     }
-    assert!(removed * 10 > diagonals * 8, "{removed} of {diagonals}");
+    // 78.8 % (80.3 % when placement bisected every edge: vertices next to the border corners
+    // now sit elsewhere on their edges).
+    assert!(removed * 4 > diagonals * 3, "{removed} of {diagonals}");
 }
 
 /// Lattice-scale noise (as above) simplified as far as the checks allow, in slabs two cells

@@ -19,9 +19,11 @@
 //!    closed 2-manifold, with no ambiguous case.
 //! 4. [`place`]: each output vertex moves along its lattice edge to where `w` crosses `½`:
 //!    at the edge's crossing with the input triangles ([`crossings`], with [`remesh_guided`])
-//!    once two evaluations confirm it, else by bisection (a fixed number of steps); `w` jumps
-//!    across a sheet, so linear interpolation of `w` would misplace it. Vertices stay strictly
-//!    inside their edges, which is all the no-self-intersection argument needs.
+//!    once two evaluations confirm it (several crossings are told apart by evaluations between
+//!    them), else by a bracketed search on the field (ITP: regula falsi where `w` is smooth,
+//!    bisection's count at worst); `w` jumps across a sheet, so linear interpolation of `w`
+//!    alone would misplace it. Vertices stay strictly inside their edges, which is all the
+//!    no-self-intersection argument needs.
 //! 5. [`simplify`] (on by default, [`RemeshOptions::simplify`]): half-edge collapses on the
 //!    exact fixed-point vertices that refuse any collapse that would break the manifold (link
 //!    condition), flip a face, move a removed vertex farther than a tolerance, or make two faces
@@ -66,8 +68,9 @@ use crate::eval::antipodal::WindingNumber;
 /// Largest accepted `--res`: lattice coordinates are packed in 20 bits per axis.
 pub const MAX_RESOLUTION: usize = 1 << 16;
 
-/// Default number of bisection steps per output vertex (the vertex is then within
-/// `edge length / 2^(steps+1)` of a point where the class changes).
+/// Default vertex precision, in bisection steps: each vertex is within
+/// `edge length / 2^(steps+1)` of a point where the class changes (the placement spends about
+/// half as many evaluations where `w` is smooth, 1–2 at a verified crossing).
 pub const DEFAULT_BISECTION_STEPS: u32 = 8;
 
 /// Largest accepted number of bisection steps (beyond it the interval is below `f64` spacing
@@ -85,7 +88,9 @@ pub struct RemeshOptions {
     /// Finest equivalent resolution: cells of edge `h = longest extent / res`, and at least
     /// `res / 4` cells across every axis of the box ([`lattice::THIN_AXIS_DIVISOR`]).
     pub resolution: usize,
-    /// Bisection steps per output vertex (0: the midpoint of the lattice edge).
+    /// Vertex precision in bisection steps: within `edge / 2^(steps+1)` of a class change (0:
+    /// the midpoint of the lattice edge). What bisection alone would need per vertex; the
+    /// placement ([`place`]) usually needs fewer.
     pub bisection_steps: u32,
     /// Most lattice points to classify before giving up with [`RemeshError::OutOfMemory`];
     /// `None`: the memory available ([`crate::grid::available_memory`]) over
@@ -187,9 +192,9 @@ pub struct RemeshStats {
     pub split_cells: usize,
     /// Finest cells with differing corner classes (the band that is extracted).
     pub band_cells: usize,
-    /// Evaluations spent on vertex placement (verifications and bisection).
+    /// Evaluations spent on vertex placement (verifications and the field search).
     pub placement_evaluations: usize,
-    /// Vertices placed at a verified crossing with the input triangles (no bisection).
+    /// Vertices placed at a verified crossing with the input triangles (no field search).
     pub guided_vertices: usize,
     /// Triangles of the marching-tetrahedra surface (before simplification).
     pub extracted_faces: usize,
@@ -268,8 +273,8 @@ impl RemeshPhase {
 
 /// [`remesh`], with the input triangles (`guide`) proposing where each vertex goes: a lattice
 /// edge that crosses them once gets its vertex at the crossing after two evaluations of `w`
-/// confirm the class change there, instead of `bisection_steps` evaluations (see
-/// [`place`]). Every octree cell that a triangle of `guide` meets is also refined to the finest
+/// confirm the class change there, instead of a search on the field (up to `bisection_steps`
+/// evaluations; see [`place`]). Every octree cell that a triangle of `guide` meets is also refined to the finest
 /// level: when `w` jumps only across the guide's triangles (a closed input as its own guide),
 /// every finest lattice point is labelled by its true class, so no part of the solid holding a
 /// finest lattice point is lost. The output's guarantees and the vertex precision are those of
@@ -334,6 +339,7 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
         evaluator,
         &lattice,
         &band.edges,
+        &classified.edge_values(&band.edges),
         options.bisection_steps,
         guide,
     );

@@ -35,11 +35,37 @@ use crate::grid::{GridSpec, evaluate};
 /// An octree cell: level (`2^level` finest cells wide) and packed minimum corner.
 pub type Cell = (u32, u64);
 
+/// A classified corner: its class and the `w` that decided it.
+#[derive(Clone, Copy, Debug)]
+pub struct CornerValue {
+    /// `w > ½` (border corners: `false`).
+    pub inside: bool,
+    /// `w` rounded to `f32`; NaN at border corners, which are declared outside, never
+    /// evaluated. Only placement's interpolation reads it; the class is `inside`, which the
+    /// rounding could flip next to ½. (The pair takes the 16 bytes a hash entry of a `u64` key
+    /// and a `bool` took already.)
+    pub w: f32,
+}
+
+impl CornerValue {
+    fn of(w: f64) -> CornerValue {
+        CornerValue {
+            inside: w > 0.5,
+            w: w as f32,
+        }
+    }
+
+    const BORDER: CornerValue = CornerValue {
+        inside: false,
+        w: f32::NAN,
+    };
+}
+
 /// The classification of a lattice.
 #[derive(Debug, Default)]
 pub struct Classified {
-    /// `w > ½` at every classified corner (packed key); border corners are `false`.
-    pub labels: KeyMap<bool>,
+    /// Every classified corner (packed key).
+    pub labels: KeyMap<CornerValue>,
     /// The cells that were split.
     pub split: KeySet<Cell>,
     /// Minimum corners of the finest cells whose corners differ.
@@ -50,7 +76,23 @@ impl Classified {
     /// The class of a classified corner (`false` when it was never classified; callers only ask
     /// about classified ones).
     pub fn label(&self, c: Corner) -> bool {
-        self.labels.get(&pack(c)).copied().unwrap_or(false)
+        self.labels.get(&pack(c)).is_some_and(|v| v.inside)
+    }
+
+    /// `w` at a classified corner (NaN at border corners, and at unclassified ones, which
+    /// callers never ask about).
+    pub fn value(&self, c: Corner) -> f64 {
+        self.labels
+            .get(&pack(c))
+            .map_or(f64::NAN, |v| f64::from(v.w))
+    }
+
+    /// `w` at both corners of each edge, for [`super::place::place_vertices`].
+    pub fn edge_values(&self, edges: &[(Corner, Corner)]) -> Vec<[f64; 2]> {
+        edges
+            .par_iter()
+            .map(|&(i, o)| [self.value(i), self.value(o)])
+            .collect()
     }
 
     /// The leaf holding the finest cell with minimum corner `c`.
@@ -79,8 +121,8 @@ impl Classified {
                         continue;
                     }
                     let p = [m[0] + dx, m[1] + dy, m[2] + dz];
-                    if let Some(&l) = self.labels.get(&pack(p)) {
-                        if l != first {
+                    if let Some(v) = self.labels.get(&pack(p)) {
+                        if v.inside != first {
                             return true;
                         }
                     }
@@ -151,8 +193,12 @@ pub fn classify<E: Evaluator + ?Sized>(
         for j in 0..dims[1] {
             for i in 0..dims[0] {
                 let c = [i, j, k].map(|x| x as u32 * coarse);
-                let inside = !lattice.is_border(c) && values[spec.index(i, j, k)] > 0.5;
-                out.labels.insert(pack(c), inside);
+                let value = if lattice.is_border(c) {
+                    CornerValue::BORDER
+                } else {
+                    CornerValue::of(values[spec.index(i, j, k)])
+                };
+                out.labels.insert(pack(c), value);
             }
         }
     }
@@ -223,10 +269,10 @@ pub fn classify<E: Evaluator + ?Sized>(
             .collect();
         let values = evaluator.eval_batch(&positions);
         for &p in &new_points {
-            out.labels.insert(pack(p), false);
+            out.labels.insert(pack(p), CornerValue::BORDER);
         }
         for (p, w) in interior.iter().zip(values) {
-            out.labels.insert(pack(*p), w > 0.5);
+            out.labels.insert(pack(*p), CornerValue::of(w));
         }
         // (2) new children whose closed box is mixed or that a triangle meets.
         let mut next: Vec<(u32, Corner)> = cells

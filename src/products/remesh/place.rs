@@ -10,14 +10,21 @@
 //! final bracket strictly between the corners (`1 ≤ k ≤ T − 1`), which keeps every triangle inside
 //! its tetrahedron (the no-self-intersection argument of `docs/remesh.md` needs nothing else).
 //! The final bracket is at most 2 ticks wide, so the vertex is within one tick,
-//! `|edge| / 2^(steps+1)`, of a point where the class changes. Two ways to get there:
-//! - **bisection**: `steps` evaluations from `[0, T]`;
-//! - **guided** (when the input triangles are given): the segment's crossings with the input
-//!   triangles ([`SegmentBvh`]); when they round to one tick `k`, two evaluations at `k − 1` and
-//!   `k + 1` (fewer at a corner, whose class is known) *verify* it. If the verification fails,
-//!   the half whose ends still differ is bisected, so a wrong proposal costs evaluations, never
-//!   the guarantee. Several crossings (thin parts, double walls) or none (`w` crossing `½` away
-//!   from the triangles, at a hole) fall back to bisection.
+//! `|edge| / 2^(steps+1)`, of a point where the class changes. Every evaluation is at a tick
+//! strictly inside the bracket and only ever narrows it, so how a probe is chosen costs
+//! evaluations, never the guarantee. Rounds of probes, one parallel batch each, choose per edge:
+//! - **a crossing** (when the input triangles are given): the segment's crossings with the
+//!   input triangles ([`SegmentBvh`]), rounded to ticks, are where `w` may jump. With one of
+//!   them, `k`, inside the bracket, two evaluations at `k − 1` and `k + 1` (fewer next to a
+//!   known end) *verify* it; with several (thin parts, double walls), one evaluation between the
+//!   middle two says on which side of it the change is. A crossing that does not verify leaves
+//!   the bracket on one side of it.
+//! - **the field** (no crossing inside the bracket: a hole, an inconsistently oriented sheet, a
+//!   point cloud): away from the triangles `w` is harmonic, hence smooth, and the bracket's ends
+//!   carry its values (the corners' from [`super::octree`]), so the probe is the ITP step
+//!   (interpolate, truncate, project; Oliveira & Takahashi 2020) on `w − ½`: regula falsi where
+//!   `w` is smooth, and never more than one evaluation over bisection's count where it is not.
+//!   Across a closed sheet (`w` = 1 and 0 at the ends) regula falsi *is* bisection.
 //!
 //! Ticks are dyadic, so each vertex is exact in fixed point: lattice units times `T`
 //! ([`Placement::fixed`]), which the exact self-intersection check of [`super::intersect`] uses.
@@ -27,6 +34,13 @@ use rayon::prelude::*;
 use super::crossings::SegmentBvh;
 use super::lattice::{Corner, Lattice};
 use crate::eval::Evaluator;
+
+/// ITP's truncation constant `κ1`, times the bracket's width when the field steps begin (the
+/// paper's suggested `0.2 / (b − a)`).
+const ITP_KAPPA1_WIDTHS: f64 = 0.2;
+
+/// ITP's slack `n0`: evaluations allowed over bisection's count per edge.
+const ITP_SLACK: u32 = 1;
 
 /// Placed vertices.
 #[derive(Clone, Debug, Default)]
@@ -39,131 +53,241 @@ pub struct Placement {
     pub ticks_per_cell: i64,
     /// Evaluations of `w` spent.
     pub evaluations: usize,
-    /// Vertices placed by a verified crossing (no bisection).
+    /// Vertices placed by a verified crossing.
     pub guided: usize,
 }
 
+/// One edge's search: the bracket, `w` at its ends, and the ITP state.
+#[derive(Clone, Copy, Debug)]
+struct Search {
+    /// Highest tick known inside.
+    lo: i64,
+    /// Lowest tick known outside.
+    hi: i64,
+    w_lo: f64,
+    w_hi: f64,
+    /// Field steps made.
+    itp_steps: u32,
+    /// Field steps allowed before bisection (set at the first field step).
+    itp_budget: u32,
+    /// Bracket width at the first field step.
+    itp_width: i64,
+    /// The bracket closed on a verified crossing.
+    verified: bool,
+}
+
+impl Search {
+    fn is_open(&self) -> bool {
+        self.hi - self.lo > 2
+    }
+
+    /// A probe's answer: it narrows the bracket when it lies inside it (a verification pair's
+    /// second probe may not, after the first moved `hi` past it).
+    fn narrow(&mut self, tick: i64, w: f64) {
+        if self.lo < tick && tick < self.hi {
+            if w > 0.5 {
+                (self.lo, self.w_lo) = (tick, w);
+            } else {
+                (self.hi, self.w_hi) = (tick, w);
+            }
+        }
+    }
+
+    /// The ITP probe (ε = 1 tick: bisection closes the bracket to 2 ticks in
+    /// `⌈log2(width / 2)⌉` steps).
+    fn field_probe(&mut self) -> i64 {
+        let (lo, hi) = (self.lo, self.hi);
+        if self.w_hi.is_nan() {
+            // A border corner: outside by declaration, `w` there unknown (and often above ½:
+            // then the change is at the corner, and a bisection would spend every step getting
+            // there). One probe next to it settles that case, and gives the field's value
+            // there for the other, where the ITP steps start afresh.
+            return hi - 1;
+        }
+        let width = (hi - lo) as f64;
+        if self.itp_steps == 0 {
+            self.itp_width = hi - lo;
+            self.itp_budget = (width / 2.0).log2().ceil() as u32 + ITP_SLACK;
+        }
+        let half = 0.5 * (lo + hi) as f64;
+        let x = if self.itp_steps >= self.itp_budget {
+            half
+        } else {
+            // w_lo > ½ ≥ w_hi, so the denominator is positive.
+            let (y_lo, y_hi) = (self.w_lo - 0.5, self.w_hi - 0.5);
+            let falsi = lo as f64 + y_lo / (y_lo - y_hi) * width;
+            if !falsi.is_finite() {
+                half
+            } else {
+                let sigma = (half - falsi).signum();
+                let delta = ITP_KAPPA1_WIDTHS / self.itp_width as f64 * width * width;
+                let truncated = if delta <= (half - falsi).abs() {
+                    falsi + sigma * delta
+                } else {
+                    half
+                };
+                let radius = (f64::from(1u32 << (self.itp_budget - self.itp_steps).min(31))
+                    - 0.5 * width)
+                    .max(0.0);
+                if (truncated - half).abs() <= radius {
+                    truncated
+                } else {
+                    half - sigma * radius
+                }
+            }
+        };
+        self.itp_steps += 1;
+        // The end game: with the estimate within 2 ticks of an end, a probe 2 ticks from that
+        // end closes the bracket if the estimate is right (rounding the estimate would move
+        // the near end again and leave the far one for another probe).
+        let probe = if x - (lo as f64) < 2.0 {
+            lo + 2
+        } else if (hi as f64) - x < 2.0 {
+            hi - 2
+        } else {
+            x.round() as i64
+        };
+        probe.clamp(lo + 1, hi - 1)
+    }
+}
+
 /// Positions of the vertices on `edges` (inside corner, outside corner), within one tick
-/// (`|edge| / 2^(steps+1)`) of a class change; `guide` proposes crossings (see the module
-/// documentation).
+/// (`|edge| / 2^(steps+1)`) of a class change; `corner_w` is `w` at each edge's two corners
+/// (the first above ½, the second not or NaN for a corner declared outside without an
+/// evaluation; only the number of evaluations depends on them), and `guide` proposes crossings
+/// (see the module documentation).
 pub fn place_vertices<E: Evaluator + ?Sized>(
     evaluator: &E,
     lattice: &Lattice,
     edges: &[(Corner, Corner)],
+    corner_w: &[[f64; 2]],
     steps: u32,
     guide: Option<&SegmentBvh>,
 ) -> Placement {
+    assert_eq!(edges.len(), corner_w.len());
     let ticks: i64 = 1 << (steps + 1);
     let at = |(i, o): (Corner, Corner), k: i64| -> [f64; 3] {
         let t = k as f64 / ticks as f64;
         lattice
             .position([0, 1, 2].map(|a| f64::from(i[a]) + t * (f64::from(o[a]) - f64::from(i[a]))))
     };
+    // Each edge's crossing ticks, sorted and distinct, as ranges of one list.
+    let (crossings, crossing_ranges): (Vec<i64>, Vec<(u32, u32)>) =
+        match guide.filter(|b| !b.is_empty()) {
+            None => (Vec::new(), vec![(0, 0); edges.len()]),
+            Some(bvh) => {
+                let per_edge: Vec<Vec<i64>> = edges
+                    .par_iter()
+                    .map_init(Vec::new, |hits, &e| {
+                        hits.clear();
+                        bvh.crossings(at(e, 0), at(e, ticks), hits);
+                        let mut ks: Vec<i64> = hits
+                            .iter()
+                            .map(|&t| ((t * ticks as f64).round() as i64).clamp(1, ticks - 1))
+                            .collect();
+                        ks.sort_unstable();
+                        ks.dedup();
+                        ks
+                    })
+                    .collect();
+                let mut all = Vec::with_capacity(per_edge.iter().map(Vec::len).sum());
+                let ranges = per_edge
+                    .into_iter()
+                    .map(|ks| {
+                        let first = all.len() as u32;
+                        all.extend(ks);
+                        (first, all.len() as u32)
+                    })
+                    .collect();
+                (all, ranges)
+            }
+        };
+    let mut searches: Vec<Search> = corner_w
+        .iter()
+        .map(|&[w_lo, w_hi]| Search {
+            lo: 0,
+            hi: ticks,
+            w_lo,
+            w_hi,
+            itp_steps: 0,
+            itp_budget: 0,
+            itp_width: ticks,
+            verified: false,
+        })
+        .collect();
     let mut evaluations = 0;
-    let mut guided = 0;
-    // Brackets (lo inside, hi outside) in ticks.
-    let mut bracket: Vec<(i64, i64)> = vec![(0, ticks); edges.len()];
-    if let Some(bvh) = guide.filter(|b| !b.is_empty()) {
-        // The proposed tick per edge, when the crossings round to a single one.
-        let proposal: Vec<Option<i64>> = edges
-            .par_iter()
-            .map_init(Vec::new, |hits, &e| {
-                hits.clear();
-                bvh.crossings(at(e, 0), at(e, ticks), hits);
-                let mut ks = hits
-                    .iter()
-                    .map(|&t| ((t * ticks as f64).round() as i64).clamp(1, ticks - 1));
-                let k = ks.next()?;
-                ks.all(|x| x == k).then_some(k)
-            })
-            .collect();
-        // One batch of the verification points; `None` where a corner's class is known.
-        let mut points = Vec::new();
-        let mut slots: Vec<(usize, bool)> = Vec::new();
-        for (j, (&e, p)) in edges.iter().zip(&proposal).enumerate() {
-            if let Some(k) = *p {
-                if k - 1 > 0 {
-                    points.push(at(e, k - 1));
-                    slots.push((j, false));
-                }
-                if k + 1 < ticks {
-                    points.push(at(e, k + 1));
-                    slots.push((j, true));
-                }
-            }
-        }
-        let w = evaluator.eval_batch(&points);
-        evaluations += points.len();
-        // Per edge: (below proposal is inside, above proposal is outside).
-        let mut verdict: Vec<(bool, bool)> = vec![(true, true); edges.len()];
-        for (&(j, above), w) in slots.iter().zip(w) {
-            if above {
-                verdict[j].1 = w <= 0.5;
-            } else {
-                verdict[j].0 = w > 0.5;
-            }
-        }
-        for ((b, p), v) in bracket.iter_mut().zip(&proposal).zip(&verdict) {
-            let Some(k) = *p else { continue };
-            *b = match *v {
-                (true, true) => {
-                    guided += 1;
-                    (k - 1, k + 1)
-                }
-                // Tick k − 1 is outside: the class changes in [0, k − 1].
-                (false, _) => (0, k - 1),
-                // Tick k + 1 is inside: the class changes in [k + 1, T].
-                (true, false) => (k + 1, ticks),
-            };
-        }
-    }
-    // Bisection of every bracket wider than 2 ticks, one parallel batch per round.
+    let mut probes: Vec<(u32, i64)> = Vec::new();
     loop {
-        let open: Vec<usize> = (0..edges.len())
-            .filter(|&j| bracket[j].1 - bracket[j].0 > 2)
-            .collect();
-        if open.is_empty() {
+        probes.clear();
+        for (j, s) in searches.iter_mut().enumerate() {
+            if !s.is_open() {
+                continue;
+            }
+            let (first, end) = crossing_ranges[j];
+            let ks = &crossings[first as usize..end as usize];
+            // The crossings strictly inside the bracket.
+            let a = ks.partition_point(|&k| k <= s.lo);
+            let b = ks.partition_point(|&k| k < s.hi);
+            let inside = &ks[a..b];
+            let j = j as u32;
+            match inside.len() {
+                0 => probes.push((j, s.field_probe())),
+                1 => {
+                    let k = inside[0];
+                    if k - 1 > s.lo {
+                        probes.push((j, k - 1));
+                    }
+                    if k + 1 < s.hi {
+                        probes.push((j, k + 1));
+                    }
+                }
+                n => {
+                    let (left, right) = (inside[n / 2 - 1], inside[n / 2]);
+                    probes.push((j, ((left + right) / 2).clamp(s.lo + 1, s.hi - 1)));
+                }
+            }
+        }
+        if probes.is_empty() {
             break;
         }
-        let mids: Vec<[f64; 3]> = open
+        let points: Vec<[f64; 3]> = probes
             .par_iter()
-            .map(|&j| {
-                let (lo, hi) = bracket[j];
-                at(edges[j], (lo + hi) / 2)
-            })
+            .map(|&(j, k)| at(edges[j as usize], k))
             .collect();
-        let w = evaluator.eval_batch(&mids);
-        evaluations += mids.len();
-        for (&j, w) in open.iter().zip(w) {
-            let (lo, hi) = &mut bracket[j];
-            let mid = (*lo + *hi) / 2;
-            if w > 0.5 {
-                *lo = mid;
-            } else {
-                *hi = mid;
+        let w = evaluator.eval_batch(&points);
+        evaluations += points.len();
+        for (&(j, k), w) in probes.iter().zip(w) {
+            let s = &mut searches[j as usize];
+            let was_open = s.is_open();
+            s.narrow(k, w);
+            // Closed by a probe next to a crossing: the crossing is verified.
+            if was_open && !s.is_open() {
+                let (first, end) = crossing_ranges[j as usize];
+                let ks = &crossings[first as usize..end as usize];
+                s.verified = s.hi - s.lo == 2 && ks.binary_search(&(s.lo + 1)).is_ok();
             }
         }
     }
     // The vertex tick: the middle of a 2-tick bracket, else the end that is not a corner.
-    let tick = |(lo, hi): (i64, i64)| -> i64 {
-        if hi - lo == 2 {
-            lo + 1
-        } else if lo > 0 {
-            lo
+    let tick = |s: &Search| -> i64 {
+        if s.hi - s.lo == 2 {
+            s.lo + 1
+        } else if s.lo > 0 {
+            s.lo
         } else {
-            hi
+            s.hi
         }
     };
     let positions = edges
         .par_iter()
-        .zip(&bracket)
-        .map(|(&e, &b)| at(e, tick(b)))
+        .zip(&searches)
+        .map(|(&e, s)| at(e, tick(s)))
         .collect();
     let fixed = edges
         .par_iter()
-        .zip(&bracket)
-        .map(|(&(i, o), &b)| {
-            let k = tick(b);
+        .zip(&searches)
+        .map(|(&(i, o), s)| {
+            let k = tick(s);
             [0, 1, 2].map(|a| i64::from(i[a]) * ticks + k * (i64::from(o[a]) - i64::from(i[a])))
         })
         .collect();
@@ -172,6 +296,241 @@ pub fn place_vertices<E: Evaluator + ?Sized>(
         fixed,
         ticks_per_cell: ticks,
         evaluations,
-        guided,
+        guided: searches.iter().filter(|s| s.verified).count(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::base::bounding_box::BoundingBox;
+
+    /// A field given by a closure.
+    struct Field<F>(F);
+
+    impl<F: Fn([f64; 3]) -> f64 + Send + Sync> Evaluator for Field<F> {
+        fn eval(&self, q: [f64; 3]) -> f64 {
+            (self.0)(q)
+        }
+    }
+
+    const STEPS: u32 = 8;
+    const TICKS: i64 = 1 << (STEPS + 1);
+
+    /// The unit cube in 8 cells: lattice units are eighths, corner `[0, 0, 0]` at the origin
+    /// less a coarse margin.
+    fn lattice() -> Lattice {
+        let bounds = BoundingBox {
+            min: [0.0; 3],
+            max: [1.0; 3],
+        };
+        Lattice::new(bounds, 8).unwrap()
+    }
+
+    /// Every lattice edge (either direction of the 8³ cells around the cube) whose corner
+    /// classes differ, inside corner first, with `w` at its corners.
+    fn band_edges<E: Evaluator>(field: &E, lattice: &Lattice) -> Vec<((Corner, Corner), [f64; 2])> {
+        let mut out = Vec::new();
+        let n = lattice.cells.map(|c| c as u32);
+        for z in 0..n[2] {
+            for y in 0..n[1] {
+                for x in 0..n[0] {
+                    let a = [x, y, z];
+                    for axis in 0..3 {
+                        let mut b = a;
+                        b[axis] += 1;
+                        let (wa, wb) = (
+                            field.eval(lattice.corner_position(a)),
+                            field.eval(lattice.corner_position(b)),
+                        );
+                        match (wa > 0.5, wb > 0.5) {
+                            (true, false) => out.push(((a, b), [wa, wb])),
+                            (false, true) => out.push(((b, a), [wb, wa])),
+                            _ => {}
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// The guarantee: the vertex's tick and a tick next to it hold both classes (ticks 0 and
+    /// `T` by their corners' declared classes).
+    fn assert_within_a_tick_of_a_change<E: Evaluator>(
+        field: &E,
+        lattice: &Lattice,
+        (i, o): (Corner, Corner),
+        fixed: [i64; 3],
+    ) {
+        let axis = (0..3).find(|&a| i[a] != o[a]).unwrap();
+        let k = (fixed[axis] - i64::from(i[axis]) * TICKS).abs();
+        assert!(
+            (1..TICKS).contains(&k),
+            "tick {k} not strictly inside the edge"
+        );
+        let inside = |t: i64| {
+            if t == 0 {
+                return true;
+            }
+            if t == TICKS {
+                return false;
+            }
+            let s = t as f64 / TICKS as f64;
+            let p = [0, 1, 2].map(|a| f64::from(i[a]) + s * (f64::from(o[a]) - f64::from(i[a])));
+            field.eval(lattice.position(p)) > 0.5
+        };
+        let classes = [inside(k - 1), inside(k), inside(k + 1)];
+        assert!(
+            classes.contains(&true) && classes.contains(&false),
+            "no class change within a tick of tick {k} on {i:?} → {o:?}: {classes:?}"
+        );
+    }
+
+    /// Places each edge alone (so that its evaluations are its own) and checks the guarantee;
+    /// returns the evaluations per edge.
+    fn place_one_by_one<E: Evaluator>(
+        field: &E,
+        lattice: &Lattice,
+        edges: &[((Corner, Corner), [f64; 2])],
+        guide: Option<&SegmentBvh>,
+    ) -> Vec<usize> {
+        edges
+            .iter()
+            .map(|&(e, w)| {
+                let p = place_vertices(field, lattice, &[e], &[w], STEPS, guide);
+                assert_within_a_tick_of_a_change(field, lattice, e, p.fixed[0]);
+                p.evaluations
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_smooth_field_takes_three_fifths_of_bisections_evaluations_or_fewer() {
+        // A smooth bump, `w = ½` on the sphere of radius 0.35 about the cube's centre.
+        let field = Field(|q: [f64; 3]| {
+            let r2: f64 = q.iter().map(|x| (x - 0.5) * (x - 0.5)).sum();
+            1.0 / (1.0 + r2 / (0.35 * 0.35))
+        });
+        let lattice = lattice();
+        let edges = band_edges(&field, &lattice);
+        assert!(edges.len() > 100, "{}", edges.len());
+        let evaluations = place_one_by_one(&field, &lattice, &edges, None);
+        let total: usize = evaluations.iter().sum();
+        // 4.6 per edge here, against bisection's 8 (the first step is nearly always the
+        // midpoint: ITP's truncation hedges against a poor interpolation).
+        let bisection = STEPS as usize * edges.len();
+        assert!(
+            5 * total <= 3 * bisection,
+            "{total} evaluations for {} edges (bisection: {bisection})",
+            edges.len()
+        );
+        // All at once gives the same vertices as one by one (each edge's search is its own).
+        let (e, w): (Vec<_>, Vec<_>) = edges.iter().copied().unzip();
+        let together = place_vertices(&field, &lattice, &e, &w, STEPS, None);
+        assert_eq!(together.evaluations, total);
+        for (&edge, &fixed) in e.iter().zip(&together.fixed) {
+            assert_within_a_tick_of_a_change(&field, &lattice, edge, fixed);
+        }
+    }
+
+    #[test]
+    fn a_field_that_jumps_from_one_to_zero_is_bisected() {
+        // A closed sheet crossed once: regula falsi between 1 and 0 is the midpoint, and each
+        // edge takes exactly bisection's `STEPS` evaluations.
+        let field = Field(|q: [f64; 3]| f64::from(u8::from(q[0] + 0.3 * q[1] < 0.61)));
+        let lattice = lattice();
+        let edges = band_edges(&field, &lattice);
+        assert!(!edges.is_empty());
+        for n in place_one_by_one(&field, &lattice, &edges, None) {
+            assert_eq!(n, STEPS as usize);
+        }
+    }
+
+    #[test]
+    fn rough_fields_cost_at_most_one_evaluation_over_bisection() {
+        // Steps of pseudo-random heights, from 3 to 5,000 per cell along x and y: `w` crosses
+        // ½ once or many times along an edge, and regula falsi's estimates are poor. Every
+        // vertex still ends within a tick of a change, at a bounded cost.
+        let mut most = 0;
+        for (seed, per_cell) in (0..16u64).zip([3.0, 37.0, 300.0, 5000.0].iter().cycle()) {
+            let per_unit = 8.0 * per_cell;
+            let field = Field(move |q: [f64; 3]| {
+                let cell = [0, 1].map(|a| (q[a] * per_unit).floor() as i64 as u64);
+                let mut h = cell[0]
+                    .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+                    .wrapping_add(cell[1].wrapping_mul(0xC2B2_AE3D_27D4_EB4F))
+                    .wrapping_add(seed);
+                h ^= h >> 31;
+                h = h.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+                h ^= h >> 29;
+                let noise = (h >> 11) as f64 / (1u64 << 53) as f64;
+                // Inside the ball of radius 0.3 about the centre the heights lean above ½.
+                let r2: f64 = q.iter().map(|x| (x - 0.5) * (x - 0.5)).sum();
+                0.35 * noise + if r2 < 0.09 { 0.4 } else { 0.1 }
+            });
+            let lattice = lattice();
+            let edges = band_edges(&field, &lattice);
+            assert!(edges.len() > 50, "{}", edges.len());
+            let n = place_one_by_one(&field, &lattice, &edges, None);
+            most = most.max(n.into_iter().max().unwrap());
+        }
+        assert!(most <= (STEPS + ITP_SLACK) as usize, "{most} evaluations");
+    }
+
+    #[test]
+    fn a_border_corner_with_the_field_above_half_costs_one_evaluation() {
+        // The outside corner is declared outside (NaN: never evaluated) but `w` is 0.7 all
+        // along the edge: the change is at the corner, and one probe next to it finds that.
+        let field = Field(|_: [f64; 3]| 0.7);
+        let lattice = lattice();
+        let edge = ([3, 4, 4], [4, 4, 4]);
+        let p = place_vertices(&field, &lattice, &[edge], &[[0.7, f64::NAN]], STEPS, None);
+        assert_eq!(p.evaluations, 1);
+        assert_eq!(p.fixed[0][0], 4 * TICKS - 1);
+        // With the change inside the edge after all (at its middle), the search goes on from
+        // that probe.
+        let (x0, h) = (lattice.corner_position(edge.0)[0], lattice.h[0]);
+        let field = Field(move |q: [f64; 3]| 0.7 - 0.4 * (q[0] - x0) / h);
+        let p = place_vertices(&field, &lattice, &[edge], &[[0.7, f64::NAN]], STEPS, None);
+        let k = p.fixed[0][0] - 3 * TICKS;
+        assert!((k - TICKS / 2).abs() <= 1, "{k}");
+        assert!(p.evaluations <= 4, "{}", p.evaluations);
+    }
+
+    #[test]
+    fn a_double_wall_is_told_apart_by_one_evaluation_between_the_walls() {
+        // Two walls across the edge (x-parallel edges of the lattice cross the planes
+        // x = 0.3 and 0.6 of the cell): `w` is 1 before the first, 0.8 between (an inner wall
+        // that does not change the class), 0 after the second. One evaluation between the walls
+        // puts the change beyond the middle, two verify the second wall.
+        let lattice = lattice();
+        let edge: (Corner, Corner) = ([3, 4, 4], [4, 4, 4]);
+        let x0 = lattice.corner_position(edge.0)[0];
+        let h = lattice.h[0];
+        let walls = [x0 + 0.3 * h, x0 + 0.6 * h];
+        let wall = |x: f64| [[x, -1.0, -1.0], [x, 3.0, -1.0], [x, -1.0, 3.0]];
+        let guide = SegmentBvh::new(walls.map(wall));
+        let field = Field(move |q: [f64; 3]| {
+            if q[0] < walls[0] {
+                1.0
+            } else if q[0] < walls[1] {
+                0.8
+            } else {
+                0.0
+            }
+        });
+        let p = place_vertices(
+            &field,
+            &lattice,
+            &[edge],
+            &[[1.0, 0.0]],
+            STEPS,
+            Some(&guide),
+        );
+        assert_eq!((p.evaluations, p.guided), (3, 1));
+        assert_within_a_tick_of_a_change(&field, &lattice, edge, p.fixed[0]);
+        let k = p.fixed[0][0] - 3 * TICKS;
+        assert!((k as f64 - 0.6 * TICKS as f64).abs() <= 1.0, "{k}");
     }
 }
