@@ -3,10 +3,11 @@
 //! surface), so that changes to `simplify/` can be timed and compared side by side.
 //!
 //! ```text
-//! cargo run --release --features examples --example simplify_bench -- MESH RES [--repeat N] [--check] [--no-relocate] [--flat TOL] [--no-diagonals] [--slab-cells N]
+//! cargo run --release --features examples --example simplify_bench -- MESH RES [--repeat N] [--check] [--no-relocate] [--no-input-planes] [--flat TOL] [--no-diagonals] [--slab-cells N]
 //! ```
 //! The surface before simplification (exact evaluator, guided placement) is computed once and
-//! cached in `$TMPDIR` (`gwn-simplify-<mesh>-<res>-<lattice cells>.bin`). `--flat TOL`: the
+//! cached in `$TMPDIR` (`gwn-simplify2-<mesh>-<res>-<lattice cells>.bin`, with the input's planes at
+//! the vertices; `--no-input-planes` leaves them out of the quadrics). `--flat TOL`: the
 //! flat tolerance in cells (`SimplifyOptions::flat_tolerance`; 0: stop at the target). `--no-diagonals`: no cube-by-cube pass over the diagonal vertices
 //! (`SimplifyOptions::lattice_diagonals`). `--slab-cells N`: slab thickness of the parallel
 //! collapses (`SimplifyOptions::slab_cells`; 0: none). `--check` also counts exact
@@ -26,6 +27,8 @@ use gwn::products::remesh::{
 
 struct Surface {
     fixed: Vec<[i64; 3]>,
+    /// The input's plane at each vertex placed on it (lattice units; NaN: none).
+    planes: Vec<[f64; 4]>,
     triangles: Vec<[u32; 3]>,
     ticks: i64,
     marching_cubes: usize,
@@ -48,8 +51,14 @@ fn build(mesh_path: &PathBuf, res: usize) -> Result<Surface, Box<dyn std::error:
         DEFAULT_BISECTION_STEPS,
         Some(&guide),
     );
+    let planes = placed
+        .planes_in_lattice_units(&lattice)
+        .into_iter()
+        .map(|p| p.unwrap_or([f64::NAN; 4]))
+        .collect();
     Ok(Surface {
         fixed: placed.fixed,
+        planes,
         triangles: band.triangles,
         ticks: placed.ticks_per_cell,
         marching_cubes: band.marching_cubes_triangles,
@@ -67,6 +76,11 @@ fn save(s: &Surface, path: &PathBuf) -> std::io::Result<()> {
         out.extend_from_slice(&x.to_le_bytes());
     }
     for p in &s.fixed {
+        for c in p {
+            out.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    for p in &s.planes {
         for c in p {
             out.extend_from_slice(&c.to_le_bytes());
         }
@@ -93,11 +107,15 @@ fn load(path: &PathBuf) -> std::io::Result<Surface> {
     let fixed = (0..nv)
         .map(|_| [0; 3].map(|_: i64| u64_() as i64))
         .collect();
+    let planes = (0..nv)
+        .map(|_| [0; 4].map(|_: i32| f64::from_bits(u64_())))
+        .collect();
     let triangles = (0..nt)
         .map(|_| [0; 3].map(|_: u32| u32::from_le_bytes(take(4).try_into().unwrap_or([0; 4]))))
         .collect();
     Ok(Surface {
         fixed,
+        planes,
         triangles,
         ticks: ticks as i64,
         marching_cubes: mc as usize,
@@ -114,6 +132,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut repeat = 1;
     let mut check = false;
     let mut relocate = true;
+    let mut input_planes = true;
     let mut diagonals = true;
     let mut flat = simplify::DEFAULT_FLAT_TOLERANCE;
     let mut slab_cells = simplify::DEFAULT_SLAB_CELLS;
@@ -122,6 +141,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--repeat" => repeat = args.next().ok_or("--repeat N")?.parse()?,
             "--check" => check = true,
             "--no-relocate" => relocate = false,
+            "--no-input-planes" => input_planes = false,
             "--no-diagonals" => diagonals = false,
             "--flat" => flat = args.next().ok_or("--flat TOL")?.parse()?,
             "--slab-cells" => slab_cells = args.next().ok_or("--slab-cells N")?.parse()?,
@@ -139,7 +159,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .ok_or("empty mesh")?;
     let cells = Lattice::new(bounds, res).ok_or("bad bounds")?.cells;
     let cache = std::env::temp_dir().join(format!(
-        "gwn-simplify-{name}-{res}-{}x{}x{}.bin",
+        "gwn-simplify2-{name}-{res}-{}x{}x{}.bin",
         cells[0], cells[1], cells[2]
     ));
     let surface = match load(&cache) {
@@ -152,6 +172,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let options = simplify::SimplifyOptions {
         relocate,
+        input_planes,
         flat_tolerance: flat,
         lattice_diagonals: diagonals,
         slab_cells,
@@ -161,12 +182,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         (options.target_fraction_of_marching_cubes * surface.marching_cubes as f64) as usize;
     for _ in 0..repeat {
         let t0 = Instant::now();
-        let s = simplify::simplify(
+        let planes: Vec<Option<[f64; 4]>> = surface
+            .planes
+            .iter()
+            .map(|p| (!p[0].is_nan()).then_some(*p))
+            .collect();
+        let s = simplify::simplify_with_planes(
             &surface.fixed,
             &surface.triangles,
             surface.ticks,
             &options,
             target,
+            options.input_planes.then_some(&planes[..]),
         );
         let dt = t0.elapsed().as_secs_f64();
         // FNV-1a over the output: equal surfaces, equal fingerprints.

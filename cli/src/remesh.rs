@@ -76,6 +76,10 @@ pub struct Args {
     /// quadric minimum after the collapses).
     #[arg(long)]
     pub no_relocate: bool,
+    /// Rank collapses and relocate vertices by the planes of the marching-tetrahedra faces, not
+    /// by the input triangles' planes at the vertices placed on them.
+    #[arg(long)]
+    pub no_input_planes: bool,
     #[command(flatten)]
     pub method: MethodArgs,
     #[command(flatten)]
@@ -145,6 +149,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             max_distance: args.simplify_distance,
             target_fraction_of_marching_cubes: args.simplify_target,
             relocate: !args.no_relocate,
+            input_planes: !args.no_input_planes,
             flat_tolerance: args.simplify_flat,
             ..SimplifyOptions::default()
         }),

@@ -607,6 +607,88 @@ fn a_misleading_guide_costs_evaluations_not_correctness() {
     }
 }
 
+/// An octahedron turned off the lattice's axes: its 12 sharp edges and 6 corners cross cells
+/// every which way, and the marching-tetrahedra surface cuts them off (its vertices are on the
+/// faces, its triangles chords across the edges). The relocation's quadrics, made of the
+/// input's planes at the vertices (`SimplifyOptions::input_planes`), move vertices onto the
+/// edges: the corners and edge points end closer to the output than with the quadrics of the
+/// marching-tetrahedra faces, and the output stays closed, manifold and free of
+/// self-intersections either way.
+#[test]
+fn sharp_edges_off_the_lattice_come_back_with_the_inputs_planes() {
+    let (a, b) = (0.37f64, 0.61f64);
+    let turn = |p: [f64; 3]| {
+        let (x, y, z) = (
+            p[0],
+            p[1] * a.cos() - p[2] * a.sin(),
+            p[1] * a.sin() + p[2] * a.cos(),
+        );
+        [x * b.cos() - y * b.sin(), x * b.sin() + y * b.cos(), z]
+    };
+    let corners: Vec<[f64; 3]> = [
+        [1.0, 0.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+    ]
+    .map(turn)
+    .to_vec();
+    let faces = vec![
+        [0, 2, 4],
+        [2, 1, 4],
+        [1, 3, 4],
+        [3, 0, 4],
+        [2, 0, 5],
+        [1, 2, 5],
+        [3, 1, 5],
+        [0, 3, 5],
+    ];
+    let mesh = Mesh::new(corners.clone(), faces.clone()).unwrap();
+    // Points along every edge (a corner's own cell is the hardest; edges show the rule).
+    let mut sharp = corners.clone();
+    for f in &faces {
+        for k in 0..3 {
+            let (p, q) = (corners[f[k] as usize], corners[f[(k + 1) % 3] as usize]);
+            for t in [0.2, 0.35, 0.5, 0.65, 0.8] {
+                sharp.push([0, 1, 2].map(|c| p[c] + t * (q[c] - p[c])));
+            }
+        }
+    }
+    let worst = |input_planes: bool| {
+        let options = RemeshOptions {
+            simplify: Some(gwn::products::remesh::simplify::SimplifyOptions {
+                input_planes,
+                ..Default::default()
+            }),
+            ..RemeshOptions::with_resolution(24)
+        };
+        let (out, r) = run_with(&mesh, &options);
+        assert_closed_manifold(&r);
+        assert_eq!((r.euler_characteristic, r.components), (2, 1), "{r}");
+        let out_mesh = Mesh::new(out.positions.clone(), out.triangles.clone()).unwrap();
+        let distance = SignedDistance::new(&out_mesh).unwrap();
+        let edge = sharp[6..]
+            .iter()
+            .map(|&p| distance.eval(p).abs())
+            .fold(0.0, f64::max);
+        let corner = sharp[..6]
+            .iter()
+            .map(|&p| distance.eval(p).abs())
+            .fold(0.0, f64::max);
+        (edge / out.cell_size, corner / out.cell_size)
+    };
+    let (faces_edge, faces_corner) = worst(false);
+    let (planes_edge, planes_corner) = worst(true);
+    // Measured: edges 0.35 -> 0.28 cells, corners 0.79 -> 0.42 cells.
+    assert!(
+        planes_edge < 0.9 * faces_edge && planes_corner < 0.6 * faces_corner,
+        "edges {faces_edge} -> {planes_edge}, corners {faces_corner} -> {planes_corner} cells"
+    );
+    assert!(planes_corner < 0.5, "{planes_corner} cells");
+}
+
 #[test]
 fn hausdorff_distance_of_a_sphere_is_below_one_cell() {
     let mesh = sphere([0.0; 3], 1.0, 32, false);

@@ -353,6 +353,7 @@ fn generous() -> SimplifyOptions {
         max_face_extent: 16,
         target_fraction_of_marching_cubes: 0.0,
         relocate: true,
+        input_planes: true,
         flat_tolerance: 0.0,
         lattice_diagonals: true,
         lattice_diagonal_error: f64::INFINITY,

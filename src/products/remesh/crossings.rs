@@ -68,6 +68,17 @@ impl SegmentBvh {
     /// Pushes onto `out` the parameters `t ∈ [0, 1]` (clamped) at which the segment `p → q`
     /// crosses a triangle, in no particular order.
     pub fn crossings(&self, p: [f64; 3], q: [f64; 3], out: &mut Vec<f64>) {
+        self.for_each_crossing(p, q, |t, _| out.push(t));
+    }
+
+    /// Calls `hit(t, triangle)` for each triangle the segment `p → q` crosses, with `t ∈ [0, 1]`
+    /// (clamped), in the hierarchy's order (deterministic, not sorted by `t`).
+    pub fn for_each_crossing(
+        &self,
+        p: [f64; 3],
+        q: [f64; 3],
+        mut hit: impl FnMut(f64, &[[f64; 3]; 3]),
+    ) {
         if self.nodes.is_empty() {
             return;
         }
@@ -85,7 +96,7 @@ impl SegmentBvh {
                 let first = node.first as usize;
                 for tri in &self.triangles[first..first + node.count as usize] {
                     if let Some(t) = segment_triangle(p, d, tri) {
-                        out.push(t.clamp(0.0, 1.0));
+                        hit(t.clamp(0.0, 1.0), tri);
                     }
                 }
             } else if top + 2 <= stack.len() {

@@ -105,6 +105,17 @@ impl Lattice {
         [0, 1, 2].map(|a| self.origin[a] + p[a] * self.h[a])
     }
 
+    /// The world plane `n·x + d = 0` (`[n, d]`, `|n| = 1`) in lattice units (the same points,
+    /// `x = position(u)`), with a unit normal again; `None` if `n` is 0 or not finite.
+    pub fn plane_in_lattice_units(&self, [a, b, c, d]: [f64; 4]) -> Option<[f64; 4]> {
+        // n·(origin + h∘u) + d = (n∘h)·u + (n·origin + d).
+        let n = [a * self.h[0], b * self.h[1], c * self.h[2]];
+        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        let offset = a * self.origin[0] + b * self.origin[1] + c * self.origin[2] + d;
+        (len > 0.0 && len.is_finite() && offset.is_finite())
+            .then(|| [n[0] / len, n[1] / len, n[2] / len, offset / len])
+    }
+
     /// The largest cell edge (along the longest axis of the box): the unit of the reports'
     /// distances in cells.
     pub fn largest_cell(&self) -> f64 {
@@ -179,6 +190,31 @@ mod tests {
             max: [-1.0 + extent[0], 2.0 + extent[1], 3.0 + extent[2]],
         };
         Lattice::new(bounds, res).unwrap()
+    }
+
+    #[test]
+    fn a_plane_in_lattice_units_holds_the_same_points() {
+        // A thin box: cells of different edges per axis.
+        let l = lattice([100.0, 60.0, 2.0], 64);
+        assert!(l.h[2] < l.h[0]);
+        let n = [0.3f64, -0.5, 0.8];
+        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        let n = n.map(|x| x / len);
+        let through = [10.0, 25.0, 4.0];
+        let d = -(n[0] * through[0] + n[1] * through[1] + n[2] * through[2]);
+        let p = l.plane_in_lattice_units([n[0], n[1], n[2], d]).unwrap();
+        assert!((p[0] * p[0] + p[1] * p[1] + p[2] * p[2] - 1.0).abs() < 1e-12);
+        for u in [[0.0, 0.0, 0.0], [3.5, 7.25, 1.0], [60.0, 2.0, 30.0]] {
+            let x = l.position(u);
+            let world = n[0] * x[0] + n[1] * x[1] + n[2] * x[2] + d;
+            let lattice = p[0] * u[0] + p[1] * u[1] + p[2] * u[2] + p[3];
+            // Same sign, and the lattice distance is the world one in cells along the normal.
+            assert_eq!(world > 0.0, lattice > 0.0, "{u:?}");
+            let h_n = (0..3).map(|a| (n[a] * l.h[a]).powi(2)).sum::<f64>().sqrt();
+            assert!((lattice - world / h_n).abs() < 1e-9, "{lattice} {world}");
+        }
+        assert_eq!(l.plane_in_lattice_units([0.0; 4]), None);
+        assert_eq!(l.plane_in_lattice_units([f64::NAN, 0.0, 0.0, 0.0]), None);
     }
 
     #[test]

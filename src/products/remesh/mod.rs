@@ -335,7 +335,7 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
         return Err(RemeshError::TooManyVertices);
     }
     progress(RemeshPhase::Place);
-    let placed = place::place_vertices(
+    let mut placed = place::place_vertices(
         evaluator,
         &lattice,
         &band.edges,
@@ -362,13 +362,21 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
         None => (placed.positions, placed.fixed, band.triangles),
         Some(simplify_options) => {
             progress(RemeshPhase::Simplify);
-            let s = simplify::simplify(
+            // The input's planes at the vertices placed on them, for the relocation; the world
+            // planes and positions are not needed any more.
+            let planes = simplify_options
+                .input_planes
+                .then(|| placed.planes_in_lattice_units(&lattice));
+            placed.planes = Vec::new();
+            placed.positions = Vec::new();
+            let s = simplify::simplify_with_planes(
                 &placed.fixed,
                 &band.triangles,
                 placed.ticks_per_cell,
                 simplify_options,
                 (simplify_options.target_fraction_of_marching_cubes
                     * band.marching_cubes_triangles as f64) as usize,
+                planes.as_deref(),
             );
             stats.simplify = s.stats;
             // From the fixed point, as `place` does (exact dyadic steps: the same `f64` for a

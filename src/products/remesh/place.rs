@@ -55,6 +55,41 @@ pub struct Placement {
     pub evaluations: usize,
     /// Vertices placed by a verified crossing.
     pub guided: usize,
+    /// Per vertex placed at a verified crossing, the plane of the input triangle crossed there
+    /// (world coordinates); `None` for the others. The simplification's quadrics take it in
+    /// place of the marching-tetrahedra faces' planes, which cut across sharp edges.
+    pub planes: Vec<Option<Plane>>,
+}
+
+impl Placement {
+    /// [`Placement::planes`] in lattice units, as [`super::simplify::simplify_with_planes`]
+    /// takes them.
+    pub fn planes_in_lattice_units(&self, lattice: &Lattice) -> Vec<Option<Plane>> {
+        self.planes
+            .iter()
+            .map(|p| p.and_then(|p| lattice.plane_in_lattice_units(p)))
+            .collect()
+    }
+}
+
+/// A plane `n·x + d = 0` as `[n_x, n_y, n_z, d]` with `|n| = 1`.
+pub type Plane = [f64; 4];
+
+/// The plane of a triangle (a zero normal for a degenerate one: its quadric is 0).
+fn plane_of(t: &[[f64; 3]; 3]) -> Plane {
+    use crate::base::vec3::{cross, norm, sub};
+    let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
+    let len = norm(n);
+    if len == 0.0 || !len.is_finite() {
+        return [0.0; 4];
+    }
+    let n = n.map(|x| x / len);
+    [
+        n[0],
+        n[1],
+        n[2],
+        -(n[0] * t[0][0] + n[1] * t[0][1] + n[2] * t[0][2]),
+    ]
 }
 
 /// One edge's search: the bracket, `w` at its ends, and the ITP state.
@@ -171,35 +206,49 @@ pub fn place_vertices<E: Evaluator + ?Sized>(
         lattice
             .position([0, 1, 2].map(|a| f64::from(i[a]) + t * (f64::from(o[a]) - f64::from(i[a]))))
     };
-    // Each edge's crossing ticks, sorted and distinct, as ranges of one list.
-    let (crossings, crossing_ranges): (Vec<i64>, Vec<(u32, u32)>) =
+    // Each edge's crossing ticks, sorted and distinct, as ranges of one list, with the plane of
+    // a triangle crossed there (the first in the hierarchy's order).
+    let (crossings, crossing_planes, crossing_ranges): (Vec<i64>, Vec<Plane>, Vec<(u32, u32)>) =
         match guide.filter(|b| !b.is_empty()) {
-            None => (Vec::new(), vec![(0, 0); edges.len()]),
+            None => (Vec::new(), Vec::new(), vec![(0, 0); edges.len()]),
             Some(bvh) => {
-                let per_edge: Vec<Vec<i64>> = edges
-                    .par_iter()
-                    .map_init(Vec::new, |hits, &e| {
-                        hits.clear();
-                        bvh.crossings(at(e, 0), at(e, ticks), hits);
-                        let mut ks: Vec<i64> = hits
-                            .iter()
-                            .map(|&t| ((t * ticks as f64).round() as i64).clamp(1, ticks - 1))
-                            .collect();
-                        ks.sort_unstable();
-                        ks.dedup();
-                        ks
+                // By chunks of edges (a `Vec` per edge cost ~100 bytes each at the peak).
+                let chunks: Vec<(Vec<i64>, Vec<Plane>, Vec<u32>)> = edges
+                    .par_chunks(4096)
+                    .map(|chunk| {
+                        let (mut ks, mut planes, mut counts) = (Vec::new(), Vec::new(), Vec::new());
+                        let mut hits: Vec<(i64, Plane)> = Vec::new();
+                        for &e in chunk {
+                            hits.clear();
+                            bvh.for_each_crossing(at(e, 0), at(e, ticks), |t, tri| {
+                                let k = ((t * ticks as f64).round() as i64).clamp(1, ticks - 1);
+                                hits.push((k, plane_of(tri)));
+                            });
+                            // Stable: the first triangle in the hierarchy's order keeps its tick.
+                            hits.sort_by_key(|&(k, _)| k);
+                            hits.dedup_by_key(|&mut (k, _)| k);
+                            counts.push(hits.len() as u32);
+                            for &(k, plane) in &hits {
+                                ks.push(k);
+                                planes.push(plane);
+                            }
+                        }
+                        (ks, planes, counts)
                     })
                     .collect();
-                let mut all = Vec::with_capacity(per_edge.iter().map(Vec::len).sum());
-                let ranges = per_edge
-                    .into_iter()
-                    .map(|ks| {
-                        let first = all.len() as u32;
-                        all.extend(ks);
-                        (first, all.len() as u32)
-                    })
-                    .collect();
-                (all, ranges)
+                let n = chunks.iter().map(|c| c.0.len()).sum();
+                let (mut all, mut planes) = (Vec::with_capacity(n), Vec::with_capacity(n));
+                let mut ranges = Vec::with_capacity(edges.len());
+                for (ks, ps, counts) in chunks {
+                    let mut start = all.len() as u32;
+                    for c in counts {
+                        ranges.push((start, start + c));
+                        start += c;
+                    }
+                    all.extend(ks);
+                    planes.extend(ps);
+                }
+                (all, planes, ranges)
             }
         };
     let mut searches: Vec<Search> = corner_w
@@ -291,12 +340,24 @@ pub fn place_vertices<E: Evaluator + ?Sized>(
             [0, 1, 2].map(|a| i64::from(i[a]) * ticks + k * (i64::from(o[a]) - i64::from(i[a])))
         })
         .collect();
+    let planes = searches
+        .par_iter()
+        .zip(&crossing_ranges)
+        .map(|(s, &(first, end))| {
+            let ks = &crossings[first as usize..end as usize];
+            s.verified
+                .then(|| ks.binary_search(&(s.lo + 1)).ok())
+                .flatten()
+                .map(|i| crossing_planes[first as usize + i])
+        })
+        .collect();
     Placement {
         positions,
         fixed,
         ticks_per_cell: ticks,
         evaluations,
         guided: searches.iter().filter(|s| s.verified).count(),
+        planes,
     }
 }
 
@@ -532,5 +593,12 @@ mod tests {
         assert_within_a_tick_of_a_change(&field, &lattice, edge, p.fixed[0]);
         let k = p.fixed[0][0] - 3 * TICKS;
         assert!((k as f64 - 0.6 * TICKS as f64).abs() <= 1.0, "{k}");
+        // The vertex carries the plane of the wall it was verified on: x = walls[1].
+        let [a, b, c, d] = p.planes[0].expect("a verified crossing has a plane");
+        assert_eq!((a.abs(), b, c), (1.0, 0.0, 0.0));
+        assert!((d / a + walls[1]).abs() < 1e-12, "{d}");
+        // Without a guide no vertex has a plane.
+        let p = place_vertices(&field, &lattice, &[edge], &[[1.0, 0.0]], STEPS, None);
+        assert_eq!(p.planes, vec![None]);
     }
 }

@@ -83,6 +83,7 @@ struct SlabResult {
 struct SlabVertex {
     removed: bool,
     quadric: [f64; 11],
+    relocation_quadric: Option<[f64; 11]>,
 }
 
 impl SlabWork {
@@ -95,6 +96,7 @@ impl SlabWork {
                 let vertex = SlabVertex {
                     removed: s.removed[x],
                     quadric: s.quadric[x],
+                    relocation_quadric: s.relocation_quadric.get(x).copied(),
                 };
                 (global[x], vertex)
             })
@@ -282,6 +284,14 @@ impl Simplifier {
             alive: vec![true; faces.len()],
             removed: global.iter().map(|&x| self.removed[x as usize]).collect(),
             quadric: global.iter().map(|&x| self.quadric[x as usize]).collect(),
+            relocation_quadric: if self.relocation_quadric.is_empty() {
+                Vec::new()
+            } else {
+                global
+                    .iter()
+                    .map(|&x| self.relocation_quadric[x as usize])
+                    .collect()
+            },
             vertex_faces,
             support,
             grids: Vec::new(),
@@ -312,6 +322,9 @@ impl Simplifier {
                 let g = g as usize;
                 self.removed[g] = v.removed;
                 self.quadric[g] = v.quadric;
+                if let Some(q) = v.relocation_quadric {
+                    self.relocation_quadric[g] = q;
+                }
             }
             for (t, s) in w.faces {
                 faces.push(t);
