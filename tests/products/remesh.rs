@@ -635,16 +635,7 @@ fn sharp_edges_off_the_lattice_come_back_with_the_inputs_planes() {
     ]
     .map(turn)
     .to_vec();
-    let faces = vec![
-        [0, 2, 4],
-        [2, 1, 4],
-        [1, 3, 4],
-        [3, 0, 4],
-        [2, 0, 5],
-        [1, 2, 5],
-        [3, 1, 5],
-        [0, 3, 5],
-    ];
+    let faces = common::OCTAHEDRON_FACES.to_vec();
     let mesh = Mesh::new(corners.clone(), faces.clone()).unwrap();
     // Points along every edge (a corner's own cell is the hardest; edges show the rule).
     let mut sharp = corners.clone();

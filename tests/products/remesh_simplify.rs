@@ -449,16 +449,7 @@ fn the_link_condition_keeps_small_solids_closed() {
         [0, 0, 32],
         [0, 0, -32],
     ];
-    let of = vec![
-        [0, 2, 4],
-        [2, 1, 4],
-        [1, 3, 4],
-        [3, 0, 4],
-        [2, 0, 5],
-        [1, 2, 5],
-        [3, 1, 5],
-        [0, 3, 5],
-    ];
+    let of = common::OCTAHEDRON_FACES.to_vec();
     let out = simplify(&oct, &of, T, &generous(), 0);
     // Its vertices are lattice corners, on no lattice segment: no pass over the diagonals.
     assert_eq!(out.stats.diagonal_collapses, 0);
