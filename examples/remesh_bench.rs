@@ -90,13 +90,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let (positions, triangles) = if simplified {
                 let planes = placed.planes_in_lattice_units(&lattice);
                 let s = simplify::simplify_with_planes(
-                    &placed.fixed,
-                    &band.triangles,
+                    placed.fixed.clone(),
+                    band.triangles.clone(),
                     placed.ticks_per_cell,
                     &simplify::SimplifyOptions::default(),
                     (simplify::DEFAULT_TARGET_FRACTION * band.marching_cubes_triangles as f64)
                         as usize,
-                    Some(&planes),
+                    Some(planes),
                 );
                 let positions: Vec<[f64; 3]> = s
                     .vertices

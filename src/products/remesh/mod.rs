@@ -363,20 +363,23 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
         Some(simplify_options) => {
             progress(RemeshPhase::Simplify);
             // The input's planes at the vertices placed on them, for the relocation; the world
-            // planes and positions are not needed any more.
+            // planes and positions and the lattice edges are not needed any more, and the
+            // simplifier takes the surface and the planes by value (at res 256 a cube's
+            // surface is 1.6M vertices and 3.1M faces: ~300 MB less at the peak, measured).
             let planes = simplify_options
                 .input_planes
                 .then(|| placed.planes_in_lattice_units(&lattice));
             placed.planes = Vec::new();
             placed.positions = Vec::new();
+            drop(band.edges);
             let s = simplify::simplify_with_planes(
-                &placed.fixed,
-                &band.triangles,
+                std::mem::take(&mut placed.fixed),
+                band.triangles,
                 placed.ticks_per_cell,
                 simplify_options,
                 (simplify_options.target_fraction_of_marching_cubes
                     * band.marching_cubes_triangles as f64) as usize,
-                planes.as_deref(),
+                planes,
             );
             stats.simplify = s.stats;
             // From the fixed point, as `place` does (exact dyadic steps: the same `f64` for a

@@ -257,8 +257,8 @@ pub fn simplify(
     target_faces: usize,
 ) -> Simplified {
     simplify_with_planes(
-        points,
-        triangles,
+        points.to_vec(),
+        triangles.to_vec(),
         ticks_per_cell,
         options,
         target_faces,
@@ -277,16 +277,16 @@ pub fn simplify(
 /// curved inputs: up to 80 % more faces, for no better distance). Only relocation targets
 /// change; every check, hence every guarantee, is the same.
 pub fn simplify_with_planes(
-    points: &[P],
-    triangles: &[[u32; 3]],
+    points: Vec<P>,
+    triangles: Vec<[u32; 3]>,
     ticks_per_cell: i64,
     options: &SimplifyOptions,
     target_faces: usize,
-    planes: Option<&[Option<[f64; 4]>]>,
+    planes: Option<Vec<Option<[f64; 4]>>>,
 ) -> Simplified {
     let planes = planes.filter(|p| p.len() == points.len());
     match Simplifier::new_unindexed(points, triangles, ticks_per_cell, options, planes) {
-        Some(mut s) => {
+        Ok(mut s) => {
             let diagonals = options
                 .lattice_diagonals
                 .then_some(options.lattice_diagonal_error);
@@ -313,16 +313,16 @@ pub fn simplify_with_planes(
             }
             s.finish()
         }
-        None => Simplified {
-            triangles: triangles.to_vec(),
+        Err((points, triangles)) => Simplified {
             vertices: (0..points.len() as u32).collect(),
-            points: points.to_vec(),
+            points,
             stats: SimplifyStats {
                 faces_before: triangles.len(),
                 faces_after: triangles.len(),
                 skipped: true,
                 ..SimplifyStats::default()
             },
+            triangles,
         },
     }
 }
@@ -399,19 +399,30 @@ impl Simplifier {
         ticks_per_cell: i64,
         options: &SimplifyOptions,
     ) -> Option<Simplifier> {
-        let mut s = Simplifier::new_unindexed(points, triangles, ticks_per_cell, options, None)?;
+        let mut s = Simplifier::new_unindexed(
+            points.to_vec(),
+            triangles.to_vec(),
+            ticks_per_cell,
+            options,
+            None,
+        )
+        .ok()?;
         s.build_index();
         Some(s)
     }
 
     /// [`Simplifier::new`] without the spatial index (built by [`Simplifier::build_index`]).
+    /// Takes the surface by value (a res-256 surface is 3M faces: copies would double it) and
+    /// gives it back when it cannot be simplified; `planes` is dropped once the relocation
+    /// quadrics are built.
+    #[allow(clippy::type_complexity)]
     fn new_unindexed(
-        points: &[P],
-        triangles: &[[u32; 3]],
+        points: Vec<P>,
+        triangles: Vec<[u32; 3]>,
         ticks_per_cell: i64,
         options: &SimplifyOptions,
-        planes: Option<&[Option<[f64; 4]>]>,
-    ) -> Option<Simplifier> {
+        planes: Option<Vec<Option<[f64; 4]>>>,
+    ) -> Result<Simplifier, (Vec<P>, Vec<[u32; 3]>)> {
         if ticks_per_cell <= 0
             || !(options.max_distance.is_finite() && options.max_distance >= 0.0)
             || points
@@ -421,14 +432,14 @@ impl Simplifier {
                 .iter()
                 .any(|t| t.iter().any(|&v| v as usize >= points.len()))
         {
-            return None;
+            return Err((points, triangles));
         }
         let scale = 1.0 / ticks_per_cell as f64;
         let at: Vec<[f64; 3]> = points.iter().map(|p| p.map(|c| c as f64 * scale)).collect();
         // The topology check alongside the face lists and quadrics (two threads: it is the
         // larger half of the set-up).
         let (report, lists) = rayon::join(
-            || super::report::TopologyReport::of(&at, triangles),
+            || super::report::TopologyReport::of(&at, &triangles),
             || {
                 if triangles.par_iter().any(|t| {
                     let p = t.map(|v| points[v as usize]);
@@ -461,7 +472,7 @@ impl Simplifier {
                 // three corners (a third of its area each; its own plane where a corner has
                 // none), so a vertex next to a sharp edge holds the planes of both sides
                 // through its ring.
-                let relocation_quadric: Vec<[f64; 11]> = match planes {
+                let relocation_quadric: Vec<[f64; 11]> = match &planes {
                     None => Vec::new(),
                     Some(planes) => vertex_faces
                         .par_iter()
@@ -492,9 +503,12 @@ impl Simplifier {
         if !(report.closed && report.edge_manifold && report.vertex_manifold && report.oriented)
             || report.degenerate_faces > 0
         {
-            return None;
+            return Err((points, triangles));
         }
-        let (vertex_faces, quadric, relocation_quadric) = lists?;
+        let Some((vertex_faces, quadric, relocation_quadric)) = lists else {
+            return Err((points, triangles));
+        };
+        drop(planes);
         let largest = points
             .iter()
             .flat_map(|p| p.iter().map(|c| c.unsigned_abs()))
@@ -502,14 +516,15 @@ impl Simplifier {
             .unwrap_or(0);
         let shift = (64 - largest.leading_zeros()).saturating_sub(30);
         let max_extent = i64::from(options.max_face_extent.max(1)).saturating_mul(ticks_per_cell);
-        Some(Simplifier {
-            points: points.to_vec(),
+        let (vertices, faces) = (points.len(), triangles.len());
+        Ok(Simplifier {
+            points,
             at,
-            faces: triangles.to_vec(),
-            alive: vec![true; triangles.len()],
+            faces: triangles,
+            alive: vec![true; faces],
             vertex_faces,
-            removed: vec![false; points.len()],
-            support: vec![Vec::new(); triangles.len()],
+            removed: vec![false; vertices],
+            support: vec![Vec::new(); faces],
             quadric,
             relocation_quadric,
             grids: Vec::new(),
@@ -521,7 +536,7 @@ impl Simplifier {
             flat_limit: None,
             slab: None,
             stats: SimplifyStats {
-                faces_before: triangles.len(),
+                faces_before: faces,
                 ..SimplifyStats::default()
             },
         })

@@ -74,31 +74,47 @@ struct SlabWork {
 struct SlabResult {
     /// Its live faces, owned or new, and the removed vertices each answers for.
     faces: Vec<([u32; 3], Vec<u32>)>,
-    /// Its vertices inside the open slab (the only ones that change).
-    vertices: Vec<(u32, SlabVertex)>,
+    /// The vertices it removed.
+    removed: Vec<u32>,
+    /// The kept vertices whose quadrics it changed (collapse targets), with the new quadrics.
+    /// Only changes travel: all of a slab's vertices with their quadrics took 200 bytes each,
+    /// and every slab's were alive until the merge (314 MB of the README cube's 790 MB peak at
+    /// res 256).
+    merged: Vec<(u32, SlabQuadrics)>,
     stats: SimplifyStats,
 }
 
-/// What a slab may change of a vertex inside it.
-struct SlabVertex {
-    removed: bool,
+/// A kept vertex's quadrics after a slab's collapses.
+struct SlabQuadrics {
     quadric: [f64; 11],
     relocation_quadric: Option<[f64; 11]>,
 }
 
 impl SlabWork {
-    fn result(self) -> SlabResult {
+    /// The slab's changes against `before`, the simplifier it was cut from. Only vertices inside
+    /// the open slab can change (a collapse's ring, its target included, lies inside it).
+    fn result(self, before: &Simplifier) -> SlabResult {
         let SlabWork { s, global, owned } = self;
         let slab = s.slab;
-        let vertices = (0..global.len())
-            .filter(|&x| slab.is_some_and(|slab| slab.holds((s.points[x], s.points[x]))))
+        let inside = |x: usize| slab.is_some_and(|slab| slab.holds((s.points[x], s.points[x])));
+        let removed = (0..global.len())
+            .filter(|&x| s.removed[x] && !before.removed[global[x] as usize] && inside(x))
+            .map(|x| global[x])
+            .collect();
+        let merged = (0..global.len())
+            .filter(|&x| {
+                let g = global[x] as usize;
+                !s.removed[x]
+                    && (s.quadric[x] != before.quadric[g]
+                        || s.relocation_quadric.get(x) != before.relocation_quadric.get(g))
+                    && inside(x)
+            })
             .map(|x| {
-                let vertex = SlabVertex {
-                    removed: s.removed[x],
+                let quadrics = SlabQuadrics {
                     quadric: s.quadric[x],
                     relocation_quadric: s.relocation_quadric.get(x).copied(),
                 };
-                (global[x], vertex)
+                (global[x], quadrics)
             })
             .collect();
         let faces = (0..s.faces.len())
@@ -112,7 +128,8 @@ impl SlabWork {
             .collect();
         SlabResult {
             faces,
-            vertices,
+            removed,
+            merged,
             stats: s.stats,
         }
     }
@@ -133,25 +150,17 @@ impl Simplifier {
         slabs: &[Slab],
         work: impl Fn(&mut Simplifier, f64, usize) + Sync,
     ) {
-        let Some(axis) = slabs.first().map(|s| s.axis) else {
+        if slabs.is_empty() {
             return;
-        };
-        let spans: Vec<(i64, i64)> = self
-            .faces
-            .par_iter()
-            .map(|t| {
-                let c = t.map(|x| self.points[x as usize][axis]);
-                (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]))
-            })
-            .collect();
+        }
         let live = self.alive.iter().filter(|&&a| a).count().max(1);
         let results: Vec<SlabResult> = slabs
             .par_iter()
             .map(|slab| {
-                let mut w = self.slab(*slab, &spans);
+                let mut w = self.slab(*slab);
                 let owned = w.owned.iter().filter(|&&o| o).count();
                 work(&mut w.s, owned as f64 / live as f64, w.owned.len() - owned);
-                w.result()
+                w.result(self)
             })
             .collect();
         self.merge(results);
@@ -230,13 +239,18 @@ impl Simplifier {
         slabs
     }
 
-    /// The simplifier of `slab`: the live faces whose spans (`spans`, per face) meet the closed
+    /// The simplifier of `slab`: the live faces whose spans along the axis meet the closed
     /// slab (a face in a slab plane is in both slabs' and no slab may change it), their vertices
     /// and the removed vertices they answer for, renumbered in the global order (the
     /// extraction's, which keeps neighbours near each other in memory).
-    fn slab(&self, slab: Slab, spans: &[(i64, i64)]) -> SlabWork {
+    fn slab(&self, slab: Slab) -> SlabWork {
+        // Computed per slab, not stored per face (16 bytes × 3M faces at res 256).
+        let span = |f: u32| {
+            let c = self.faces[f as usize].map(|x| self.points[x as usize][slab.axis]);
+            (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]))
+        };
         let mine: Vec<u32> = (0..self.faces.len() as u32)
-            .filter(|&f| self.alive[f as usize] && slab.meets(spans[f as usize]))
+            .filter(|&f| self.alive[f as usize] && slab.meets(span(f)))
             .collect();
         let mut local = vec![u32::MAX; self.points.len()];
         for &f in &mine {
@@ -268,7 +282,7 @@ impl Simplifier {
         let owned: Vec<bool> = mine
             .iter()
             .map(|&f| {
-                let lowest = spans[f as usize].0;
+                let lowest = span(f).0;
                 slab.lo <= lowest && lowest < slab.hi
             })
             .collect();
@@ -318,12 +332,14 @@ impl Simplifier {
         let mut faces = Vec::new();
         let mut support = Vec::new();
         for w in work {
-            for (g, v) in w.vertices {
+            for g in w.removed {
+                self.removed[g as usize] = true;
+            }
+            for (g, q) in w.merged {
                 let g = g as usize;
-                self.removed[g] = v.removed;
-                self.quadric[g] = v.quadric;
-                if let Some(q) = v.relocation_quadric {
-                    self.relocation_quadric[g] = q;
+                self.quadric[g] = q.quadric;
+                if let Some(r) = q.relocation_quadric {
+                    self.relocation_quadric[g] = r;
                 }
             }
             for (t, s) in w.faces {
