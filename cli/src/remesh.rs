@@ -76,10 +76,15 @@ pub struct Args {
     /// quadric minimum after the collapses).
     #[arg(long)]
     pub no_relocate: bool,
-    /// Rank collapses and relocate vertices by the planes of the marching-tetrahedra faces, not
-    /// by the input triangles' planes at the vertices placed on them.
+    /// Relocate vertices by the planes of the marching-tetrahedra faces, not by the input
+    /// triangles' planes at the vertices placed on them.
     #[arg(long)]
     pub no_input_planes: bool,
+    /// Keep the lattice of --res alone: do not make the cells finer across widespread plates of
+    /// the input thinner than two cells (at most 4 times finer, all axes together; meshes and
+    /// soups only).
+    #[arg(long)]
+    pub no_plate_refinement: bool,
     #[command(flatten)]
     pub method: MethodArgs,
     #[command(flatten)]
@@ -153,6 +158,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             flat_tolerance: args.simplify_flat,
             ..SimplifyOptions::default()
         }),
+        refine_plates: !args.no_plate_refinement,
     };
     // Phases: classify, extract, place, [simplify,] write, self-intersections, Hausdorff,
     // agreement.
@@ -227,6 +233,23 @@ pub fn run(args: Args) -> Result<(), CliError> {
         s.classified_points,
         s.band_cells
     )?;
+    if s.plates.refines() {
+        let axes: Vec<String> = (0..3)
+            .filter(|&a| s.plates.refinement[a] > 1.0)
+            .map(|a| {
+                let thickness = s.plates.thickness[a].unwrap_or(f64::NAN);
+                format!(
+                    "{:.2}x along {} (plates {thickness:.4e} thick)",
+                    s.plates.refinement[a],
+                    ["x", "y", "z"][a]
+                )
+            })
+            .collect();
+        outln!(
+            "cells made finer for plates of the input thinner than a cell: {}",
+            axes.join(", ")
+        )?;
+    }
     outln!("{topology}")?;
     if options.simplify.is_some() {
         outln!(
@@ -306,6 +329,23 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 format!(
                     "[{:?}, {:?}, {:?}]",
                     out.cell_sizes[0], out.cell_sizes[1], out.cell_sizes[2]
+                ),
+            ),
+            (
+                "plate_refinement",
+                format!(
+                    "[{:?}, {:?}, {:?}]",
+                    s.plates.refinement[0], s.plates.refinement[1], s.plates.refinement[2]
+                ),
+            ),
+            (
+                "plate_thickness",
+                format!(
+                    "[{}]",
+                    s.plates
+                        .thickness
+                        .map(|t| t.map_or("null".to_string(), |t| format!("{t:?}")))
+                        .join(", ")
                 ),
             ),
             ("seconds", format!("{secs:.3}")),

@@ -191,8 +191,9 @@ def remesh(
     tolerance: Optional[float] = None,
     threads: Optional[int] = None,
     thicken: Optional[float] = None,
+    refine_plates: bool = True,
 ) -> Tuple[_F64, _I64]:
-    """A closed, manifold, oriented surface of the solid w > 1/2 as (V float64 (n, 3), F int64 (m, 3)); simplify=False: the raw marching-tetrahedra surface."""
+    """A closed, manifold, oriented surface of the solid w > 1/2 as (V float64 (n, 3), F int64 (m, 3)); simplify=False: the raw marching-tetrahedra surface; refine_plates=False keeps the lattice of res alone."""
 
 def sdf(
     V: _Floats,

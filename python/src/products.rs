@@ -423,9 +423,11 @@ pub fn filter_tets<'py>(
 /// ``tolerance`` as in :func:`voxelize`; refused (``ValueError``) when the surface would not fit
 /// in memory. ``thicken=EPS`` closes open sheets (``w`` near 1/2 on both sides, no volume) into
 /// slabs of half-thickness ``EPS`` where ``w`` says the surface is open, as ``gwn remesh
-/// --thicken``; ``EPS`` must be at least one finest cell.
+/// --thicken``; ``EPS`` must be at least one finest cell. ``refine_plates`` (default on) makes
+/// the cells finer (at most 4 times, all axes together) across widespread plates of the input
+/// thinner than two cells, as ``gwn remesh`` does (``--no-plate-refinement``).
 #[pyfunction]
-#[pyo3(signature = (V, F, res = 128, *, bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS, simplify = true, method = "exact", beta = None, order = None, tolerance = None, threads = None, thicken = None))]
+#[pyo3(signature = (V, F, res = 128, *, bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS, simplify = true, method = "exact", beta = None, order = None, tolerance = None, threads = None, thicken = None, refine_plates = true))]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub fn remesh<'py>(
     py: Python<'py>,
@@ -440,6 +442,7 @@ pub fn remesh<'py>(
     tolerance: Option<f64>,
     threads: Option<Threads>,
     thicken: Option<f64>,
+    refine_plates: bool,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
     use gwn::products::remesh::{
         RemeshOptions, crossings::SegmentBvh, remesh_guided, thicken::ThickenedSheets,
@@ -456,6 +459,7 @@ pub fn remesh<'py>(
         bisection_steps: bisect,
         max_classified_points: None,
         simplify: simplify.then(gwn::products::remesh::simplify::SimplifyOptions::default),
+        refine_plates,
     };
     if let Some(eps) = thicken {
         let extent = (0..3)

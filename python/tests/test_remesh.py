@@ -84,3 +84,21 @@ def test_thicken_turns_an_open_square_into_a_slab():
     assert 0.1 < volume(V2, F2) < 0.22
     with pytest.raises(ValueError, match="finest cell"):
         gwn.remesh(V, F, res=24, thicken=0.01)
+
+
+def test_a_plate_thinner_than_a_cell_gets_finer_cells_across_it():
+    # A 1.5-thick 100 x 100 plate on a 40-high pedestal at res 32 (cubes of 3.125): placed
+    # between two lattice planes, the plate is lost without refine_plates, kept with it.
+    def box(lo, hi):
+        return lo + CUBE_V * (np.asarray(hi) - np.asarray(lo))
+
+    z0 = 25.8  # the lattice is centred on the box: planes at 24.6875 and 27.8125
+    V = np.vstack([box([40, 40, 0], [60, 60, 40]), box([0, 0, z0], [100, 100, z0 + 1.5])])
+    F = np.vstack([CUBE_F, CUBE_F + 8])
+    want = 20 * 20 * 40 + 100 * 100 * 1.5 - 20 * 20 * 1.5
+    V1, F1 = gwn.remesh(V, F, res=32)
+    assert edge_census(F1)[:2] == (True, True)
+    assert abs(volume(V1, F1) / want - 1) < 0.02
+    V0, F0 = gwn.remesh(V, F, res=32, refine_plates=False)
+    assert edge_census(F0)[:2] == (True, True)
+    assert volume(V0, F0) < 0.7 * want

@@ -376,6 +376,94 @@ fn plate_thinner_than_a_cube_cell_is_kept() {
     }
 }
 
+/// A 1.5-thick plate of 100 × 100 on a 40-high pedestal at res 32: the box is not thin (the
+/// pedestal), so cells are cubes of 3.125 and the plate, placed between two lattice planes, holds
+/// no lattice point off the pedestal. The plate probe finds it (a plate run along z over most of
+/// the lines) and makes the cells 4 times finer along z, which puts lattice planes inside it.
+#[test]
+fn plate_thinner_than_a_cell_on_a_pedestal_gets_finer_cells_across_it() {
+    use gwn::products::remesh::lattice::Lattice;
+    let cube = common::unit_cube();
+    let block = |lo: [f64; 3], hi: [f64; 3]| -> Vec<[f64; 3]> {
+        cube.positions()
+            .iter()
+            .map(|p| std::array::from_fn(|a| lo[a] + p[a] * (hi[a] - lo[a])))
+            .collect()
+    };
+    let (pedestal_lo, pedestal_hi) = ([40.0, 40.0, 0.0], [60.0, 60.0, 40.0]);
+    let bounds = gwn::BoundingBox {
+        min: [0.0, 0.0, 0.0],
+        max: [100.0, 100.0, 40.0],
+    };
+    let res = 32;
+    let h = 100.0 / res as f64;
+    let lattice = Lattice::new(bounds, res).unwrap();
+    assert_eq!(lattice.h, [h; 3]);
+    // Between the lattice planes k and k + 1 near z = 25 (0.8 above one, 0.825 below the next).
+    let k = ((25.0 - lattice.origin[2]) / h).ceil();
+    let z0 = lattice.origin[2] + k * h + 0.8;
+    let thickness = 1.5;
+    let mut positions = block(pedestal_lo, pedestal_hi);
+    positions.extend(block([0.0, 0.0, z0], [100.0, 100.0, z0 + thickness]));
+    let mut triangles = cube.triangles().to_vec();
+    triangles.extend(cube.triangles().iter().map(|t| t.map(|v| v + 8)));
+    let mesh = Mesh::new(positions, triangles).unwrap();
+    assert_eq!(mesh.bounding_box().unwrap(), bounds);
+    let wn = WindingNumber::new(&mesh).unwrap();
+    // Points in the plate, over a cell and a half away from its rim and the pedestal (where
+    // chamfers cut corners off): all inside the input.
+    let mut rng = common::Rng(0x51ab);
+    let in_plate: Vec<[f64; 3]> = std::iter::repeat_with(|| {
+        [
+            rng.range(5.0, 95.0),
+            rng.range(5.0, 95.0),
+            rng.range(z0 + 0.1, z0 + thickness - 0.1),
+        ]
+    })
+    .filter(|p| !(35.0..65.0).contains(&p[0]) || !(35.0..65.0).contains(&p[1]))
+    .take(2000)
+    .collect();
+    assert!(in_plate.iter().all(|&p| wn.eval(p) > 0.5));
+    let kept = |out: &Remeshed| {
+        let out_mesh = Mesh::new(out.positions.clone(), out.triangles.clone()).unwrap();
+        let output = WindingNumber::new(&out_mesh).unwrap();
+        let inside = output
+            .eval_batch(&in_plate)
+            .iter()
+            .filter(|&&w| w > 0.5)
+            .count();
+        inside as f64 / in_plate.len() as f64
+    };
+    // Without the probe: the plate is lost wherever the pedestal does not hold it up.
+    let (coarse, r) = run_with(
+        &mesh,
+        &RemeshOptions {
+            refine_plates: false,
+            ..RemeshOptions::with_resolution(res)
+        },
+    );
+    assert_closed_manifold(&r);
+    assert_eq!(coarse.cell_sizes, [h; 3]);
+    assert!(kept(&coarse) < 0.1, "kept {}", kept(&coarse));
+    for options in [RemeshOptions::with_resolution(res), raw(res)] {
+        let (out, r) = run_with(&mesh, &options);
+        assert_closed_manifold(&r);
+        assert_eq!((r.euler_characteristic, r.components), (2, 1), "{r}");
+        let plates = out.stats.plates;
+        // Wanted: 2 cells across 1.5 (4.17 times finer), capped at 4.
+        assert_eq!(plates.refinement, [1.0, 1.0, 4.0], "{plates:?}");
+        assert!((plates.thickness[2].unwrap() - thickness).abs() < 1e-9);
+        assert!(plates.thin_fraction[2] > 0.02, "{plates:?}");
+        assert_eq!(out.cell_sizes, [h, h, h / 4.0]);
+        // Distances in cells keep the resolution's cell.
+        assert_eq!(out.cell_size, h);
+        assert_eq!(kept(&out), 1.0);
+        let want = 20.0 * 20.0 * 40.0 + 100.0 * 100.0 * thickness - 20.0 * 20.0 * thickness;
+        let vol = signed_volume(&out, |_| true);
+        assert!((vol / want - 1.0).abs() < 0.02, "volume {vol}, want {want}");
+    }
+}
+
 #[test]
 fn double_walls_and_inner_faces_vanish() {
     // Two cubes sharing the face x = 1: the double wall is inside the union (w = 1 on both sides).

@@ -50,6 +50,12 @@ impl Lattice {
     /// see the [module documentation](self)), with one coarse cell of margin on every side;
     /// `None` when `bounds` is not finite or inverted.
     pub fn new(bounds: BoundingBox, res: usize) -> Option<Lattice> {
+        Lattice::refined(bounds, res, [1.0; 3])
+    }
+
+    /// [`Lattice::new`] with the cell edge along axis `a` divided by `refinement[a]` (at least 1;
+    /// [`super::plates`] decides it), down to at most [`MAX_ANISOTROPY`] times below the cube.
+    pub fn refined(bounds: BoundingBox, res: usize, refinement: [f64; 3]) -> Option<Lattice> {
         let ok = (0..3).all(|a| {
             bounds.min[a].is_finite() && bounds.max[a].is_finite() && bounds.min[a] <= bounds.max[a]
         });
@@ -65,9 +71,16 @@ impl Lattice {
             1.0
         };
         // A flat axis (extent 0: a planar sheet, no volume) keeps the cube edge.
-        let h = extent.map(|e| {
+        let h = [0, 1, 2].map(|a| {
+            let e = extent[a];
+            let finer = if refinement[a].is_finite() {
+                refinement[a].max(1.0)
+            } else {
+                1.0
+            };
             if e > 0.0 {
-                (THIN_AXIS_DIVISOR * e / res as f64).clamp(cube / MAX_ANISOTROPY, cube)
+                ((THIN_AXIS_DIVISOR * e / res as f64).min(cube) / finer)
+                    .clamp(cube / MAX_ANISOTROPY, cube)
             } else {
                 cube
             }

@@ -55,6 +55,7 @@ pub mod intersect;
 pub mod lattice;
 pub mod octree;
 pub mod place;
+pub mod plates;
 pub mod report;
 pub mod simplify;
 pub mod thicken;
@@ -99,6 +100,10 @@ pub struct RemeshOptions {
     /// Simplify the marching-tetrahedra surface by edge collapses ([`simplify`]) that keep every
     /// guarantee; `None`: the raw marching-tetrahedra surface.
     pub simplify: Option<simplify::SimplifyOptions>,
+    /// With the input triangles ([`remesh_guided`]): make the cells finer across widespread
+    /// plates thinner than two cells ([`plates`]; at most 4 times, all axes together). Only the
+    /// lattice changes; `false` keeps the lattice of `resolution` alone.
+    pub refine_plates: bool,
 }
 
 impl RemeshOptions {
@@ -109,6 +114,7 @@ impl RemeshOptions {
             bisection_steps: DEFAULT_BISECTION_STEPS,
             max_classified_points: None,
             simplify: Some(simplify::SimplifyOptions::default()),
+            refine_plates: true,
         }
     }
 }
@@ -178,7 +184,7 @@ impl std::fmt::Display for RemeshError {
 impl std::error::Error for RemeshError {}
 
 /// Work counters of one [`remesh`] run (for reports and benchmarks).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RemeshStats {
     /// Cells per axis of the finest lattice (margin included).
     pub lattice_cells: [usize; 3],
@@ -205,6 +211,9 @@ pub struct RemeshStats {
     pub marching_cubes_faces: usize,
     /// Simplification counters (all 0 without simplification).
     pub simplify: simplify::SimplifyStats,
+    /// What the plate probe found and how much finer it made the cells along each axis
+    /// ([`RemeshOptions::refine_plates`]).
+    pub plates: plates::PlateProbe,
 }
 
 /// The surface [`remesh`] returns.
@@ -220,8 +229,9 @@ pub struct Remeshed {
     pub fixed: Vec<[i64; 3]>,
     /// Fixed-point units per lattice cell edge (`2^(bisection_steps + 1)`).
     pub ticks_per_cell: i64,
-    /// The largest lattice spacing (cells are cubes of this edge, finer along an axis on which
-    /// the box is thin: [`Remeshed::cell_sizes`]); the unit of distances "in cells".
+    /// The resolution's cell edge, `longest extent / resolution` (cells are cubes of this edge,
+    /// finer along an axis on which the box is thin or across plates thinner than a cell:
+    /// [`Remeshed::cell_sizes`]); the unit of distances "in cells".
     pub cell_size: f64,
     /// The lattice spacing along each axis.
     pub cell_sizes: [f64; 3],
@@ -319,8 +329,18 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
             }
         }
     }
-    let lattice =
+    let mut lattice =
         lattice::Lattice::new(bounds, options.resolution).ok_or(RemeshError::BadBounds)?;
+    // The unit of distances in cells stays the resolution's cell whatever the plates refine.
+    let cell_size = lattice.largest_cell();
+    let plates = match guide {
+        Some(guide) if options.refine_plates => plates::probe(evaluator, guide, bounds, lattice.h),
+        _ => plates::PlateProbe::none(),
+    };
+    if plates.refines() {
+        lattice = lattice::Lattice::refined(bounds, options.resolution, plates.refinement)
+            .ok_or(RemeshError::BadBounds)?;
+    }
     let max_points = options.max_classified_points.unwrap_or_else(|| {
         crate::grid::available_memory().map_or(1 << 31, |bytes| {
             usize::try_from(bytes / BYTES_PER_CLASSIFIED_POINT).unwrap_or(usize::MAX)
@@ -356,6 +376,7 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
         extracted_vertices: band.edges.len(),
         marching_cubes_faces: band.marching_cubes_triangles,
         simplify: simplify::SimplifyStats::default(),
+        plates,
     };
     drop(classified);
     let (positions, fixed, triangles) = match &options.simplify {
@@ -400,7 +421,7 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
         triangles,
         fixed,
         ticks_per_cell: placed.ticks_per_cell,
-        cell_size: lattice.largest_cell(),
+        cell_size,
         cell_sizes: lattice.h,
         stats,
     })
