@@ -393,6 +393,102 @@ mod tests {
         assert!(!slab.meets((33, 40)) && !slab.meets((0, 15)));
     }
 
+    /// Collapses merge quadrics, so the sum of the kept vertices' quadrics is the sum over all
+    /// vertices before; the same for the relocation quadrics. After the slabs' collapses are
+    /// taken back, both sums must hold and every collapse must have removed one vertex: a slab
+    /// that gave back too little (a target's quadric, a removed vertex) breaks them.
+    #[test]
+    fn slabs_give_back_every_removed_vertex_and_merged_quadric() {
+        use crate::eval::antipodal::WindingNumber;
+        use crate::products::remesh::{crossings::SegmentBvh, extract, lattice, octree, place};
+        // A cube turned off the axes (generic planes), at res 40 in 8-cell slabs.
+        let (c, s) = (0.8f64, 0.6f64);
+        let turn = |p: [f64; 3]| [c * p[0] - s * p[1], s * p[0] + c * p[1], p[2]];
+        let corners: Vec<[f64; 3]> = (0..8)
+            .map(|i| turn([(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64]))
+            .collect();
+        let faces = [
+            [0, 2, 1],
+            [1, 2, 3],
+            [4, 5, 6],
+            [5, 7, 6],
+            [0, 1, 4],
+            [1, 5, 4],
+            [2, 6, 3],
+            [3, 6, 7],
+            [0, 4, 2],
+            [2, 4, 6],
+            [1, 3, 5],
+            [3, 7, 5],
+        ];
+        let mesh = crate::Mesh::from_slices(&corners, &faces).unwrap();
+        let wn = WindingNumber::new(&mesh).unwrap();
+        let guide = SegmentBvh::of_mesh(&mesh);
+        let lattice = lattice::Lattice::new(mesh.bounding_box().unwrap(), 40).unwrap();
+        let classified = octree::classify(&wn, &lattice, Some(&guide), usize::MAX).unwrap();
+        let band = extract::extract(&lattice, &classified);
+        let placed = place::place_vertices(
+            &wn,
+            &lattice,
+            &band.edges,
+            &classified.edge_values(&band.edges),
+            8,
+            Some(&guide),
+        );
+        let planes = placed.planes_in_lattice_units(&lattice);
+        assert!(planes.iter().filter(|p| p.is_some()).count() * 2 > planes.len());
+        let options = super::super::SimplifyOptions::default();
+        let Ok(mut simplifier) = Simplifier::new_unindexed(
+            placed.fixed.clone(),
+            band.triangles.clone(),
+            placed.ticks_per_cell,
+            &options,
+            Some(planes),
+        ) else {
+            panic!("the marching-tetrahedra surface is simplifiable");
+        };
+        let sum = |s: &Simplifier, q: &[[f64; 11]]| {
+            let mut total = [0.0; 11];
+            for (x, q) in q.iter().enumerate() {
+                if !s.removed[x] {
+                    for (t, v) in total.iter_mut().zip(q) {
+                        *t += v;
+                    }
+                }
+            }
+            total
+        };
+        let before = (
+            sum(&simplifier, &simplifier.quadric),
+            sum(&simplifier, &simplifier.relocation_quadric),
+        );
+        let slabs = simplifier.slabs(8);
+        assert!(slabs.len() >= 4, "{slabs:?}");
+        simplifier.in_slabs(&slabs, |slab, _, _| {
+            slab.collapse_lattice_diagonals(options.lattice_diagonal_error);
+            slab.run(0);
+        });
+        let stats = simplifier.stats;
+        assert!(stats.slab_collapses > 1000, "{stats:?}");
+        let removed = simplifier.removed.iter().filter(|&&r| r).count();
+        assert_eq!(removed, stats.slab_collapses);
+        let after = (
+            sum(&simplifier, &simplifier.quadric),
+            sum(&simplifier, &simplifier.relocation_quadric),
+        );
+        for (b, a) in [(before.0, after.0), (before.1, after.1)] {
+            let scale: f64 = b.iter().map(|x| x.abs()).sum();
+            for k in 0..11 {
+                assert!(
+                    (a[k] - b[k]).abs() <= 1e-9 * scale,
+                    "{k}: {} vs {}",
+                    a[k],
+                    b[k]
+                );
+            }
+        }
+    }
+
     #[test]
     fn a_slab_target_is_its_share_with_slack_plus_what_it_cannot_change() {
         assert_eq!(Simplifier::slab_target(0, 0.5, 7), 0);
