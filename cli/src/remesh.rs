@@ -348,6 +348,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
                         .join(", ")
                 ),
             ),
+            (
+                "plate_thin_fraction",
+                format!(
+                    "[{:?}, {:?}, {:?}]",
+                    s.plates.thin_fraction[0], s.plates.thin_fraction[1], s.plates.thin_fraction[2]
+                ),
+            ),
             ("seconds", format!("{secs:.3}")),
             ("classified_points", s.classified_points.to_string()),
             ("band_cells", s.band_cells.to_string()),

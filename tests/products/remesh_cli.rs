@@ -296,3 +296,82 @@ fn report_number(json: &str, key: &str) -> f64 {
         .and_then(|s| s.trim().parse().ok())
         .unwrap_or_else(|| panic!("no {key} in {json}"))
 }
+
+/// A 1.5-thick plate on a 40-high pedestal at res 32 (cubes of 3.125, the plate between two
+/// lattice planes): the report says the cells got 4 times finer along z and the plate is kept
+/// (agreement); `--no-plate-refinement` keeps the cubes and loses the plate.
+#[test]
+fn remesh_reports_the_plate_refinement_and_can_turn_it_off() {
+    let dir = std::env::temp_dir().join(format!("gwn-cli-remesh-plate-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let input = dir.join("pedestal_plate.obj");
+    let cube = gwn::testing::unit_cube(false);
+    let block = |lo: [f64; 3], hi: [f64; 3]| {
+        let positions = cube
+            .positions()
+            .iter()
+            .map(|p| std::array::from_fn(|a| lo[a] + p[a] * (hi[a] - lo[a])))
+            .collect();
+        gwn::Mesh::new(positions, cube.triangles().to_vec()).unwrap()
+    };
+    // The lattice of the box [0, 100]² × [0, 40] at res 32 has planes at z = 24.6875, 27.8125.
+    let mesh = block([40.0, 40.0, 0.0], [60.0, 60.0, 40.0])
+        .concatenated(&block([0.0, 0.0, 25.8], [100.0, 100.0, 27.3]))
+        .unwrap();
+    gwn::mesh::write_obj(std::fs::File::create(&input).unwrap(), &mesh).unwrap();
+    let run = |extra: &[&str]| {
+        let (out, report) = (dir.join("o.ply"), dir.join("r.json"));
+        let mut args = vec![
+            "remesh",
+            input.to_str().unwrap(),
+            "--res",
+            "32",
+            "--samples",
+            "20000",
+            "--out",
+            out.to_str().unwrap(),
+            "--report",
+            report.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let (ok, stdout, stderr) = gwn(&args);
+        assert!(ok, "{stderr}");
+        assert!(stdout.contains("closed: yes"), "{stdout}");
+        (stdout, std::fs::read_to_string(&report).unwrap())
+    };
+    let (stdout, json) = run(&[]);
+    assert!(
+        stdout.contains(
+            "cells made finer for plates of the input thinner than a cell: 4.00x along z"
+        ),
+        "{stdout}"
+    );
+    assert!(
+        json.contains("\"plate_refinement\": [1.0, 1.0, 4.0]"),
+        "{json}"
+    );
+    assert!(
+        json.contains("\"cell_sizes\": [3.125, 3.125, 0.78125]"),
+        "{json}"
+    );
+    assert!(json.contains("\"cell_size\": 3.125"), "{json}");
+    let thickness = json
+        .split("\"plate_thickness\": [null, null, ")
+        .nth(1)
+        .unwrap();
+    let thickness: f64 = thickness.split(']').next().unwrap().parse().unwrap();
+    assert!((thickness - 1.5).abs() < 1e-9, "{json}");
+    assert!(
+        report_number(&json, "occupancy_agreement") > 0.999,
+        "{json}"
+    );
+    let (stdout, json) = run(&["--no-plate-refinement"]);
+    assert!(!stdout.contains("cells made finer"), "{stdout}");
+    assert!(
+        json.contains("\"plate_refinement\": [1.0, 1.0, 1.0]"),
+        "{json}"
+    );
+    // The plate is 3.6 % of the box; most of it is lost.
+    assert!(report_number(&json, "occupancy_agreement") < 0.98, "{json}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
