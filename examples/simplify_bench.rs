@@ -209,13 +209,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
         }
         println!(
-            "{name} res {res}: {} -> {} faces (MC {}), {} collapses ({} of diagonal vertices, {} kept) in {} rounds, refused {:?}, {} relocated ({} refused), {dt:.2} s, {:.2} us/collapse, fingerprint {h:016x}",
+            "{name} res {res}: {} -> {} faces (MC {}), {} collapses ({} of diagonal vertices, {} kept; {} of flat stars) in {} rounds, refused {:?}, {} relocated ({} refused), {dt:.2} s, {:.2} us/collapse, fingerprint {h:016x}",
             s.stats.faces_before,
             s.stats.faces_after,
             surface.marching_cubes,
             s.stats.collapses,
             s.stats.diagonal_collapses,
             s.stats.diagonals_left,
+            s.stats.flat_star_collapses,
             s.stats.rounds,
             s.stats.refused,
             s.stats.relocated,

@@ -228,6 +228,9 @@ pub struct SimplifyStats {
     pub relocations_refused: usize,
     /// Collapses refused, by reason: link, face size, flip, distance, intersection.
     pub refused: [usize; 5],
+    /// Of [`SimplifyStats::collapses`], those of vertices whose faces all lay in one plane,
+    /// which need no intersection check (`Simplifier::star_is_flat` says why).
+    pub flat_star_collapses: usize,
     /// The input was not a closed oriented manifold without collinear faces: left unchanged.
     pub skipped: bool,
 }
@@ -387,6 +390,8 @@ struct Plan {
     v: u32,
     /// The neighbours of `u` (their best collapses change), when known.
     ring: Vec<u32>,
+    /// Whether `u`'s faces all lay in one plane (no intersection check was needed).
+    flat_star: bool,
 }
 
 impl Simplifier {
@@ -970,6 +975,7 @@ impl Simplifier {
     /// Makes the collapse `plan` of `u` (computed on the current surface).
     fn apply(&mut self, u: u32, plan: Plan) {
         let v = plan.v;
+        self.stats.flat_star_collapses += usize::from(plan.flat_star);
         for &f in &plan.old {
             self.alive[f as usize] = false;
             self.index(f, false);
@@ -1108,9 +1114,18 @@ impl Simplifier {
             }
             support[best].push(x);
         }
-        // Intersections: new faces against each other and against the live faces near them.
+        // Intersections: new faces against each other and against the live faces near them,
+        // unless `u`'s star is flat, where the new faces cover what the old ones did.
         let exact: Vec<[P; 3]> = new.iter().map(|t| t.map(p)).collect();
+        let flat_star = cubes.is_none() && self.star_is_flat(&old);
         let meets = match cubes {
+            None if flat_star => {
+                debug_assert!(
+                    !self.meets_other_faces(&exact, &old),
+                    "a collapse of the flat star of {u} meets another face"
+                );
+                false
+            }
             None => self.meets_other_faces(&exact, &old),
             Some(cubes) => cubes.refuses(self, u, &new, &exact, &old),
         };
@@ -1118,12 +1133,55 @@ impl Simplifier {
             return Err(Refusal::Intersection);
         }
         Ok(Plan {
+            flat_star,
             old,
             new,
             support,
             v,
             ring: Vec::new(),
         })
+    }
+
+    /// Whether the faces `star` of a vertex `u` (all of them, so all hold `u`) have parallel
+    /// normals with positive dot products, exactly: they lie in one plane through `u`, with one
+    /// orientation. Then a collapse of `u` that passes the flip check needs no intersection
+    /// check:
+    /// 1. the star tiles the polygon `L` bounded by `u`'s link: its faces are positively
+    ///    oriented in the plane around `u`, so they wind `k ≥ 1` times around it, and `k ≥ 2`
+    ///    would overlap two of them, a self-intersection of the surface, which it has none of;
+    /// 2. the new faces `(v, a_i, a_i+1)`, one per link edge away from `v`, are positively
+    ///    oriented too (the flip check: non-degenerate, positive dot product with the old
+    ///    normal), and a fan from `v` over `L`'s edges covers each point `x` as many times,
+    ///    counted with orientation, as `L` winds around `x`: once inside, never outside. All
+    ///    positive, they tile `L` too, and their directions from `v` turn strictly, so no
+    ///    vertex of `L` lies on a new edge and no two new faces meet outside what they share;
+    /// 3. a face `g` outside the star (not holding `u`) met the old faces only in vertices and
+    ///    edges it shares with them, all on `L`'s boundary; a new face meets that boundary only in
+    ///    its own vertices and boundary edges, so `g` meets a new face only where they share a
+    ///    vertex or an edge.
+    ///
+    /// The surface as a point set does not change. Conservative: `false` where an exact cross
+    /// product of normals would overflow `i128` (coordinates of 2^30 ticks and more).
+    fn star_is_flat(&self, star: &[u32]) -> bool {
+        let p = |x: u32| self.points[x as usize];
+        let Some(&first) = star.first() else {
+            return false;
+        };
+        let n0 = normal(self.faces[first as usize].map(p));
+        let parallel = |n: [i128; 3]| {
+            (0..3).all(|k| {
+                let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+                match (n0[i].checked_mul(n[j]), n0[j].checked_mul(n[i])) {
+                    (Some(a), Some(b)) => a == b,
+                    _ => false,
+                }
+            })
+        };
+        n0 != [0; 3]
+            && star.iter().all(|&f| {
+                let n = normal(self.faces[f as usize].map(p));
+                parallel(n) && dot_sign(n0, n) > 0
+            })
     }
 
     /// Whether the faces `exact` (replacing the faces `old`) meet each other or any other live

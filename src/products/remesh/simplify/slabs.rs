@@ -352,6 +352,7 @@ impl Simplifier {
             self.stats.rounds += st.rounds;
             self.stats.diagonal_collapses += st.diagonal_collapses;
             self.stats.diagonals_left += st.diagonals_left;
+            self.stats.flat_star_collapses += st.flat_star_collapses;
             for (a, b) in self.stats.refused.iter_mut().zip(st.refused) {
                 *a += b;
             }
