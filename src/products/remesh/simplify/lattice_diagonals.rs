@@ -139,7 +139,8 @@ impl CubeFaces {
 
     /// Whether the collapse of `u` into the faces `new` (vertex indices, and `exact` their
     /// points; replacing `old`) breaks a rule of the module documentation, or a new face meets
-    /// another new face or a face of its owner.
+    /// another new face or a face of its owner. With `flat_star` (`u`'s faces lie in one plane
+    /// with one orientation: `Simplifier::star_is_flat`) the rules alone: no face can meet.
     pub(super) fn refuses(
         &self,
         s: &Simplifier,
@@ -147,6 +148,7 @@ impl CubeFaces {
         new: &[[u32; 3]],
         exact: &[[P; 3]],
         old: &[u32],
+        flat_star: bool,
     ) -> bool {
         let ticks = s.ticks;
         let pu = s.points[u as usize];
@@ -183,6 +185,18 @@ impl CubeFaces {
             }
             owners.push(m);
         }
+        if flat_star {
+            debug_assert!(
+                !self.meets_in_owners(s, exact, old, &owners),
+                "a collapse of the flat star of {u} meets another face"
+            );
+            return false;
+        }
+        self.meets_in_owners(s, exact, old, &owners)
+    }
+
+    /// Whether a face of `exact` (replacing `old`) meets another or a face of its owner cube.
+    fn meets_in_owners(&self, s: &Simplifier, exact: &[[P; 3]], old: &[u32], owners: &[P]) -> bool {
         let boxes: Vec<(P, P)> = exact.iter().map(|t| face_box(*t)).collect();
         for i in 0..exact.len() {
             for j in i + 1..exact.len() {
@@ -192,7 +206,7 @@ impl CubeFaces {
             }
         }
         let p = |x: u32| s.points[x as usize];
-        for ((t, b), m) in exact.iter().zip(&boxes).zip(&owners) {
+        for ((t, b), m) in exact.iter().zip(&boxes).zip(owners) {
             for &g in self.of(*m) {
                 if old.contains(&g) {
                     continue;

@@ -1117,7 +1117,7 @@ impl Simplifier {
         // Intersections: new faces against each other and against the live faces near them,
         // unless `u`'s star is flat, where the new faces cover what the old ones did.
         let exact: Vec<[P; 3]> = new.iter().map(|t| t.map(p)).collect();
-        let flat_star = cubes.is_none() && self.star_is_flat(&old);
+        let flat_star = self.star_is_flat(&old);
         let meets = match cubes {
             None if flat_star => {
                 debug_assert!(
@@ -1127,7 +1127,7 @@ impl Simplifier {
                 false
             }
             None => self.meets_other_faces(&exact, &old),
-            Some(cubes) => cubes.refuses(self, u, &new, &exact, &old),
+            Some(cubes) => cubes.refuses(self, u, &new, &exact, &old, flat_star),
         };
         if meets {
             return Err(Refusal::Intersection);
