@@ -6,7 +6,7 @@ use clap::Args as ClapArgs;
 use gwn::products::remesh::crossings::SegmentBvh;
 use gwn::products::remesh::intersect::self_intersections;
 use gwn::products::remesh::report::{
-    NoSurface, TopologyReport, hausdorff_distance, occupancy_agreement,
+    NoSurface, TopologyReport, hausdorff_distance, hausdorff_to_solid_boundary, occupancy_agreement,
 };
 use gwn::products::remesh::simplify::SimplifyOptions;
 use gwn::products::remesh::thicken::ThickenedSheets;
@@ -199,6 +199,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
         Some(m) if args.samples > 0 => hausdorff_distance(m, &mesh, args.samples, 0x4a5d),
         _ => None,
     };
+    // The same samples, the input's side kept where it bounds the solid (a hundredth of a cell
+    // to each side of the face); not for thickened sheets, which bound nothing.
+    let boundary_hausdorff = match input.mesh() {
+        Some(m) if args.samples > 0 && thickened.is_none() => {
+            hausdorff_to_solid_boundary(m, wn, &mesh, args.samples, 0x4a5d, 0.01 * out.cell_size)
+        }
+        _ => None,
+    };
     bar.inc(1);
     bar.set_message("occupancy agreement");
     // The agreement compares against the written surface's own exact winding number; an empty
@@ -305,6 +313,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
             d / cell_size
         )?;
     }
+    if let Some(b) = boundary_hausdorff {
+        outln!(
+            "  to the input where it bounds the solid (w > 1/2 on one side only: {:.1} % of its \
+             samples): {:.4e} = {:.3} cells",
+            100.0 * b.boundary_fraction,
+            b.distance,
+            b.distance / cell_size
+        )?;
+    }
     if let Some(t) = &thickened {
         outln!(
             "thickened open sheets: half-thickness {:.4e} = {:.3} cells (agreement is against \
@@ -382,6 +399,17 @@ pub fn run(args: Args) -> Result<(), CliError> {
         if let Some(d) = hausdorff {
             extra.push(("hausdorff", format!("{d:?}")));
             extra.push(("hausdorff_cells", format!("{:?}", d / cell_size)));
+        }
+        if let Some(b) = boundary_hausdorff {
+            extra.push(("hausdorff_boundary", format!("{:?}", b.distance)));
+            extra.push((
+                "hausdorff_boundary_cells",
+                format!("{:?}", b.distance / cell_size),
+            ));
+            extra.push((
+                "hausdorff_boundary_fraction",
+                format!("{:?}", b.boundary_fraction),
+            ));
         }
         if let Some(t) = &thickened {
             extra.push(("thicken", format!("{:?}", t.eps())));

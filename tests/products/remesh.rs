@@ -8,7 +8,9 @@ use gwn::eval::Evaluator;
 use gwn::eval::antipodal::WindingNumber;
 use gwn::products::remesh::crossings::SegmentBvh;
 use gwn::products::remesh::intersect::self_intersections;
-use gwn::products::remesh::report::{TopologyReport, hausdorff_distance};
+use gwn::products::remesh::report::{
+    TopologyReport, hausdorff_distance, hausdorff_to_solid_boundary,
+};
 use gwn::products::remesh::{RemeshError, RemeshOptions, Remeshed, remesh, remesh_guided};
 use gwn::products::sdf::SignedDistance;
 
@@ -784,6 +786,37 @@ fn hausdorff_distance_of_a_sphere_is_below_one_cell() {
     let far = hausdorff_distance(&bigger, &out_mesh, 4000, 1).unwrap();
     assert!(far > 0.2 - out.cell_size, "{far}");
     assert_eq!(hausdorff_distance(&Mesh::default(), &out_mesh, 10, 1), None);
+}
+
+/// Two overlapping unit cubes, one self-intersecting closed input: the output is the union's
+/// surface, and the parts of each cube inside the other (22 % of the area) are up to ~0.35 from
+/// it, which the plain sampled distance counts as misses; measured from where the input bounds
+/// the solid, the distance is below a cell. A part the output lacks still counts: against the
+/// same input with a third, disjoint cube, the distance is at least the gap.
+#[test]
+fn hausdorff_to_the_solid_boundary_leaves_out_inner_faces() {
+    let pair = common::unit_cube()
+        .concatenated(&common::unit_cube().translated([0.5, 0.3, 0.2]))
+        .unwrap();
+    let (out, _) = run(&pair, 32);
+    let out_mesh = Mesh::new(out.positions.clone(), out.triangles.clone()).unwrap();
+    let h = out.cell_size;
+    let plain = hausdorff_distance(&pair, &out_mesh, 4000, 1).unwrap();
+    assert!(plain > 5.0 * h, "{plain} vs cell {h}");
+    let wn = WindingNumber::new(&pair).unwrap();
+    let b = hausdorff_to_solid_boundary(&pair, &wn, &out_mesh, 4000, 1, 0.01 * h).unwrap();
+    assert!(b.distance < h, "{b:?} vs cell {h}");
+    // Inner parts: 2 × (0.7·0.8 + 0.5·0.8 + 0.5·0.7) = 2.62 of the area 12.
+    assert!(
+        (b.boundary_fraction - (1.0 - 2.62 / 12.0)).abs() < 0.02,
+        "{b:?}"
+    );
+    let three = pair
+        .concatenated(&common::unit_cube().translated([4.0, 0.0, 0.0]))
+        .unwrap();
+    let wn3 = WindingNumber::new(&three).unwrap();
+    let lost = hausdorff_to_solid_boundary(&three, &wn3, &out_mesh, 4000, 1, 0.01 * h).unwrap();
+    assert!(lost.distance > 2.5, "{lost:?}");
 }
 
 /// `--thicken`: an open square (w = ±½ beside it, no volume) becomes a closed slab of thickness

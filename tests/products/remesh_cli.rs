@@ -26,6 +26,7 @@ fn remesh_writes_every_format_and_a_report() {
         ]);
         assert!(ok, "{stderr}");
         assert!(stdout.contains("closed: yes") && stdout.contains("Euler characteristic 2"));
+        assert!(stdout.contains("to the input where it bounds the solid (w > 1/2 on one side only: 100.0 % of its samples)"), "{stdout}");
         let json = std::fs::read_to_string(&report).unwrap();
         for member in [
             "\"closed\": true",
@@ -38,6 +39,9 @@ fn remesh_writes_every_format_and_a_report() {
             "\"self_intersections\": 0",
             "\"collinear_faces\": 0",
             "\"hausdorff_cells\": ",
+            // A clean cube bounds its solid everywhere.
+            "\"hausdorff_boundary_fraction\": 1.0",
+            "\"hausdorff_boundary_cells\": ",
             "\"simplified\": true",
             "\"marching_tetrahedra_faces\": ",
             "\"marching_cubes_faces\": ",
@@ -198,6 +202,8 @@ fn remesh_thickens_an_open_sheet_on_request() {
     ] {
         assert!(json.contains(member), "{member} not in {json}");
     }
+    // Thickened sheets bound nothing of the input's solid: no distance to its boundary.
+    assert!(!json.contains("hausdorff_boundary"), "{json}");
     // Below one finest cell (1/24) the slab could fall between lattice points: refused.
     for (eps, needle) in [
         ("0.01", "below one finest cell"),

@@ -276,27 +276,111 @@ pub fn hausdorff_distance(
     samples: usize,
     seed: u64,
 ) -> Option<f64> {
-    use rayon::prelude::*;
     if a.is_empty() || b.is_empty() {
         return None;
     }
-    let one_sided = |from: &crate::Mesh, to: &crate::Mesh, seed: u64| -> f64 {
-        let distance = crate::products::sdf::SignedDistance::with_evaluator(to, NoSurface);
-        let triangles: Vec<[[f64; 3]; 3]> = (0..from.triangles().len())
-            .map(|f| from.triangle_positions(f))
-            .collect();
-        let points = surface_samples(&triangles, samples, seed);
-        points
-            .par_iter()
-            .map(|&p| distance.unsigned(p))
-            .reduce(|| 0.0, f64::max)
-    };
-    Some(one_sided(a, b, seed).max(one_sided(b, a, seed ^ 0x5bd1_e995)))
+    let from_a: Vec<[f64; 3]> = surface_samples(&triangles_of(a), samples, seed)
+        .into_iter()
+        .map(|(p, _)| p)
+        .collect();
+    Some(farthest(&from_a, b).max(farthest_from_surface(b, a, samples, seed ^ 0x5bd1_e995)))
 }
 
-/// `samples` points uniform by area on `triangles` (seeded SplitMix64).
-fn surface_samples(triangles: &[[[f64; 3]; 3]], samples: usize, seed: u64) -> Vec<[f64; 3]> {
-    let mut points: Vec<[f64; 3]> = Vec::with_capacity(samples);
+/// [`hausdorff_distance`] with the input's side restricted to where the input bounds the solid
+/// `w > ½`: the remesher drops inner faces, double walls and the parts of self-intersecting
+/// shells inside the solid because `w` says so, and the plain distance counts each of them as
+/// a miss (cgal-mpi at res 256: 55.9 cells). An input sample on face `f` counts where `w` of
+/// `input_w` at `p ± offset·n_f` (`n_f` the face's unit normal) is above ½ on one side only;
+/// the output's samples are measured against the whole input (so that side is a lower bound of
+/// the distance to the boundary part). The same seeds as [`hausdorff_distance`], so the two
+/// share their samples.
+pub fn hausdorff_to_solid_boundary<E: crate::eval::Evaluator + ?Sized>(
+    input: &crate::Mesh,
+    input_w: &E,
+    output: &crate::Mesh,
+    samples: usize,
+    seed: u64,
+    offset: f64,
+) -> Option<BoundaryHausdorff> {
+    if input.is_empty() || output.is_empty() {
+        return None;
+    }
+    let triangles = triangles_of(input);
+    let sampled = surface_samples(&triangles, samples, seed);
+    let unit_normal = |t: &[[f64; 3]; 3]| {
+        use crate::base::vec3::{cross, norm, sub};
+        let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
+        let l = norm(n);
+        n.map(|c| c / l)
+    };
+    let sides: Vec<[f64; 3]> = sampled
+        .iter()
+        .flat_map(|&(p, f)| {
+            let n = unit_normal(&triangles[f]);
+            [1.0, -1.0].map(|s| std::array::from_fn(|k| p[k] + s * offset * n[k]))
+        })
+        .collect();
+    let w = input_w.eval_batch(&sides);
+    let bounding: Vec<[f64; 3]> = sampled
+        .iter()
+        .zip(w.chunks_exact(2))
+        .filter(|(_, w)| (w[0] > 0.5) != (w[1] > 0.5))
+        .map(|(&(p, _), _)| p)
+        .collect();
+    let boundary_fraction = bounding.len() as f64 / sampled.len().max(1) as f64;
+    let distance = farthest(&bounding, output).max(farthest_from_surface(
+        output,
+        input,
+        samples,
+        seed ^ 0x5bd1_e995,
+    ));
+    Some(BoundaryHausdorff {
+        distance,
+        boundary_fraction,
+    })
+}
+
+/// The result of [`hausdorff_to_solid_boundary`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BoundaryHausdorff {
+    /// The sampled symmetric distance.
+    pub distance: f64,
+    /// The fraction of the input's samples where it bounds the solid.
+    pub boundary_fraction: f64,
+}
+
+fn triangles_of(mesh: &crate::Mesh) -> Vec<[[f64; 3]; 3]> {
+    (0..mesh.triangles().len())
+        .map(|f| mesh.triangle_positions(f))
+        .collect()
+}
+
+/// The largest distance from `points` to the surface `to` (0 for no points).
+fn farthest(points: &[[f64; 3]], to: &crate::Mesh) -> f64 {
+    use rayon::prelude::*;
+    let distance = crate::products::sdf::SignedDistance::with_evaluator(to, NoSurface);
+    points
+        .par_iter()
+        .map(|&p| distance.unsigned(p))
+        .reduce(|| 0.0, f64::max)
+}
+
+/// The largest distance to `to` from `samples` points on `from`.
+fn farthest_from_surface(from: &crate::Mesh, to: &crate::Mesh, samples: usize, seed: u64) -> f64 {
+    let points: Vec<[f64; 3]> = surface_samples(&triangles_of(from), samples, seed)
+        .into_iter()
+        .map(|(p, _)| p)
+        .collect();
+    farthest(&points, to)
+}
+
+/// `samples` points uniform by area on `triangles` (seeded SplitMix64), each with its triangle.
+fn surface_samples(
+    triangles: &[[[f64; 3]; 3]],
+    samples: usize,
+    seed: u64,
+) -> Vec<([f64; 3], usize)> {
+    let mut points: Vec<([f64; 3], usize)> = Vec::with_capacity(samples);
     let area = |t: &[[f64; 3]; 3]| {
         use crate::base::vec3::{cross, norm, sub};
         0.5 * norm(cross(sub(t[1], t[0]), sub(t[2], t[0])))
@@ -323,9 +407,9 @@ fn surface_samples(triangles: &[[[f64; 3]; 3]], samples: usize, seed: u64) -> Ve
             (r1, r2) = (1.0 - r1, 1.0 - r2);
         }
         let t = &triangles[f];
-        points.push(std::array::from_fn(|k| {
-            t[0][k] + r1 * (t[1][k] - t[0][k]) + r2 * (t[2][k] - t[0][k])
-        }));
+        let p =
+            std::array::from_fn(|k| t[0][k] + r1 * (t[1][k] - t[0][k]) + r2 * (t[2][k] - t[0][k]));
+        points.push((p, f));
     }
     points
 }
