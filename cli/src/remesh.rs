@@ -195,16 +195,18 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .map_err(|e| CliError(format!("{}: {e}", args.out.display())))?;
     bar.inc(1);
     bar.set_message("sampling the Hausdorff distance");
-    let hausdorff = match input.mesh() {
-        Some(m) if args.samples > 0 => hausdorff_distance(m, &mesh, args.samples, 0x4a5d),
-        _ => None,
-    };
-    // The same samples, the input's side kept where it bounds the solid (a hundredth of a cell
-    // to each side of the face); not for thickened sheets, which bound nothing.
+    // With the input's side also kept where it bounds the solid (a hundredth of a cell to
+    // each side of the face; the plain distance comes with it, on the same samples); not for
+    // thickened sheets, which bound nothing.
     let boundary_hausdorff = match input.mesh() {
         Some(m) if args.samples > 0 && thickened.is_none() => {
             hausdorff_to_solid_boundary(m, wn, &mesh, args.samples, 0x4a5d, 0.01 * out.cell_size)
         }
+        _ => None,
+    };
+    let hausdorff = match (input.mesh(), boundary_hausdorff) {
+        (_, Some(b)) => Some(b.plain),
+        (Some(m), None) if args.samples > 0 => hausdorff_distance(m, &mesh, args.samples, 0x4a5d),
         _ => None,
     };
     bar.inc(1);

@@ -806,6 +806,10 @@ fn hausdorff_to_the_solid_boundary_leaves_out_inner_faces() {
     let wn = WindingNumber::new(&pair).unwrap();
     let b = hausdorff_to_solid_boundary(&pair, &wn, &out_mesh, 4000, 1, 0.01 * h).unwrap();
     assert!(b.distance < h, "{b:?} vs cell {h}");
+    assert_eq!(
+        b.plain, plain,
+        "the same samples give the plain distance too"
+    );
     // Inner parts: 2 × (0.7·0.8 + 0.5·0.8 + 0.5·0.7) = 2.62 of the area 12.
     assert!(
         (b.boundary_fraction - (1.0 - 2.62 / 12.0)).abs() < 0.02,

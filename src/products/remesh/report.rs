@@ -321,22 +321,23 @@ pub fn hausdorff_to_solid_boundary<E: crate::eval::Evaluator + ?Sized>(
         })
         .collect();
     let w = input_w.eval_batch(&sides);
-    let bounding: Vec<[f64; 3]> = sampled
-        .iter()
-        .zip(w.chunks_exact(2))
-        .filter(|(_, w)| (w[0] > 0.5) != (w[1] > 0.5))
-        .map(|(&(p, _), _)| p)
-        .collect();
-    let boundary_fraction = bounding.len() as f64 / sampled.len().max(1) as f64;
-    let distance = farthest(&bounding, output).max(farthest_from_surface(
-        output,
-        input,
-        samples,
-        seed ^ 0x5bd1_e995,
-    ));
+    // Each input sample's distance once: its maximum over all samples is the plain distance's
+    // input side, over the bounding ones this one's.
+    let points: Vec<[f64; 3]> = sampled.iter().map(|&(p, _)| p).collect();
+    let distances = distances_to(&points, output);
+    let (mut all, mut bounding, mut count) = (0.0f64, 0.0f64, 0usize);
+    for (d, w) in distances.iter().zip(w.chunks_exact(2)) {
+        all = all.max(*d);
+        if (w[0] > 0.5) != (w[1] > 0.5) {
+            bounding = bounding.max(*d);
+            count += 1;
+        }
+    }
+    let output_side = farthest_from_surface(output, input, samples, seed ^ 0x5bd1_e995);
     Some(BoundaryHausdorff {
-        distance,
-        boundary_fraction,
+        distance: bounding.max(output_side),
+        plain: all.max(output_side),
+        boundary_fraction: count as f64 / sampled.len().max(1) as f64,
     })
 }
 
@@ -345,6 +346,8 @@ pub fn hausdorff_to_solid_boundary<E: crate::eval::Evaluator + ?Sized>(
 pub struct BoundaryHausdorff {
     /// The sampled symmetric distance.
     pub distance: f64,
+    /// [`hausdorff_distance`] on the same samples (every input sample counted).
+    pub plain: f64,
     /// The fraction of the input's samples where it bounds the solid.
     pub boundary_fraction: f64,
 }
@@ -357,12 +360,14 @@ fn triangles_of(mesh: &crate::Mesh) -> Vec<[[f64; 3]; 3]> {
 
 /// The largest distance from `points` to the surface `to` (0 for no points).
 fn farthest(points: &[[f64; 3]], to: &crate::Mesh) -> f64 {
+    distances_to(points, to).into_iter().fold(0.0, f64::max)
+}
+
+/// The distance from each of `points` to the surface `to`.
+fn distances_to(points: &[[f64; 3]], to: &crate::Mesh) -> Vec<f64> {
     use rayon::prelude::*;
     let distance = crate::products::sdf::SignedDistance::with_evaluator(to, NoSurface);
-    points
-        .par_iter()
-        .map(|&p| distance.unsigned(p))
-        .reduce(|| 0.0, f64::max)
+    points.par_iter().map(|&p| distance.unsigned(p)).collect()
 }
 
 /// The largest distance to `to` from `samples` points on `from`.
