@@ -85,6 +85,11 @@ pub struct Args {
     /// soups only).
     #[arg(long)]
     pub no_plate_refinement: bool,
+    /// Levels of cells below --res (0 to 3): a cell that an input triangle crosses while its
+    /// corners agree (a part thinner than a cell: a tip, a leg, a rib) is cut into eight, down
+    /// to this many levels, with conforming transitions (meshes and soups only).
+    #[arg(long, default_value_t = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS)]
+    pub sub_cell_levels: u32,
     #[command(flatten)]
     pub method: MethodArgs,
     #[command(flatten)]
@@ -159,6 +164,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             ..SimplifyOptions::default()
         }),
         refine_plates: !args.no_plate_refinement,
+        sub_cell_levels: args.sub_cell_levels,
     };
     // Phases: classify, extract, place, [simplify,] write, self-intersections, Hausdorff,
     // agreement.
@@ -243,6 +249,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
         s.classified_points,
         s.band_cells
     )?;
+    if options.sub_cell_levels > 0 {
+        outln!(
+            "sub-cell levels: {} ({} cells crossed by the input with agreeing corners refined)",
+            options.sub_cell_levels,
+            s.refined_cells
+        )?;
+    }
     if s.plates.refines() {
         let axes: Vec<String> = (0..3)
             .filter(|&a| s.plates.refinement[a] > 1.0)
@@ -377,6 +390,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
             ("seconds", format!("{secs:.3}")),
             ("classified_points", s.classified_points.to_string()),
             ("band_cells", s.band_cells.to_string()),
+            ("sub_cell_levels", options.sub_cell_levels.to_string()),
+            ("refined_cells", s.refined_cells.to_string()),
             ("method", format!("\"{}\"", gwn::eval::Evaluator::name(&wn))),
             ("guided_vertices", s.guided_vertices.to_string()),
             ("placement_evaluations", s.placement_evaluations.to_string()),

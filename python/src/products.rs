@@ -426,8 +426,11 @@ pub fn filter_tets<'py>(
 /// --thicken``; ``EPS`` must be at least one finest cell. ``refine_plates`` (default on) makes
 /// the cells finer (at most 4 times, all axes together) across widespread plates of the input
 /// thinner than two cells, as ``gwn remesh`` does (``--no-plate-refinement``).
+/// ``sub_cell_levels`` (0 to 3) cuts cells that an input triangle crosses while their corners
+/// agree (parts thinner than a cell) into eight, down to that many levels below ``res``, as
+/// ``gwn remesh --sub-cell-levels``.
 #[pyfunction]
-#[pyo3(signature = (V, F, res = 128, *, bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS, simplify = true, method = "exact", beta = None, order = None, tolerance = None, threads = None, thicken = None, refine_plates = true))]
+#[pyo3(signature = (V, F, res = 128, *, bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS, simplify = true, method = "exact", beta = None, order = None, tolerance = None, threads = None, thicken = None, refine_plates = true, sub_cell_levels = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS))]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub fn remesh<'py>(
     py: Python<'py>,
@@ -443,6 +446,7 @@ pub fn remesh<'py>(
     threads: Option<Threads>,
     thicken: Option<f64>,
     refine_plates: bool,
+    sub_cell_levels: u32,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
     use gwn::products::remesh::{
         RemeshOptions, crossings::SegmentBvh, remesh_guided, thicken::ThickenedSheets,
@@ -460,6 +464,7 @@ pub fn remesh<'py>(
         max_classified_points: None,
         simplify: simplify.then(gwn::products::remesh::simplify::SimplifyOptions::default),
         refine_plates,
+        sub_cell_levels,
     };
     if let Some(eps) = thicken {
         let extent = (0..3)

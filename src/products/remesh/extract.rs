@@ -41,59 +41,94 @@ pub struct Band {
     pub marching_cubes_triangles: usize,
 }
 
-/// Extracts the separating surface of the band of `classified`.
+/// Extracts the separating surface of the band of `classified`: the regular cells'
+/// Freudenthal split, and with sub-levels the refined cells' finer one and the transition
+/// split between them ([`super::transition`]).
 pub fn extract(lattice: &Lattice, classified: &Classified) -> Band {
-    let _ = lattice;
+    let size = lattice.regular_cell();
     let mut band = Band {
-        band_cells: classified.band.len(),
+        band_cells: classified.band.len()
+            + classified.fine_band.len()
+            + classified.transition.len(),
         ..Band::default()
     };
     // Keyed by the packed corners: hashing two u64 costs a third of hashing six u32.
     let mut vertex_of: std::collections::HashMap<(u64, u64), u32, KeyHash> = Default::default();
-    let mut vertex = |edge: (Corner, Corner), edges: &mut Vec<(Corner, Corner)>| -> u32 {
-        *vertex_of
-            .entry((pack(edge.0), pack(edge.1)))
-            .or_insert_with(|| {
-                edges.push(edge);
-                (edges.len() - 1) as u32
-            })
+    let mut march = |v: [Corner; 4], band: &mut Band| {
+        let ins = v.map(|c| classified.label(c));
+        let mut in_idx = [0usize; 4];
+        let mut out_idx = [0usize; 4];
+        let (mut n_in, mut n_out) = (0, 0);
+        for (i, &inside) in ins.iter().enumerate() {
+            if inside {
+                in_idx[n_in] = i;
+                n_in += 1;
+            } else {
+                out_idx[n_out] = i;
+                n_out += 1;
+            }
+        }
+        let quad;
+        let tris: &[[(usize, usize); 3]] = match n_in {
+            1 => {
+                let i = in_idx[0];
+                quad = [[(i, out_idx[0]), (i, out_idx[1]), (i, out_idx[2])]; 2];
+                &quad[..1]
+            }
+            3 => {
+                let o = out_idx[0];
+                quad = [[(in_idx[0], o), (in_idx[1], o), (in_idx[2], o)]; 2];
+                &quad[..1]
+            }
+            2 => {
+                let (a, b) = (in_idx[0], in_idx[1]);
+                let (c, d) = (out_idx[0], out_idx[1]);
+                quad = [[(a, c), (a, d), (b, d)], [(a, c), (b, d), (b, c)]];
+                &quad[..]
+            }
+            _ => return,
+        };
+        for tri in tris {
+            let mut e = tri.map(|(i, o)| (v[i], v[o]));
+            if !outward(&e) {
+                e.swap(1, 2);
+            }
+            let t = e.map(|edge| {
+                *vertex_of
+                    .entry((pack(edge.0), pack(edge.1)))
+                    .or_insert_with(|| {
+                        band.edges.push(edge);
+                        (band.edges.len() - 1) as u32
+                    })
+            });
+            band.triangles.push(t);
+        }
     };
     let mc_table = marching_cubes_table();
-    for &m in &classified.band {
-        let corners: [Corner; 8] = std::array::from_fn(|b| offset(m, b, 1));
-        let inside: [bool; 8] = std::array::from_fn(|b| classified.label(corners[b]));
-        let case = (0..8).filter(|&b| inside[b]).fold(0, |c, b| c | (1 << b));
+    let marching_cubes = |m: Corner, band: &mut Band| {
+        let case = (0..8)
+            .filter(|&b| classified.label(offset(m, b, size)))
+            .fold(0, |c, b| c | (1 << b));
         band.marching_cubes_triangles += usize::from(mc_table[case]);
+    };
+    for &m in &classified.band {
+        marching_cubes(m, &mut band);
         for tet in FREUDENTHAL {
-            let v = tet.map(|b| corners[b]);
-            let ins = tet.map(|b| inside[b]);
-            let n_in = ins.iter().filter(|&&x| x).count();
-            let in_idx: Vec<usize> = (0..4).filter(|&i| ins[i]).collect();
-            let out_idx: Vec<usize> = (0..4).filter(|&i| !ins[i]).collect();
-            let tris: Vec<[(usize, usize); 3]> = match n_in {
-                1 => {
-                    let i = in_idx[0];
-                    vec![[(i, out_idx[0]), (i, out_idx[1]), (i, out_idx[2])]]
-                }
-                3 => {
-                    let o = out_idx[0];
-                    vec![[(in_idx[0], o), (in_idx[1], o), (in_idx[2], o)]]
-                }
-                2 => {
-                    let (a, b) = (in_idx[0], in_idx[1]);
-                    let (c, d) = (out_idx[0], out_idx[1]);
-                    vec![[(a, c), (a, d), (b, d)], [(a, c), (b, d), (b, c)]]
-                }
-                _ => continue,
-            };
-            for tri in tris {
-                let mut e = tri.map(|(i, o)| (v[i], v[o]));
-                if !outward(&e) {
-                    e.swap(1, 2);
-                }
-                let t = e.map(|edge| vertex(edge, &mut band.edges));
-                band.triangles.push(t);
-            }
+            march(tet.map(|b| offset(m, b, size)), &mut band);
+        }
+    }
+    for &(level, m) in &classified.transition {
+        if level == lattice.sub_levels {
+            marching_cubes(m, &mut band);
+        }
+        let refined = |c: Corner| classified.split.contains(&(level, pack(c)));
+        for tet in super::transition::tetrahedra(m, 1 << level, refined) {
+            march(tet, &mut band);
+        }
+    }
+    for &(level, m) in &classified.fine_band {
+        for tet in FREUDENTHAL {
+            march(tet.map(|b| offset(m, b, 1 << level)), &mut band);
         }
     }
     band

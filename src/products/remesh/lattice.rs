@@ -43,6 +43,10 @@ pub struct Lattice {
     pub cells: [usize; 3],
     /// Octree levels: a coarse cell is `2^levels` finest cells wide.
     pub levels: u32,
+    /// Levels below the resolution's cell ([`Lattice::with_sub_levels`]): the resolution's cell
+    /// (the *regular* cell) is `2^sub_levels` finest cells wide, and the octree refines below it
+    /// only where [`super::octree`] finds parts thinner than it.
+    pub sub_levels: u32,
 }
 
 impl Lattice {
@@ -105,7 +109,41 @@ impl Lattice {
             h,
             cells,
             levels,
+            sub_levels: 0,
         })
+    }
+
+    /// The same lattice with every regular cell cut into `2^sub_levels` finest cells per axis
+    /// (the corners and the box do not move; the octree gets `sub_levels` more levels). `None`
+    /// if the corners would not fit [`pack`]'s 21 bits per axis.
+    pub fn with_sub_levels(self, sub_levels: u32) -> Option<Lattice> {
+        let scale = 1usize << sub_levels;
+        let cells = self.cells.map(|c| c * scale);
+        (cells.iter().all(|&c| c < 1 << 21) && sub_levels <= 4).then(|| Lattice {
+            origin: self.origin,
+            h: self.h.map(|h| h / scale as f64),
+            cells,
+            levels: self.levels + sub_levels,
+            sub_levels: self.sub_levels + sub_levels,
+        })
+    }
+
+    /// The lattice of regular cells: the same box and corners at every `2^sub_levels`-th
+    /// finest corner (the units of the simplification's tolerances and of the report).
+    pub fn regular(self) -> Lattice {
+        let scale = 1usize << self.sub_levels;
+        Lattice {
+            origin: self.origin,
+            h: self.h.map(|h| h * scale as f64),
+            cells: self.cells.map(|c| c / scale),
+            levels: self.levels - self.sub_levels,
+            sub_levels: 0,
+        }
+    }
+
+    /// Finest cells per regular cell along each axis.
+    pub fn regular_cell(&self) -> u32 {
+        1 << self.sub_levels
     }
 
     /// Coarse cells per axis.

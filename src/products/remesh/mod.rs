@@ -59,6 +59,7 @@ pub mod plates;
 pub mod report;
 pub mod simplify;
 pub mod thicken;
+pub mod transition;
 pub mod write;
 
 use crate::base::bounding_box::BoundingBox;
@@ -73,6 +74,10 @@ pub const MAX_RESOLUTION: usize = 1 << 16;
 /// `edge length / 2^(steps+1)` of a point where the class changes (the placement spends about
 /// half as many evaluations where `w` is smooth, 1–2 at a verified crossing).
 pub const DEFAULT_BISECTION_STEPS: u32 = 8;
+
+/// Default [`RemeshOptions::sub_cell_levels`] (of [`RemeshOptions::with_resolution`], the CLI
+/// and Python).
+pub const DEFAULT_SUB_CELL_LEVELS: u32 = 0;
 
 /// Largest accepted number of bisection steps (beyond it the interval is below `f64` spacing
 /// for any reasonable box).
@@ -104,6 +109,13 @@ pub struct RemeshOptions {
     /// plates thinner than two cells ([`plates`]; at most 4 times, all axes together). Only the
     /// lattice changes; `false` keeps the lattice of `resolution` alone.
     pub refine_plates: bool,
+    /// With the input triangles ([`remesh_guided`]): levels of cells below the resolution's
+    /// (at most [`octree::MAX_SUB_LEVELS`]). A cell that a triangle crosses while its corners
+    /// agree holds a part thinner than a cell (a horn's tip, a leg, a rib) that no corner sees;
+    /// it is cut into eight, and so are its children while the same holds, down to this many
+    /// levels, with a conforming transition to the neighbours ([`transition`]). 0: one
+    /// uniform finest level.
+    pub sub_cell_levels: u32,
 }
 
 impl RemeshOptions {
@@ -115,6 +127,7 @@ impl RemeshOptions {
             max_classified_points: None,
             simplify: Some(simplify::SimplifyOptions::default()),
             refine_plates: true,
+            sub_cell_levels: DEFAULT_SUB_CELL_LEVELS,
         }
     }
 }
@@ -134,6 +147,12 @@ pub enum RemeshError {
     },
     /// The bounds are not finite, or `min > max` on some axis.
     BadBounds,
+    /// More sub-cell levels than [`octree::MAX_SUB_LEVELS`], or more than the lattice's
+    /// coordinates hold at this resolution.
+    BadSubCellLevels {
+        /// The levels asked for.
+        levels: u32,
+    },
     /// A simplification option is out of range: a tolerance or target that is negative or not
     /// finite, or a face extent of 0.
     BadSimplification {
@@ -161,6 +180,11 @@ impl std::fmt::Display for RemeshError {
             RemeshError::BadBisectionSteps { steps } => write!(
                 f,
                 "{steps} bisection steps is above the limit {MAX_BISECTION_STEPS}"
+            ),
+            RemeshError::BadSubCellLevels { levels } => write!(
+                f,
+                "{levels} sub-cell levels is above the limit {} (or too many at this resolution)",
+                octree::MAX_SUB_LEVELS
             ),
             RemeshError::BadBounds => {
                 f.write_str("bounds must be finite with min <= max on every axis")
@@ -198,6 +222,9 @@ pub struct RemeshStats {
     pub split_cells: usize,
     /// Finest cells with differing corner classes (the band that is extracted).
     pub band_cells: usize,
+    /// Regular cells cut into eight for a part thinner than a cell
+    /// ([`RemeshOptions::refine_thin_parts`]).
+    pub refined_cells: usize,
     /// Evaluations spent on vertex placement (verifications and the field search).
     pub placement_evaluations: usize,
     /// Vertices placed at a verified crossing with the input triangles (no field search).
@@ -303,6 +330,11 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
             resolution: options.resolution,
         });
     }
+    if options.sub_cell_levels > octree::MAX_SUB_LEVELS {
+        return Err(RemeshError::BadSubCellLevels {
+            levels: options.sub_cell_levels,
+        });
+    }
     if options.bisection_steps > MAX_BISECTION_STEPS {
         return Err(RemeshError::BadBisectionSteps {
             steps: options.bisection_steps,
@@ -341,6 +373,16 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
         lattice = lattice::Lattice::refined(bounds, options.resolution, plates.refinement)
             .ok_or(RemeshError::BadBounds)?;
     }
+    if options.sub_cell_levels > 0 && guide.is_some() {
+        lattice = lattice.with_sub_levels(options.sub_cell_levels).ok_or(
+            RemeshError::BadSubCellLevels {
+                levels: options.sub_cell_levels,
+            },
+        )?;
+    }
+    // Distances and fixed-point units per regular cell: the simplification's tolerances and
+    // the report's cells do not change with the sub-levels.
+    let regular = lattice.regular();
     let max_points = options.max_classified_points.unwrap_or_else(|| {
         crate::grid::available_memory().map_or(1 << 31, |bytes| {
             usize::try_from(bytes / BYTES_PER_CLASSIFIED_POINT).unwrap_or(usize::MAX)
@@ -370,6 +412,7 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
         classified_points: classified.labels.len(),
         split_cells: classified.split.len(),
         band_cells: band.band_cells,
+        refined_cells: classified.refined_cells,
         placement_evaluations: placed.evaluations,
         guided_vertices: placed.guided,
         extracted_faces: band.triangles.len(),
@@ -389,14 +432,14 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
             // surface is 1.6M vertices and 3.1M faces: ~300 MB less at the peak, measured).
             let planes = simplify_options
                 .input_planes
-                .then(|| placed.planes_in_lattice_units(&lattice));
+                .then(|| placed.planes_in_lattice_units(&regular));
             placed.planes = Vec::new();
             placed.positions = Vec::new();
             drop(band.edges);
             let s = simplify::simplify_with_planes(
                 std::mem::take(&mut placed.fixed),
                 band.triangles,
-                placed.ticks_per_cell,
+                placed.ticks_per_cell * i64::from(lattice.regular_cell()),
                 simplify_options,
                 (simplify_options.target_fraction_of_marching_cubes
                     * band.marching_cubes_triangles as f64) as usize,
@@ -420,9 +463,9 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
         positions,
         triangles,
         fixed,
-        ticks_per_cell: placed.ticks_per_cell,
+        ticks_per_cell: placed.ticks_per_cell * i64::from(lattice.regular_cell()),
         cell_size,
-        cell_sizes: lattice.h,
+        cell_sizes: regular.h,
         stats,
     })
 }

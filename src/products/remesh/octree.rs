@@ -29,6 +29,7 @@ use rayon::prelude::*;
 
 use super::crossings::SegmentBvh;
 use super::lattice::{Corner, KeyMap, KeySet, Lattice, pack};
+use super::transition;
 use crate::eval::Evaluator;
 use crate::grid::{GridSpec, evaluate};
 
@@ -68,8 +69,18 @@ pub struct Classified {
     pub labels: KeyMap<CornerValue>,
     /// The cells that were split.
     pub split: KeySet<Cell>,
-    /// Minimum corners of the finest cells whose corners differ.
+    /// Minimum corners of the regular cells (edge [`Lattice::regular_cell`]) whose corners
+    /// differ, Freudenthal-split (the band; all of it without sub-levels).
     pub band: Vec<Corner>,
+    /// Level and minimum corner of the cells below the regular level whose corners differ,
+    /// in the regular cells split for a part thinner than a cell; Freudenthal-split.
+    pub fine_band: Vec<(u32, Corner)>,
+    /// Level and minimum corner of the leaves (at most regular) across a face or an edge from
+    /// a split cell of their level whose transition split ([`transition::tetrahedra`]) has
+    /// vertices of both classes.
+    pub transition: Vec<(u32, Corner)>,
+    /// Regular cells split for a part thinner than a cell.
+    pub refined_cells: usize,
 }
 
 impl Classified {
@@ -163,15 +174,21 @@ fn touched(guide: Option<&SegmentBvh>, lattice: &Lattice, level: u32, m: Corner)
 
 /// Classifies the lattice (see the [module documentation](self)); `None` as soon as more than
 /// `max_points` lattice points would be classified. `guide`: the input triangles, whose cells
-/// are refined to the finest level too.
+/// are refined to the regular level too (and below it where a part is thinner than a cell,
+/// when the lattice has [`Lattice::sub_levels`]).
 pub fn classify<E: Evaluator + ?Sized>(
     evaluator: &E,
     lattice: &Lattice,
     guide: Option<&SegmentBvh>,
     max_points: usize,
 ) -> Option<Classified> {
+    assert!(
+        lattice.sub_levels <= MAX_SUB_LEVELS,
+        "sub-levels beyond MAX_SUB_LEVELS"
+    );
     let mut out = Classified::default();
     let levels = lattice.levels;
+    let regular = lattice.sub_levels;
     let coarse = 1u32 << levels;
     let cc = lattice.coarse_cells();
     // The coarse corners as a grid of cell-centre samples: a box half a coarse cell larger on
@@ -202,140 +219,296 @@ pub fn classify<E: Evaluator + ?Sized>(
             }
         }
     }
-    let mut coarse_mixed = Vec::new();
-    for k in 0..cc[2] {
-        for j in 0..cc[1] {
-            for i in 0..cc[0] {
-                let m = [i, j, k].map(|x| x as u32 * coarse);
-                if out.corners_mixed(levels, m) {
-                    coarse_mixed.push(m);
-                }
-            }
-        }
-    }
-    if levels == 0 {
-        out.band = coarse_mixed;
-        return Some(out);
-    }
-    // Coarse cells that a triangle meets, whatever their corners say.
-    let coarse_touched: Vec<Corner> = if guide.is_some() {
-        let all: Vec<Corner> = (0..cc[2])
-            .flat_map(|k| (0..cc[1]).flat_map(move |j| (0..cc[0]).map(move |i| [i, j, k])))
-            .map(|c| c.map(|x| x as u32 * coarse))
+    let coarse_cells: Vec<Corner> = (0..cc[2])
+        .flat_map(|k| (0..cc[1]).flat_map(move |j| (0..cc[0]).map(move |i| [i, j, k])))
+        .map(|c| c.map(|x| x as u32 * coarse))
+        .collect();
+    if levels > regular {
+        let mut queue: Vec<(u32, Corner)> = coarse_cells
+            .iter()
+            .filter(|&&m| out.corners_mixed(levels, m))
+            .map(|&m| (levels, m))
             .collect();
-        all.into_par_iter()
-            .filter(|&m| touched(guide, lattice, levels, m))
-            .collect()
-    } else {
-        Vec::new()
-    };
-    let first = coarse_mixed.iter().chain(&coarse_touched);
-    let mut queue: Vec<Cell> = first.clone().map(|&m| (levels, pack(m))).collect();
-    let mut queued_min: KeyMap<Corner> = first.map(|&m| (pack(m), m)).collect();
-    while !queue.is_empty() {
-        queue.sort_unstable();
-        queue.dedup();
-        queue.retain(|cell| cell.0 > 0 && !out.split.contains(cell));
-        let cells: Vec<(u32, Corner)> = queue.iter().map(|&(l, k)| (l, queued_min[&k])).collect();
-        // The new corners of the children of every cell split in this round.
-        let mut fresh = KeySet::<u64>::default();
-        let mut new_points: Vec<Corner> = Vec::new();
-        for &(level, m) in &cells {
-            let half = 1u32 << (level - 1);
-            for dz in 0..3 {
-                for dy in 0..3 {
-                    for dx in 0..3 {
-                        let p = [m[0] + dx * half, m[1] + dy * half, m[2] + dz * half];
-                        let key = pack(p);
-                        if !out.labels.contains_key(&key) && fresh.insert(key) {
-                            new_points.push(p);
-                        }
-                    }
-                }
-            }
-            out.split.insert((level, pack(m)));
+        // Coarse cells that a triangle meets, whatever their corners say.
+        if guide.is_some() {
+            queue.par_extend(
+                coarse_cells
+                    .par_iter()
+                    .filter(|&&m| touched(guide, lattice, levels, m))
+                    .map(|&m| (levels, m)),
+            );
         }
-        if out.labels.len() + new_points.len() > max_points {
+        out.split_rounds(evaluator, lattice, guide, queue, max_points)?;
+    }
+    // The cells of the tree at `level` (split or leaves): the children of split cells one level
+    // up, or the coarse cells.
+    let cells_at = |out: &Classified, level: u32| -> Vec<Corner> {
+        if level == levels {
+            coarse_cells.clone()
+        } else {
+            out.children_of_split(level + 1).collect()
+        }
+    };
+    if regular > 0
+        && let Some(guide) = guide
+    {
+        // Parts thinner than a cell: a cell that a triangle crosses (not only touches: the box
+        // is shrunk) while its corners agree holds a piece of surface that no corner sees.
+        // Split it, level by level down to the finest.
+        for level in (1..=regular).rev() {
+            let thin: Vec<(u32, Corner)> = cells_at(&out, level)
+                .into_par_iter()
+                .filter(|&m| {
+                    !out.split.contains(&(level, pack(m)))
+                        && !out.corners_mixed(level, m)
+                        && crosses(guide, lattice, level, m)
+                })
+                .map(|m| (level, m))
+                .collect();
+            out.split_rounds(evaluator, lattice, Some(guide), thin, max_points)?;
+        }
+        // Balance: the cells around a split cell of a level at most the regular one are
+        // leaves of its level or split, so that leaves next to each other differ by one level
+        // at most (what the transition split of `transition.rs` assumes).
+        loop {
+            let coarser: Vec<(u32, Corner)> = (1..=regular)
+                .flat_map(|level| {
+                    let out = &out;
+                    cells_at(out, level)
+                        .into_iter()
+                        .filter(move |&m| out.split.contains(&(level, pack(m))))
+                        .flat_map(move |m| neighbours(lattice, m, 1 << level))
+                        .map(move |n| (level, out.leaf(lattice, n)))
+                        .filter(|&(level, (leaf_level, _))| leaf_level > level)
+                        .map(|(_, leaf)| leaf)
+                })
+                .collect();
+            if coarser.is_empty() {
+                break;
+            }
+            out.split_rounds(evaluator, lattice, Some(guide), coarser, max_points)?;
+        }
+    }
+    // Leaves next to a split cell of their level across a face or an edge get the transition
+    // split; the other leaves at or below the regular level the Freudenthal split.
+    let mut transition: Vec<(u32, Corner)> = Vec::new();
+    let mut leaves: Vec<(u32, Corner)> = Vec::new();
+    for level in 0..=regular {
+        let cells = if level == 0 && regular == 0 {
+            cells_at(&out, 0)
+        } else if level == 0 {
+            out.children_of_split(1).collect()
+        } else {
+            cells_at(&out, level)
+        };
+        for m in cells {
+            if level == 0 || !out.split.contains(&(level, pack(m))) {
+                leaves.push((level, m));
+            } else {
+                out.refined_cells += usize::from(level == regular);
+                transition.extend(
+                    neighbours(lattice, m, 1 << level)
+                        .filter(|&n| touches_edge(n, m) && !out.split.contains(&(level, pack(n))))
+                        .map(|n| (level, n)),
+                );
+            }
+        }
+    }
+    transition.sort_unstable_by_key(|&(l, c)| (l, c[2], c[1], c[0]));
+    transition.dedup();
+    if !transition.is_empty() {
+        let split = &out.split;
+        let is_refined = |level: u32| move |c: Corner| split.contains(&(level, pack(c)));
+        let mut fresh: Vec<Corner> = transition
+            .iter()
+            .flat_map(|&(l, m)| {
+                transition::tetrahedra(m, 1 << l, is_refined(l))
+                    .into_iter()
+                    .flatten()
+            })
+            .filter(|p| !out.labels.contains_key(&pack(*p)))
+            .collect();
+        fresh.sort_unstable();
+        fresh.dedup();
+        if out.labels.len() + fresh.len() > max_points {
             return None;
         }
-        let interior: Vec<Corner> = new_points
-            .iter()
-            .copied()
-            .filter(|&p| !lattice.is_border(p))
-            .collect();
-        let positions: Vec<[f64; 3]> = interior
-            .par_iter()
-            .map(|&p| lattice.corner_position(p))
-            .collect();
+        // Cell and face centres: inside leaves at most regular and on faces between two of
+        // them, on no larger leaf's closed box, so the octree's invariant is not concerned.
+        let positions: Vec<[f64; 3]> = fresh.iter().map(|&p| lattice.corner_position(p)).collect();
         let values = evaluator.eval_batch(&positions);
-        for &p in &new_points {
-            out.labels.insert(pack(p), CornerValue::BORDER);
-        }
-        for (p, w) in interior.iter().zip(values) {
+        for (p, w) in fresh.iter().zip(values) {
             out.labels.insert(pack(*p), CornerValue::of(w));
         }
-        // (2) new children whose closed box is mixed or that a triangle meets.
-        let mut next: Vec<(u32, Corner)> = cells
-            .par_iter()
-            .filter(|&&(level, _)| level > 1)
-            .flat_map_iter(|&(level, m)| {
-                let half = 1u32 << (level - 1);
-                let out = &out;
-                (0..8).filter_map(move |b| {
-                    let child = offset(m, b, half);
-                    (out.closed_box_mixed(level - 1, child)
-                        || touched(guide, lattice, level - 1, child))
-                    .then_some((level - 1, child))
-                })
-            })
-            .collect();
-        // (3) leaves around each new point that it contradicts.
-        for &p in &new_points {
-            let lp = out.label(p);
-            for b in 0..8 {
-                let mut min = [0u32; 3];
-                let mut ok = true;
-                for a in 0..3 {
-                    let back = (b >> a & 1) as u32;
-                    if p[a] < back || (p[a] - back) as usize >= lattice.cells[a] {
-                        ok = false;
-                    } else {
-                        min[a] = p[a] - back;
-                    }
-                }
-                if !ok {
-                    continue;
-                }
-                let (level, m) = out.leaf(lattice, min);
-                if level > 0 && out.label(m) != lp {
-                    next.push((level, m));
-                }
-            }
-        }
-        queue.clear();
-        queued_min.clear();
-        for (level, m) in next {
-            queued_min.insert(pack(m), m);
-            queue.push((level, pack(m)));
-        }
+        let split = &out.split;
+        let is_refined = |level: u32| move |c: Corner| split.contains(&(level, pack(c)));
+        transition.retain(|&(l, m)| {
+            let first = out.label(m);
+            transition::tetrahedra(m, 1 << l, is_refined(l))
+                .iter()
+                .flatten()
+                .any(|&p| out.label(p) != first)
+        });
     }
-    // Every finest leaf: the children of the split level-1 cells.
+    let transition_set: KeySet<(u32, u64)> =
+        transition.iter().map(|&(l, c)| (l, pack(c))).collect();
     let mut band = Vec::new();
-    for &(level, key) in &out.split {
-        if level != 1 {
-            continue;
-        }
-        let m = unpack(key);
-        for b in 0..8 {
-            let child = offset(m, b, 1);
-            if out.corners_mixed(0, child) {
-                band.push(child);
+    let mut fine_band = Vec::new();
+    for (level, m) in leaves {
+        if !transition_set.contains(&(level, pack(m))) && out.corners_mixed(level, m) {
+            if level == regular {
+                band.push(m);
+            } else {
+                fine_band.push((level, m));
             }
         }
     }
     band.sort_unstable_by_key(|c| (c[2], c[1], c[0]));
+    fine_band.sort_unstable_by_key(|&(l, c)| (l, c[2], c[1], c[0]));
     out.band = band;
+    out.fine_band = fine_band;
+    out.transition = transition;
     Some(out)
+}
+
+/// Most sub-levels [`classify`] refines below the regular cells (each level costs up to 19
+/// evaluations per cell split, and the finest lattice keeps 21 bits per axis).
+pub const MAX_SUB_LEVELS: u32 = 3;
+
+/// The cells of edge `size` around the cell with minimum `m` (26, fewer at the lattice's
+/// border).
+fn neighbours(lattice: &Lattice, m: Corner, size: u32) -> impl Iterator<Item = Corner> + '_ {
+    (0..27).filter(|&i| i != 13).filter_map(move |i: i64| {
+        let d = [i % 3 - 1, i / 3 % 3 - 1, i / 9 - 1];
+        let c = [0, 1, 2].map(|a| i64::from(m[a]) + d[a] * i64::from(size));
+        (0..3)
+            .all(|a| c[a] >= 0 && (c[a] + i64::from(size)) as u64 <= lattice.cells[a] as u64)
+            .then(|| c.map(|x| x as u32))
+    })
+}
+
+/// Whether the cells with minimum corners `n` and `m` (same size, neighbours) share a face or
+/// an edge, not only a corner.
+fn touches_edge(n: Corner, m: Corner) -> bool {
+    (0..3).filter(|&a| n[a] != m[a]).count() <= 2
+}
+
+/// Whether a triangle of `guide` meets the open interior of the cell `(level, m)`, shrunk by a
+/// millionth of a cell: triangles in its faces, as on CAD models at round coordinates, do not.
+fn crosses(guide: &SegmentBvh, lattice: &Lattice, level: u32, m: Corner) -> bool {
+    let size = 1u32 << level;
+    let lo = lattice.corner_position(m);
+    let hi = lattice.corner_position(m.map(|x| x + size));
+    guide.meets_box(lo, hi, -1e-6 * lattice.smallest_cell() * f64::from(size))
+}
+
+impl Classified {
+    /// The children of the split cells of `level`.
+    fn children_of_split(&self, level: u32) -> impl Iterator<Item = Corner> + '_ {
+        let half = 1u32 << (level - 1);
+        self.split
+            .iter()
+            .filter(move |&&(l, _)| l == level)
+            .flat_map(move |&(_, key)| (0..8).map(move |b| offset(unpack(key), b, half)))
+    }
+
+    /// Splits the cells of `queue` and whatever keeps the invariant of the [module
+    /// documentation](self): mixed or touched children above the regular level, and leaves
+    /// above it that a new point contradicts. `None` past `max_points`.
+    fn split_rounds<E: Evaluator + ?Sized>(
+        &mut self,
+        evaluator: &E,
+        lattice: &Lattice,
+        guide: Option<&SegmentBvh>,
+        mut queue: Vec<(u32, Corner)>,
+        max_points: usize,
+    ) -> Option<()> {
+        let regular = lattice.sub_levels;
+        let out = self;
+        while !queue.is_empty() {
+            queue.sort_unstable_by_key(|&(l, m)| (l, pack(m)));
+            queue.dedup();
+            queue.retain(|&(level, m)| level > 0 && !out.split.contains(&(level, pack(m))));
+            let cells = std::mem::take(&mut queue);
+            // The new corners of the children of every cell split in this round.
+            let mut fresh = KeySet::<u64>::default();
+            let mut new_points: Vec<Corner> = Vec::new();
+            for &(level, m) in &cells {
+                let half = 1u32 << (level - 1);
+                for dz in 0..3 {
+                    for dy in 0..3 {
+                        for dx in 0..3 {
+                            let p = [m[0] + dx * half, m[1] + dy * half, m[2] + dz * half];
+                            let key = pack(p);
+                            if !out.labels.contains_key(&key) && fresh.insert(key) {
+                                new_points.push(p);
+                            }
+                        }
+                    }
+                }
+                out.split.insert((level, pack(m)));
+            }
+            if out.labels.len() + new_points.len() > max_points {
+                return None;
+            }
+            let interior: Vec<Corner> = new_points
+                .iter()
+                .copied()
+                .filter(|&p| !lattice.is_border(p))
+                .collect();
+            let positions: Vec<[f64; 3]> = interior
+                .par_iter()
+                .map(|&p| lattice.corner_position(p))
+                .collect();
+            let values = evaluator.eval_batch(&positions);
+            for &p in &new_points {
+                out.labels.insert(pack(p), CornerValue::BORDER);
+            }
+            for (p, w) in interior.iter().zip(values) {
+                out.labels.insert(pack(*p), CornerValue::of(w));
+            }
+            // (2) new children above the regular level whose closed box is mixed or that a
+            // triangle meets.
+            let reader = &*out;
+            queue = cells
+                .par_iter()
+                .filter(|&&(level, _)| level > regular + 1)
+                .flat_map_iter(|&(level, m)| {
+                    let half = 1u32 << (level - 1);
+                    (0..8).filter_map(move |b| {
+                        let child = offset(m, b, half);
+                        (reader.closed_box_mixed(level - 1, child)
+                            || touched(guide, lattice, level - 1, child))
+                        .then_some((level - 1, child))
+                    })
+                })
+                .collect();
+            // (3) leaves above the regular level around each new point that it contradicts.
+            for &p in &new_points {
+                let lp = out.label(p);
+                for b in 0..8 {
+                    let mut min = [0u32; 3];
+                    let mut ok = true;
+                    for a in 0..3 {
+                        let back = (b >> a & 1) as u32;
+                        if p[a] < back || (p[a] - back) as usize >= lattice.cells[a] {
+                            ok = false;
+                        } else {
+                            min[a] = p[a] - back;
+                        }
+                    }
+                    if !ok {
+                        continue;
+                    }
+                    let (level, m) = out.leaf(lattice, min);
+                    if level > regular && out.label(m) != lp {
+                        queue.push((level, m));
+                    }
+                }
+            }
+        }
+        Some(())
+    }
 }
 
 /// Inverse of [`pack`].
