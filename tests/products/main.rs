@@ -14,3 +14,4 @@ mod products;
 mod remesh;
 mod remesh_cli;
 mod remesh_simplify;
+mod remesh_sub_cell;

@@ -265,7 +265,35 @@ pub fn classify<E: Evaluator + ?Sized>(
                 })
                 .map(|m| (level, m))
                 .collect();
+            let mut split_now: Vec<Corner> = thin.iter().map(|&(_, m)| m).collect();
             out.split_rounds(evaluator, lattice, Some(guide), thin, max_points)?;
+            // A thin part goes on into cells whose corners do not agree (a plate through a
+            // corner of them): a leaf of this level next to a cell just split, where one of
+            // the split's new points on their common face or edge has a class that the corners
+            // around it do not explain (a regular edge crossed twice, a face pierced between
+            // its corners), and that a triangle crosses, is split too, and so on along the
+            // part.
+            while !split_now.is_empty() {
+                let size = 1u32 << level;
+                let mut next: Vec<(u32, Corner)> = split_now
+                    .par_iter()
+                    .flat_map_iter(|&m| {
+                        let out = &out;
+                        neighbours(lattice, m, size)
+                            .filter(move |&n| touches_edge(n, m))
+                            .filter(move |&n| {
+                                out.leaf(lattice, n) == (level, n)
+                                    && out.unexplained_point_between(n, m, level)
+                                    && crosses(guide, lattice, level, n)
+                            })
+                    })
+                    .map(|n| (level, n))
+                    .collect();
+                next.sort_unstable_by_key(|&(l, c)| (l, pack(c)));
+                next.dedup();
+                split_now = next.iter().map(|&(_, m)| m).collect();
+                out.split_rounds(evaluator, lattice, Some(guide), next, max_points)?;
+            }
         }
         // Balance: the cells around a split cell of a level at most the regular one are
         // leaves of its level or split, so that leaves next to each other differ by one level
@@ -334,11 +362,20 @@ pub fn classify<E: Evaluator + ?Sized>(
             return None;
         }
         // Cell and face centres: inside leaves at most regular and on faces between two of
-        // them, on no larger leaf's closed box, so the octree's invariant is not concerned.
-        let positions: Vec<[f64; 3]> = fresh.iter().map(|&p| lattice.corner_position(p)).collect();
+        // them, on no larger leaf's closed box, so the octree's invariant is not concerned. A
+        // face centre on the lattice's outer faces is declared outside, like every point there.
+        let (border, interior): (Vec<Corner>, Vec<Corner>) =
+            fresh.into_iter().partition(|&p| lattice.is_border(p));
+        let positions: Vec<[f64; 3]> = interior
+            .par_iter()
+            .map(|&p| lattice.corner_position(p))
+            .collect();
         let values = evaluator.eval_batch(&positions);
-        for (p, w) in fresh.iter().zip(values) {
+        for (p, w) in interior.iter().zip(values) {
             out.labels.insert(pack(*p), CornerValue::of(w));
+        }
+        for p in border {
+            out.labels.insert(pack(p), CornerValue::BORDER);
         }
         let split = &out.split;
         let is_refined = |level: u32| move |c: Corner| split.contains(&(level, pack(c)));
@@ -403,6 +440,45 @@ fn crosses(guide: &SegmentBvh, lattice: &Lattice, level: u32, m: Corner) -> bool
 }
 
 impl Classified {
+    /// Whether a point of the split cell `m` (of `level`) on the closed box of its neighbour
+    /// `n` (same level) has a class that the corners of `n` around it do not explain: an edge's
+    /// midpoint of the other class than both ends, a face's centre of the other class than its
+    /// four corners.
+    fn unexplained_point_between(&self, n: Corner, m: Corner, level: u32) -> bool {
+        let half = 1u32 << (level - 1);
+        let size = 2 * half;
+        let on_n = |p: Corner| (0..3).all(|a| p[a] >= n[a] && p[a] <= n[a] + size);
+        for i in 0..27u32 {
+            let step = [i % 3, i / 3 % 3, i / 9];
+            let p: Corner = std::array::from_fn(|a| m[a] + step[a] * half);
+            if !on_n(p) {
+                continue;
+            }
+            let halves: Vec<usize> = (0..3)
+                .filter(|&a| !(p[a] - n[a]).is_multiple_of(size))
+                .collect();
+            if halves.is_empty() || halves.len() == 3 {
+                continue;
+            }
+            let around = (0..1u32 << halves.len()).map(|bits| {
+                let mut c = p;
+                for (k, &a) in halves.iter().enumerate() {
+                    if bits >> k & 1 == 1 {
+                        c[a] += half;
+                    } else {
+                        c[a] -= half;
+                    }
+                }
+                self.label(c)
+            });
+            let own = self.label(p);
+            if around.clone().all(|x| x != own) {
+                return true;
+            }
+        }
+        false
+    }
+
     /// The children of the split cells of `level`.
     fn children_of_split(&self, level: u32) -> impl Iterator<Item = Corner> + '_ {
         let half = 1u32 << (level - 1);

@@ -9,37 +9,39 @@
 //! (link, flip, size, distance: [`Simplifier::plan_with_ring`]) except that the intersection
 //! check only looks inside the cube of each new face, which the following argument allows.
 //!
-//! **Invariants** (in lattice units; *cube*: a closed unit cube of the lattice; *facet*: a
-//! closed unit square of a lattice plane):
-//! 1. every vertex lies strictly inside a lattice segment — an axis edge, a face diagonal or a
-//!    body diagonal of a cube, in the direction `+e_a (+e_b (+e_c))` of the Freudenthal split —
-//!    and no two vertices lie on the same segment;
-//! 2. every face lies in a cube, its *owner* (the per-axis minimum of its vertices' cells), and
+//! **Invariants** (in regular lattice units — cells of the resolution, whatever sub-cell levels
+//! refine below them; *cube*: a closed unit cube of the lattice; *facet*: a closed unit square
+//! of a lattice plane):
+//! 1. every face lies in a cube, its *owner* (the per-axis minimum of its vertices' cells), and
 //!    not in a facet of it;
-//! 3. the surface has no self-intersection.
+//! 2. the surface has no self-intersection.
 //!
-//! [`CubeFaces::new`] checks 1 and 2 on the input (a marching-tetrahedra triangle lies in its
-//! tetrahedron, its vertices on the tetrahedron's edges, and never in a facet: a facet triangle
-//! has 0 or 2 crossed edges); 3 is the simplifier's own precondition.
+//! [`CubeFaces::new`] checks 1 on the input (a marching-tetrahedra triangle lies in its
+//! tetrahedron, which lies in a cube, and never in a face of the tetrahedron — its vertices are
+//! on three edges that no face holds — so never in a facet either: the tetrahedron is on one side
+//! of the facet's plane); 2 is the simplifier's own precondition. The pass collapses the
+//! vertices strictly inside a face or body diagonal of a cube (`+e_a (+e_b (+e_c))`, the
+//! Freudenthal split's; with sub-cell levels, also vertices of the finer split that lie on such
+//! a segment).
 //!
 //! **Lemma.** Let `T` and `G` be faces with owners `C ≠ E`. Then `T ∩ G ⊆ C ∩ E = S`, a facet,
-//! a lattice edge or a corner. As `T ⊂ C` and `S` is a face of the convex cube, `T ∩ S` is the
-//! convex hull of `T`'s vertices in `S`; so is `G ∩ S`. A corner holds no vertex and a lattice
-//! edge at most one (invariant 1), so there `T ∩ G` is empty or a common vertex. On a facet `F`
-//! the hulls are vertices or segments of the planar graph that the surface's vertices and edges
-//! in `F` form, and that graph has no crossing and no vertex inside an edge (invariant 3): two
-//! of its elements meet in common vertices or are the same edge, which `T` and `G` then share.
+//! a lattice edge or a corner, which lies in a facet `F` of both. As `T ⊂ C` and `S` is a face
+//! of the convex cube, `T ∩ S` is the convex hull of `T`'s vertices in `S`, at most two of them
+//! (invariant 1): a vertex or an edge of the planar graph that the surface's vertices and edges
+//! in `F` form; so is `G ∩ S`. That graph has no crossing and no vertex inside an edge
+//! (invariant 2): two of its elements meet in common vertices or are the same edge, which `T`
+//! and `G` then share.
 //! So **a face can only meet a face of another owner properly**, and a new face needs testing
 //! only against the other new faces and the faces of its own owner — if the collapse keeps the
 //! invariants, which these rules make sure of ([`CubeFaces::refuses`]):
-//! - every new face lies in its owner and not in a facet (invariant 2; invariant 1 holds since
-//!   no vertex moves);
+//! - every new face lies in its owner and not in a facet (invariant 1);
 //! - two vertices of a new face on a common facet `F` of its owner are joined by an edge of the
 //!   surface already (so the graph of `F` does not change), except one: when `u` is a face
 //!   diagonal's vertex, the surface in its facet `F` is the path `t₁ u t₂` (checked: no other
 //!   vertex of the two cubes on `F` lies in `F`), and the collapse `u → t₁` replaces it by the
-//!   edge `t₁ t₂`, whose interior lies inside `F` (its ends are on two different sides of the
-//!   square), where no other vertex or edge is. The graph stays free of crossings.
+//!   edge `t₁ t₂`, whose interior lies inside `F` (checked: its ends are not on one side of the
+//!   square, which another facet holds too), where no other vertex or edge is. The graph stays
+//!   free of crossings.
 //!
 //! A body diagonal's vertex has all its faces in its own cube (the six tetrahedra around the
 //! diagonal each hold one piece through it), so its collapse onto a vertex of its link only
@@ -110,19 +112,8 @@ pub(super) struct CubeFaces {
 }
 
 impl CubeFaces {
-    /// The faces of `s` by cube, if `s` satisfies invariants 1 and 2 of the module
-    /// documentation.
+    /// The faces of `s` by cube, if `s` satisfies invariant 1 of the module documentation.
     fn new(s: &Simplifier) -> Option<CubeFaces> {
-        let mut segments: Vec<Segment> = Vec::with_capacity(s.points.len());
-        for (x, p) in s.points.iter().enumerate() {
-            if !s.removed[x] && !s.vertex_faces[x].is_empty() {
-                segments.push(Segment::of(*p, s.ticks)?);
-            }
-        }
-        segments.sort_unstable();
-        if segments.windows(2).any(|w| w[0] == w[1]) {
-            return None;
-        }
         let mut faces: KeyMap<Vec<u32>> = KeyMap::default();
         for (f, t) in s.faces.iter().enumerate() {
             if s.alive[f] {
@@ -240,7 +231,20 @@ impl CubeFaces {
                             .contains(&q[b])
                 })
         };
-        if !ends.iter().all(|&x| in_facet(s.points[x as usize])) {
+        let [p, q] = ends.map(|x| s.points[x as usize]);
+        if !in_facet(p) || !in_facet(q) {
+            return false;
+        }
+        // Both ends on one side of the square: the new edge would lie in that side, which a
+        // facet of other cubes holds too. (Never so on the uniform Freudenthal split, where the
+        // ends are on two sides; possible on the finer splits of sub-cell levels.)
+        let one_side = (0..3).any(|b| {
+            b != a
+                && [segment.base[b], segment.base[b] + 1]
+                    .iter()
+                    .any(|&k| p[b] == k * s.ticks && q[b] == k * s.ticks)
+        });
+        if one_side {
             return false;
         }
         let mut below = segment.base;
@@ -268,7 +272,7 @@ impl Simplifier {
     /// cheapest neighbour (quadric error, at most `max_error` cells) that passes the checks,
     /// with the cube-local
     /// intersection check of the module documentation. Does nothing when the surface is not a
-    /// marching-tetrahedra surface of the lattice (invariants 1 and 2).
+    /// marching-tetrahedra surface of the lattice (invariant 1).
     ///
     /// One at a time, in index order (the extraction's: by `z`, then `y`, then `x`, so
     /// neighbours follow each other in memory). Tried and slower: planning the collapses of
