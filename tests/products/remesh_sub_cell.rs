@@ -92,6 +92,32 @@ fn a_ball_refines_few_cells() {
     );
 }
 
+/// Overlapping parts: the faces of each box inside the other cross many cells whose corners
+/// all agree (inside), but `w` is above ½ on both sides of them, so they hide nothing and cut
+/// no cell; only what each box alone cuts (where an edge of a box pokes into a cell between
+/// its corners) is cut. Without the probe on both sides of the crossing triangles, each inner
+/// face would cut every cell it crosses.
+#[test]
+fn inner_faces_of_overlapping_parts_cut_no_cells() {
+    let res = 24;
+    let a = tilted_box([2.0, 1.6, 1.2], 0.4, 0.3, [0.0, 0.0, 0.0]);
+    let b = tilted_box([1.8, 1.4, 1.6], -0.3, 0.6, [0.6, 0.3, 0.2]);
+    let both = a.concatenated(&b).unwrap();
+    let refined = |mesh: &Mesh| {
+        let (out, report) = run_with(mesh, &with_levels(res, 2));
+        assert_closed_manifold(&report);
+        (out.stats.refined_cells, out.stats.band_cells)
+    };
+    let (alone_a, _) = refined(&a);
+    let (alone_b, _) = refined(&b);
+    let (overlapping, band) = refined(&both);
+    assert!(
+        overlapping <= alone_a + alone_b,
+        "{overlapping} cells cut for the union, {alone_a} + {alone_b} for the boxes alone \
+         ({band} band cells)"
+    );
+}
+
 /// A field that is noise at a scale near the cells', so that cells of every level and every
 /// transition split see every labelling.
 struct Noise(f64);

@@ -146,6 +146,106 @@ impl SegmentBvh {
     }
 }
 
+impl SegmentBvh {
+    /// Up to `max` points where triangles cross the box `lo..=hi`, each with its triangle's
+    /// unit normal: the vertex average of the triangle's part inside the box (a convex polygon,
+    /// so the average lies in it). Degenerate triangles are skipped. Only refinement reads the
+    /// points (they tell where to look for a class no corner of a cell has), never a label.
+    pub fn surface_points_in_box(
+        &self,
+        lo: [f64; 3],
+        hi: [f64; 3],
+        max: usize,
+    ) -> Vec<([f64; 3], [f64; 3])> {
+        let mut out = Vec::new();
+        if self.nodes.is_empty() || max == 0 {
+            return out;
+        }
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let node = self.nodes[stack[top] as usize];
+            if (0..3).any(|a| node.lo[a] > hi[a] || node.hi[a] < lo[a]) {
+                continue;
+            }
+            if node.count > 0 {
+                let first = node.first as usize;
+                for t in &self.triangles[first..first + node.count as usize] {
+                    if !triangle_meets_box(t, lo, hi) {
+                        continue;
+                    }
+                    let n = unit_normal(t);
+                    let Some(n) = n else { continue };
+                    let part = clip_to_box(t, lo, hi);
+                    if part.is_empty() {
+                        continue;
+                    }
+                    let k = part.len() as f64;
+                    let centre = [0, 1, 2].map(|a| part.iter().map(|p| p[a]).sum::<f64>() / k);
+                    out.push((centre, n));
+                    if out.len() == max {
+                        return out;
+                    }
+                }
+            } else if top + 2 <= stack.len() {
+                stack[top] = node.first;
+                stack[top + 1] = node.second;
+                top += 2;
+            }
+        }
+        out
+    }
+}
+
+/// The unit normal of a triangle (right-hand rule), `None` if it is degenerate.
+fn unit_normal(t: &[[f64; 3]; 3]) -> Option<[f64; 3]> {
+    let u = [0, 1, 2].map(|a| t[1][a] - t[0][a]);
+    let v = [0, 1, 2].map(|a| t[2][a] - t[0][a]);
+    let n = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    (len > 0.0 && len.is_finite()).then(|| n.map(|x| x / len))
+}
+
+/// The part of a triangle inside the box, as a polygon (Sutherland–Hodgman against the six
+/// planes; empty when they do not meet).
+fn clip_to_box(t: &[[f64; 3]; 3], lo: [f64; 3], hi: [f64; 3]) -> Vec<[f64; 3]> {
+    let mut poly: Vec<[f64; 3]> = t.to_vec();
+    for a in 0..3 {
+        for (bound, keep_below) in [(lo[a], false), (hi[a], true)] {
+            let inside = |p: &[f64; 3]| {
+                if keep_below {
+                    p[a] <= bound
+                } else {
+                    p[a] >= bound
+                }
+            };
+            let mut next = Vec::with_capacity(poly.len() + 1);
+            for i in 0..poly.len() {
+                let (p, q) = (poly[i], poly[(i + 1) % poly.len()]);
+                if inside(&p) {
+                    next.push(p);
+                }
+                if inside(&p) != inside(&q) {
+                    let s = (bound - p[a]) / (q[a] - p[a]);
+                    let mut x = [0, 1, 2].map(|b| p[b] + s * (q[b] - p[b]));
+                    x[a] = bound;
+                    next.push(x);
+                }
+            }
+            poly = next;
+            if poly.is_empty() {
+                return poly;
+            }
+        }
+    }
+    poly
+}
+
 /// The separating-axis test of a triangle against a box (Akenine-Möller): the box's 3 axes, the
 /// triangle's normal and the 9 cross products of their edges. A degenerate axis (a zero cross
 /// product) projects everything to 0 and separates nothing, so degenerate triangles fall back to
@@ -308,6 +408,33 @@ fn segment_triangle(p: [f64; 3], d: [f64; 3], tri: &[[f64; 3]; 3]) -> Option<f64
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn surface_points_lie_on_the_triangles_inside_the_box() {
+        // A large tilted triangle through the unit box, one far away, one degenerate.
+        let tilted = [[-3.0, -3.0, 0.2], [4.0, -3.0, 0.6], [-3.0, 4.0, 0.9]];
+        let far = [[10.0, 10.0, 10.0], [11.0, 10.0, 10.0], [10.0, 11.0, 10.0]];
+        let flat = [[0.5, 0.5, 0.5], [0.6, 0.6, 0.6], [0.7, 0.7, 0.7]];
+        let bvh = SegmentBvh::new([tilted, far, flat]);
+        let points = bvh.surface_points_in_box([0.0; 3], [1.0; 3], 8);
+        assert_eq!(points.len(), 1, "{points:?}");
+        let (p, n) = points[0];
+        assert!(p.iter().all(|&x| (0.0..=1.0).contains(&x)), "{p:?}");
+        let n0 = unit_normal(&tilted).unwrap();
+        assert!((0..3).all(|a| (n[a] - n0[a]).abs() < 1e-15));
+        // On the triangle's plane.
+        let d = (0..3).map(|a| (p[a] - tilted[0][a]) * n0[a]).sum::<f64>();
+        assert!(d.abs() < 1e-12, "{d}");
+        // The triangle's own centroid is far outside the box: the point is its clipped part's.
+        assert!(tilted.iter().map(|v| v[0]).sum::<f64>() / 3.0 < -0.5);
+        assert!(bvh.surface_points_in_box([5.0; 3], [6.0; 3], 8).is_empty());
+        let many = SegmentBvh::new((0..10).map(|k| {
+            let z = 0.05 + 0.09 * f64::from(k);
+            [[-1.0, -1.0, z], [3.0, -1.0, z], [-1.0, 3.0, z]]
+        }));
+        assert_eq!(many.surface_points_in_box([0.0; 3], [1.0; 3], 3).len(), 3);
+        assert_eq!(many.surface_points_in_box([0.0; 3], [1.0; 3], 30).len(), 10);
+    }
 
     /// Brute force over every triangle, same test: the BVH must find exactly the same hits.
     #[test]

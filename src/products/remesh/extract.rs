@@ -126,6 +126,13 @@ pub fn extract(lattice: &Lattice, classified: &Classified) -> Band {
             march(tet, &mut band);
         }
     }
+    // A dense marching cubes at the resolution has faces in the refined cells whose corners
+    // differ, as in any band cell (and none for what only the finer levels see).
+    for &m in &classified.refined {
+        if classified.corners_mixed(lattice.sub_levels, m) {
+            marching_cubes(m, &mut band);
+        }
+    }
     for &(level, m) in &classified.fine_band {
         for tet in FREUDENTHAL {
             march(tet.map(|b| offset(m, b, 1 << level)), &mut band);

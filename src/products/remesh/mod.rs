@@ -412,7 +412,7 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
         classified_points: classified.labels.len(),
         split_cells: classified.split.len(),
         band_cells: band.band_cells,
-        refined_cells: classified.refined_cells,
+        refined_cells: classified.refined.len(),
         placement_evaluations: placed.evaluations,
         guided_vertices: placed.guided,
         extracted_faces: band.triangles.len(),

@@ -24,6 +24,29 @@
 //! right. Every finest lattice point is then labelled by its true class, and a part of the
 //! solid that holds a finest lattice point is in the output, however far it is from any coarse
 //! corner (a plate thinner than a coarse cell, say).
+//!
+//! # Below the regular cells (`Lattice::sub_levels`)
+//! A part thinner than a regular cell (a horn, a fin, a tilted plate) can lie between a cell's
+//! corners, which then agree. With `S` sub-levels the regular cells are `2^S` finest cells wide
+//! and, with a guide, three rules split below them, level by level from `S` down to 1:
+//! - **thin**: a leaf that a triangle *crosses* (meets its interior, shrunk by 10⁻⁶ cell: CAD
+//!   faces lying in a cell's face do not count) while its corners agree, and where `w` just off
+//!   one of (up to four of) the crossing triangles, on either side, has the other class: the
+//!   evidence that something no corner sees is there (an inner face of overlapping parts, with
+//!   the corners' class on both sides, is not worth eight children);
+//! - **propagation**: a leaf next to a cell just split (across a face or an edge) whose shared
+//!   face or edge holds a new point of a class that the corners around it do not explain (an
+//!   edge's midpoint against both ends, a face's centre against its four corners), and that a
+//!   triangle crosses — the thin part goes on into a cell whose corners differ for another
+//!   reason;
+//! - **balance**: every cell around a split cell of level `l ≤ S` is a leaf of level `l` or
+//!   split, so leaves side by side differ by one level at most.
+//!
+//! All three only split more cells, so rules (2) and (3) and the invariant hold as above. The
+//! leaves of levels `0..S` next to a split cell of their level take the transition split of
+//! [`super::transition`]; its extra points (cell and face centres) lie in leaves of level at
+//! most `S`, off every larger leaf's closed box, so they are classified outright (on the
+//! lattice's outer faces: declared outside, as every point there).
 
 use rayon::prelude::*;
 
@@ -79,8 +102,8 @@ pub struct Classified {
     /// a split cell of their level whose transition split ([`transition::tetrahedra`]) has
     /// vertices of both classes.
     pub transition: Vec<(u32, Corner)>,
-    /// Regular cells split for a part thinner than a cell.
-    pub refined_cells: usize,
+    /// Minimum corners of the regular cells split for a part thinner than a cell.
+    pub refined: Vec<Corner>,
 }
 
 impl Classified {
@@ -144,7 +167,7 @@ impl Classified {
     }
 
     /// Whether the 8 corners of the cell `(level, m)` (all classified) differ.
-    fn corners_mixed(&self, level: u32, m: Corner) -> bool {
+    pub fn corners_mixed(&self, level: u32, m: Corner) -> bool {
         let size = 1u32 << level;
         let first = self.label(m);
         (1..8).any(|b| self.label(offset(m, b, size)) != first)
@@ -256,13 +279,17 @@ pub fn classify<E: Evaluator + ?Sized>(
         // is shrunk) while its corners agree holds a piece of surface that no corner sees.
         // Split it, level by level down to the finest.
         for level in (1..=regular).rev() {
-            let thin: Vec<(u32, Corner)> = cells_at(&out, level)
+            let crossed: Vec<Corner> = cells_at(&out, level)
                 .into_par_iter()
                 .filter(|&m| {
                     !out.split.contains(&(level, pack(m)))
                         && !out.corners_mixed(level, m)
                         && crosses(guide, lattice, level, m)
                 })
+                .collect();
+            let thin: Vec<(u32, Corner)> = out
+                .with_hidden_class(evaluator, lattice, guide, level, crossed)
+                .into_iter()
                 .map(|m| (level, m))
                 .collect();
             let mut split_now: Vec<Corner> = thin.iter().map(|&(_, m)| m).collect();
@@ -333,7 +360,9 @@ pub fn classify<E: Evaluator + ?Sized>(
             if level == 0 || !out.split.contains(&(level, pack(m))) {
                 leaves.push((level, m));
             } else {
-                out.refined_cells += usize::from(level == regular);
+                if level == regular {
+                    out.refined.push(m);
+                }
                 transition.extend(
                     neighbours(lattice, m, 1 << level)
                         .filter(|&n| touches_edge(n, m) && !out.split.contains(&(level, pack(n))))
@@ -439,7 +468,64 @@ fn crosses(guide: &SegmentBvh, lattice: &Lattice, level: u32, m: Corner) -> bool
     guide.meets_box(lo, hi, -1e-6 * lattice.smallest_cell() * f64::from(size))
 }
 
+/// Triangles probed per cell by [`Classified::with_hidden_class`]: a thin part shows on the
+/// first one it has in the cell; more only costs evaluations where nothing is hidden.
+const PROBED_TRIANGLES: usize = 4;
+
+/// How far off a triangle [`Classified::with_hidden_class`] probes, in finest cells: far above
+/// the rounding of the probe point, far below any part the lattice could resolve.
+const PROBE_OFFSET: f64 = 1e-3;
+
 impl Classified {
+    /// The cells of `cells` (of `level`, corners of one class, crossed by a triangle) in which
+    /// `w` has the other class next to a crossing triangle: probed on both sides of up to
+    /// [`PROBED_TRIANGLES`] of them, one parallel batch. A cell crossed only by faces with the
+    /// same class on both sides (inner faces of overlapping parts, double walls) hides nothing
+    /// and is not worth eight children.
+    fn with_hidden_class<E: Evaluator + ?Sized>(
+        &self,
+        evaluator: &E,
+        lattice: &Lattice,
+        guide: &SegmentBvh,
+        level: u32,
+        cells: Vec<Corner>,
+    ) -> Vec<Corner> {
+        let size = 1u32 << level;
+        let shrink = 1e-6 * lattice.smallest_cell() * f64::from(size);
+        let offset = PROBE_OFFSET * lattice.smallest_cell();
+        let probes: Vec<Vec<[f64; 3]>> = cells
+            .par_iter()
+            .map(|&m| {
+                let lo = lattice.corner_position(m).map(|x| x + shrink);
+                let hi = lattice
+                    .corner_position(m.map(|x| x + size))
+                    .map(|x| x - shrink);
+                guide
+                    .surface_points_in_box(lo, hi, PROBED_TRIANGLES)
+                    .into_iter()
+                    .flat_map(|(p, n)| {
+                        [1.0, -1.0].map(|s| [0, 1, 2].map(|a| p[a] + s * offset * n[a]))
+                    })
+                    .collect()
+            })
+            .collect();
+        let flat: Vec<[f64; 3]> = probes.iter().flatten().copied().collect();
+        let values = evaluator.eval_batch(&flat);
+        let mut next = 0;
+        let mut hidden = Vec::new();
+        for (&m, points) in cells.iter().zip(&probes) {
+            let class = self.label(m);
+            let found = values[next..next + points.len()]
+                .iter()
+                .any(|&w| (w > 0.5) != class);
+            next += points.len();
+            if found {
+                hidden.push(m);
+            }
+        }
+        hidden
+    }
+
     /// Whether a point of the split cell `m` (of `level`) on the closed box of its neighbour
     /// `n` (same level) has a class that the corners of `n` around it do not explain: an edge's
     /// midpoint of the other class than both ends, a face's centre of the other class than its
