@@ -115,51 +115,23 @@ impl SegmentBvh {
     /// `pad` of it. Only refinement depends on the answer, never a label, so a spurious `true`
     /// costs time and a `false` must never be wrong.
     pub fn meets_box(&self, lo: [f64; 3], hi: [f64; 3], pad: f64) -> bool {
-        if self.nodes.is_empty() {
-            return false;
-        }
         let (blo, bhi) = (
             [0, 1, 2].map(|a| lo[a] - pad),
             [0, 1, 2].map(|a| hi[a] + pad),
         );
-        let mut stack = [0u32; 64];
-        let mut top = 1;
-        while top > 0 {
-            top -= 1;
-            let node = self.nodes[stack[top] as usize];
-            if (0..3).any(|a| node.lo[a] > bhi[a] || node.hi[a] < blo[a]) {
-                continue;
-            }
-            if node.count > 0 {
-                let first = node.first as usize;
-                let tris = &self.triangles[first..first + node.count as usize];
-                if tris.iter().any(|t| triangle_meets_box(t, blo, bhi)) {
-                    return true;
-                }
-            } else if top + 2 <= stack.len() {
-                stack[top] = node.first;
-                stack[top + 1] = node.second;
-                top += 2;
-            }
-        }
-        false
+        let mut met = false;
+        self.visit_box(blo, bhi, |t| {
+            met = triangle_meets_box(t, blo, bhi);
+            met
+        });
+        met
     }
-}
 
-impl SegmentBvh {
-    /// Up to `max` points where triangles cross the box `lo..=hi`, each with its triangle's
-    /// unit normal: the vertex average of the triangle's part inside the box (a convex polygon,
-    /// so the average lies in it). Degenerate triangles are skipped. Only refinement reads the
-    /// points (they tell where to look for a class no corner of a cell has), never a label.
-    pub fn surface_points_in_box(
-        &self,
-        lo: [f64; 3],
-        hi: [f64; 3],
-        max: usize,
-    ) -> Vec<([f64; 3], [f64; 3])> {
-        let mut out = Vec::new();
-        if self.nodes.is_empty() || max == 0 {
-            return out;
+    /// Calls `f` on the triangles whose leaves' boxes meet the box `lo..=hi` (a superset of
+    /// those that meet it) until it returns `true`.
+    fn visit_box(&self, lo: [f64; 3], hi: [f64; 3], mut f: impl FnMut(&[[f64; 3]; 3]) -> bool) {
+        if self.nodes.is_empty() {
+            return;
         }
         let mut stack = [0u32; 64];
         let mut top = 1;
@@ -172,20 +144,8 @@ impl SegmentBvh {
             if node.count > 0 {
                 let first = node.first as usize;
                 for t in &self.triangles[first..first + node.count as usize] {
-                    if !triangle_meets_box(t, lo, hi) {
-                        continue;
-                    }
-                    let n = unit_normal(t);
-                    let Some(n) = n else { continue };
-                    let part = clip_to_box(t, lo, hi);
-                    if part.is_empty() {
-                        continue;
-                    }
-                    let k = part.len() as f64;
-                    let centre = [0, 1, 2].map(|a| part.iter().map(|p| p[a]).sum::<f64>() / k);
-                    out.push((centre, n));
-                    if out.len() == max {
-                        return out;
+                    if f(t) {
+                        return;
                     }
                 }
             } else if top + 2 <= stack.len() {
@@ -194,12 +154,46 @@ impl SegmentBvh {
                 top += 2;
             }
         }
+    }
+
+    /// Up to `max` points where triangles cross the box `lo..=hi`, each with its triangle's
+    /// unit normal: the vertex average of the triangle's part inside the box (a convex polygon,
+    /// so the average lies in it). Degenerate triangles are skipped. Only refinement reads the
+    /// points (they tell where to look for a class no corner of a cell has), never a label.
+    pub fn surface_points_in_box(
+        &self,
+        lo: [f64; 3],
+        hi: [f64; 3],
+        max: usize,
+    ) -> Vec<([f64; 3], [f64; 3])> {
+        let mut out = Vec::new();
+        if max == 0 {
+            return out;
+        }
+        self.visit_box(lo, hi, |t| {
+            if !triangle_meets_box(t, lo, hi) {
+                return false;
+            }
+            let Some(n) = unit_normal(t) else {
+                return false;
+            };
+            let part = clip_to_box(t, lo, hi);
+            if part.is_empty() {
+                return false;
+            }
+            let k = part.len() as f64;
+            out.push((
+                [0, 1, 2].map(|a| part.iter().map(|p| p[a]).sum::<f64>() / k),
+                n,
+            ));
+            out.len() == max
+        });
         out
     }
 }
 
 /// The unit normal of a triangle (right-hand rule), `None` if it is degenerate.
-fn unit_normal(t: &[[f64; 3]; 3]) -> Option<[f64; 3]> {
+pub(super) fn unit_normal(t: &[[f64; 3]; 3]) -> Option<[f64; 3]> {
     let u = [0, 1, 2].map(|a| t[1][a] - t[0][a]);
     let v = [0, 1, 2].map(|a| t[2][a] - t[0][a]);
     let n = [

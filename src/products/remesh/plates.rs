@@ -239,15 +239,7 @@ fn plate_runs_of_line(crossings: &[Crossing], classes: &[bool]) -> Vec<f64> {
 
 /// Whether the triangle's unit normal is within [`PLATE_COSINE`] of `axis`.
 fn perpendicular(tri: &[[f64; 3]; 3], axis: usize) -> bool {
-    let e1 = [0, 1, 2].map(|k| tri[1][k] - tri[0][k]);
-    let e2 = [0, 1, 2].map(|k| tri[2][k] - tri[0][k]);
-    let n = [
-        e1[1] * e2[2] - e1[2] * e2[1],
-        e1[2] * e2[0] - e1[0] * e2[2],
-        e1[0] * e2[1] - e1[1] * e2[0],
-    ];
-    let len2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
-    len2 > 0.0 && n[axis] * n[axis] >= PLATE_COSINE * PLATE_COSINE * len2
+    super::crossings::unit_normal(tri).is_some_and(|n| n[axis].abs() >= PLATE_COSINE)
 }
 
 #[cfg(test)]
