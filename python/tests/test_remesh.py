@@ -102,3 +102,27 @@ def test_a_plate_thinner_than_a_cell_gets_finer_cells_across_it():
     V0, F0 = gwn.remesh(V, F, res=32, refine_plates=False)
     assert edge_census(F0)[:2] == (True, True)
     assert volume(V0, F0) < 0.7 * want
+
+
+def test_sub_cell_levels_keep_a_tilted_plate_thinner_than_a_cell():
+    # A unit cube and, beside it, a 1.2 x 1.0 plate 0.04 thick, tilted so that no lattice plane
+    # follows it: at res 24 (cells of ~0.124) a third of a cell thick, so lattice points fall
+    # in it only here and there; two levels below (cells of ~0.031) hold all of it.
+    a, b = 0.5, 0.7
+    rz = np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
+    rx = np.array([[1, 0, 0], [0, np.cos(b), -np.sin(b)], [0, np.sin(b), np.cos(b)]])
+    rot = rx @ rz
+    centre = np.array([2.2, 0.5, 0.5])
+    plate = ((CUBE_V - 0.5) * [1.2, 1.0, 0.04]) @ rot.T + centre
+    V = np.vstack([CUBE_V, plate])
+    F = np.vstack([CUBE_F, CUBE_F + 8])
+    u, v = np.meshgrid(np.linspace(-0.45, 0.45, 30), np.linspace(-0.35, 0.35, 30))
+    mid_plane = np.stack([u.ravel(), v.ravel(), np.zeros(u.size)], axis=1) @ rot.T + centre
+    kept = {}
+    for levels in (0, 2):
+        Vo, Fo = gwn.remesh(V, F, res=24, sub_cell_levels=levels)
+        assert edge_census(Fo)[:2] == (True, True)
+        kept[levels] = np.mean(gwn.winding_number(Vo, Fo, mid_plane) > 0.5)
+    assert kept[0] < 0.5 and kept[2] > 0.98, kept
+    with pytest.raises(ValueError, match="sub-cell levels"):
+        gwn.remesh(V, F, res=24, sub_cell_levels=4)
