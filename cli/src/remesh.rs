@@ -90,6 +90,15 @@ pub struct Args {
     /// to this many levels, with conforming transitions (meshes and soups only).
     #[arg(long, default_value_t = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS)]
     pub sub_cell_levels: u32,
+    /// Levels of cells above --res (0 to 3) kept whole where the input in them is flat (within
+    /// a tenth of a cell of one plane, with an integer winding number at their corners): a flat
+    /// face costs cells by its area in cells up to 2^N times larger. At most N: a probe of the
+    /// input says how many pay (meshes and soups only).
+    #[arg(long, default_value_t = gwn::products::remesh::DEFAULT_PLANAR_LEVELS)]
+    pub planar_levels: u32,
+    /// Use all --planar-levels, whatever the flatness probe finds.
+    #[arg(long)]
+    pub no_flatness_probe: bool,
     #[command(flatten)]
     pub method: MethodArgs,
     #[command(flatten)]
@@ -165,6 +174,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
         }),
         refine_plates: !args.no_plate_refinement,
         sub_cell_levels: args.sub_cell_levels,
+        planar_levels: args.planar_levels,
+        probe_flatness: !args.no_flatness_probe,
     };
     // Phases: classify, extract, place, [simplify,] write, self-intersections, Hausdorff,
     // agreement.
@@ -254,6 +265,19 @@ pub fn run(args: Args) -> Result<(), CliError> {
             "sub-cell levels: {} ({} cells crossed by the input with agreeing corners refined)",
             options.sub_cell_levels,
             s.refined_cells
+        )?;
+    }
+    if options.planar_levels > 0 {
+        let f = s.flatness.flat_fraction;
+        outln!(
+            "planar levels: {} of {} (cells up to {}x the resolution's kept whole where the input \
+             is flat; input area flat at 2x, 4x, 8x: {:.0} %, {:.0} %, {:.0} %)",
+            s.planar_levels,
+            options.planar_levels,
+            1u32 << s.planar_levels,
+            100.0 * f[1],
+            100.0 * f[2],
+            100.0 * f[3]
         )?;
     }
     if s.plates.refines() {
@@ -392,6 +416,16 @@ pub fn run(args: Args) -> Result<(), CliError> {
             ("band_cells", s.band_cells.to_string()),
             ("sub_cell_levels", options.sub_cell_levels.to_string()),
             ("refined_cells", s.refined_cells.to_string()),
+            ("planar_levels", s.planar_levels.to_string()),
+            (
+                "flat_fraction",
+                format!(
+                    "[{:?}, {:?}, {:?}]",
+                    s.flatness.flat_fraction[1],
+                    s.flatness.flat_fraction[2],
+                    s.flatness.flat_fraction[3]
+                ),
+            ),
             ("method", format!("\"{}\"", gwn::eval::Evaluator::name(&wn))),
             ("guided_vertices", s.guided_vertices.to_string()),
             ("placement_evaluations", s.placement_evaluations.to_string()),

@@ -13,5 +13,6 @@ mod label;
 mod products;
 mod remesh;
 mod remesh_cli;
+mod remesh_planar;
 mod remesh_simplify;
 mod remesh_sub_cell;

@@ -365,6 +365,7 @@ fn generous() -> SimplifyOptions {
         flat_tolerance: 0.0,
         lattice_diagonals: true,
         lattice_diagonal_error: f64::INFINITY,
+        lattice_cube_cells: 1,
         // Slabs a cell thick: the hand-made surfaces are cut wherever they are thick enough.
         slab_cells: 1,
     }

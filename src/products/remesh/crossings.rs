@@ -190,17 +190,103 @@ impl SegmentBvh {
         });
         out
     }
+
+    /// `n` points drawn on the triangles uniformly by area (seeded), each with its triangle's
+    /// unit normal; none when the triangles have no area.
+    pub fn surface_samples(&self, n: usize, seed: u64) -> Vec<([f64; 3], [f64; 3])> {
+        let mut cumulative = Vec::with_capacity(self.triangles.len());
+        let mut total = 0.0;
+        for t in &self.triangles {
+            let c = cross(t);
+            total += (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+            cumulative.push(total);
+        }
+        if !(total > 0.0 && total.is_finite()) {
+            return Vec::new();
+        }
+        let mut rng = crate::base::splitmix::SplitMix64(seed);
+        (0..n)
+            .filter_map(|_| {
+                let x = rng.unit() * total;
+                let i = cumulative
+                    .partition_point(|&c| c <= x)
+                    .min(cumulative.len() - 1);
+                let t = &self.triangles[i];
+                let normal = unit_normal(t)?;
+                let (mut u, mut v) = (rng.unit(), rng.unit());
+                if u + v > 1.0 {
+                    (u, v) = (1.0 - u, 1.0 - v);
+                }
+                let p =
+                    [0, 1, 2].map(|a| t[0][a] + u * (t[1][a] - t[0][a]) + v * (t[2][a] - t[0][a]));
+                Some((p, normal))
+            })
+            .collect()
+    }
+
+    /// The plane (unit normal, a point) within `tolerance` of which the triangles meeting the
+    /// box `lo..=hi` grown by `pad` lie inside it (the plane of the largest of them); `None`
+    /// when they do not, or none or more than `max` meet it. Only refinement reads it (a flat
+    /// cell may stay coarse), never a label.
+    pub fn flat_in_box(
+        &self,
+        lo: [f64; 3],
+        hi: [f64; 3],
+        pad: f64,
+        tolerance: f64,
+        max: usize,
+    ) -> Option<([f64; 3], [f64; 3])> {
+        let (blo, bhi) = (
+            [0, 1, 2].map(|a| lo[a] - pad),
+            [0, 1, 2].map(|a| hi[a] + pad),
+        );
+        let mut met: Vec<[[f64; 3]; 3]> = Vec::new();
+        let mut too_many = false;
+        self.visit_box(blo, bhi, |t| {
+            if triangle_meets_box(t, blo, bhi) {
+                if met.len() == max {
+                    too_many = true;
+                    return true;
+                }
+                met.push(*t);
+            }
+            false
+        });
+        if too_many {
+            return None;
+        }
+        let area2 = |t: &[[f64; 3]; 3]| {
+            let n = cross(t);
+            n[0] * n[0] + n[1] * n[1] + n[2] * n[2]
+        };
+        let largest = met.iter().max_by(|a, b| area2(a).total_cmp(&area2(b)))?;
+        let n = unit_normal(largest)?;
+        let p0 = largest[0];
+        met.iter()
+            .all(|t| {
+                clip_to_box(t, blo, bhi).iter().all(|p| {
+                    let d: f64 = (0..3).map(|a| n[a] * (p[a] - p0[a])).sum();
+                    d.abs() <= tolerance
+                })
+            })
+            .then_some((n, p0))
+    }
+}
+
+/// The (unnormalised) normal of a triangle, right-hand rule.
+fn cross(t: &[[f64; 3]; 3]) -> [f64; 3] {
+    let u = [0, 1, 2].map(|a| t[1][a] - t[0][a]);
+    let v = [0, 1, 2].map(|a| t[2][a] - t[0][a]);
+    [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ]
 }
 
 /// The unit normal of a triangle (right-hand rule), `None` if it is degenerate.
 pub(super) fn unit_normal(t: &[[f64; 3]; 3]) -> Option<[f64; 3]> {
-    let u = [0, 1, 2].map(|a| t[1][a] - t[0][a]);
-    let v = [0, 1, 2].map(|a| t[2][a] - t[0][a]);
-    let n = [
-        u[1] * v[2] - u[2] * v[1],
-        u[2] * v[0] - u[0] * v[2],
-        u[0] * v[1] - u[1] * v[0],
-    ];
+    let n = cross(t);
     let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
     (len > 0.0 && len.is_finite()).then(|| n.map(|x| x / len))
 }

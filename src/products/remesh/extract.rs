@@ -105,35 +105,40 @@ pub fn extract(lattice: &Lattice, classified: &Classified) -> Band {
         }
     };
     let mc_table = marching_cubes_table();
-    let marching_cubes = |m: Corner, band: &mut Band| {
-        let case = (0..8)
-            .filter(|&b| classified.label(offset(m, b, size)))
-            .fold(0, |c, b| c | (1 << b));
-        band.marching_cubes_triangles += usize::from(mc_table[case]);
+    // A dense marching cubes at the resolution: exact in the resolution's cells, estimated in
+    // larger ones (which stay whole where the input is flat: its faces there grow with the
+    // area, 4 per level), none for what only the finer levels see.
+    let resolution = lattice.resolution_level();
+    let marching_cubes = |level: u32, m: Corner, band: &mut Band| {
+        if level >= resolution {
+            let case = (0..8)
+                .filter(|&b| classified.label(offset(m, b, 1 << level)))
+                .fold(0, |c, b| c | (1 << b));
+            band.marching_cubes_triangles +=
+                usize::from(mc_table[case]) << (2 * (level - resolution));
+        }
     };
     for &m in &classified.band {
-        marching_cubes(m, &mut band);
+        marching_cubes(lattice.sub_levels, m, &mut band);
         for tet in FREUDENTHAL {
             march(tet.map(|b| offset(m, b, size)), &mut band);
         }
     }
     for &(level, m) in &classified.transition {
-        if level == lattice.sub_levels {
-            marching_cubes(m, &mut band);
-        }
+        marching_cubes(level, m, &mut band);
         let refined = |c: Corner| classified.split.contains(&(level, pack(c)));
         for tet in super::transition::tetrahedra(m, 1 << level, refined) {
             march(tet, &mut band);
         }
     }
-    // A dense marching cubes at the resolution has faces in the refined cells whose corners
-    // differ, as in any band cell (and none for what only the finer levels see).
+    // The resolution's cells split below it count as in any band cell if their corners differ.
     for &m in &classified.refined {
-        if classified.corners_mixed(lattice.sub_levels, m) {
-            marching_cubes(m, &mut band);
+        if classified.corners_mixed(resolution, m) {
+            marching_cubes(resolution, m, &mut band);
         }
     }
     for &(level, m) in &classified.fine_band {
+        marching_cubes(level, m, &mut band);
         for tet in FREUDENTHAL {
             march(tet.map(|b| offset(m, b, 1 << level)), &mut band);
         }

@@ -43,10 +43,16 @@ pub struct Lattice {
     pub cells: [usize; 3],
     /// Octree levels: a coarse cell is `2^levels` finest cells wide.
     pub levels: u32,
-    /// Levels below the resolution's cell ([`Lattice::with_sub_levels`]): the resolution's cell
-    /// (the *regular* cell) is `2^sub_levels` finest cells wide, and the octree refines below it
-    /// only where [`super::octree`] finds parts thinner than it.
+    /// Octree levels below the *regular* cell, the cell of the lattice's regular band
+    /// ([`Lattice::with_sub_levels`], [`Lattice::with_planar_levels`]): a regular cell is
+    /// `2^sub_levels` finest cells wide, and the octree refines below it only where
+    /// [`super::octree`] finds a reason to.
     pub sub_levels: u32,
+    /// How many of the [`Lattice::sub_levels`] lie above the resolution's cell
+    /// ([`Lattice::with_planar_levels`]): the regular cell is `2^planar_levels` resolution cells
+    /// wide, and is cut down to the resolution's cell wherever the input in it is not flat.
+    /// The resolution's cell is `2^(sub_levels − planar_levels)` finest cells wide.
+    pub planar_levels: u32,
 }
 
 impl Lattice {
@@ -110,6 +116,7 @@ impl Lattice {
             cells,
             levels,
             sub_levels: 0,
+            planar_levels: 0,
         })
     }
 
@@ -119,31 +126,55 @@ impl Lattice {
     pub fn with_sub_levels(self, sub_levels: u32) -> Option<Lattice> {
         let scale = 1usize << sub_levels;
         let cells = self.cells.map(|c| c * scale);
-        (cells.iter().all(|&c| c < 1 << 21) && sub_levels <= 4).then(|| Lattice {
+        (cells.iter().all(|&c| c < 1 << 21) && self.sub_levels + sub_levels <= 8).then(|| Lattice {
             origin: self.origin,
             h: self.h.map(|h| h / scale as f64),
             cells,
             levels: self.levels + sub_levels,
             sub_levels: self.sub_levels + sub_levels,
+            planar_levels: self.planar_levels,
         })
     }
 
-    /// The lattice of regular cells: the same box and corners at every `2^sub_levels`-th
-    /// finest corner (the units of the simplification's tolerances and of the report).
-    pub fn regular(self) -> Lattice {
-        let scale = 1usize << self.sub_levels;
+    /// [`Lattice::with_sub_levels`] for a lattice built at `2^planar_levels` times coarser than
+    /// the resolution: its regular cells are that many resolution cells wide, and the new levels
+    /// lie above the resolution's cell ([`Lattice::planar_levels`]).
+    pub fn with_planar_levels(self, planar_levels: u32) -> Option<Lattice> {
+        self.with_sub_levels(planar_levels).map(|l| Lattice {
+            planar_levels: l.planar_levels + planar_levels,
+            ..l
+        })
+    }
+
+    /// The octree level of the resolution's cell (0: the finest).
+    pub fn resolution_level(&self) -> u32 {
+        self.sub_levels - self.planar_levels
+    }
+
+    /// The lattice of resolution cells: the same box and corners at every
+    /// `2^resolution_level`-th finest corner (the units of the simplification's tolerances and
+    /// of the report).
+    pub fn resolution(self) -> Lattice {
+        let level = self.resolution_level();
+        let scale = 1usize << level;
         Lattice {
             origin: self.origin,
             h: self.h.map(|h| h * scale as f64),
             cells: self.cells.map(|c| c / scale),
-            levels: self.levels - self.sub_levels,
-            sub_levels: 0,
+            levels: self.levels - level,
+            sub_levels: self.planar_levels,
+            planar_levels: self.planar_levels,
         }
     }
 
     /// Finest cells per regular cell along each axis.
     pub fn regular_cell(&self) -> u32 {
         1 << self.sub_levels
+    }
+
+    /// Finest cells per resolution cell along each axis.
+    pub fn resolution_cell(&self) -> u32 {
+        1 << self.resolution_level()
     }
 
     /// Coarse cells per axis.

@@ -51,6 +51,7 @@
 
 pub mod crossings;
 pub mod extract;
+pub mod flatness;
 pub mod intersect;
 pub mod lattice;
 pub mod octree;
@@ -78,6 +79,15 @@ pub const DEFAULT_BISECTION_STEPS: u32 = 8;
 /// Default [`RemeshOptions::sub_cell_levels`] (of [`RemeshOptions::with_resolution`], the CLI
 /// and Python).
 pub const DEFAULT_SUB_CELL_LEVELS: u32 = 0;
+
+/// Default [`RemeshOptions::planar_levels`] (of [`RemeshOptions::with_resolution`], the CLI and
+/// Python).
+pub const DEFAULT_PLANAR_LEVELS: u32 = 3;
+
+/// [`RemeshOptions::planar_levels`] stop where the lattice of the largest cells would have fewer
+/// than this many cells along the longest axis (a cell holding an eighth of the model is split
+/// anyway unless the model is a box).
+pub const MIN_PLANAR_RESOLUTION: usize = 8;
 
 /// Largest accepted number of bisection steps (beyond it the interval is below `f64` spacing
 /// for any reasonable box).
@@ -116,6 +126,17 @@ pub struct RemeshOptions {
     /// levels, with a conforming transition to the neighbours ([`transition`]). 0: one
     /// uniform finest level.
     pub sub_cell_levels: u32,
+    /// With the input triangles ([`remesh_guided`]): levels of cells above the resolution's
+    /// (at most [`octree::MAX_PLANAR_LEVELS`]) kept whole where the input in them is flat
+    /// (within [`octree::PLANAR_TOLERANCE`] of a plane, with an integer `w` at the corners):
+    /// the lattice is built that many times coarser (down to [`MIN_PLANAR_RESOLUTION`] cells)
+    /// and cut down to the resolution's cell everywhere else, with a conforming transition
+    /// ([`transition`]). A flat face costs cells in proportion to its area in large cells, not
+    /// in resolution cells. 0: every cell is at least as fine as the resolution's.
+    pub planar_levels: u32,
+    /// Use only as many of [`RemeshOptions::planar_levels`] as the [`flatness`] probe finds
+    /// pay (none on an input curved everywhere, where they only cost time); `false`: all.
+    pub probe_flatness: bool,
 }
 
 impl RemeshOptions {
@@ -128,6 +149,8 @@ impl RemeshOptions {
             simplify: Some(simplify::SimplifyOptions::default()),
             refine_plates: true,
             sub_cell_levels: DEFAULT_SUB_CELL_LEVELS,
+            planar_levels: DEFAULT_PLANAR_LEVELS,
+            probe_flatness: true,
         }
     }
 }
@@ -150,6 +173,11 @@ pub enum RemeshError {
     /// More sub-cell levels than [`octree::MAX_SUB_LEVELS`], or more than the lattice's
     /// coordinates hold at this resolution.
     BadSubCellLevels {
+        /// The levels asked for.
+        levels: u32,
+    },
+    /// More planar levels than [`octree::MAX_PLANAR_LEVELS`].
+    BadPlanarLevels {
         /// The levels asked for.
         levels: u32,
     },
@@ -185,6 +213,11 @@ impl std::fmt::Display for RemeshError {
                 f,
                 "{levels} sub-cell levels is above the limit {} (or too many at this resolution)",
                 octree::MAX_SUB_LEVELS
+            ),
+            RemeshError::BadPlanarLevels { levels } => write!(
+                f,
+                "{levels} planar levels is above the limit {}",
+                octree::MAX_PLANAR_LEVELS
             ),
             RemeshError::BadBounds => {
                 f.write_str("bounds must be finite with min <= max on every axis")
@@ -225,6 +258,11 @@ pub struct RemeshStats {
     /// Regular cells cut into eight for a part thinner than a cell
     /// ([`RemeshOptions::refine_thin_parts`]).
     pub refined_cells: usize,
+    /// Levels above the resolution's cell kept where the input is flat
+    /// ([`RemeshOptions::planar_levels`], fewer on a small lattice, 0 without the triangles).
+    pub planar_levels: u32,
+    /// What the [`flatness`] probe found (all 0 when it did not run).
+    pub flatness: flatness::FlatnessProbe,
     /// Evaluations spent on vertex placement (verifications and the field search).
     pub placement_evaluations: usize,
     /// Vertices placed at a verified crossing with the input triangles (no field search).
@@ -335,6 +373,11 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
             levels: options.sub_cell_levels,
         });
     }
+    if options.planar_levels > octree::MAX_PLANAR_LEVELS {
+        return Err(RemeshError::BadPlanarLevels {
+            levels: options.planar_levels,
+        });
+    }
     if options.bisection_steps > MAX_BISECTION_STEPS {
         return Err(RemeshError::BadBisectionSteps {
             steps: options.bisection_steps,
@@ -369,8 +412,32 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
         Some(guide) if options.refine_plates => plates::probe(evaluator, guide, bounds, lattice.h),
         _ => plates::PlateProbe::none(),
     };
-    if plates.refines() {
-        lattice = lattice::Lattice::refined(bounds, options.resolution, plates.refinement)
+    // Planar levels need the triangles (only they say where the input is flat), are used as
+    // far as the flatness probe finds they pay, and stop where the lattice of the largest
+    // cells would get too coarse.
+    let flatness = match guide {
+        Some(guide) if options.planar_levels > 0 && options.probe_flatness => {
+            flatness::probe(evaluator, guide, &lattice, options.planar_levels)
+        }
+        Some(_) => flatness::FlatnessProbe {
+            levels: options.planar_levels,
+            ..flatness::FlatnessProbe::default()
+        },
+        None => flatness::FlatnessProbe::default(),
+    };
+    let planar = if guide.is_some() {
+        (0..=flatness.levels)
+            .rev()
+            .find(|&l| options.resolution.div_ceil(1 << l) >= MIN_PLANAR_RESOLUTION)
+            .unwrap_or(0)
+    } else {
+        0
+    };
+    if plates.refines() || planar > 0 {
+        // Rounded up: the resolution's cell is never coarser than asked for.
+        let coarse = options.resolution.div_ceil(1 << planar);
+        lattice = lattice::Lattice::refined(bounds, coarse, plates.refinement)
+            .and_then(|l| l.with_planar_levels(planar))
             .ok_or(RemeshError::BadBounds)?;
     }
     if options.sub_cell_levels > 0 && guide.is_some() {
@@ -380,9 +447,9 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
             },
         )?;
     }
-    // Distances and fixed-point units per regular cell: the simplification's tolerances and
-    // the report's cells do not change with the sub-levels.
-    let regular = lattice.regular();
+    // Distances and fixed-point units per resolution cell: the simplification's tolerances and
+    // the report's cells do not change with the sub-levels or the planar levels.
+    let resolution = lattice.resolution();
     let max_points = options.max_classified_points.unwrap_or_else(|| {
         crate::grid::available_memory().map_or(1 << 31, |bytes| {
             usize::try_from(bytes / BYTES_PER_CLASSIFIED_POINT).unwrap_or(usize::MAX)
@@ -402,7 +469,9 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
         &lattice,
         &band.edges,
         &classified.edge_values(&band.edges),
-        options.bisection_steps,
+        // The precision is per lattice edge: a cell `2^planar` times larger takes as many
+        // more steps, so vertices stay as close to the class change in resolution cells.
+        options.bisection_steps + planar,
         guide,
     );
     let mut stats = RemeshStats {
@@ -413,6 +482,8 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
         split_cells: classified.split.len(),
         band_cells: band.band_cells,
         refined_cells: classified.refined.len(),
+        planar_levels: lattice.planar_levels,
+        flatness,
         placement_evaluations: placed.evaluations,
         guided_vertices: placed.guided,
         extracted_faces: band.triangles.len(),
@@ -432,14 +503,18 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
             // surface is 1.6M vertices and 3.1M faces: ~300 MB less at the peak, measured).
             let planes = simplify_options
                 .input_planes
-                .then(|| placed.planes_in_lattice_units(&regular));
+                .then(|| placed.planes_in_lattice_units(&resolution));
             placed.planes = Vec::new();
             placed.positions = Vec::new();
             drop(band.edges);
+            let simplify_options = &simplify::SimplifyOptions {
+                lattice_cube_cells: 1 << planar,
+                ..*simplify_options
+            };
             let s = simplify::simplify_with_planes(
                 std::mem::take(&mut placed.fixed),
                 band.triangles,
-                placed.ticks_per_cell * i64::from(lattice.regular_cell()),
+                placed.ticks_per_cell * i64::from(lattice.resolution_cell()),
                 simplify_options,
                 (simplify_options.target_fraction_of_marching_cubes
                     * band.marching_cubes_triangles as f64) as usize,
@@ -463,9 +538,9 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
         positions,
         triangles,
         fixed,
-        ticks_per_cell: placed.ticks_per_cell * i64::from(lattice.regular_cell()),
+        ticks_per_cell: placed.ticks_per_cell * i64::from(lattice.resolution_cell()),
         cell_size,
-        cell_sizes: regular.h,
+        cell_sizes: resolution.h,
         stats,
     })
 }

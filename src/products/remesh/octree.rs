@@ -102,7 +102,8 @@ pub struct Classified {
     /// a split cell of their level whose transition split ([`transition::tetrahedra`]) has
     /// vertices of both classes.
     pub transition: Vec<(u32, Corner)>,
-    /// Minimum corners of the regular cells split for a part thinner than a cell.
+    /// Minimum corners of the resolution's cells (level [`Lattice::resolution_level`]) split
+    /// for a part thinner than a cell.
     pub refined: Vec<Corner>,
 }
 
@@ -206,12 +207,13 @@ pub fn classify<E: Evaluator + ?Sized>(
     max_points: usize,
 ) -> Option<Classified> {
     assert!(
-        lattice.sub_levels <= MAX_SUB_LEVELS,
-        "sub-levels beyond MAX_SUB_LEVELS"
+        lattice.resolution_level() <= MAX_SUB_LEVELS && lattice.planar_levels <= MAX_PLANAR_LEVELS,
+        "sub-levels beyond MAX_SUB_LEVELS or planar levels beyond MAX_PLANAR_LEVELS"
     );
     let mut out = Classified::default();
     let levels = lattice.levels;
     let regular = lattice.sub_levels;
+    let resolution = lattice.resolution_level();
     let coarse = 1u32 << levels;
     let cc = lattice.coarse_cells();
     // The coarse corners as a grid of cell-centre samples: a box half a coarse cell larger on
@@ -279,6 +281,22 @@ pub fn classify<E: Evaluator + ?Sized>(
         // is shrunk) while its corners agree holds a piece of surface that no corner sees.
         // Split it, level by level down to the finest.
         for level in (1..=regular).rev() {
+            // Above the resolution's cell: a leaf whose corners differ stays whole only where
+            // the input in it is flat (`Classified::flat`), cut to the resolution's cell
+            // elsewhere.
+            let mut curved: Vec<(u32, Corner)> = Vec::new();
+            if level > resolution {
+                curved = cells_at(&out, level)
+                    .into_par_iter()
+                    .filter(|&m| {
+                        !out.split.contains(&(level, pack(m)))
+                            && out.corners_mixed(level, m)
+                            && !out.flat(lattice, guide, level, m)
+                    })
+                    .map(|m| (level, m))
+                    .collect();
+                out.split_rounds(evaluator, lattice, Some(guide), curved.clone(), max_points)?;
+            }
             let crossed: Vec<Corner> = cells_at(&out, level)
                 .into_par_iter()
                 .filter(|&m| {
@@ -292,7 +310,7 @@ pub fn classify<E: Evaluator + ?Sized>(
                 .into_iter()
                 .map(|m| (level, m))
                 .collect();
-            let mut split_now: Vec<Corner> = thin.iter().map(|&(_, m)| m).collect();
+            let mut split_now: Vec<Corner> = thin.iter().chain(&curved).map(|&(_, m)| m).collect();
             out.split_rounds(evaluator, lattice, Some(guide), thin, max_points)?;
             // A thin part goes on into cells whose corners do not agree (a plate through a
             // corner of them): a leaf of this level next to a cell just split, where one of
@@ -360,7 +378,7 @@ pub fn classify<E: Evaluator + ?Sized>(
             if level == 0 || !out.split.contains(&(level, pack(m))) {
                 leaves.push((level, m));
             } else {
-                if level == regular {
+                if level == resolution {
                     out.refined.push(m);
                 }
                 transition.extend(
@@ -373,6 +391,9 @@ pub fn classify<E: Evaluator + ?Sized>(
     }
     transition.sort_unstable_by_key(|&(l, c)| (l, c[2], c[1], c[0]));
     transition.dedup();
+    if let Some(guide) = guide {
+        out.lend_untouched_transitions(lattice, guide, &mut transition);
+    }
     if !transition.is_empty() {
         let split = &out.split;
         let is_refined = |level: u32| move |c: Corner| split.contains(&(level, pack(c)));
@@ -441,6 +462,10 @@ pub fn classify<E: Evaluator + ?Sized>(
 /// evaluations per cell split, and the finest lattice keeps 21 bits per axis).
 pub const MAX_SUB_LEVELS: u32 = 3;
 
+/// Most levels [`classify`] keeps above the resolution's cell where the input is flat
+/// ([`Lattice::planar_levels`]).
+pub const MAX_PLANAR_LEVELS: u32 = 3;
+
 /// The cells of edge `size` around the cell with minimum `m` (26, fewer at the lattice's
 /// border).
 fn neighbours(lattice: &Lattice, m: Corner, size: u32) -> impl Iterator<Item = Corner> + '_ {
@@ -467,6 +492,21 @@ fn crosses(guide: &SegmentBvh, lattice: &Lattice, level: u32, m: Corner) -> bool
     let hi = lattice.corner_position(m.map(|x| x + size));
     guide.meets_box(lo, hi, -1e-6 * lattice.smallest_cell() * f64::from(size))
 }
+
+/// How far the input may stray from one plane in a cell above the resolution's that stays
+/// whole ([`Classified::flat`]), in resolution cells: the marching tetrahedra of the cell put
+/// their vertices on the input, so the surface in it is off the input by about this much, a
+/// tenth of what the resolution's own cells may be off by.
+pub const PLANAR_TOLERANCE: f64 = 0.1;
+
+/// Most triangles a cell that stays whole may meet: more, and its input is detail worth the
+/// resolution's cells (and the flatness test's cost stays bounded).
+pub const PLANAR_MAX_TRIANGLES: usize = 32;
+
+/// How close to an integer `w` must be at the corners of a cell that stays whole or lends its
+/// class: across a closed input `w` is an integer off the triangles, so the triangles are where
+/// it changes; near a hole or an open sheet it is not, and its level set may bend anywhere.
+pub const INTEGRAL_W_SLACK: f64 = 1e-3;
 
 /// Triangles probed per cell by [`Classified::with_hidden_class`]: a thin part shows on the
 /// first one it has in the cell; more only costs evaluations where nothing is hidden.
@@ -524,6 +564,100 @@ impl Classified {
             }
         }
         hidden
+    }
+
+    /// Whether the cell `(level, m)` may stay whole above the resolution's cell: `w` is within
+    /// [`INTEGRAL_W_SLACK`] of an integer at its corners, the input triangles meeting its closed
+    /// box lie in it within [`PLANAR_TOLERANCE`] of one plane, and that plane separates the
+    /// corners' classes (the corners on each side, farther than the tolerance, have one class).
+    /// With an integer `w` the triangles are where it changes, so each side of the plane holds
+    /// one value and the marching tetrahedra of the cell, whose vertices are placed on the
+    /// input, follow the plane; the last condition catches a field whose surface is not the
+    /// triangles' (thickened sheets: two planes at `±eps` from one).
+    fn flat(&self, lattice: &Lattice, guide: &SegmentBvh, level: u32, m: Corner) -> bool {
+        let size = 1u32 << level;
+        let integral = (0..8).all(|b| {
+            let w = self.value(offset(m, b, size));
+            (w - w.round()).abs() <= INTEGRAL_W_SLACK
+        });
+        if !integral {
+            return false;
+        }
+        let lo = lattice.corner_position(m);
+        let hi = lattice.corner_position(m.map(|x| x + size));
+        let cell = lattice.smallest_cell() * f64::from(lattice.resolution_cell());
+        let tolerance = PLANAR_TOLERANCE * cell;
+        let Some((n, p0)) = guide.flat_in_box(lo, hi, 1e-6 * cell, tolerance, PLANAR_MAX_TRIANGLES)
+        else {
+            return false;
+        };
+        // The class seen on each side: None until a corner there is met.
+        let mut side_class = [None; 2];
+        (0..8).all(|b| {
+            let c = offset(m, b, size);
+            let p = lattice.corner_position(c);
+            let d: f64 = (0..3).map(|a| n[a] * (p[a] - p0[a])).sum();
+            if d.abs() <= tolerance {
+                return true;
+            }
+            let class = self.label(c);
+            let seen = &mut side_class[usize::from(d > 0.0)];
+            *seen.get_or_insert(class) == class
+        })
+    }
+
+    /// Takes out of `transition` the leaves that no input triangle touches, whose classified
+    /// points on the closed box agree and whose corners' `w` is an integer (within
+    /// [`INTEGRAL_W_SLACK`]), and gives the points of their transition split that are not
+    /// classified yet (their centre, fanned faces' centres) the leaf's class without evaluating
+    /// them: the argument of the octree's invariant (`w` jumps only across the triangles, so it
+    /// is constant on a box that none touches) for the leaves at most regular. Such a leaf holds
+    /// no surface; around the refined band of a curved input most transition leaves are such.
+    /// A lent point is labelled once, so every split that holds it reads one class, and the
+    /// surface stays closed whatever the field (a leaf whose lent class would put an inside
+    /// point on the lattice's border, which is outside, keeps its transition split).
+    fn lend_untouched_transitions(
+        &mut self,
+        lattice: &Lattice,
+        guide: &SegmentBvh,
+        transition: &mut Vec<(u32, Corner)>,
+    ) {
+        let this = &*self;
+        // Per leaf: the points to lend, or `None` to keep its split.
+        let lent: Vec<Option<(CornerValue, Vec<Corner>)>> = transition
+            .par_iter()
+            .map(|&(l, m)| {
+                let size = 1u32 << l;
+                let integral = (0..8).all(|b| {
+                    let w = this.value(offset(m, b, size));
+                    (w - w.round()).abs() <= INTEGRAL_W_SLACK
+                });
+                if !integral || this.closed_box_mixed(l, m) || touched(Some(guide), lattice, l, m) {
+                    return None;
+                }
+                let is_refined = |c: Corner| this.split.contains(&(l, pack(c)));
+                let points: Vec<Corner> = transition::tetrahedra(m, 1 << l, is_refined)
+                    .into_iter()
+                    .flatten()
+                    .filter(|p| !this.labels.contains_key(&pack(*p)))
+                    .collect();
+                let value = this.labels[&pack(m)];
+                (!value.inside || !points.iter().any(|&p| lattice.is_border(p)))
+                    .then_some((value, points))
+            })
+            .collect();
+        let mut kept = Vec::with_capacity(transition.len());
+        for (&leaf, lent) in transition.iter().zip(lent) {
+            match lent {
+                None => kept.push(leaf),
+                Some((value, points)) => {
+                    for p in points {
+                        self.labels.entry(pack(p)).or_insert(value);
+                    }
+                }
+            }
+        }
+        *transition = kept;
     }
 
     /// Whether a point of the split cell `m` (of `level`) on the closed box of its neighbour

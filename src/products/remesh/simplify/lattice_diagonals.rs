@@ -117,7 +117,7 @@ impl CubeFaces {
         let mut faces: KeyMap<Vec<u32>> = KeyMap::default();
         for (f, t) in s.faces.iter().enumerate() {
             if s.alive[f] {
-                let m = owner(t.map(|x| s.points[x as usize]), s.ticks)?;
+                let m = owner(t.map(|x| s.points[x as usize]), s.cube_ticks)?;
                 faces.entry(bucket_key(m)).or_default().push(f as u32);
             }
         }
@@ -141,7 +141,7 @@ impl CubeFaces {
         old: &[u32],
         flat_star: bool,
     ) -> bool {
-        let ticks = s.ticks;
+        let ticks = s.cube_ticks;
         let pu = s.points[u as usize];
         let Some(segment) = Segment::of(pu, ticks) else {
             return true;
@@ -227,7 +227,7 @@ impl CubeFaces {
             q[a] == side
                 && (0..3).all(|b| {
                     b == a
-                        || (segment.base[b] * s.ticks..=(segment.base[b] + 1) * s.ticks)
+                        || (segment.base[b] * s.cube_ticks..=(segment.base[b] + 1) * s.cube_ticks)
                             .contains(&q[b])
                 })
         };
@@ -242,7 +242,7 @@ impl CubeFaces {
             b != a
                 && [segment.base[b], segment.base[b] + 1]
                     .iter()
-                    .any(|&k| p[b] == k * s.ticks && q[b] == k * s.ticks)
+                    .any(|&k| p[b] == k * s.cube_ticks && q[b] == k * s.cube_ticks)
         });
         if one_side {
             return false;
@@ -284,7 +284,7 @@ impl Simplifier {
         let Some(mut cubes) = CubeFaces::new(self) else {
             return;
         };
-        let ticks = self.ticks;
+        let ticks = self.cube_ticks;
         for axes in [3, 2] {
             for u in 0..self.points.len() as u32 {
                 let p = self.points[u as usize];
@@ -316,7 +316,7 @@ impl Simplifier {
             self.stats.diagonals_left += 1;
             return;
         };
-        let ticks = self.ticks;
+        let ticks = self.cube_ticks;
         let p = |s: &Simplifier, f: u32| s.faces[f as usize].map(|x| s.points[x as usize]);
         for &f in &plan.old {
             if let Some(m) = owner(p(self, f), ticks) {
@@ -343,7 +343,7 @@ impl Simplifier {
         cubes: &CubeFaces,
         max_error: f64,
     ) -> (Option<Plan>, [usize; 5]) {
-        let facet = Segment::of(self.points[u as usize], self.ticks)
+        let facet = Segment::of(self.points[u as usize], self.cube_ticks)
             .and_then(|s| s.facet_axis())
             .map(|a| (a, self.points[u as usize][a]));
         // A face diagonal's faces lie in the two cubes of its facet: only a target in the facet

@@ -158,6 +158,10 @@ pub struct SimplifyOptions {
     /// planes, in finest cells) of a collapse in that pass; larger ones are left to the
     /// cost-ordered collapses ([`DEFAULT_DIAGONAL_ERROR`] says why).
     pub lattice_diagonal_error: f64,
+    /// The cubes of that pass, in finest cells: the cells of the lattice whose Freudenthal
+    /// split the marching tetrahedra followed (the remesher's regular cells, larger than the
+    /// resolution's with [`super::RemeshOptions::planar_levels`]). 1 by default.
+    pub lattice_cube_cells: u32,
     /// Before the global collapses, cut the surface across its longest axis into slabs about
     /// this many finest cells thick (an even number of them, 2 to 8, about equal in faces; none
     /// if the surface is less than two slabs thick) and collapse inside each slab, all slabs at
@@ -178,6 +182,7 @@ impl Default for SimplifyOptions {
             flat_tolerance: DEFAULT_FLAT_TOLERANCE,
             lattice_diagonals: true,
             lattice_diagonal_error: DEFAULT_DIAGONAL_ERROR,
+            lattice_cube_cells: 1,
             slab_cells: DEFAULT_SLAB_CELLS,
         }
     }
@@ -366,6 +371,9 @@ pub struct Simplifier {
     indexed: bool,
     shift: u32,
     ticks: i64,
+    /// Fixed-point units per lattice cube of the pass over the lattice diagonals
+    /// ([`SimplifyOptions::lattice_cube_cells`] cells).
+    cube_ticks: i64,
     max_extent: i64,
     /// Squared distance bound, lattice units.
     max_distance2: f64,
@@ -536,6 +544,7 @@ impl Simplifier {
             indexed: false,
             shift,
             ticks: ticks_per_cell,
+            cube_ticks: ticks_per_cell.saturating_mul(i64::from(options.lattice_cube_cells.max(1))),
             max_extent,
             max_distance2: (options.max_distance * options.max_distance),
             flat_limit: None,

@@ -312,6 +312,7 @@ impl Simplifier {
             indexed: false,
             shift: self.shift,
             ticks: self.ticks,
+            cube_ticks: self.cube_ticks,
             max_extent: self.max_extent,
             max_distance2: self.max_distance2,
             flat_limit: None,
