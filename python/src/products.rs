@@ -428,9 +428,11 @@ pub fn filter_tets<'py>(
 /// thinner than two cells, as ``gwn remesh`` does (``--no-plate-refinement``).
 /// ``sub_cell_levels`` (0 to 3) cuts cells that an input triangle crosses while their corners
 /// agree (parts thinner than a cell) into eight, down to that many levels below ``res``, as
-/// ``gwn remesh --sub-cell-levels``.
+/// ``gwn remesh --sub-cell-levels``. ``planar_levels`` (0 to 3, default 3) keeps cells up to
+/// ``2**planar_levels`` times larger whole where the input in them is flat, as many levels as a
+/// probe of the input finds pay (none on curved inputs), as ``gwn remesh --planar-levels``.
 #[pyfunction]
-#[pyo3(signature = (V, F, res = 128, *, bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS, simplify = true, method = "exact", beta = None, order = None, tolerance = None, threads = None, thicken = None, refine_plates = true, sub_cell_levels = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS))]
+#[pyo3(signature = (V, F, res = 128, *, bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS, simplify = true, method = "exact", beta = None, order = None, tolerance = None, threads = None, thicken = None, refine_plates = true, sub_cell_levels = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS, planar_levels = gwn::products::remesh::DEFAULT_PLANAR_LEVELS))]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub fn remesh<'py>(
     py: Python<'py>,
@@ -447,6 +449,7 @@ pub fn remesh<'py>(
     thicken: Option<f64>,
     refine_plates: bool,
     sub_cell_levels: u32,
+    planar_levels: u32,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
     use gwn::products::remesh::{
         RemeshOptions, crossings::SegmentBvh, remesh_guided, thicken::ThickenedSheets,
@@ -465,6 +468,8 @@ pub fn remesh<'py>(
         simplify: simplify.then(gwn::products::remesh::simplify::SimplifyOptions::default),
         refine_plates,
         sub_cell_levels,
+        planar_levels,
+        probe_flatness: true,
     };
     if let Some(eps) = thicken {
         let extent = (0..3)

@@ -126,3 +126,18 @@ def test_sub_cell_levels_keep_a_tilted_plate_thinner_than_a_cell():
     assert kept[0] < 0.5 and kept[2] > 0.98, kept
     with pytest.raises(ValueError, match="sub-cell levels"):
         gwn.remesh(V, F, res=24, sub_cell_levels=4)
+
+
+def test_planar_levels_keep_a_box_closed_and_on_its_faces():
+    # A unit cube at res 64: its faces are flat, so the default keeps cells up to 8x larger
+    # whole there; the output is as closed and its vertices as close (on the cube within a
+    # tick) as with planar_levels=0, the resolution's cells everywhere.
+    for levels in (0, 3):
+        Vo, Fo = gwn.remesh(CUBE_V, CUBE_F, res=64, planar_levels=levels)
+        assert edge_census(Fo)[:2] == (True, True)
+        assert abs(volume(Vo, Fo) - 1.0) < 1e-3, volume(Vo, Fo)
+        # Every vertex on the cube's surface: one coordinate at 0 or 1.
+        off = np.min(np.minimum(np.abs(Vo), np.abs(Vo - 1.0)), axis=1)
+        assert off.max() < 1e-3, off.max()
+    with pytest.raises(ValueError, match="planar levels"):
+        gwn.remesh(CUBE_V, CUBE_F, res=64, planar_levels=4)

@@ -490,6 +490,83 @@ mod tests {
     use super::*;
 
     #[test]
+    fn surface_samples_are_on_the_triangles_by_area() {
+        // Areas 1/2 and 3/2 (the second in the plane z = 5), and a degenerate one (no area).
+        let small = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let large = [[0.0, 0.0, 5.0], [3.0, 0.0, 5.0], [0.0, 1.0, 5.0]];
+        let degenerate = [[0.5, 0.5, 0.5], [0.6, 0.6, 0.6], [0.7, 0.7, 0.7]];
+        let bvh = SegmentBvh::new([small, degenerate, large]);
+        let samples = bvh.surface_samples(4000, 7);
+        assert_eq!(samples.len(), 4000);
+        let mut on_large = 0;
+        for (p, n) in &samples {
+            assert!(p[0] >= 0.0 && p[1] >= 0.0, "{p:?}");
+            if p[2] == 5.0 {
+                on_large += 1;
+                assert!(p[0] / 3.0 + p[1] <= 1.0 + 1e-12, "{p:?}");
+            } else {
+                assert_eq!(p[2], 0.0);
+                assert!(p[0] + p[1] <= 1.0 + 1e-12, "{p:?}");
+            }
+            assert_eq!(*n, [0.0, 0.0, 1.0]);
+        }
+        // 3/4 of them on the large one (one standard deviation: 0.7 %).
+        let share = f64::from(on_large) / 4000.0;
+        assert!((share - 0.75).abs() < 0.03, "{share}");
+        assert!(
+            SegmentBvh::new([degenerate])
+                .surface_samples(10, 7)
+                .is_empty()
+        );
+    }
+
+    #[test]
+    fn flat_in_box_reads_only_the_parts_inside_the_box() {
+        // Two triangles of one tilted plane through the unit box, and a third at 30 degrees to
+        // it whose part inside the box is tiny (it enters near one corner) or absent.
+        let plane = |x: f64, y: f64| [x, y, 0.4 + 0.1 * x + 0.05 * y];
+        let a = [plane(-2.0, -2.0), plane(3.0, -2.0), plane(-2.0, 3.0)];
+        let b = [plane(3.0, -2.0), plane(3.0, 3.0), plane(-2.0, 3.0)];
+        let unit = ([0.0; 3], [1.0; 3]);
+        let flat = SegmentBvh::new([a, b]);
+        let (n, p0) = flat.flat_in_box(unit.0, unit.1, 1e-9, 1e-3, 8).unwrap();
+        let d = |p: [f64; 3]| (0..3).map(|k| n[k] * (p[k] - p0[k])).sum::<f64>();
+        assert!(d(plane(0.3, 0.7)).abs() < 1e-12);
+        // A crossing plane whose part in the box is far off the first: not flat.
+        let steep = [[0.5, -2.0, -2.0], [0.5, 3.0, -2.0], [0.5, -2.0, 3.0]];
+        assert!(
+            SegmentBvh::new([a, b, steep])
+                .flat_in_box(unit.0, unit.1, 1e-9, 0.1, 8)
+                .is_none()
+        );
+        // The same crossing plane cut off before the box (its part inside is empty): flat.
+        let outside = [[0.5, 1.5, -2.0], [0.5, 3.0, -2.0], [0.5, 1.5, 3.0]];
+        assert!(
+            SegmentBvh::new([a, b, outside])
+                .flat_in_box(unit.0, unit.1, 1e-9, 0.1, 8)
+                .is_some()
+        );
+        // A bump of 0.05 over the plane: flat at a tolerance of 0.1, not at 0.01.
+        let bump = [plane(0.2, 0.2), plane(0.8, 0.2), {
+            let mut p = plane(0.5, 0.8);
+            p[2] += 0.05;
+            p
+        }];
+        let bumpy = SegmentBvh::new([a, b, bump]);
+        assert!(bumpy.flat_in_box(unit.0, unit.1, 1e-9, 0.1, 8).is_some());
+        assert!(bumpy.flat_in_box(unit.0, unit.1, 1e-9, 0.01, 8).is_none());
+        // More triangles than allowed, nothing in the box, or only degenerate ones: not flat.
+        assert!(bumpy.flat_in_box(unit.0, unit.1, 1e-9, 0.1, 2).is_none());
+        assert!(flat.flat_in_box([5.0; 3], [6.0; 3], 1e-9, 0.1, 8).is_none());
+        let degenerate = [[0.5, 0.5, 0.5], [0.6, 0.6, 0.6], [0.7, 0.7, 0.7]];
+        assert!(
+            SegmentBvh::new([degenerate])
+                .flat_in_box(unit.0, unit.1, 1e-9, 0.1, 8)
+                .is_none()
+        );
+    }
+
+    #[test]
     fn surface_points_lie_on_the_triangles_inside_the_box() {
         // A large tilted triangle through the unit box, one far away, one degenerate.
         let tilted = [[-3.0, -3.0, 0.2], [4.0, -3.0, 0.6], [-3.0, 4.0, 0.9]];

@@ -42,11 +42,19 @@
 //! - **balance**: every cell around a split cell of level `l ≤ S` is a leaf of level `l` or
 //!   split, so leaves side by side differ by one level at most.
 //!
-//! All three only split more cells, so rules (2) and (3) and the invariant hold as above. The
+//! With [`Lattice::planar_levels`] `P` the regular cells are `2^P` resolution cells wide, and a
+//! fourth rule splits at the levels above the resolution's:
+//! - **curved**: a leaf whose corners differ, unless it is flat ([`Classified::flat`]: `w` an
+//!   integer at its corners, the triangles meeting it within [`PLANAR_TOLERANCE`] of a plane
+//!   that separates the corners' classes), so that a flat face keeps its large cells and
+//!   everything else comes down to the resolution.
+//!
+//! All four only split more cells, so rules (2) and (3) and the invariant hold as above. The
 //! leaves of levels `0..S` next to a split cell of their level take the transition split of
 //! [`super::transition`]; its extra points (cell and face centres) lie in leaves of level at
 //! most `S`, off every larger leaf's closed box, so they are classified outright (on the
-//! lattice's outer faces: declared outside, as every point there).
+//! lattice's outer faces: declared outside, as every point there), or lent the leaf's class
+//! where no triangle touches it (`Classified::lend_untouched_transitions`).
 
 use rayon::prelude::*;
 
