@@ -14,6 +14,18 @@ use gwn::products::remesh::report::{
 use gwn::products::remesh::{RemeshError, RemeshOptions, Remeshed, remesh, remesh_guided};
 use gwn::products::sdf::SignedDistance;
 
+/// A field that is noise at a scale near the cells' (integers 0 and 1), so that cells of every
+/// level and every transition split see every labelling (the sub-cell and planar proptests).
+pub(crate) struct Noise(pub(crate) f64);
+
+impl Evaluator for Noise {
+    fn eval(&self, q: [f64; 3]) -> f64 {
+        let cell = q.map(|x| (x * self.0).floor() as i64);
+        let k = (cell[0] * 73_856_093) ^ (cell[1] * 19_349_663) ^ (cell[2] * 83_492_791);
+        if k.rem_euclid(3) == 0 { 1.0 } else { 0.0 }
+    }
+}
+
 /// UV sphere of radius `r` centred at `c`, outward (`flip`: inward), `n` segments.
 pub(crate) fn sphere(c: [f64; 3], r: f64, n: usize, flip: bool) -> Mesh {
     let (rings, segs) = (n, 2 * n);
@@ -108,6 +120,34 @@ pub(crate) fn assert_no_self_intersections(out: &Remeshed) {
     assert_eq!((si.pairs, si.degenerate_faces), (0, 0), "{si:?}");
     // Neighbouring faces were really compared.
     assert!(si.tested_pairs >= out.triangles.len(), "{si:?}");
+}
+
+/// Remeshes `mesh` with `options`, guided by its own triangles, with its winding number or
+/// (`noise`: the scale) [`Noise`] as the field, and asserts every guarantee on a non-empty
+/// output: closed, manifold, oriented, no self-intersection (exact).
+pub(crate) fn assert_guarantees_on(mesh: &Mesh, options: &RemeshOptions, noise: Option<f64>) {
+    let Some(bounds) = mesh.bounding_box() else {
+        return;
+    };
+    let guide = SegmentBvh::of_mesh(mesh);
+    let wn;
+    let noisy;
+    let field: &dyn Evaluator = match noise {
+        Some(scale) => {
+            noisy = Noise(scale);
+            &noisy
+        }
+        None => {
+            wn = WindingNumber::new(mesh).unwrap();
+            &wn
+        }
+    };
+    let out = remesh_guided(field, Some(&guide), bounds, options, &|_| {}).unwrap();
+    let report = TopologyReport::of(&out.positions, &out.triangles);
+    if report.faces > 0 {
+        assert_closed_manifold(&report);
+        assert_no_self_intersections(&out);
+    }
 }
 
 pub(crate) fn assert_closed_manifold(r: &TopologyReport) {

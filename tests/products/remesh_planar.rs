@@ -6,14 +6,13 @@
 //! not an integer (an open box) the output stays as close as at the resolution alone.
 
 use gwn::Mesh;
-use gwn::eval::Evaluator;
 use gwn::eval::antipodal::WindingNumber;
 use gwn::products::remesh::crossings::SegmentBvh;
-use gwn::products::remesh::report::{TopologyReport, hausdorff_distance, occupancy_agreement};
+use gwn::products::remesh::report::{hausdorff_distance, occupancy_agreement};
 use gwn::products::remesh::{RemeshError, RemeshOptions, Remeshed, remesh_guided};
 use proptest::prelude::*;
 
-use crate::remesh::{assert_closed_manifold, assert_no_self_intersections, run_with, sphere};
+use crate::remesh::{assert_closed_manifold, assert_guarantees_on, run_with, sphere};
 
 /// All `planar` levels, whatever the flatness probe would find.
 fn with_planar(res: usize, planar: u32) -> RemeshOptions {
@@ -159,18 +158,6 @@ fn planar_levels_beyond_the_limit_are_refused() {
     assert_eq!(small.stats.planar_levels, 1);
 }
 
-/// A field that is noise at a scale near the cells', so that cells of every level and every
-/// transition split see every labelling.
-struct Noise(f64);
-
-impl Evaluator for Noise {
-    fn eval(&self, q: [f64; 3]) -> f64 {
-        let cell = q.map(|x| (x * self.0).floor() as i64);
-        let k = (cell[0] * 73_856_093) ^ (cell[1] * 19_349_663) ^ (cell[2] * 83_492_791);
-        if k.rem_euclid(3) == 0 { 1.0 } else { 0.0 }
-    }
-}
-
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(24))]
 
@@ -187,9 +174,6 @@ proptest! {
         simplify in any::<bool>(),
         res in 16usize..40,
     ) {
-        let mesh = &case.mesh;
-        let Some(bounds) = mesh.bounding_box() else { return Ok(()) };
-        let guide = SegmentBvh::of_mesh(mesh);
         let mut options = RemeshOptions {
             sub_cell_levels: sub,
             ..with_planar(res, planar)
@@ -197,18 +181,6 @@ proptest! {
         if !simplify {
             options.simplify = None;
         }
-        let wn;
-        let field: &dyn Evaluator = if noise {
-            &Noise(res as f64 * 0.3)
-        } else {
-            wn = WindingNumber::new(mesh).unwrap();
-            &wn
-        };
-        let out = remesh_guided(field, Some(&guide), bounds, &options, &|_| {}).unwrap();
-        let report = TopologyReport::of(&out.positions, &out.triangles);
-        if report.faces > 0 {
-            assert_closed_manifold(&report);
-            assert_no_self_intersections(&out);
-        }
+        assert_guarantees_on(&case.mesh, &options, noise.then_some(res as f64 * 0.3));
     }
 }
