@@ -269,12 +269,19 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     if options.planar_levels > 0 {
         let f = s.flatness.flat_fraction;
+        let kept = if s.planar_levels > 0 {
+            format!(
+                "cells up to {}x the resolution's kept whole where the input is flat",
+                1u32 << s.planar_levels
+            )
+        } else {
+            "too little of the input is flat for them to pay".to_string()
+        };
         outln!(
-            "planar levels: {} of {} (cells up to {}x the resolution's kept whole where the input \
-             is flat; input area flat at 2x, 4x, 8x: {:.0} %, {:.0} %, {:.0} %)",
+            "planar levels: {} of {} ({kept}; input area flat at 2x, 4x, 8x: {:.0} %, {:.0} %, \
+             {:.0} %)",
             s.planar_levels,
             options.planar_levels,
-            1u32 << s.planar_levels,
             100.0 * f[1],
             100.0 * f[2],
             100.0 * f[3]
