@@ -574,6 +574,15 @@ impl Classified {
         hidden
     }
 
+    /// Whether `w` is within [`INTEGRAL_W_SLACK`] of an integer at the 8 corners of the cell
+    /// `(level, m)` (NaN at border corners: no).
+    fn corners_integral(&self, level: u32, m: Corner) -> bool {
+        (0..8).all(|b| {
+            let w = self.value(offset(m, b, 1 << level));
+            (w - w.round()).abs() <= INTEGRAL_W_SLACK
+        })
+    }
+
     /// Whether the cell `(level, m)` may stay whole above the resolution's cell: `w` is within
     /// [`INTEGRAL_W_SLACK`] of an integer at its corners, the input triangles meeting its closed
     /// box lie in it within [`PLANAR_TOLERANCE`] of one plane, and that plane separates the
@@ -584,11 +593,7 @@ impl Classified {
     /// triangles' (thickened sheets: two planes at `±eps` from one).
     fn flat(&self, lattice: &Lattice, guide: &SegmentBvh, level: u32, m: Corner) -> bool {
         let size = 1u32 << level;
-        let integral = (0..8).all(|b| {
-            let w = self.value(offset(m, b, size));
-            (w - w.round()).abs() <= INTEGRAL_W_SLACK
-        });
-        if !integral {
+        if !self.corners_integral(level, m) {
             return false;
         }
         let lo = lattice.corner_position(m);
@@ -635,12 +640,10 @@ impl Classified {
         let lent: Vec<Option<(CornerValue, Vec<Corner>)>> = transition
             .par_iter()
             .map(|&(l, m)| {
-                let size = 1u32 << l;
-                let integral = (0..8).all(|b| {
-                    let w = this.value(offset(m, b, size));
-                    (w - w.round()).abs() <= INTEGRAL_W_SLACK
-                });
-                if !integral || this.closed_box_mixed(l, m) || touched(Some(guide), lattice, l, m) {
+                if !this.corners_integral(l, m)
+                    || this.closed_box_mixed(l, m)
+                    || touched(Some(guide), lattice, l, m)
+                {
                     return None;
                 }
                 let is_refined = |c: Corner| this.split.contains(&(l, pack(c)));
