@@ -120,6 +120,32 @@ fn near_edge_pad(a: [i64; 3], b: [i64; 3]) -> i64 {
     (len >> 7).max(16)
 }
 
+/// Whether `q` may lie within `pad` of the segment `a b` (grid units): the tube of
+/// [`near_edge_pad`]'s error model, whose `d` is the distance to the segment, not to its box.
+/// The box alone (the test before this one) flagged every query in the box of a long oblique
+/// edge: on inconsistently oriented meshes, whose every edge is a boundary edge, that was 20 %
+/// of a remesh band's queries, each 30× slower (docs/benchmarks.md, "Near-edge tube").
+///
+/// Soft and conservative: it tests `2·pad`, and in the padded box `|q − a|` and `|b − a|` are
+/// at most `√3·(len + pad)` with `pad ≥ len/128`, so the `f64` rounding of the differences and
+/// of the projection (a few `u = 2^-53` relative of that) is below `2^-40·pad`, far inside the
+/// factor 2: a query it lets through is more than `pad` from the segment.
+#[inline]
+fn within_twice_pad_of_segment(q: [i64; 3], a: [i64; 3], b: [i64; 3], pad: i64) -> bool {
+    let d: [f64; 3] = std::array::from_fn(|k| (b[k] - a[k]) as f64);
+    let v: [f64; 3] = std::array::from_fn(|k| (q[k] - a[k]) as f64);
+    let dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    let vd = v[0] * d[0] + v[1] * d[1] + v[2] * d[2];
+    let t = if dd > 0.0 {
+        (vd / dd).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let e: [f64; 3] = std::array::from_fn(|k| v[k] - t * d[k]);
+    let reach = 2.0 * pad as f64;
+    e[0] * e[0] + e[1] * e[1] + e[2] * e[2] <= reach * reach
+}
+
 /// Half-width (grid units) of the column above each boundary vertex in which a query takes the
 /// double-double path: `limit / 2^14` (`2^45` cells at 60 bits, about `1e-5` of the extent).
 ///
@@ -444,6 +470,7 @@ impl BoundaryEdges {
             let pad = near_edge_pad(a, b);
             if z_exact
                 && (0..3).all(|k| qi[k] >= a[k].min(b[k]) - pad && qi[k] <= a[k].max(b[k]) + pad)
+                && within_twice_pad_of_segment(qi, a, b, pad)
             {
                 flagged = true;
                 return;
@@ -796,6 +823,50 @@ mod tests {
             }
         }
         assert_eq!(checked, 6250);
+    }
+
+    /// The near-edge test is a tube around the segment, not its box: a query in the box of a
+    /// long oblique edge but far from it takes the `f64` loop, and that loop agrees there with
+    /// the double-double sum within the error model of [`near_edge_pad`]; a query inside the
+    /// tube is flagged.
+    #[test]
+    fn near_edge_test_is_a_tube_and_the_loop_is_accurate_outside_it() {
+        use crate::kernel::input_predicates::InputPoint;
+        use crate::kernel::predicates::W128;
+        // Large enough that no vertex is in the ray tube above a query (`ray_tube`: 2^45).
+        let l = 1_i64 << 57;
+        // A closed oblique triangle's three edges (one boundary: an open triangle).
+        let p = [[0, 0, 0], [l, l / 2, l], [l / 3, l, l / 5]];
+        let a = vec![p[0], p[1], p[2]];
+        let b = vec![p[1], p[2], p[0]];
+        let edges = BoundaryEdges::new(a, b, vec![1.0; 3], 60);
+        let pad = near_edge_pad(p[0], p[1]) as f64;
+        // Unit normal-ish offset from the first edge, away from the triangle's other edges.
+        let dir = [1.0, -2.0, 0.0];
+        let norm = (5.0_f64).sqrt();
+        let mut outside = 0;
+        for (s, &(t, dist)) in [(0.5, 0.5), (0.5, 1.5), (0.5, 3.0), (0.3, 8.0), (0.7, 30.0)]
+            .iter()
+            .enumerate()
+        {
+            let q: [i64; 3] = std::array::from_fn(|k| {
+                (p[1][k] as f64 * t + dir[k] / norm * dist * pad).round() as i64
+            });
+            let inside_box = (0..3).all(|k| q[k] >= 0 && q[k] <= l);
+            assert!(inside_box, "case {s}: {q:?} is in the edge's box");
+            let flagged = edges.needs_accurate_sum::<W128>(q, [0.0; 3], true);
+            assert_eq!(flagged, dist <= 1.5, "case {s}: distance {dist} pads");
+            if !flagged {
+                outside += 1;
+                let fast = edges.area_sum::<W128>(q, [0.0; 3], true, 0.0);
+                let accurate = edges.area_sum_accurate::<W128>(&InputPoint::lattice(q), true, 0.0);
+                assert!(
+                    (fast - accurate).abs() <= 1e-12,
+                    "case {s}: {fast} vs {accurate}"
+                );
+            }
+        }
+        assert_eq!(outside, 3);
     }
 
     /// The chained sum equals the sum of exact per-edge terms on boundaries full of edges
