@@ -120,18 +120,22 @@ fn near_edge_pad(a: [i64; 3], b: [i64; 3]) -> i64 {
     (len >> 7).max(16)
 }
 
-/// Whether `q` may lie within `pad` of the segment `a b` (grid units): the tube of
+/// Whether `q` may lie within `reach` of the segment `a b` (grid units): the tube of
 /// [`near_edge_pad`]'s error model, whose `d` is the distance to the segment, not to its box.
 /// The box alone (the test before this one) flagged every query in the box of a long oblique
 /// edge: on inconsistently oriented meshes, whose every edge is a boundary edge, that was 20 %
 /// of a remesh band's queries, each 30× slower (docs/benchmarks.md, "Near-edge tube").
 ///
-/// Soft and conservative: it tests `2·pad`, and in the padded box `|q − a|` and `|b − a|` are
-/// at most `√3·(len + pad)` with `pad ≥ len/128`, so the `f64` rounding of the differences and
-/// of the projection (a few `u = 2^-53` relative of that) is below `2^-40·pad`, far inside the
-/// factor 2: a query it lets through is more than `pad` from the segment.
+/// Soft and conservative: callers pass `reach ≥ 2·pad` and call it only for `q` in the box
+/// grown by `reach`, where `|q − a|` and `|b − a|` are at most `√3·(len + reach)` with
+/// `pad ≥ len/128`, so the `f64` rounding of the differences and of the projection (a few
+/// `u = 2^-53` relative of that) is below `2^-40·reach`: a query it lets through is more than
+/// `reach/2 ≥ pad` from the segment.
 #[inline]
-fn within_twice_pad_of_segment(q: [i64; 3], a: [i64; 3], b: [i64; 3], pad: i64) -> bool {
+fn within_reach_of_segment(q: [i64; 3], a: [i64; 3], b: [i64; 3], reach: i64) -> bool {
+    if !(0..3).all(|k| q[k] >= a[k].min(b[k]) - reach && q[k] <= a[k].max(b[k]) + reach) {
+        return false;
+    }
     let d: [f64; 3] = std::array::from_fn(|k| (b[k] - a[k]) as f64);
     let v: [f64; 3] = std::array::from_fn(|k| (q[k] - a[k]) as f64);
     let dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
@@ -142,8 +146,40 @@ fn within_twice_pad_of_segment(q: [i64; 3], a: [i64; 3], b: [i64; 3], pad: i64) 
         0.0
     };
     let e: [f64; 3] = std::array::from_fn(|k| v[k] - t * d[k]);
-    let reach = 2.0 * pad as f64;
+    let reach = reach as f64;
     e[0] * e[0] + e[1] * e[1] + e[2] * e[2] <= reach * reach
+}
+
+/// Pads (of [`near_edge_pad`]) within which a query takes the double-double path: twice the
+/// error model's distance, the margin that [`within_reach_of_segment`]'s rounding needs.
+const FLAG_PADS: i64 = 2;
+
+/// Pads within which a query on the double-double path gets an edge's term in double-double;
+/// farther edges take the `f64` term (exact signs, `f64` magnitudes), which errs by at most
+/// `4u·len/d ≤ 64u = 7e-15` there ([`near_edge_pad`]'s model at `d = 8·len/128`), instead of
+/// the loop's `900u` at the flagging distance: the path stays more accurate than the loop.
+const ACCURATE_TERM_PADS: i64 = 8;
+
+/// Whether the `f64` term of edge `a b` at the lattice query `qi` can err beyond the loop's
+/// model: an endpoint in the column above the query ([`ray_tube`], half-width `tube`), or
+/// (`z_exact`) the query within `pads` pads ([`near_edge_pad`]) of the segment.
+#[inline]
+fn ill_conditioned(
+    a: [i64; 3],
+    b: [i64; 3],
+    qi: [i64; 3],
+    z_exact: bool,
+    tube: i64,
+    pads: i64,
+) -> bool {
+    let near_ray = |p: [i64; 3]| {
+        (p[0] - qi[0]).abs() <= tube
+            && (p[1] - qi[1]).abs() <= tube
+            && (!z_exact || p[2] >= qi[2] - 1)
+    };
+    near_ray(a)
+        || near_ray(b)
+        || (z_exact && within_reach_of_segment(qi, a, b, pads * near_edge_pad(a, b)))
 }
 
 /// Half-width (grid units) of the column above each boundary vertex in which a query takes the
@@ -458,20 +494,7 @@ impl BoundaryEdges {
                 return;
             }
             let (a, b) = (self.a[e as usize], self.b[e as usize]);
-            let near_ray = |p: [i64; 3]| {
-                (p[0] - qi[0]).abs() <= tube
-                    && (p[1] - qi[1]).abs() <= tube
-                    && (!z_exact || p[2] >= qi[2] - 1)
-            };
-            if near_ray(a) || near_ray(b) {
-                flagged = true;
-                return;
-            }
-            let pad = near_edge_pad(a, b);
-            if z_exact
-                && (0..3).all(|k| qi[k] >= a[k].min(b[k]) - pad && qi[k] <= a[k].max(b[k]) + pad)
-                && within_twice_pad_of_segment(qi, a, b, pad)
-            {
+            if ill_conditioned(a, b, qi, z_exact, tube, FLAG_PADS) {
                 flagged = true;
                 return;
             }
@@ -490,8 +513,10 @@ impl BoundaryEdges {
     /// `Σ w·Area` at the exact query `q = qi + r` (see [`BoundaryEdges::needs_accurate_sum`]):
     /// every sign from the exact predicates (the `_at` ones on the lattice, the input ones for
     /// edges with an endpoint off the lattice or a query whose residual underflowed), every
-    /// magnitude from double-double offsets of the exact points. `O(B)` scalar.
-    #[cold]
+    /// magnitude from double-double offsets of the exact points: in double-double for the edges
+    /// near the query ([`ACCURATE_TERM_PADS`], and those with an endpoint in the ray's column),
+    /// in `f64` from those offsets for the rest (a query near one edge of a long boundary paid
+    /// ~30× the loop on every edge before). `O(B)` scalar.
     pub fn area_sum_accurate<W: Width>(&self, q: &InputPoint, z_exact: bool, qz_units: f64) -> f64 {
         let (qi, r) = (q.n, q.r);
         let lattice_query = q.residual_exact();
@@ -508,6 +533,7 @@ impl BoundaryEdges {
             };
             [along(0), along(1), z]
         };
+        let tube = ray_tube(self.limit);
         let mut sum = NeumaierSum::new();
         for i in 0..self.a.len() {
             let (a, b) = (self.a[i], self.b[i]);
@@ -540,7 +566,13 @@ impl BoundaryEdges {
                 };
                 (signs, offset(a, [0.0; 3]), offset(b, [0.0; 3]))
             };
-            sum.add(self.weight[i] * antipodal_edge_area_accurate(ra, rb, signs));
+            let term = if ill_conditioned(a, b, qi, z_exact, tube, ACCURATE_TERM_PADS) {
+                antipodal_edge_area_accurate(ra, rb, signs)
+            } else {
+                // `hi` is the offset rounded once (normalized pairs): the loop's error model.
+                antipodal_edge_area(ra.map(|x| x.hi), rb.map(|x| x.hi), signs)
+            };
+            sum.add(self.weight[i] * term);
         }
         sum.value()
     }
