@@ -82,7 +82,7 @@ pub struct CornerValue {
 impl CornerValue {
     fn of(w: f64) -> CornerValue {
         CornerValue {
-            inside: w > 0.5,
+            inside: super::inside(w),
             w: w as f32,
         }
     }
@@ -565,7 +565,7 @@ impl Classified {
             let class = self.label(m);
             let found = values[next..next + points.len()]
                 .iter()
-                .any(|&w| (w > 0.5) != class);
+                .any(|&w| super::inside(w) != class);
             next += points.len();
             if found {
                 hidden.push(m);

@@ -120,7 +120,7 @@ impl Search {
     /// second probe may not, after the first moved `hi` past it).
     fn narrow(&mut self, tick: i64, w: f64) {
         if self.lo < tick && tick < self.hi {
-            if w > 0.5 {
+            if super::inside(w) {
                 (self.lo, self.w_lo) = (tick, w);
             } else {
                 (self.hi, self.w_hi) = (tick, w);
@@ -148,8 +148,11 @@ impl Search {
         let x = if self.itp_steps >= self.itp_budget {
             half
         } else {
-            // w_lo > ½ ≥ w_hi, so the denominator is positive.
-            let (y_lo, y_hi) = (self.w_lo - 0.5, self.w_hi - 0.5);
+            // w_lo > level ≥ w_hi (super::inside), so the denominator is positive.
+            let (y_lo, y_hi) = (
+                self.w_lo - super::INSIDE_LEVEL,
+                self.w_hi - super::INSIDE_LEVEL,
+            );
             let falsi = lo as f64 + y_lo / (y_lo - y_hi) * width;
             if !falsi.is_finite() {
                 half
@@ -404,7 +407,7 @@ mod tests {
                             field.eval(lattice.corner_position(a)),
                             field.eval(lattice.corner_position(b)),
                         );
-                        match (wa > 0.5, wb > 0.5) {
+                        match (super::super::inside(wa), super::super::inside(wb)) {
                             (true, false) => out.push(((a, b), [wa, wb])),
                             (false, true) => out.push(((b, a), [wb, wa])),
                             _ => {}
@@ -439,7 +442,7 @@ mod tests {
             }
             let s = t as f64 / TICKS as f64;
             let p = [0, 1, 2].map(|a| f64::from(i[a]) + s * (f64::from(o[a]) - f64::from(i[a])));
-            field.eval(lattice.position(p)) > 0.5
+            super::super::inside(field.eval(lattice.position(p)))
         };
         let classes = [inside(k - 1), inside(k), inside(k + 1)];
         assert!(

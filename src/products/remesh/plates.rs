@@ -208,7 +208,10 @@ fn plate_runs<E: Evaluator + ?Sized>(
     let mut runs = Vec::new();
     for (_, crossings) in &lines {
         let n = crossings.len() - 1;
-        let classes: Vec<bool> = w[next..next + n].iter().map(|&x| x > 0.5).collect();
+        let classes: Vec<bool> = w[next..next + n]
+            .iter()
+            .map(|&x| super::inside(x))
+            .collect();
         next += n;
         runs.extend(
             plate_runs_of_line(crossings, &classes)

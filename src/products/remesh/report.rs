@@ -249,7 +249,7 @@ where
     let agree = wi
         .iter()
         .zip(&wo)
-        .filter(|(a, b)| (**a > 0.5) == (**b > 0.5))
+        .filter(|(a, b)| super::inside(**a) == super::inside(**b))
         .count();
     Some(agree as f64 / samples as f64)
 }
@@ -328,7 +328,7 @@ pub fn hausdorff_to_solid_boundary<E: crate::eval::Evaluator + ?Sized>(
     let (mut all, mut bounding, mut count) = (0.0f64, 0.0f64, 0usize);
     for (d, w) in distances.iter().zip(w.chunks_exact(2)) {
         all = all.max(*d);
-        if (w[0] > 0.5) != (w[1] > 0.5) {
+        if super::inside(w[0]) != super::inside(w[1]) {
             bounding = bounding.max(*d);
             count += 1;
         }

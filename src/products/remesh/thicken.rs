@@ -76,7 +76,7 @@ impl<'a, E: Evaluator + ?Sized> ThickenedSheets<'a, E> {
     #[inline]
     fn candidate(&self, q: [f64; 3], w: f64) -> Candidate {
         // NaN (a non-finite query) stays as it is.
-        if w.is_nan() || w > 0.5 {
+        if w.is_nan() || super::inside(w) {
             return Candidate::Keep;
         }
         match self.distance.closest(q) {
@@ -118,7 +118,7 @@ impl<'a, E: Evaluator + ?Sized> ThickenedSheets<'a, E> {
             }
         }
         for (&i, &wm) in ids.iter().zip(&wm) {
-            if wm <= 0.5 {
+            if !super::inside(wm) {
                 w[i] = 1.0;
             }
         }
