@@ -574,17 +574,9 @@ fn fields_that_tend_to_one_half_on_the_faces_are_not_decided_by_rounding() {
         &[[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]],
     )
     .unwrap();
-    let rays = [
-        RayAxis::PosZ,
-        RayAxis::NegZ,
-        RayAxis::PosX,
-        RayAxis::NegX,
-        RayAxis::PosY,
-        RayAxis::NegY,
-    ];
     for (name, mesh, res) in [("lone triangle", &lone, 64), ("tetrahedron", &tet, 32)] {
         let guide = SegmentBvh::of_mesh(mesh);
-        for ray in rays {
+        for ray in RayAxis::ALL {
             let options = Options {
                 ray,
                 ..Options::default()
