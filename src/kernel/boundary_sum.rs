@@ -126,8 +126,8 @@ fn near_edge_pad(a: [i64; 3], b: [i64; 3]) -> i64 {
 /// edge: on inconsistently oriented meshes, whose every edge is a boundary edge, that was 20 %
 /// of a remesh band's queries, each 30× slower (docs/benchmarks.md, "Near-edge tube").
 ///
-/// Soft and conservative: callers pass `reach ≥ 2·pad` and call it only for `q` in the box
-/// grown by `reach`, where `|q − a|` and `|b − a|` are at most `√3·(len + reach)` with
+/// Soft and conservative: callers pass `reach ≥ 2·pad`; past the box test (the segment's box
+/// grown by `reach`) `|q − a|` and `|b − a|` are at most `√3·(len + reach)` with
 /// `pad ≥ len/128`, so the `f64` rounding of the differences and of the projection (a few
 /// `u = 2^-53` relative of that) is below `2^-40·reach`: a query it lets through is more than
 /// `reach/2 ≥ pad` from the segment.

@@ -63,6 +63,11 @@ pub mod thicken;
 pub mod transition;
 pub mod write;
 
+use crate::base::bounding_box::BoundingBox;
+use crate::eval::Evaluator;
+#[cfg(doc)]
+use crate::eval::antipodal::WindingNumber;
+
 /// How far above `½` the remesher's inside test sits: a point is inside when
 /// `w > ½ + INSIDE_MARGIN` ([`inside`]).
 ///
@@ -92,11 +97,6 @@ pub const INSIDE_LEVEL: f64 = 0.5 + INSIDE_MARGIN;
 pub fn inside(w: f64) -> bool {
     w > INSIDE_LEVEL
 }
-
-use crate::base::bounding_box::BoundingBox;
-use crate::eval::Evaluator;
-#[cfg(doc)]
-use crate::eval::antipodal::WindingNumber;
 
 /// Largest accepted `--res`: lattice coordinates are packed in 20 bits per axis.
 pub const MAX_RESOLUTION: usize = 1 << 16;
