@@ -188,6 +188,50 @@ fn flat_regions_collapse_past_the_target() {
     );
 }
 
+/// The flat collapses run in the slabs too, once a slab reached its share of the target (their
+/// global rounds stay small: flat collapses cost about the same, so the cheapest are neighbours
+/// and wait for each other). A box cut into slabs: the slabs make most of the flat collapses
+/// (without the flat tolerance they stop at the target), and the box comes out as simplified as
+/// without slabs, with the same guarantees.
+#[test]
+fn flat_collapses_run_in_the_slabs() {
+    let cube = common::unit_cube().translated([0.013, -0.021, 0.007]);
+    let with = |slab_cells: u32, flat_tolerance: f64| {
+        run_with(
+            &cube,
+            &RemeshOptions {
+                simplify: Some(SimplifyOptions {
+                    slab_cells,
+                    flat_tolerance,
+                    ..SimplifyOptions::default()
+                }),
+                ..RemeshOptions::with_resolution(96)
+            },
+        )
+    };
+    let (sliced, r) = with(12, 0.01);
+    let (at_target, _) = with(12, 0.0);
+    let (whole, _) = with(0, 0.01);
+    assert_closed_manifold(&r);
+    assert_eq!((r.euler_characteristic, r.components), (2, 1), "{r}");
+    let (st, st0) = (sliced.stats.simplify, at_target.stats.simplify);
+    assert!(st.slabs >= 6 && whole.stats.simplify.slabs == 0, "{st:?}");
+    // The slabs' collapses past the target are flat ones: most of the collapses the flat
+    // tolerance adds are made in the slabs.
+    let flat_collapses = st.collapses - st0.collapses;
+    let flat_in_slabs = st.slab_collapses - st0.slab_collapses;
+    assert!(
+        flat_collapses > 0 && flat_in_slabs * 2 > flat_collapses,
+        "{flat_in_slabs} of {flat_collapses} flat collapses in the slabs"
+    );
+    assert!(
+        sliced.triangles.len() * 10 <= whole.triangles.len() * 11,
+        "{} faces in slabs, {} without",
+        sliced.triangles.len(),
+        whole.triangles.len()
+    );
+}
+
 /// The collapses and the relocation run in rounds planned in parallel: the surface must not
 /// depend on the thread count (a torus at res 32 takes several rounds of collapses).
 #[test]
