@@ -23,8 +23,9 @@
 //! surface draws on the facets in those planes (the other slab's side of the argument) do not
 //! change; and every slab keeps the pass's invariants by the same rules.
 //! The slabs collapse, cheapest first, to their share of the target with [`SLAB_SLACK`] to
-//! spare; the global collapses ([`Simplifier::run`]) then finish in global cost order, which
-//! also takes the vertices within a ring of the planes.
+//! spare, then make the flat collapses ([`Simplifier::run_flat`], same checks); the global
+//! collapses ([`Simplifier::run`], then [`Simplifier::run_flat`]) finish in global cost order,
+//! which also takes the vertices within a ring of the planes.
 
 use super::{P, Simplifier, SimplifyStats};
 use rayon::prelude::*;
