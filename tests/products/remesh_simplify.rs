@@ -605,67 +605,49 @@ fn collapses_in_slabs_keep_every_guarantee_on_noise() {
         slab_cells: 2,
         ..SimplifyOptions::default()
     };
-    let (mut collapses, mut in_slabs) = (0, 0);
-    for seed in 0..8 {
-        let out = noise_surface(seed);
-        let before = TopologyReport::of(&out.positions, &out.triangles);
-        let s = simplify(&out.fixed, &out.triangles, out.ticks_per_cell, &options, 0);
-        assert!(s.stats.slabs >= 6, "seed {seed}: {:?}", s.stats);
-        assert!(is_clean(&s.points, &s.triangles), "seed {seed}");
-        let r = report_of(&s);
-        assert_closed_manifold(&r);
-        assert_eq!(
-            (r.euler_characteristic, r.components),
-            (before.euler_characteristic, before.components),
-            "seed {seed}"
-        );
-        collapses += s.stats.collapses;
-        in_slabs += s.stats.slab_collapses;
-    }
-    assert!(
-        in_slabs * 4 > collapses && in_slabs < collapses,
-        "{in_slabs} of {collapses} in slabs"
-    );
     // With a face target and a loose flat tolerance, the slabs also make flat collapses past
     // their share of the target, on the same noise: the same guarantees.
     let flat = SimplifyOptions {
         flat_tolerance: 0.5,
         ..options
     };
+    let (mut collapses, mut in_slabs) = (0, 0);
     let (mut past_target, mut total) = (0, 0);
     for seed in 0..8 {
         let out = noise_surface(seed);
         let before = TopologyReport::of(&out.positions, &out.triangles);
+        let run = |options: &SimplifyOptions, target: usize| {
+            let s = simplify(
+                &out.fixed,
+                &out.triangles,
+                out.ticks_per_cell,
+                options,
+                target,
+            );
+            assert!(s.stats.slabs >= 6, "seed {seed}: {:?}", s.stats);
+            assert!(is_clean(&s.points, &s.triangles), "seed {seed}");
+            let r = report_of(&s);
+            assert_closed_manifold(&r);
+            assert_eq!(
+                (r.euler_characteristic, r.components),
+                (before.euler_characteristic, before.components),
+                "seed {seed}"
+            );
+            s.stats
+        };
+        let all = run(&options, 0);
+        collapses += all.collapses;
+        in_slabs += all.slab_collapses;
         let target = out.triangles.len() * 3 / 4;
-        let at_target = simplify(
-            &out.fixed,
-            &out.triangles,
-            out.ticks_per_cell,
-            &options,
-            target,
-        );
-        let s = simplify(
-            &out.fixed,
-            &out.triangles,
-            out.ticks_per_cell,
-            &flat,
-            target,
-        );
-        assert!(s.stats.slabs >= 6, "seed {seed}: {:?}", s.stats);
-        assert!(is_clean(&s.points, &s.triangles), "seed {seed}");
-        let r = report_of(&s);
-        assert_closed_manifold(&r);
-        assert_eq!(
-            (r.euler_characteristic, r.components),
-            (before.euler_characteristic, before.components),
-            "seed {seed}"
-        );
-        past_target += s
-            .stats
-            .slab_collapses
-            .saturating_sub(at_target.stats.slab_collapses);
-        total += s.stats.collapses;
+        let at_target = run(&options, target);
+        let past = run(&flat, target);
+        past_target += past.slab_collapses.saturating_sub(at_target.slab_collapses);
+        total += past.collapses;
     }
+    assert!(
+        in_slabs * 4 > collapses && in_slabs < collapses,
+        "{in_slabs} of {collapses} in slabs"
+    );
     assert!(
         past_target * 20 > total,
         "{past_target} of {total} flat in slabs"
