@@ -16,6 +16,7 @@
 
 use super::lattice::{Corner, KeyHash, Lattice, pack};
 use super::octree::{Classified, offset};
+use rayon::prelude::*;
 
 /// The six tetrahedra of the Freudenthal split, as cube-corner bits (x: 1, y: 2, z: 4).
 pub const FREUDENTHAL: [[usize; 4]; 6] = [
@@ -45,54 +46,29 @@ pub struct Band {
 /// Freudenthal split, and with sub-levels the refined cells' finer one and the transition
 /// split between them ([`super::transition`]).
 pub fn extract(lattice: &Lattice, classified: &Classified) -> Band {
-    let size = lattice.regular_cell();
     let mut band = Band {
         band_cells: classified.band.len()
             + classified.fine_band.len()
             + classified.transition.len(),
         ..Band::default()
     };
-    // Keyed by the packed corners: hashing two u64 costs a third of hashing six u32.
-    let mut vertex_of: std::collections::HashMap<(u64, u64), u32, KeyHash> = Default::default();
-    let mut march = |v: [Corner; 4], band: &mut Band| {
-        let ins = v.map(|c| classified.label(c));
-        let mut in_idx = [0usize; 4];
-        let mut out_idx = [0usize; 4];
-        let (mut n_in, mut n_out) = (0, 0);
-        for (i, &inside) in ins.iter().enumerate() {
-            if inside {
-                in_idx[n_in] = i;
-                n_in += 1;
-            } else {
-                out_idx[n_out] = i;
-                n_out += 1;
-            }
+    let mc_table = marching_cubes_table();
+    // A dense marching cubes at the resolution: exact in the resolution's cells, estimated in
+    // larger ones (which stay whole where the input is flat: its faces there grow with the
+    // area, 4 per level), none for what only the finer levels see.
+    let resolution = lattice.resolution_level();
+    let marching_cubes = |level: u32, inside: [bool; 8]| -> usize {
+        if level < resolution {
+            return 0;
         }
-        let quad;
-        let tris: &[[(usize, usize); 3]] = match n_in {
-            1 => {
-                let i = in_idx[0];
-                quad = [[(i, out_idx[0]), (i, out_idx[1]), (i, out_idx[2])]; 2];
-                &quad[..1]
-            }
-            3 => {
-                let o = out_idx[0];
-                quad = [[(in_idx[0], o), (in_idx[1], o), (in_idx[2], o)]; 2];
-                &quad[..1]
-            }
-            2 => {
-                let (a, b) = (in_idx[0], in_idx[1]);
-                let (c, d) = (out_idx[0], out_idx[1]);
-                quad = [[(a, c), (a, d), (b, d)], [(a, c), (b, d), (b, c)]];
-                &quad[..]
-            }
-            _ => return,
-        };
-        for tri in tris {
-            let mut e = tri.map(|(i, o)| (v[i], v[o]));
-            if !outward(&e) {
-                e.swap(1, 2);
-            }
+        let case = (0..8).filter(|&b| inside[b]).fold(0, |c, b| c | (1 << b));
+        usize::from(mc_table[case]) << (2 * (level - resolution))
+    };
+    // Output vertices numbered by first use (serial: it fixes the numbering), keyed by the
+    // packed corners: hashing two u64 costs a third of hashing six u32.
+    let mut vertex_of: std::collections::HashMap<(u64, u64), u32, KeyHash> = Default::default();
+    let mut number = |triangles: Vec<EdgeTriangle>, band: &mut Band| {
+        for e in triangles {
             let t = e.map(|edge| {
                 *vertex_of
                     .entry((pack(edge.0), pack(edge.1)))
@@ -104,46 +80,116 @@ pub fn extract(lattice: &Lattice, classified: &Classified) -> Band {
             band.triangles.push(t);
         }
     };
-    let mc_table = marching_cubes_table();
-    // A dense marching cubes at the resolution: exact in the resolution's cells, estimated in
-    // larger ones (which stay whole where the input is flat: its faces there grow with the
-    // area, 4 per level), none for what only the finer levels see.
-    let resolution = lattice.resolution_level();
-    let marching_cubes = |level: u32, m: Corner, band: &mut Band| {
-        if level >= resolution {
-            let case = (0..8)
-                .filter(|&b| classified.label(offset(m, b, 1 << level)))
-                .fold(0, |c, b| c | (1 << b));
-            band.marching_cubes_triangles +=
-                usize::from(mc_table[case]) << (2 * (level - resolution));
+    // The cubes of one Freudenthal split (the regular band and the finer one): their eight
+    // corners looked up once (not once per tetrahedron: 8 lookups instead of 32), in parallel
+    // chunks whose triangles are numbered in the cubes' order, so the output does not depend
+    // on the thread count; a batch of chunks at a time, so that the triangles waiting to be
+    // numbered stay a small part of the surface.
+    let cubes = |cells: &[(u32, Corner)], band: &mut Band, number: &mut dyn FnMut(_, &mut Band)| {
+        for batch in cells.chunks(CUBES_PER_CHUNK * CHUNKS_PER_BATCH) {
+            let parts: Vec<(Vec<EdgeTriangle>, usize)> = batch
+                .par_chunks(CUBES_PER_CHUNK)
+                .map(|chunk| {
+                    let mut triangles = Vec::new();
+                    let mut marching = 0;
+                    for &(level, m) in chunk {
+                        let corners: [Corner; 8] =
+                            std::array::from_fn(|b| offset(m, b, 1 << level));
+                        let inside = corners.map(|c| classified.label(c));
+                        marching += marching_cubes(level, inside);
+                        for tet in FREUDENTHAL {
+                            march(tet.map(|b| (corners[b], inside[b])), &mut triangles);
+                        }
+                    }
+                    (triangles, marching)
+                })
+                .collect();
+            for (triangles, marching) in parts {
+                band.marching_cubes_triangles += marching;
+                number(triangles, band);
+            }
         }
     };
-    for &m in &classified.band {
-        marching_cubes(lattice.sub_levels, m, &mut band);
-        for tet in FREUDENTHAL {
-            march(tet.map(|b| offset(m, b, size)), &mut band);
-        }
-    }
+    // The regular cells' edge is `1 << sub_levels` finest cells (`Lattice::regular_cell`).
+    let regular = lattice.sub_levels;
+    let regular_cells: Vec<(u32, Corner)> = classified.band.iter().map(|&m| (regular, m)).collect();
+    cubes(&regular_cells, &mut band, &mut number);
     for &(level, m) in &classified.transition {
-        marching_cubes(level, m, &mut band);
+        let corners: [Corner; 8] = std::array::from_fn(|b| offset(m, b, 1 << level));
+        band.marching_cubes_triangles +=
+            marching_cubes(level, corners.map(|c| classified.label(c)));
         let refined = |c: Corner| classified.split.contains(&(level, pack(c)));
+        let mut triangles = Vec::new();
         for tet in super::transition::tetrahedra(m, 1 << level, refined) {
-            march(tet, &mut band);
+            march(tet.map(|c| (c, classified.label(c))), &mut triangles);
         }
+        number(triangles, &mut band);
     }
     // The resolution's cells split below it count as in any band cell if their corners differ.
     for &m in &classified.refined {
         if classified.corners_mixed(resolution, m) {
-            marching_cubes(resolution, m, &mut band);
+            let corners: [Corner; 8] = std::array::from_fn(|b| offset(m, b, 1 << resolution));
+            band.marching_cubes_triangles +=
+                marching_cubes(resolution, corners.map(|c| classified.label(c)));
         }
     }
-    for &(level, m) in &classified.fine_band {
-        marching_cubes(level, m, &mut band);
-        for tet in FREUDENTHAL {
-            march(tet.map(|b| offset(m, b, 1 << level)), &mut band);
-        }
-    }
+    cubes(&classified.fine_band, &mut band, &mut number);
     band
+}
+
+/// A triangle of the extracted surface as its three lattice edges (inside corner, outside
+/// corner), before its vertices are numbered.
+type EdgeTriangle = [(Corner, Corner); 3];
+
+/// Cubes per parallel task of [`extract`] (a few hundred microseconds of work each).
+const CUBES_PER_CHUNK: usize = 1024;
+
+/// Parallel tasks of [`extract`] whose triangles are numbered together.
+const CHUNKS_PER_BATCH: usize = 16;
+
+/// The outward triangles of the separating surface in the tetrahedron `v` (corners with their
+/// class), as lattice edges (inside corner, outside corner): one where one corner is apart
+/// from the other three, two (a quadrilateral) where two and two.
+fn march(v: [(Corner, bool); 4], triangles: &mut Vec<EdgeTriangle>) {
+    let mut in_idx = [0usize; 4];
+    let mut out_idx = [0usize; 4];
+    let (mut n_in, mut n_out) = (0, 0);
+    for (i, &(_, inside)) in v.iter().enumerate() {
+        if inside {
+            in_idx[n_in] = i;
+            n_in += 1;
+        } else {
+            out_idx[n_out] = i;
+            n_out += 1;
+        }
+    }
+    let quad;
+    let tris: &[[(usize, usize); 3]] = match n_in {
+        1 => {
+            let i = in_idx[0];
+            quad = [[(i, out_idx[0]), (i, out_idx[1]), (i, out_idx[2])]; 2];
+            &quad[..1]
+        }
+        3 => {
+            let o = out_idx[0];
+            quad = [[(in_idx[0], o), (in_idx[1], o), (in_idx[2], o)]; 2];
+            &quad[..1]
+        }
+        2 => {
+            let (a, b) = (in_idx[0], in_idx[1]);
+            let (c, d) = (out_idx[0], out_idx[1]);
+            quad = [[(a, c), (a, d), (b, d)], [(a, c), (b, d), (b, c)]];
+            &quad[..]
+        }
+        _ => return,
+    };
+    for tri in tris {
+        let mut e = tri.map(|(i, o)| (v[i].0, v[o].0));
+        if !outward(&e) {
+            e.swap(1, 2);
+        }
+        triangles.push(e);
+    }
 }
 
 /// Triangles of marching cubes in a cube whose inside corners are the set bits of `case`
@@ -224,7 +270,7 @@ pub fn marching_cubes_table() -> [u8; 256] {
 /// normal pointing from the inside corner to the outside corner of `edges[0]` (exact: twice the
 /// midpoints are integers; the product is nonzero because the midpoint plane of a tetrahedron
 /// never holds a whole edge).
-fn outward(edges: &[(Corner, Corner); 3]) -> bool {
+fn outward(edges: &EdgeTriangle) -> bool {
     let mid = |(i, o): (Corner, Corner)| -> [i64; 3] {
         [0, 1, 2].map(|a| i64::from(i[a]) + i64::from(o[a]))
     };

@@ -447,17 +447,13 @@ pub fn classify<E: Evaluator + ?Sized>(
     }
     let transition_set: KeySet<(u32, u64)> =
         transition.iter().map(|&(l, c)| (l, pack(c))).collect();
-    let mut band = Vec::new();
-    let mut fine_band = Vec::new();
-    for (level, m) in leaves {
-        if !transition_set.contains(&(level, pack(m))) && out.corners_mixed(level, m) {
-            if level == regular {
-                band.push(m);
-            } else {
-                fine_band.push((level, m));
-            }
-        }
-    }
+    let (band, mut fine_band): (Vec<_>, Vec<_>) = leaves
+        .into_par_iter()
+        .filter(|&(level, m)| {
+            !transition_set.contains(&(level, pack(m))) && out.corners_mixed(level, m)
+        })
+        .partition(|&(level, _)| level == regular);
+    let mut band: Vec<Corner> = band.into_iter().map(|(_, m)| m).collect();
     band.sort_unstable_by_key(|c| (c[2], c[1], c[0]));
     fine_band.sort_unstable_by_key(|&(l, c)| (l, c[2], c[1], c[0]));
     out.band = band;
@@ -738,21 +734,20 @@ impl Classified {
             queue.retain(|&(level, m)| level > 0 && !out.split.contains(&(level, pack(m))));
             let cells = std::mem::take(&mut queue);
             // The new corners of the children of every cell split in this round.
-            let mut fresh = KeySet::<u64>::default();
-            let mut new_points: Vec<Corner> = Vec::new();
+            let labels = &out.labels;
+            let mut new_points: Vec<Corner> = cells
+                .par_iter()
+                .flat_map_iter(|&(level, m)| {
+                    let half = 1u32 << (level - 1);
+                    (0..27u32)
+                        .map(move |i| [i % 3, i / 3 % 3, i / 9].map(|d| d * half))
+                        .map(move |d| [0, 1, 2].map(|a| m[a] + d[a]))
+                })
+                .filter(|&p| !labels.contains_key(&pack(p)))
+                .collect();
+            new_points.par_sort_unstable_by_key(|&p| pack(p));
+            new_points.dedup();
             for &(level, m) in &cells {
-                let half = 1u32 << (level - 1);
-                for dz in 0..3 {
-                    for dy in 0..3 {
-                        for dx in 0..3 {
-                            let p = [m[0] + dx * half, m[1] + dy * half, m[2] + dz * half];
-                            let key = pack(p);
-                            if !out.labels.contains_key(&key) && fresh.insert(key) {
-                                new_points.push(p);
-                            }
-                        }
-                    }
-                }
                 out.split.insert((level, pack(m)));
             }
             if out.labels.len() + new_points.len() > max_points {
@@ -768,6 +763,7 @@ impl Classified {
                 .map(|&p| lattice.corner_position(p))
                 .collect();
             let values = evaluator.eval_batch(&positions);
+            out.labels.reserve(new_points.len());
             for &p in &new_points {
                 out.labels.insert(pack(p), CornerValue::BORDER);
             }
@@ -791,28 +787,23 @@ impl Classified {
                 })
                 .collect();
             // (3) leaves above the regular level around each new point that it contradicts.
-            for &p in &new_points {
-                let lp = out.label(p);
-                for b in 0..8 {
+            // (In parallel: the lookups of eight leaves per point were the serial half of a
+            // round; the queue is sorted before use.)
+            queue.par_extend(new_points.par_iter().flat_map_iter(|&p| {
+                let lp = reader.label(p);
+                (0..8).filter_map(move |b| {
                     let mut min = [0u32; 3];
-                    let mut ok = true;
                     for a in 0..3 {
                         let back = (b >> a & 1) as u32;
                         if p[a] < back || (p[a] - back) as usize >= lattice.cells[a] {
-                            ok = false;
-                        } else {
-                            min[a] = p[a] - back;
+                            return None;
                         }
+                        min[a] = p[a] - back;
                     }
-                    if !ok {
-                        continue;
-                    }
-                    let (level, m) = out.leaf(lattice, min);
-                    if level > regular && out.label(m) != lp {
-                        queue.push((level, m));
-                    }
-                }
-            }
+                    let (level, m) = reader.leaf(lattice, min);
+                    (level > regular && reader.label(m) != lp).then_some((level, m))
+                })
+            }));
         }
         Some(())
     }
