@@ -14,5 +14,6 @@ mod products;
 mod remesh;
 mod remesh_cli;
 mod remesh_planar;
+mod remesh_report;
 mod remesh_simplify;
 mod remesh_sub_cell;

@@ -2,7 +2,7 @@
 //! characteristic, components. Computed from the triangles alone (it checks the output of the
 //! remesher, and serves any other mesh as well).
 
-use super::lattice::KeyMap;
+use rayon::prelude::*;
 
 /// The topology of a triangle surface.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -39,44 +39,60 @@ pub struct TopologyReport {
 
 impl TopologyReport {
     /// The report of `triangles` (indices into `positions`, which only sizes the tables).
+    ///
+    /// Each undirected edge is counted at its lower vertex, from a list of the edges there
+    /// (higher vertex, direction), so the vertices are independent and run in parallel: a hash
+    /// table of the edges made this serial, and it checks every raw surface the simplifier
+    /// takes (a million faces at res 256).
     pub fn of(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> TopologyReport {
         let n = positions.len();
         let mut r = TopologyReport {
             faces: triangles.len(),
             ..TopologyReport::default()
         };
-        // Edge table: lo << 32 | hi -> (triangles, triangles going lo -> hi).
-        let mut edges: KeyMap<(u32, u32)> = KeyMap::default();
-        edges.reserve(triangles.len() * 3 / 2);
+        r.degenerate_faces = triangles
+            .par_iter()
+            .filter(|t| t[0] == t[1] || t[1] == t[2] || t[2] == t[0])
+            .count();
+        // Edge `(a, b)` of a triangle, at vertex min(a, b): (max(a, b), whether a < b).
+        let at_lower = per_vertex(n, triangles, |t, k| {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            (a.min(b), (a.max(b), a < b))
+        });
         let mut used = vec![false; n];
-        let mut parent: Vec<u32> = (0..n as u32).collect();
         for t in triangles {
-            if t[0] == t[1] || t[1] == t[2] || t[2] == t[0] {
-                r.degenerate_faces += 1;
-            }
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                used[a as usize] = true;
-                let key = (u64::from(a.min(b)) << 32) | u64::from(a.max(b));
-                let e = edges.entry(key).or_insert((0, 0));
-                e.0 += 1;
-                if a < b {
-                    e.1 += 1;
-                }
-                union(&mut parent, a, b);
+            for &v in t {
+                used[v as usize] = true;
             }
         }
         r.vertices = used.iter().filter(|&&u| u).count();
-        r.edges = edges.len();
-        for &(count, forward) in edges.values() {
-            match count {
-                1 => r.boundary_edges += 1,
-                2 => {
-                    if forward != 1 {
-                        r.misoriented_edges += 1
+        let counts = (0..n)
+            .into_par_iter()
+            .map_init(Vec::new, |list: &mut Vec<(u32, bool)>, v| {
+                list.clear();
+                list.extend_from_slice(at_lower.of(v));
+                list.sort_unstable();
+                let mut c = EdgeCounts::default();
+                for run in list.chunk_by(|x, y| x.0 == y.0) {
+                    c.edges += 1;
+                    match run.len() {
+                        1 => c.boundary += 1,
+                        // Sorted: `false` first, so one of each is `[false, true]`.
+                        2 => c.misoriented += usize::from(run[0].1 == run[1].1),
+                        _ => c.nonmanifold += 1,
                     }
                 }
-                _ => r.nonmanifold_edges += 1,
+                c
+            })
+            .reduce(EdgeCounts::default, EdgeCounts::add);
+        r.edges = counts.edges;
+        r.boundary_edges = counts.boundary;
+        r.misoriented_edges = counts.misoriented;
+        r.nonmanifold_edges = counts.nonmanifold;
+        let mut parent: Vec<u32> = (0..n as u32).collect();
+        for v in 0..n {
+            for &(w, _) in at_lower.of(v) {
+                union(&mut parent, v as u32, w);
             }
         }
         r.components = (0..n as u32)
@@ -162,37 +178,96 @@ fn union(parent: &mut [u32], a: u32, b: u32) {
     }
 }
 
-/// Vertices whose link is not a single cycle or path: the opposite edges of the vertex's
-/// triangles must form one connected graph with every node of degree at most 2.
-fn nonmanifold_vertices(n: usize, triangles: &[[u32; 3]]) -> usize {
-    // CSR of vertex -> opposite edges.
+/// Edge counts of [`TopologyReport::of`] at some vertices.
+#[derive(Clone, Copy, Default)]
+struct EdgeCounts {
+    edges: usize,
+    boundary: usize,
+    misoriented: usize,
+    nonmanifold: usize,
+}
+
+impl EdgeCounts {
+    fn add(self, o: EdgeCounts) -> EdgeCounts {
+        EdgeCounts {
+            edges: self.edges + o.edges,
+            boundary: self.boundary + o.boundary,
+            misoriented: self.misoriented + o.misoriented,
+            nonmanifold: self.nonmanifold + o.nonmanifold,
+        }
+    }
+}
+
+/// Items listed per vertex (compressed rows): `item(t, k)` gives the vertex and the item for
+/// corner `k` of triangle `t`, three per triangle.
+struct PerVertex<T> {
+    start: Vec<usize>,
+    items: Vec<T>,
+}
+
+impl<T: Copy + Default> PerVertex<T> {
+    fn of(&self, v: usize) -> &[T] {
+        &self.items[self.start[v]..self.start[v + 1]]
+    }
+}
+
+fn per_vertex<T: Copy + Default>(
+    n: usize,
+    triangles: &[[u32; 3]],
+    item: impl Fn([u32; 3], usize) -> (u32, T),
+) -> PerVertex<T> {
     let mut start = vec![0usize; n + 1];
     for t in triangles {
-        for &v in t {
-            start[v as usize + 1] += 1;
+        for k in 0..3 {
+            start[item(*t, k).0 as usize + 1] += 1;
         }
     }
     for i in 0..n {
         start[i + 1] += start[i];
     }
     let mut fill = start.clone();
-    let mut opposite = vec![(0u32, 0u32); start[n]];
+    let mut items = vec![T::default(); start[n]];
     for t in triangles {
         for k in 0..3 {
-            let v = t[k] as usize;
-            opposite[fill[v]] = (t[(k + 1) % 3], t[(k + 2) % 3]);
-            fill[v] += 1;
+            let (v, x) = item(*t, k);
+            items[fill[v as usize]] = x;
+            fill[v as usize] += 1;
         }
     }
-    let mut bad = 0;
-    let mut nodes: Vec<u32> = Vec::new();
-    let mut degree: Vec<u32> = Vec::new();
-    let mut parent: Vec<u32> = Vec::new();
-    for v in 0..n {
-        let link = &opposite[start[v]..start[v + 1]];
-        if link.is_empty() {
-            continue;
-        }
+    PerVertex { start, items }
+}
+
+/// Vertices whose link is not a single cycle or path: the opposite edges of the vertex's
+/// triangles must form one connected graph with every node of degree at most 2.
+fn nonmanifold_vertices(n: usize, triangles: &[[u32; 3]]) -> usize {
+    let opposite = per_vertex(n, triangles, |t, k| {
+        (t[k], (t[(k + 1) % 3], t[(k + 2) % 3]))
+    });
+    (0..n)
+        .into_par_iter()
+        .map_init(LinkScratch::default, |s, v| {
+            let link = opposite.of(v);
+            usize::from(!link.is_empty() && !s.is_one_cycle_or_path(link))
+        })
+        .sum()
+}
+
+/// Buffers of [`nonmanifold_vertices`], reused across the vertices of one thread.
+#[derive(Default)]
+struct LinkScratch {
+    nodes: Vec<u32>,
+    degree: Vec<u32>,
+    parent: Vec<u32>,
+}
+
+impl LinkScratch {
+    /// Whether the edges `link` form one connected graph with every node of degree at most 2.
+    fn is_one_cycle_or_path(&mut self, link: &[(u32, u32)]) -> bool {
+        let LinkScratch {
+            nodes,
+            degree,
+            parent,
+        } = self;
         nodes.clear();
         for &(a, b) in link {
             nodes.push(a);
@@ -209,16 +284,13 @@ fn nonmanifold_vertices(n: usize, triangles: &[[u32; 3]]) -> usize {
             let (la, lb) = (local(a), local(b));
             degree[la as usize] += 1;
             degree[lb as usize] += 1;
-            union(&mut parent, la, lb);
+            union(parent, la, lb);
         }
         let roots = (0..nodes.len() as u32)
-            .filter(|&i| find(&mut parent, i) == i)
+            .filter(|&i| find(parent, i) == i)
             .count();
-        if roots != 1 || degree.iter().any(|&d| d > 2) {
-            bad += 1;
-        }
+        roots == 1 && degree.iter().all(|&d| d <= 2)
     }
-    bad
 }
 
 /// Occupancy agreement: of `samples` points drawn uniformly (seeded) in `bounds`, the fraction
