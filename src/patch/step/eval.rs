@@ -322,7 +322,7 @@ impl StepWindingNumber {
             let mut hits = Vec::new();
             for fp in &face.patches {
                 if ray_meets_box(q, frame.d, fp.lo, fp.hi, 1e-9 * self.model.diagonal()) {
-                    patch_hits(fp, q, &frame, &mut hits);
+                    patch_hits(fp, q, &frame, &mut hits, &mut Vec::new());
                 }
             }
             for h in hits {
@@ -547,7 +547,19 @@ impl StepWindingNumber {
             if !ray_meets_box(q, frame.d, *lo, *hi, dedup) {
                 continue;
             }
-            for h in face_hits(face, q, frame, dedup) {
+            let found = face_hits(face, q, frame, dedup);
+            // A span where a crossing may hide blocks the line's rays through it, as an
+            // ambiguous hit at each of its ends would.
+            for [a, b] in found.unresolved {
+                for tau in [a, b] {
+                    out.push(LineHit {
+                        tau,
+                        sign: 0,
+                        ambiguous: true,
+                    });
+                }
+            }
+            for h in found.hits {
                 let n = cross(h.su, h.sv);
                 let nn = norm(n);
                 let c = face.sense * dot(n, frame.d) / nn;
@@ -585,7 +597,11 @@ impl StepWindingNumber {
             if !ray_meets_box(q, frame.d, *lo, *hi, dedup) {
                 continue;
             }
-            for h in face_hits(face, q, frame, dedup) {
+            let found = face_hits(face, q, frame, dedup);
+            if strict && found.unresolved.iter().any(|&[_, hi]| hi >= -margin) {
+                return Err(Reject::Hit);
+            }
+            for h in found.hits {
                 let n = cross(h.su, h.sv);
                 let nn = norm(n);
                 let c = face.sense * dot(n, frame.d) / nn;
@@ -794,7 +810,11 @@ impl StepWindingNumber {
         let dedup = 1e-9 * self.model.diagonal();
         let gap = ON_BOUNDARY_GAP * self.model.diagonal();
         for face in &self.model.faces {
-            for h in face_hits(face, c, frame, dedup) {
+            let found = face_hits(face, c, frame, dedup);
+            if found.unresolved.iter().any(|&[_, hi]| hi > gap) {
+                return None;
+            }
+            for h in found.hits {
                 if h.tau.abs() <= gap {
                     continue;
                 }
@@ -929,12 +949,15 @@ fn certify(
 }
 
 /// The ray's hits on the patches of `face` (patches whose box it misses are skipped), with hits
-/// closer than `dedup` to an earlier one dropped (a hit on the seam of two patches is one hit).
-fn face_hits(face: &Face, q: [f64; 3], frame: &RayFrame, dedup: f64) -> Vec<Hit> {
+/// closer than `dedup` to an earlier one dropped (a hit on the seam of two patches is one hit),
+/// and the spans `[τ_lo, τ_hi]` along the ray of the pieces whose crossings are unknown
+/// ([`patch_hits`]).
+fn face_hits(face: &Face, q: [f64; 3], frame: &RayFrame, dedup: f64) -> FaceHits {
     let mut hits: Vec<Hit> = Vec::new();
+    let mut unresolved = Vec::new();
     for fp in &face.patches {
         if ray_meets_box(q, frame.d, fp.lo, fp.hi, dedup) {
-            patch_hits(fp, q, frame, &mut hits);
+            patch_hits(fp, q, frame, &mut hits, &mut unresolved);
         }
     }
     let mut kept: Vec<Hit> = Vec::new();
@@ -943,7 +966,17 @@ fn face_hits(face: &Face, q: [f64; 3], frame: &RayFrame, dedup: f64) -> Vec<Hit>
             kept.push(h);
         }
     }
-    kept
+    FaceHits {
+        hits: kept,
+        unresolved,
+    }
+}
+
+/// [`face_hits`]' answer.
+struct FaceHits {
+    hits: Vec<Hit>,
+    /// Spans along the ray where a crossing may have been missed.
+    unresolved: Vec<[f64; 2]>,
 }
 
 /// Slab test of the ray `q + τ d, τ ≥ 0` against a box grown by `pad`.
@@ -1009,7 +1042,13 @@ struct Piece {
 /// Ray hits on one patch: subdivision culls pieces whose control hull misses the ray's line
 /// (xy box not containing the origin) or lies behind `q`; at depth [`HIT_DEPTH`] or once a piece
 /// is small, Newton's method from its centre; a root counts for the piece containing it.
-fn patch_hits(fp: &FacePatch, q: [f64; 3], frame: &RayFrame, out: &mut Vec<Hit>) {
+fn patch_hits(
+    fp: &FacePatch,
+    q: [f64; 3],
+    frame: &RayFrame,
+    out: &mut Vec<Hit>,
+    unresolved: &mut Vec<[f64; 2]>,
+) {
     let patch = &fp.patch;
     let (m, n) = patch.degree();
     let h: Vec<Homogeneous> = patch
@@ -1045,11 +1084,21 @@ fn patch_hits(fp: &FacePatch, q: [f64; 3], frame: &RayFrame, out: &mut Vec<Hit>)
             continue;
         }
         let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]).max(hi[2] - lo[2]);
-        if depth >= HIT_DEPTH
-            || (depth >= 2 && extent <= 0.05 * size && single_root(fp, frame, &piece))
-        {
-            if let Some(hit) = newton(fp, q, frame, &piece) {
-                out.push(hit);
+        let graph = depth >= 2 && extent <= 0.05 * size && single_root(fp, frame, &piece);
+        if graph || depth >= HIT_DEPTH {
+            // A piece that is a graph over the ray's plane holds at most one crossing, and
+            // Newton's method from its centre finds it or shows it lies outside. Anywhere else
+            // (a piece at the depth limit near a tangency or a collapsed patch edge, or Newton
+            // failing) the piece may hide crossings: its span along the ray is reported, and
+            // no ray may count through it. Dropping such a piece was an integer error on
+            // boxed_sphere.step (a corner blend's missed exit: `w = −1` at a point outside).
+            match newton(fp, q, frame, &piece) {
+                Ok(hit) if graph => out.extend(hit),
+                Ok(hit) => {
+                    out.extend(hit);
+                    unresolved.push([lo[2], hi[2]]);
+                }
+                Err(()) => unresolved.push([lo[2], hi[2]]),
             }
             continue;
         }
@@ -1145,7 +1194,9 @@ fn split_dir(
 }
 
 /// Newton's method for `x(s, t) = y(s, t) = 0` in the ray frame, from the piece's centre.
-fn newton(fp: &FacePatch, q: [f64; 3], frame: &RayFrame, piece: &Piece) -> Option<Hit> {
+/// `Ok(None)`: the root is outside the piece; `Err`: the method failed (singular or
+/// not converging), so the piece's crossings are unknown.
+fn newton(fp: &FacePatch, q: [f64; 3], frame: &RayFrame, piece: &Piece) -> Result<Option<Hit>, ()> {
     let mut st = [
         0.5 * (piece.s[0] + piece.s[1]),
         0.5 * (piece.t[0] + piece.t[1]),
@@ -1164,7 +1215,7 @@ fn newton(fp: &FacePatch, q: [f64; 3], frame: &RayFrame, piece: &Piece) -> Optio
         let b = [dot(frame.e2, ds), dot(frame.e2, dt)];
         let det = a[0] * b[1] - a[1] * b[0];
         if det == 0.0 || !det.is_finite() {
-            return None;
+            return Err(());
         }
         let d0 = (r[0] * b[1] - a[1] * r[1]) / det;
         let d1 = (a[0] * r[1] - r[0] * b[0]) / det;
@@ -1175,7 +1226,7 @@ fn newton(fp: &FacePatch, q: [f64; 3], frame: &RayFrame, piece: &Piece) -> Optio
         }
     }
     if !converged {
-        return None;
+        return Err(());
     }
     let tol = 1e-10;
     if st[0] < piece.s[0] - tol
@@ -1183,7 +1234,7 @@ fn newton(fp: &FacePatch, q: [f64; 3], frame: &RayFrame, piece: &Piece) -> Optio
         || st[1] < piece.t[0] - tol
         || st[1] > piece.t[1] + tol
     {
-        return None;
+        return Ok(None);
     }
     // Roots on a piece's border are found by both neighbours; `tol` keeps the one at the
     // patch border inside [0, 1]².
@@ -1191,17 +1242,17 @@ fn newton(fp: &FacePatch, q: [f64; 3], frame: &RayFrame, piece: &Piece) -> Optio
     let (p, ds, dt) = fp.patch.eval_with_partials(st[0], st[1]);
     let r = frame.map(sub(p, q));
     if (r[0] * r[0] + r[1] * r[1]).sqrt() > 1e-9 * scale {
-        return None;
+        return Ok(None);
     }
     // The surface's own (u, v), the parameters the trimming loops are in.
     let (uv, [du, dv]) = fp.uv_at(st);
-    Some(Hit {
+    Ok(Some(Hit {
         point: p,
         uv,
         su: [ds[0] / du, ds[1] / du, ds[2] / du],
         sv: [dt[0] / dv, dt[1] / dv, dt[2] / dv],
         tau: r[2],
-    })
+    }))
 }
 
 /// Trimmed models plug into grids and products like the other evaluators.
