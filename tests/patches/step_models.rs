@@ -298,7 +298,7 @@ fn boxed_sphere_corner_blends_agree_on_every_ray() {
             e.value
         })
         .collect();
-    assert!(values.iter().any(|&w| w == 1.0) && values.iter().any(|&w| w == 0.0));
+    assert!(values.contains(&1.0) && values.contains(&0.0));
     // The grid's columns along z share their line's hits (`evaluate_column`).
     for (c, column) in grid.chunks(n).enumerate() {
         let ts: Vec<f64> = column.iter().map(|q| q[2]).collect();
