@@ -1086,21 +1086,31 @@ fn patch_hits(
         let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]).max(hi[2] - lo[2]);
         let graph = depth >= 2 && extent <= 0.05 * size && single_root(fp, frame, &piece);
         if graph || depth >= HIT_DEPTH {
-            // A piece that is a graph over the ray's plane holds at most one crossing, and
-            // Newton's method from its centre finds it or shows it lies outside. Anywhere else
-            // (a piece at the depth limit near a tangency or a collapsed patch edge, or Newton
-            // failing) the piece may hide crossings: its span along the ray is reported, and
-            // no ray may count through it. Dropping such a piece was an integer error on
-            // boxed_sphere.step (a corner blend's missed exit: `w = −1` at a point outside).
+            // A piece that is a graph over the ray's plane holds at most one crossing; a root
+            // Newton's method finds in it is that one. If the iterate leaves the piece
+            // (converging to another crossing of the line, or to none) or fails, the piece may
+            // still hold one and is halved again, like any piece its hull does not rule out.
+            // At the depth limit (a tangency, a collapsed patch edge) a piece without that
+            // proof may hide crossings: its span along the ray is reported, and no ray may
+            // count through it. Dropping such pieces gave certified integer errors on
+            // boxed_sphere.step (corner blends' missed crossings: `w = −1` and `w = 1` at
+            // points outside; docs/patches.md).
             match newton(fp, q, frame, &piece) {
-                Ok(hit) if graph => out.extend(hit),
-                Ok(hit) => {
+                Ok(Some(hit)) if graph => {
+                    out.push(hit);
+                    continue;
+                }
+                Ok(hit) if depth >= HIT_DEPTH => {
                     out.extend(hit);
                     unresolved.push([lo[2], hi[2]]);
+                    continue;
                 }
-                Err(()) => unresolved.push([lo[2], hi[2]]),
+                Err(()) if depth >= HIT_DEPTH => {
+                    unresolved.push([lo[2], hi[2]]);
+                    continue;
+                }
+                _ => {}
             }
-            continue;
         }
         for (a, b) in split4(&piece, m, n) {
             stack.push((a, depth + 1));
