@@ -308,3 +308,39 @@ fn boxed_sphere_corner_blends_agree_on_every_ray() {
         }
     }
 }
+
+/// A ray through a modelling gap between two faces crosses neither: the corner blend #26 of
+/// `boxed_sphere.step` and the wall #22 below it meet ~8.5·10⁻⁶ apart, and the first
+/// direction from this point, 5.8·10⁻³ outside a bar, passed 3.0·10⁻⁶ and 5.5·10⁻⁶ beyond the
+/// two patches' edges, entered the bar unseen and left it through the blend: certified `w = 1`
+/// while the 13 other directions gave 0. A ray within `EDGE_GAP` of a surface's edge is now
+/// rejected there. The 11³ grid 4·10⁻⁶ apart around it (1,331 points) had one such point after
+/// the corner-blend fixes above; the test takes the point itself and its 3³ neighbours.
+#[test]
+fn boxed_sphere_ray_through_a_gap_between_faces_is_rejected() {
+    let Some(dir) = shared() else { return };
+    let m = load_step(&dir.join("boxed_sphere.step")).unwrap();
+    let wn = StepWindingNumber::new(&m);
+    let centre = [
+        -0.3441681116685037,
+        -0.10005808890986291,
+        -0.4042204733772715,
+    ];
+    let first = wn.directions()[0];
+    let through_gap = wn.evaluate_along(centre, first);
+    assert!(through_gap.is_none(), "{through_gap:?}");
+    for k in 0..27 {
+        let q = [
+            centre[0] + (k / 9) as f64 * 4e-6 - 4e-6,
+            centre[1] + (k / 3 % 3) as f64 * 4e-6 - 4e-6,
+            centre[2] + (k % 3) as f64 * 4e-6 - 4e-6,
+        ];
+        let e = wn.evaluate(q);
+        assert!(!e.uncertified && e.value == 0.0, "{q:?}: {e:?}");
+        for &d in wn.directions() {
+            if let Some(f) = wn.evaluate_along(q, d) {
+                assert_eq!(f.value, 0.0, "{q:?} along {d:?}: {f:?}");
+            }
+        }
+    }
+}
