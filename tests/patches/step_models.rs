@@ -344,3 +344,29 @@ fn boxed_sphere_ray_through_a_gap_between_faces_is_rejected() {
         }
     }
 }
+
+/// A certified ray that passes near an edge can still be off by one where the two faces' loops
+/// disagree by more than the hit margin: at this point of `sliced_cylinder.step`, 5·10⁻⁴
+/// outside the rim of the slanted cut, the first certified direction counts 2, the other nine
+/// 1 (its hits lie within `CLEAR_MARGIN` of the rim's loops). The evaluator takes such a ray
+/// only when a second direction agrees, or when no ray is clear of the loops.
+#[test]
+fn sliced_cylinder_ray_near_the_rim_needs_a_second_direction() {
+    let Some(dir) = shared() else { return };
+    let m = load_step(&dir.join("sliced_cylinder.step")).unwrap();
+    let wn = StepWindingNumber::new(&m);
+    let q = [8.80862141273773, -4.728453085051245, 13.294471780528257];
+    let values: Vec<f64> = wn
+        .directions()
+        .iter()
+        .filter_map(|&d| wn.evaluate_along(q, d))
+        .map(|e| e.value)
+        .collect();
+    assert_eq!(values.first(), Some(&2.0), "{values:?}");
+    assert_eq!(
+        values.iter().filter(|&&v| v == 1.0).count(),
+        values.len() - 1
+    );
+    let e = wn.evaluate(q);
+    assert!(!e.uncertified && e.value == 1.0, "{e:?}");
+}
