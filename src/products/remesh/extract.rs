@@ -64,21 +64,26 @@ pub fn extract(lattice: &Lattice, classified: &Classified) -> Band {
         let case = (0..8).filter(|&b| inside[b]).fold(0, |c, b| c | (1 << b));
         usize::from(mc_table[case]) << (2 * (level - resolution))
     };
-    // Output vertices numbered by first use (serial: it fixes the numbering), keyed by the
-    // packed corners: hashing two u64 costs a third of hashing six u32.
+    // Output vertices numbered by first use, keyed by the packed corners (hashing two u64
+    // costs a third of hashing six u32). A part arrives numbered by first use within itself
+    // (`Part::of`, in parallel), so only its own vertices are looked up here, in their order
+    // of first use: the vertices new to the surface get the numbers the serial first-use
+    // numbering of every triangle would give them.
     let mut vertex_of: std::collections::HashMap<(u64, u64), u32, KeyHash> = Default::default();
-    let mut number = |triangles: Vec<EdgeTriangle>, band: &mut Band| {
-        for e in triangles {
-            let t = e.map(|edge| {
-                *vertex_of
-                    .entry((pack(edge.0), pack(edge.1)))
-                    .or_insert_with(|| {
-                        band.edges.push(edge);
-                        (band.edges.len() - 1) as u32
-                    })
-            });
-            band.triangles.push(t);
-        }
+    let mut number = |part: Part, band: &mut Band| {
+        let global: Vec<u32> = part
+            .keys
+            .iter()
+            .zip(&part.edges)
+            .map(|(&key, &edge)| {
+                *vertex_of.entry(key).or_insert_with(|| {
+                    band.edges.push(edge);
+                    (band.edges.len() - 1) as u32
+                })
+            })
+            .collect();
+        band.triangles
+            .extend(part.triangles.iter().map(|t| t.map(|i| global[i as usize])));
     };
     // The cubes of one Freudenthal split (the regular band and the finer one): their eight
     // corners looked up once (not once per tetrahedron: 8 lookups instead of 32), in parallel
@@ -87,7 +92,7 @@ pub fn extract(lattice: &Lattice, classified: &Classified) -> Band {
     // numbered stay a small part of the surface.
     let cubes = |cells: &[(u32, Corner)], band: &mut Band, number: &mut dyn FnMut(_, &mut Band)| {
         for batch in cells.chunks(CUBES_PER_CHUNK * CHUNKS_PER_BATCH) {
-            let parts: Vec<(Vec<EdgeTriangle>, usize)> = batch
+            let parts: Vec<(Part, usize)> = batch
                 .par_chunks(CUBES_PER_CHUNK)
                 .map(|chunk| {
                     let mut triangles = Vec::new();
@@ -101,12 +106,12 @@ pub fn extract(lattice: &Lattice, classified: &Classified) -> Band {
                             march(tet.map(|b| (corners[b], inside[b])), &mut triangles);
                         }
                     }
-                    (triangles, marching)
+                    (Part::of(triangles), marching)
                 })
                 .collect();
-            for (triangles, marching) in parts {
+            for (part, marching) in parts {
                 band.marching_cubes_triangles += marching;
-                number(triangles, band);
+                number(part, band);
             }
         }
     };
@@ -123,7 +128,7 @@ pub fn extract(lattice: &Lattice, classified: &Classified) -> Band {
         for tet in super::transition::tetrahedra(m, 1 << level, refined) {
             march(tet.map(|c| (c, classified.label(c))), &mut triangles);
         }
-        number(triangles, &mut band);
+        number(Part::of(triangles), &mut band);
     }
     // The resolution's cells split below it count as in any band cell if their corners differ.
     for &m in &classified.refined {
@@ -140,6 +145,44 @@ pub fn extract(lattice: &Lattice, classified: &Classified) -> Band {
 /// A triangle of the extracted surface as its three lattice edges (inside corner, outside
 /// corner), before its vertices are numbered.
 type EdgeTriangle = [(Corner, Corner); 3];
+
+/// Triangles of one task of [`extract`] with their vertices numbered by first use within
+/// them: the lattice edges and their packed keys in that order, and the triangles as indices
+/// into them.
+struct Part {
+    keys: Vec<(u64, u64)>,
+    edges: Vec<(Corner, Corner)>,
+    triangles: Vec<[u32; 3]>,
+}
+
+impl Part {
+    fn of(triangles: Vec<EdgeTriangle>) -> Part {
+        let mut index: std::collections::HashMap<(u64, u64), u32, KeyHash> =
+            std::collections::HashMap::with_capacity_and_hasher(
+                triangles.len(),
+                Default::default(),
+            );
+        let (mut keys, mut edges) = (Vec::new(), Vec::new());
+        let triangles = triangles
+            .into_iter()
+            .map(|t| {
+                t.map(|edge| {
+                    let key = (pack(edge.0), pack(edge.1));
+                    *index.entry(key).or_insert_with(|| {
+                        keys.push(key);
+                        edges.push(edge);
+                        (keys.len() - 1) as u32
+                    })
+                })
+            })
+            .collect();
+        Part {
+            keys,
+            edges,
+            triangles,
+        }
+    }
+}
 
 /// Cubes per parallel task of [`extract`] (a few hundred microseconds of work each).
 const CUBES_PER_CHUNK: usize = 1024;
