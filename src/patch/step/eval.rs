@@ -573,27 +573,32 @@ impl StepWindingNumber {
             .collect()
     }
 
+    /// The faces whose box the ray from `q` meets (grown by the edge gap), each with its hits
+    /// ([`face_hits`]), found as the iterator is advanced. Conservative: the slab test is
+    /// monotone in the box, so a ray meeting a patch's padded box meets the face's.
+    fn hits_by_face<'a>(
+        &'a self,
+        q: [f64; 3],
+        frame: &'a RayFrame,
+    ) -> impl Iterator<Item = (&'a Face, FaceHits)> + 'a {
+        let dedup = 1e-9 * self.model.diagonal();
+        let gap = self.edge_gap();
+        self.model
+            .faces
+            .iter()
+            .zip(&self.face_boxes)
+            .zip(&self.surface_edges)
+            .filter(move |((_, (lo, hi)), _)| ray_meets_box(q, frame.d, *lo, *hi, dedup.max(gap)))
+            .map(move |((face, _), edges)| (face, face_hits(face, edges, q, frame, dedup, gap)))
+    }
+
     /// Every hit of the ray from `q` along `frame.d` on the trimmed faces, classified once:
     /// sign of the crossing (0 outside the face's loops) or ambiguous (grazing, or within
     /// [`COLUMN_HIT_MARGIN`] of the loops), at its distance `τ` from `q`.
     fn line_hits(&self, q: [f64; 3], frame: &RayFrame) -> Vec<LineHit> {
         let mut out = Vec::new();
         let column_margin = COLUMN_HIT_MARGIN * self.model.diagonal();
-        let dedup = 1e-9 * self.model.diagonal();
-        let gap = self.edge_gap();
-        for ((face, (lo, hi)), edges) in self
-            .model
-            .faces
-            .iter()
-            .zip(&self.face_boxes)
-            .zip(&self.surface_edges)
-        {
-            // Conservative: the slab test is monotone in the box, so a ray meeting a patch's
-            // padded box meets the face's.
-            if !ray_meets_box(q, frame.d, *lo, *hi, dedup.max(gap)) {
-                continue;
-            }
-            let found = face_hits(face, edges, q, frame, dedup, gap);
+        for (face, found) in self.hits_by_face(q, frame) {
             // A span where a crossing may hide blocks the line's rays through it, as an
             // ambiguous hit at each of its ends would.
             for [a, b] in found.unresolved {
@@ -641,19 +646,7 @@ impl StepWindingNumber {
         let mut chi = 0i64;
         let mut clear = true;
         let clear_margin = CLEAR_MARGIN * self.model.diagonal();
-        let dedup = 1e-9 * self.model.diagonal();
-        let gap = self.edge_gap();
-        for ((face, (lo, hi)), edges) in self
-            .model
-            .faces
-            .iter()
-            .zip(&self.face_boxes)
-            .zip(&self.surface_edges)
-        {
-            if !ray_meets_box(q, frame.d, *lo, *hi, dedup.max(gap)) {
-                continue;
-            }
-            let found = face_hits(face, edges, q, frame, dedup, gap);
+        for (face, found) in self.hits_by_face(q, frame) {
             if strict && found.unresolved.iter().any(|&[_, hi]| hi >= -margin) {
                 return Err(Reject::Hit);
             }
