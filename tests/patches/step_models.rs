@@ -370,3 +370,46 @@ fn sliced_cylinder_ray_near_the_rim_needs_a_second_direction() {
     let e = wn.evaluate(q);
     assert!(!e.uncertified && e.value == 1.0, "{e:?}");
 }
+
+/// boxed_sphere's sphere faces are lunes between meridians that meet at the poles, one of
+/// which touches the box's open side at `(0, −0.5, 0)`. At a pole one 3D point is a whole
+/// segment of the parameter plane; the loop builder dropped the start of the second meridian
+/// there as "the previous edge's end", so the loop cut from one meridian's end straight to the
+/// other's next sample: a sliver 7.7·10⁻⁴ wide in `v` outside the face, where a ray's exit
+/// from the sphere counted as outside. These points, 10⁻⁵ outside the sphere, had their 14
+/// directions split 7 to 7 once the hull test stopped rejecting rays there; with the loop along
+/// the pole's line every direction is certified and gives 0.
+#[test]
+fn boxed_sphere_loops_follow_the_pole_of_the_sphere_faces() {
+    let Some(dir) = shared() else { return };
+    let m = load_step(&dir.join("boxed_sphere.step")).unwrap();
+    let wn = StepWindingNumber::new(&m);
+    for q in [
+        [
+            -0.0004282489847541474,
+            -0.500011296117884,
+            -0.0001436447267243457,
+        ],
+        [
+            0.0004322467167573952,
+            -0.5000105027242102,
+            9.633456957029306e-5,
+        ],
+        [
+            0.0002779104155915087,
+            -0.5000058788396838,
+            0.0002593923247287212,
+        ],
+    ] {
+        let values: Vec<f64> = wn
+            .directions()
+            .iter()
+            .filter_map(|&d| wn.evaluate_along(q, d))
+            .map(|e| e.value)
+            .collect();
+        assert!(values.len() >= 12, "{q:?}: {values:?}");
+        assert!(values.iter().all(|&v| v == 0.0), "{q:?}: {values:?}");
+        let e = wn.evaluate(q);
+        assert!(!e.uncertified && e.value == 0.0, "{q:?}: {e:?}");
+    }
+}

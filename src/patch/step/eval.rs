@@ -1217,6 +1217,12 @@ fn patch_hits(
         if lo[0] > pad_xy || hi[0] < -pad_xy || lo[1] > pad_xy || hi[1] < -pad_xy || hi[2] < -pad {
             continue;
         }
+        // The box in the ray's plane is loose for a piece beside the ray and slanted to it;
+        // with the box alone the pieces next to each hit were halved down to where their box
+        // misses (1.3× per query on boxed_sphere).
+        if hull_misses_origin(&piece.h, pad_xy) {
+            continue;
+        }
         let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]).max(hi[2] - lo[2]);
         let graph = depth >= 2 && extent <= 0.05 * size && single_root(fp, frame, &piece);
         if graph || depth >= HIT_DEPTH {
@@ -1251,6 +1257,47 @@ fn patch_hits(
             stack.push((b, depth + 1));
         }
     }
+}
+
+/// Whether the convex hull of the control points projected to the ray's plane (`x/w`, `y/w`;
+/// positive weights, so it holds the piece's projection) stays farther than `pad` from the
+/// origin, the ray's line. A few steps of Gilbert's distance algorithm in 2D from the
+/// centroid: each step's direction `v` is a candidate separating line through the origin
+/// (every point beyond `pad` along `v` proves the miss); it moves to the nearest point of the
+/// segment from `v` to the support point. `false` is only "not proved".
+fn hull_misses_origin(h: &[Homogeneous], pad: f64) -> bool {
+    let point = |p: &Homogeneous| [p[0] / p[3], p[1] / p[3]];
+    let n = h.len() as f64;
+    let mut v = h
+        .iter()
+        .map(point)
+        .fold([0.0, 0.0], |c, p| [c[0] + p[0] / n, c[1] + p[1] / n]);
+    for _ in 0..4 {
+        let length = v[0].hypot(v[1]);
+        if !length.is_finite() || length <= 0.0 {
+            return false;
+        }
+        let (w, along) = h
+            .iter()
+            .map(point)
+            .map(|p| (p, p[0] * v[0] + p[1] * v[1]))
+            .fold(
+                ([0.0, 0.0], f64::INFINITY),
+                |a, b| if b.1 < a.1 { b } else { a },
+            );
+        if along > pad * length {
+            return true;
+        }
+        // Nearest point to the origin on the segment from v to w.
+        let d = [w[0] - v[0], w[1] - v[1]];
+        let dd = d[0] * d[0] + d[1] * d[1];
+        if !dd.is_finite() || dd <= 0.0 {
+            return false;
+        }
+        let t = (-(v[0] * d[0] + v[1] * d[1]) / dd).clamp(0.0, 1.0);
+        v = [v[0] + t * d[0], v[1] + t * d[1]];
+    }
+    false
 }
 
 /// Whether a small piece can hold only one crossing of the ray: its normals at the corners and

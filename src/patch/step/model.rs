@@ -245,11 +245,18 @@ impl StepModel {
                     for c in &geom {
                         let pts = sample(c, &f.surface, &mut hint, chord);
                         for (k, uv) in pts.into_iter().enumerate() {
-                            if k == 0 && !poly.is_empty() {
-                                continue; // shared with the previous piece's end
-                            }
-                            if !poly.is_empty() {
-                                real.push(!seam);
+                            if let Some(&last) = poly.last() {
+                                // A piece starts where the previous one ends, except at a
+                                // pole (a collapsed edge), where the two ends are one 3D
+                                // point inverted to different `u`: the segment between them
+                                // runs along the pole's line. Dropping it let the loop cut
+                                // from the previous end straight to this edge's next sample,
+                                // a sliver out of boxed_sphere's sphere faces (lunes between
+                                // meridians), 7.7·10⁻⁴ wide in v at the pole.
+                                if k == 0 && near_uv(last, uv) {
+                                    continue;
+                                }
+                                real.push(k == 0 || !seam);
                             }
                             poly.push(uv);
                         }
