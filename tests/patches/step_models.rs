@@ -345,6 +345,15 @@ fn boxed_sphere_ray_through_a_gap_between_faces_is_rejected() {
     }
 }
 
+/// The values along every direction whose ray is certified at `q`, in the evaluator's order.
+fn certified_values(wn: &StepWindingNumber, q: [f64; 3]) -> Vec<f64> {
+    wn.directions()
+        .iter()
+        .filter_map(|&d| wn.evaluate_along(q, d))
+        .map(|e| e.value)
+        .collect()
+}
+
 /// A certified ray that passes near an edge can still be off by one where the two faces' loops
 /// disagree by more than the hit margin: at this point of `sliced_cylinder.step`, 5·10⁻⁴
 /// outside the rim of the slanted cut, the first certified direction counts 2, the other nine
@@ -356,12 +365,7 @@ fn sliced_cylinder_ray_near_the_rim_needs_a_second_direction() {
     let m = load_step(&dir.join("sliced_cylinder.step")).unwrap();
     let wn = StepWindingNumber::new(&m);
     let q = [8.80862141273773, -4.728453085051245, 13.294471780528257];
-    let values: Vec<f64> = wn
-        .directions()
-        .iter()
-        .filter_map(|&d| wn.evaluate_along(q, d))
-        .map(|e| e.value)
-        .collect();
+    let values = certified_values(&wn, q);
     assert_eq!(values.first(), Some(&2.0), "{values:?}");
     assert_eq!(
         values.iter().filter(|&&v| v == 1.0).count(),
@@ -401,12 +405,7 @@ fn boxed_sphere_loops_follow_the_pole_of_the_sphere_faces() {
             0.0002593923247287212,
         ],
     ] {
-        let values: Vec<f64> = wn
-            .directions()
-            .iter()
-            .filter_map(|&d| wn.evaluate_along(q, d))
-            .map(|e| e.value)
-            .collect();
+        let values = certified_values(&wn, q);
         assert!(values.len() >= 12, "{q:?}: {values:?}");
         assert!(values.iter().all(|&v| v == 0.0), "{q:?}: {values:?}");
         let e = wn.evaluate(q);
