@@ -225,17 +225,7 @@ impl StepModel {
                                 q[1] += shift[1];
                             }
                         }
-                        for (k, uv) in pts.into_iter().enumerate() {
-                            if let Some(&last) = poly.last() {
-                                if k == 0 && near_uv(last, uv) {
-                                    continue;
-                                }
-                                // A gap between two uses' pcurves (at a pole, where every
-                                // `u` is one point) is closed by a segment of the loop.
-                                real.push(k == 0 || !seam);
-                            }
-                            poly.push(uv);
-                        }
+                        append_to_loop(&mut poly, &mut real, pts, seam);
                         hint = poly.last().copied();
                         continue;
                     }
@@ -244,22 +234,7 @@ impl StepModel {
                     }
                     for c in &geom {
                         let pts = sample(c, &f.surface, &mut hint, chord);
-                        for (k, uv) in pts.into_iter().enumerate() {
-                            if let Some(&last) = poly.last() {
-                                // A piece starts where the previous one ends, except at a
-                                // pole (a collapsed edge), where the two ends are one 3D
-                                // point inverted to different `u`: the segment between them
-                                // runs along the pole's line. Dropping it let the loop cut
-                                // from the previous end straight to this edge's next sample,
-                                // a sliver out of boxed_sphere's sphere faces (lunes between
-                                // meridians), 7.7·10⁻⁴ wide in v at the pole.
-                                if k == 0 && near_uv(last, uv) {
-                                    continue;
-                                }
-                                real.push(k == 0 || !seam);
-                            }
-                            poly.push(uv);
-                        }
+                        append_to_loop(&mut poly, &mut real, pts, seam);
                     }
                 }
                 if poly.len() < 2 {
@@ -437,6 +412,25 @@ fn sample(
     }
     *hint = out.last().copied();
     out
+}
+
+/// Appends an edge piece's polygon `pts` to a loop's points, with the `real` flag of each new
+/// segment (a seam's own segments are not real). The piece's first point is dropped if it is
+/// the loop's last point; otherwise the segment between them closes a gap, and is real: at a
+/// pole (a collapsed edge) the two ends are one 3D point at different `u`, and the segment
+/// runs along the pole's line. Dropping it unconditionally (the 3D-mapped path did) let the
+/// loop cut straight to the next sample: a sliver out of boxed_sphere's sphere faces (lunes
+/// between meridians), 7.7·10⁻⁴ wide in `v` at the pole.
+fn append_to_loop(poly: &mut Vec<[f64; 2]>, real: &mut Vec<bool>, pts: Vec<[f64; 2]>, seam: bool) {
+    for (k, uv) in pts.into_iter().enumerate() {
+        if let Some(&last) = poly.last() {
+            if k == 0 && near_uv(last, uv) {
+                continue;
+            }
+            real.push(k == 0 || !seam);
+        }
+        poly.push(uv);
+    }
 }
 
 /// Whether two loop points are the same up to rounding.
