@@ -72,6 +72,10 @@ pub struct Args {
     /// cells (flat regions end with few faces; 0: stop at the target).
     #[arg(long, default_value_t = gwn::products::remesh::simplify::DEFAULT_FLAT_TOLERANCE)]
     pub simplify_flat: f64,
+    /// Largest face, in finest cells along an axis, that a collapse of a flat vertex star (all
+    /// its faces in one plane) may make; other collapses keep faces within 6 cells.
+    #[arg(long, default_value_t = gwn::products::remesh::simplify::DEFAULT_MAX_FLAT_FACE_EXTENT)]
+    pub simplify_flat_extent: u32,
     /// Keep every simplified vertex on its marching-tetrahedra position (no move towards the
     /// quadric minimum after the collapses).
     #[arg(long)]
@@ -170,6 +174,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             relocate: !args.no_relocate,
             input_planes: !args.no_input_planes,
             flat_tolerance: args.simplify_flat,
+            max_flat_face_extent: args.simplify_flat_extent,
             ..SimplifyOptions::default()
         }),
         refine_plates: !args.no_plate_refinement,

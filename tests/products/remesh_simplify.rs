@@ -11,7 +11,8 @@ use gwn::Mesh;
 use gwn::products::remesh::RemeshOptions;
 use gwn::products::remesh::report::{TopologyReport, hausdorff_distance};
 use gwn::products::remesh::simplify::{
-    DEFAULT_TARGET_FRACTION, Refusal, Simplifier, SimplifyOptions, simplify,
+    DEFAULT_MAX_FACE_EXTENT, DEFAULT_MAX_FLAT_FACE_EXTENT, DEFAULT_TARGET_FRACTION, Refusal,
+    Simplifier, SimplifyOptions, simplify,
 };
 
 /// Sphere, torus, hollow shell, two cubes sharing a face: after simplification the surface is
@@ -185,6 +186,68 @@ fn flat_regions_collapse_past_the_target() {
         "{} of {}",
         curved_flat.triangles.len(),
         curved_target.triangles.len()
+    );
+}
+
+/// A collapse whose faces all lie in one plane may make faces up to `max_flat_face_extent`
+/// cells wide (they cover what the old ones did): a box off the lattice planes keeps a fraction
+/// of the faces the general bound of 6 cells leaves on its sides, every face wider than that
+/// lies in one side (all three fixed-point corners on one axis-aligned plane), the volume does
+/// not change, and every guarantee holds (`run_with` counts the exact self-intersections).
+#[test]
+fn flat_regions_take_larger_faces() {
+    let cube = common::unit_cube().translated([0.013, -0.021, 0.007]);
+    let with = |max_flat_face_extent: u32| {
+        run_with(
+            &cube,
+            &RemeshOptions {
+                simplify: Some(SimplifyOptions {
+                    max_flat_face_extent,
+                    ..SimplifyOptions::default()
+                }),
+                ..RemeshOptions::with_resolution(96)
+            },
+        )
+    };
+    let (bounded, r0) = with(DEFAULT_MAX_FACE_EXTENT);
+    let (large, r1) = with(DEFAULT_MAX_FLAT_FACE_EXTENT);
+    for r in [&r0, &r1] {
+        assert_closed_manifold(r);
+        assert_eq!((r.euler_characteristic, r.components), (2, 1), "{r}");
+    }
+    assert!(
+        large.triangles.len() * 2 < bounded.triangles.len(),
+        "{} faces with large flat faces, {} without",
+        large.triangles.len(),
+        bounded.triangles.len()
+    );
+    let bound = i64::from(DEFAULT_MAX_FACE_EXTENT) * large.ticks_per_cell;
+    let mut wide = 0;
+    for t in &large.triangles {
+        let p = t.map(|x| large.fixed[x as usize]);
+        let spread = |a: usize| {
+            p.iter().map(|q| q[a]).max().unwrap() - p.iter().map(|q| q[a]).min().unwrap()
+        };
+        let extent = (0..3).map(spread).max().unwrap();
+        if extent > bound {
+            wide += 1;
+            // On a side: within 1/64 cell of an axis-aligned plane (the placement puts the
+            // vertices of a side within a tick or two of one plane, and an exactly flat star
+            // may lie in a plane tilted by that much).
+            assert!(
+                (0..3).any(|a| spread(a) <= large.ticks_per_cell / 64),
+                "a face {extent} ticks wide off the sides: {p:?}"
+            );
+        }
+    }
+    assert!(wide > 0, "no face wider than {bound} ticks");
+    let (v0, v1) = (
+        crate::remesh::signed_volume(&bounded, |_| true),
+        crate::remesh::signed_volume(&large, |_| true),
+    );
+    assert!(
+        (v1 - 1.0).abs() < 0.01 && (v1 - v0).abs() < 1e-3,
+        "{v0} {v1}"
     );
 }
 
@@ -403,6 +466,7 @@ fn generous() -> SimplifyOptions {
     SimplifyOptions {
         max_distance: 4.0,
         max_face_extent: 16,
+        max_flat_face_extent: 16,
         target_fraction_of_marching_cubes: 0.0,
         relocate: true,
         input_planes: true,

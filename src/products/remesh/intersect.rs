@@ -395,7 +395,15 @@ pub fn faces_intersect(s: [P; 3], t: [P; 3]) -> bool {
         }
         1 => {
             let (i, j) = shared[0];
-            segment_meets_triangle(s[(i + 1) % 3], s[(i + 2) % 3], t)
+            let (p, q) = (s[(i + 1) % 3], s[(i + 2) % 3]);
+            let sides = (orient(t[0], t[1], t[2], p), orient(t[0], t[1], t[2], q));
+            // `s` off `t`'s plane but for the shared corner: `s` meets that plane, hence `t`,
+            // only there (most pairs the simplification tests share a corner, and this saves
+            // the second segment's two orientations).
+            if sides.0 == sides.1 && sides.0 != 0 {
+                return false;
+            }
+            segment_meets_triangle_on_sides(p, q, t, sides)
                 || segment_meets_triangle(t[(j + 1) % 3], t[(j + 2) % 3], s)
         }
         2 => {
@@ -414,8 +422,12 @@ pub fn faces_intersect(s: [P; 3], t: [P; 3]) -> bool {
 
 /// Whether the closed segment `p q` meets the closed (non-degenerate) triangle `t`.
 fn segment_meets_triangle(p: P, q: P, t: [P; 3]) -> bool {
-    let op = orient(t[0], t[1], t[2], p);
-    let oq = orient(t[0], t[1], t[2], q);
+    let sides = (orient(t[0], t[1], t[2], p), orient(t[0], t[1], t[2], q));
+    segment_meets_triangle_on_sides(p, q, t, sides)
+}
+
+/// [`segment_meets_triangle`] with the sides of `p` and `q` of `t`'s plane known.
+fn segment_meets_triangle_on_sides(p: P, q: P, t: [P; 3], (op, oq): (i32, i32)) -> bool {
     if op == oq && op != 0 {
         return false;
     }

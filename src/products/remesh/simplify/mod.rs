@@ -68,6 +68,9 @@ pub const DEFAULT_MAX_DISTANCE: f64 = 0.5;
 /// Default [`SimplifyOptions::max_face_extent`], in finest cells.
 pub const DEFAULT_MAX_FACE_EXTENT: u32 = 6;
 
+/// Default [`SimplifyOptions::max_flat_face_extent`], in finest cells.
+pub const DEFAULT_MAX_FLAT_FACE_EXTENT: u32 = 32;
+
 /// Default [`SimplifyOptions::target_fraction_of_marching_cubes`].
 pub const DEFAULT_TARGET_FRACTION: f64 = 0.45;
 
@@ -125,6 +128,12 @@ pub struct SimplifyOptions {
     pub max_distance: f64,
     /// Largest extent of a face's bounding box along any axis, in finest cells.
     pub max_face_extent: u32,
+    /// The same for the new faces of a collapse whose faces all lie in one plane (a box's
+    /// side, a printer bed): they cover what the old ones did, so only the spatial index's
+    /// work grows with them (they need no intersection check, and their few large faces sit
+    /// in the index's large size classes). At most [`SimplifyOptions::max_face_extent`] has
+    /// no effect.
+    pub max_flat_face_extent: u32,
     /// Stop once the face count is at most this fraction of a dense marching cubes' on the same
     /// corner classes (the remesher's [`super::RemeshStats::marching_cubes_faces`]; [`simplify`]
     /// itself takes a face count); 0: collapse as far as the other bounds allow. Collapses run
@@ -176,6 +185,7 @@ impl Default for SimplifyOptions {
         SimplifyOptions {
             max_distance: DEFAULT_MAX_DISTANCE,
             max_face_extent: DEFAULT_MAX_FACE_EXTENT,
+            max_flat_face_extent: DEFAULT_MAX_FLAT_FACE_EXTENT,
             target_fraction_of_marching_cubes: DEFAULT_TARGET_FRACTION,
             relocate: true,
             input_planes: true,
@@ -383,6 +393,8 @@ pub struct Simplifier {
     /// ([`SimplifyOptions::lattice_cube_cells`] cells).
     cube_ticks: i64,
     max_extent: i64,
+    /// The same for a flat star's new faces ([`SimplifyOptions::max_flat_face_extent`]).
+    max_flat_extent: i64,
     /// Squared distance bound, lattice units.
     max_distance2: f64,
     /// While set ([`Simplifier::run_flat`]): the largest quadric error (squared, lattice units)
@@ -537,6 +549,9 @@ impl Simplifier {
             .unwrap_or(0);
         let shift = (64 - largest.leading_zeros()).saturating_sub(30);
         let max_extent = i64::from(options.max_face_extent.max(1)).saturating_mul(ticks_per_cell);
+        let max_flat_extent = i64::from(options.max_flat_face_extent)
+            .saturating_mul(ticks_per_cell)
+            .max(max_extent);
         let (vertices, faces) = (points.len(), triangles.len());
         Ok(Simplifier {
             points,
@@ -554,6 +569,7 @@ impl Simplifier {
             ticks: ticks_per_cell,
             cube_ticks: ticks_per_cell.saturating_mul(i64::from(options.lattice_cube_cells.max(1))),
             max_extent,
+            max_flat_extent,
             max_distance2: (options.max_distance * options.max_distance),
             flat_limit: None,
             slab: None,
@@ -900,8 +916,11 @@ impl Simplifier {
         for &f in old {
             let t = self.faces[f as usize];
             let moved = t.map(p);
-            let (lo, hi) = face_box(moved);
-            if (0..3).any(|a| hi[a] - lo[a] > self.max_extent) {
+            let extent = |(lo, hi): (P, P)| (0..3).map(|a| hi[a] - lo[a]).max().unwrap_or(0);
+            // A flat region's larger faces ([`SimplifyOptions::max_flat_face_extent`]) may
+            // move, but not grow.
+            let before = face_box(t.map(|x| self.points[x as usize]));
+            if extent(face_box(moved)) > self.max_extent.max(extent(before)) {
                 return None;
             }
             let after = normal(moved);
@@ -1067,21 +1086,40 @@ impl Simplifier {
         {
             return Err(Refusal::NotAnEdge);
         }
-        let old = self.vertex_faces[u as usize].clone();
-        let mut opposite = Vec::with_capacity(2);
-        for &f in &old {
+        let old: &[u32] = &self.vertex_faces[u as usize];
+        let mut opposite = [u32::MAX; 2];
+        let mut shared = 0;
+        for &f in old {
             let t = self.faces[f as usize];
             if t.contains(&v) {
-                opposite.push(t[0] ^ t[1] ^ t[2] ^ u ^ v);
+                if shared == 2 {
+                    return Err(Refusal::NotAnEdge);
+                }
+                opposite[shared] = t[0] ^ t[1] ^ t[2] ^ u ^ v;
+                shared += 1;
             }
         }
-        if opposite.len() != 2 {
+        if shared != 2 {
             return Err(Refusal::NotAnEdge);
         }
         // Link condition: the common neighbours are exactly the two opposite vertices, and the
-        // edge between them is not in both links (the tetrahedron).
-        let nv = self.neighbours(v);
-        let common = nu.iter().filter(|x| nv.binary_search(x).is_ok()).count();
+        // edge between them is not in both links (the tetrahedron). Each of `v`'s neighbours is
+        // counted once: the first face of `v` that holds it (no sorted list of them: this runs
+        // for every candidate of every collapse).
+        let faces_of_v = &self.vertex_faces[v as usize];
+        let mut common = 0;
+        for (i, &f) in faces_of_v.iter().enumerate() {
+            for y in self.faces[f as usize] {
+                if y != v
+                    && nu.binary_search(&y).is_ok()
+                    && !faces_of_v[..i]
+                        .iter()
+                        .any(|&g| self.faces[g as usize].contains(&y))
+                {
+                    common += 1;
+                }
+            }
+        }
         if common != 2 {
             return Err(Refusal::Link);
         }
@@ -1097,14 +1135,20 @@ impl Simplifier {
         }
         let p = |x: u32| self.points[x as usize];
         let mut new = Vec::with_capacity(old.len());
-        for &f in &old {
+        // Known once asked: whether `u`'s star is flat (then its new faces may be larger).
+        let mut flat_star = None;
+        for &f in old {
             let t = self.faces[f as usize];
             if t.contains(&v) {
                 continue;
             }
             let n = t.map(|x| if x == u { v } else { x });
             let (lo, hi) = face_box(n.map(p));
-            if (0..3).any(|a| hi[a] - lo[a] > self.max_extent) {
+            let extent = (0..3).map(|a| hi[a] - lo[a]).max().unwrap_or(0);
+            if extent > self.max_extent
+                && (extent > self.max_flat_extent
+                    || !*flat_star.get_or_insert_with(|| self.star_is_flat(old)))
+            {
                 return Err(Refusal::FaceTooLarge);
             }
             let before = normal(t.map(p));
@@ -1132,24 +1176,24 @@ impl Simplifier {
         // Intersections: new faces against each other and against the live faces near them,
         // unless `u`'s star is flat, where the new faces cover what the old ones did.
         let exact: Vec<[P; 3]> = new.iter().map(|t| t.map(p)).collect();
-        let flat_star = self.star_is_flat(&old);
+        let flat_star = flat_star.unwrap_or_else(|| self.star_is_flat(old));
         let meets = match cubes {
             None if flat_star => {
                 debug_assert!(
-                    !self.meets_other_faces(&exact, &old),
+                    !self.meets_other_faces(&exact, old),
                     "a collapse of the flat star of {u} meets another face"
                 );
                 false
             }
-            None => self.meets_other_faces(&exact, &old),
-            Some(cubes) => cubes.refuses(self, u, &new, &exact, &old, flat_star),
+            None => self.meets_other_faces(&exact, old),
+            Some(cubes) => cubes.refuses(self, u, &new, &exact, old, flat_star),
         };
         if meets {
             return Err(Refusal::Intersection);
         }
         Ok(Plan {
             flat_star,
-            old,
+            old: old.to_vec(),
             new,
             support,
             v,

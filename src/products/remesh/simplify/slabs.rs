@@ -315,6 +315,7 @@ impl Simplifier {
             ticks: self.ticks,
             cube_ticks: self.cube_ticks,
             max_extent: self.max_extent,
+            max_flat_extent: self.max_flat_extent,
             max_distance2: self.max_distance2,
             flat_limit: None,
             slab: Some(slab),
