@@ -84,6 +84,46 @@ fn a_tilted_box_keeps_large_cells_on_its_faces() {
     );
 }
 
+/// With planar levels every edge places its vertex on one grid, the largest cubes' ticks,
+/// whatever its own level: on the raw surface of a box, the vertices of each side (away from
+/// its edges) lie on one plane of the fixed-point grid, although the side's cells are of
+/// several sizes (with a grid per level they were a fraction of a tick apart, and no vertex
+/// star across levels was flat for the simplification).
+#[test]
+fn the_vertices_of_a_side_lie_on_one_plane_at_every_level() {
+    let cube = crate::common::unit_cube().translated([0.013, -0.021, 0.007]);
+    let (raw, report) = run_with(
+        &cube,
+        &RemeshOptions {
+            simplify: None,
+            ..with_planar(48, 3)
+        },
+    );
+    assert_closed_manifold(&report);
+    assert!(raw.stats.planar_levels >= 2, "{}", raw.stats.planar_levels);
+    let (lo, hi) = ([0.013, -0.021, 0.007], [1.013, 0.979, 1.007]);
+    let h = raw.cell_size;
+    for axis in 0..3 {
+        for side in [lo[axis], hi[axis]] {
+            let mut planes = std::collections::BTreeMap::new();
+            for (p, f) in raw.positions.iter().zip(&raw.fixed) {
+                let inner = (0..3)
+                    .filter(|&a| a != axis)
+                    .all(|a| p[a] > lo[a] + 2.0 * h && p[a] < hi[a] - 2.0 * h);
+                if inner && (p[axis] - side).abs() < 0.5 * h {
+                    *planes.entry(f[axis]).or_insert(0) += 1;
+                }
+            }
+            assert_eq!(
+                planes.len(),
+                1,
+                "side {side} on axis {axis}: vertices on planes {planes:?}"
+            );
+            assert!(planes.values().sum::<usize>() > 100, "{planes:?}");
+        }
+    }
+}
+
 /// A sphere is nowhere flat within a tenth of a cell at this resolution: its band is cut to the
 /// resolution's cells, and the output stays within a cell, one closed genus-0 piece.
 #[test]

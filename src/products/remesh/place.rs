@@ -28,6 +28,10 @@
 //!
 //! Ticks are dyadic, so each vertex is exact in fixed point: lattice units times `T`
 //! ([`Placement::fixed`]), which the exact self-intersection check of [`super::intersect`] uses.
+//! With planar levels (cubes `2^planar` cells wide, `steps` raised by `planar`), an edge
+//! shorter than those cubes searches only every [`stride`]-th tick, so that every vertex lies
+//! on one grid, as fine as the largest cubes' ticks, whatever its edge's level; "a tick"
+//! above is then one stride.
 
 use rayon::prelude::*;
 
@@ -189,8 +193,28 @@ impl Search {
     }
 }
 
-/// Positions of the vertices on `edges` (inside corner, outside corner), within one tick
-/// (`|edge| / 2^(steps+1)`) of a class change; `corner_w` is `w` at each edge's two corners
+/// The stride, in ticks, of the search on an edge `l` finest cells long when the lattice has
+/// `planar` levels above the resolution: the edges of the largest cubes (`2^planar` cells)
+/// search every tick, shorter ones every `2^planar / l`-th. So every vertex lies on one grid of
+/// `2^planar` fixed-point units (`1 / 2^(steps − planar + 1)` of a resolution cell, the
+/// precision the steps were raised for) along every axis its edge moves along, whatever the
+/// edge's level: a side of the input on an axis-aligned plane gets all its vertices on one
+/// plane of that grid, whose vertex stars are then exactly flat for the simplification
+/// (with a finer grid on the shorter edges, vertices on one side were off by different
+/// fractions of a tick per level, and no star across levels was flat). Fewer steps on the
+/// short edges also cost fewer evaluations of the field.
+fn stride(l: i64, planar: u32) -> i64 {
+    let grid = 1i64 << planar.min(30);
+    let mut s = 1;
+    while s * 2 * l <= grid {
+        s *= 2;
+    }
+    s
+}
+
+/// Positions of the vertices on `edges` (inside corner, outside corner), within one stride
+/// of ticks (`|edge| / 2^(steps+1)` on the longest edges, the same length on shorter ones:
+/// see [`stride`]) of a class change; `corner_w` is `w` at each edge's two corners
 /// (the first above ½, the second not or NaN for a corner declared outside without an
 /// evaluation; only the number of evaluations depends on them), and `guide` proposes crossings
 /// (see the module documentation).
@@ -204,8 +228,18 @@ pub fn place_vertices<E: Evaluator + ?Sized>(
 ) -> Placement {
     assert_eq!(edges.len(), corner_w.len());
     let ticks: i64 = 1 << (steps + 1);
-    let at = |(i, o): (Corner, Corner), k: i64| -> [f64; 3] {
-        let t = k as f64 / ticks as f64;
+    // Each edge's search runs on its own units of `stride` ticks, `units(e)` of them.
+    let stride_of = |(i, o): (Corner, Corner)| {
+        let l = (0..3)
+            .map(|a| (i64::from(o[a]) - i64::from(i[a])).abs())
+            .max()
+            .unwrap_or(1);
+        stride(l, lattice.planar_levels).min(ticks / 4).max(1)
+    };
+    let units = |e: (Corner, Corner)| ticks / stride_of(e);
+    let at = |e: (Corner, Corner), k: i64| -> [f64; 3] {
+        let (i, o) = e;
+        let t = k as f64 / units(e) as f64;
         lattice
             .position([0, 1, 2].map(|a| f64::from(i[a]) + t * (f64::from(o[a]) - f64::from(i[a]))))
     };
@@ -223,8 +257,9 @@ pub fn place_vertices<E: Evaluator + ?Sized>(
                         let mut hits: Vec<(i64, Plane)> = Vec::new();
                         for &e in chunk {
                             hits.clear();
-                            bvh.for_each_crossing(at(e, 0), at(e, ticks), |t, tri| {
-                                let k = ((t * ticks as f64).round() as i64).clamp(1, ticks - 1);
+                            let n = units(e);
+                            bvh.for_each_crossing(at(e, 0), at(e, n), |t, tri| {
+                                let k = ((t * n as f64).round() as i64).clamp(1, n - 1);
                                 hits.push((k, plane_of(tri)));
                             });
                             // Stable: the first triangle in the hierarchy's order keeps its tick.
@@ -254,16 +289,17 @@ pub fn place_vertices<E: Evaluator + ?Sized>(
                 (all, planes, ranges)
             }
         };
-    let mut searches: Vec<Search> = corner_w
+    let mut searches: Vec<Search> = edges
         .iter()
-        .map(|&[w_lo, w_hi]| Search {
+        .zip(corner_w)
+        .map(|(&e, &[w_lo, w_hi])| Search {
             lo: 0,
-            hi: ticks,
+            hi: units(e),
             w_lo,
             w_hi,
             itp_steps: 0,
             itp_budget: 0,
-            itp_width: ticks,
+            itp_width: units(e),
             verified: false,
         })
         .collect();
@@ -339,7 +375,7 @@ pub fn place_vertices<E: Evaluator + ?Sized>(
         .par_iter()
         .zip(&searches)
         .map(|(&(i, o), s)| {
-            let k = tick(s);
+            let k = tick(s) * stride_of((i, o));
             [0, 1, 2].map(|a| i64::from(i[a]) * ticks + k * (i64::from(o[a]) - i64::from(i[a])))
         })
         .collect();
@@ -467,6 +503,23 @@ mod tests {
                 p.evaluations
             })
             .collect()
+    }
+
+    /// Every edge of a lattice with `planar` levels lands on the grid of `2^planar` fixed-point
+    /// units along the axes it moves along: stride × length is that grid wherever the length
+    /// divides it, and the stride is 1 for the largest edges and any longer one.
+    #[test]
+    fn strides_put_every_level_on_the_largest_cubes_grid() {
+        for planar in 0..4 {
+            let grid = 1i64 << planar;
+            for l in [1, 2, 4, 8, 16] {
+                let s = stride(l, planar);
+                assert!(s >= 1 && s.count_ones() == 1, "{l} {planar}: {s}");
+                assert_eq!(s * l, grid.max(l), "{l} {planar}");
+            }
+            // An odd length (a transition's edge) gets the largest stride that stays within it.
+            assert!(stride(3, planar) * 3 <= grid.max(3) && stride(3, planar) * 6 > grid);
+        }
     }
 
     #[test]

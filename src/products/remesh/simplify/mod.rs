@@ -68,8 +68,15 @@ pub const DEFAULT_MAX_DISTANCE: f64 = 0.5;
 /// Default [`SimplifyOptions::max_face_extent`], in finest cells.
 pub const DEFAULT_MAX_FACE_EXTENT: u32 = 6;
 
-/// Default [`SimplifyOptions::max_flat_face_extent`], in finest cells.
-pub const DEFAULT_MAX_FLAT_FACE_EXTENT: u32 = 32;
+/// Default [`SimplifyOptions::max_flat_face_extent`], in finest cells: no larger than the
+/// other faces. Larger flat faces answer for more removed vertices each, and the flat
+/// collapses' cost order (all about the same cost) grows one face after another, re-checking
+/// its removed vertices at every step: at 32 cells, on the corpus at res 256, the README's box
+/// keeps 7,624 faces instead of 51,142 at about the same time, but
+/// openscad-toomanyvertices takes 19 s instead of 8 for 10,890 faces instead of 31,260, and
+/// cura-twotrees235x235_generic 23–25 s instead of 13–15 for 5 % fewer faces
+/// (docs/benchmarks.md, "Large faces in flat regions").
+pub const DEFAULT_MAX_FLAT_FACE_EXTENT: u32 = DEFAULT_MAX_FACE_EXTENT;
 
 /// Default [`SimplifyOptions::target_fraction_of_marching_cubes`].
 pub const DEFAULT_TARGET_FRACTION: f64 = 0.45;
