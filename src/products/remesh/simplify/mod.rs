@@ -69,13 +69,11 @@ pub const DEFAULT_MAX_DISTANCE: f64 = 0.5;
 pub const DEFAULT_MAX_FACE_EXTENT: u32 = 6;
 
 /// Default [`SimplifyOptions::max_flat_face_extent`], in finest cells: no larger than the
-/// other faces. Larger flat faces answer for more removed vertices each, and the flat
-/// collapses' cost order (all about the same cost) grows one face after another, re-checking
-/// its removed vertices at every step: at 32 cells, on the corpus at res 256, the README's box
-/// keeps 7,624 faces instead of 51,142 at about the same time, but
-/// openscad-toomanyvertices takes 19 s instead of 8 for 10,890 faces instead of 31,260, and
-/// cura-twotrees235x235_generic 23–25 s instead of 13–15 for 5 % fewer faces
-/// (docs/benchmarks.md, "Large faces in flat regions").
+/// other faces. Larger flat faces answer for more removed vertices each, re-checked at every
+/// flat collapse next to them: at 32 cells, at res 256, the README's box keeps 7,624 faces
+/// instead of 51,142 at about the same time, but openscad-toomanyvertices takes 11 s instead
+/// of 7.5 for 10,890 faces instead of 31,260, and cura-twotrees235x235_generic 17 s instead
+/// of 14 for 5 % fewer faces (docs/benchmarks.md, "Large faces in flat regions").
 pub const DEFAULT_MAX_FLAT_FACE_EXTENT: u32 = DEFAULT_MAX_FACE_EXTENT;
 
 /// Default [`SimplifyOptions::target_fraction_of_marching_cubes`].
@@ -1165,16 +1163,35 @@ impl Simplifier {
             }
             new.push(n);
         }
-        // Distance: u and every vertex u's faces answer for, to the nearest new face.
+        // Distance: u and every vertex u's faces answer for, to the nearest new face. What the
+        // bound needs is that each removed vertex stays within `max_distance` of the face that
+        // answers for it (checked again whenever that face changes); the nearest is only the
+        // best guess. In a flat star the new faces cover what the old ones did, and a large
+        // flat face answers for hundreds of vertices: each first tries the face that replaces
+        // its own (one distance instead of a search; the collapse is refused exactly when it
+        // was: that face within the bound means the nearest is too), which halved the flat
+        // phase with 32-cell flat faces (docs/benchmarks.md, "Large faces in flat regions").
         let triangles: Vec<[[f64; 3]; 3]> =
             new.iter().map(|t| t.map(|x| self.at[x as usize])).collect();
         let mut support = vec![Vec::new(); new.len()];
-        let points = std::iter::once(u).chain(
-            old.iter()
-                .flat_map(|&f| self.support[f as usize].iter().copied()),
-        );
-        for x in points {
-            let (best, d2) = nearest_triangle(self.at[x as usize], &triangles);
+        let flat = *flat_star.get_or_insert_with(|| self.star_is_flat(old));
+        let mut replacing = 0;
+        let points = std::iter::once((u, None)).chain(old.iter().flat_map(|&f| {
+            let r = (!self.faces[f as usize].contains(&v)).then(|| {
+                replacing += 1;
+                replacing - 1
+            });
+            self.support[f as usize].iter().map(move |&x| (x, r))
+        }));
+        for (x, r) in points {
+            let q = self.at[x as usize];
+            if let Some(r) = r.filter(|_| flat) {
+                if point_triangle_distance2(q, &triangles[r]) <= self.max_distance2 {
+                    support[r].push(x);
+                    continue;
+                }
+            }
+            let (best, d2) = nearest_triangle(q, &triangles);
             if d2.is_nan() || d2 > self.max_distance2 {
                 return Err(Refusal::Distance);
             }
@@ -1183,7 +1200,7 @@ impl Simplifier {
         // Intersections: new faces against each other and against the live faces near them,
         // unless `u`'s star is flat, where the new faces cover what the old ones did.
         let exact: Vec<[P; 3]> = new.iter().map(|t| t.map(p)).collect();
-        let flat_star = flat_star.unwrap_or_else(|| self.star_is_flat(old));
+        let flat_star = flat;
         let meets = match cubes {
             None if flat_star => {
                 debug_assert!(
