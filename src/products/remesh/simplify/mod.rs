@@ -921,11 +921,10 @@ impl Simplifier {
         for &f in old {
             let t = self.faces[f as usize];
             let moved = t.map(p);
-            let extent = |(lo, hi): (P, P)| (0..3).map(|a| hi[a] - lo[a]).max().unwrap_or(0);
             // A flat region's larger faces ([`SimplifyOptions::max_flat_face_extent`]) may
             // move, but not grow.
-            let before = face_box(t.map(|x| self.points[x as usize]));
-            if extent(face_box(moved)) > self.max_extent.max(extent(before)) {
+            let before = face_extent(t.map(|x| self.points[x as usize]));
+            if face_extent(moved) > self.max_extent.max(before) {
                 return None;
             }
             let after = normal(moved);
@@ -1148,8 +1147,7 @@ impl Simplifier {
                 continue;
             }
             let n = t.map(|x| if x == u { v } else { x });
-            let (lo, hi) = face_box(n.map(p));
-            let extent = (0..3).map(|a| hi[a] - lo[a]).max().unwrap_or(0);
+            let extent = face_extent(n.map(p));
             if extent > self.max_extent
                 && (extent > self.max_flat_extent
                     || !*flat_star.get_or_insert_with(|| self.star_is_flat(old)))
@@ -1485,6 +1483,12 @@ fn dot_sign(a: [i128; 3], b: [i128; 3]) -> i32 {
         num_bigint::Sign::Minus => -1,
         num_bigint::Sign::NoSign => 0,
     }
+}
+
+/// The largest extent of a face's box along an axis.
+fn face_extent(t: [P; 3]) -> i64 {
+    let (lo, hi) = face_box(t);
+    (0..3).map(|a| hi[a] - lo[a]).max().unwrap_or(0)
 }
 
 fn face_box(t: [P; 3]) -> (P, P) {
