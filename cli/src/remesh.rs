@@ -73,9 +73,9 @@ pub struct Args {
     #[arg(long, default_value_t = gwn::products::remesh::simplify::DEFAULT_FLAT_TOLERANCE)]
     pub simplify_flat: f64,
     /// Largest face, in finest cells along an axis, that a collapse of a flat vertex star (all
-    /// its faces in one plane) may make; other collapses keep faces within 6 cells. 32 leaves
-    /// box-like inputs with several times fewer faces, at up to 1.5x the remesh time on large
-    /// flat regions.
+    /// its faces in one plane) may make, in a last flat stage; other collapses keep faces within
+    /// 6 cells. 6: no large flat faces (box-like inputs keep several times more faces, in less
+    /// time on large flat regions).
     #[arg(long, default_value_t = gwn::products::remesh::simplify::DEFAULT_MAX_FLAT_FACE_EXTENT)]
     pub simplify_flat_extent: u32,
     /// Keep every simplified vertex on its marching-tetrahedra position (no move towards the

@@ -68,13 +68,14 @@ pub const DEFAULT_MAX_DISTANCE: f64 = 0.5;
 /// Default [`SimplifyOptions::max_face_extent`], in finest cells.
 pub const DEFAULT_MAX_FACE_EXTENT: u32 = 6;
 
-/// Default [`SimplifyOptions::max_flat_face_extent`], in finest cells: no larger than the
-/// other faces. Larger flat faces answer for more removed vertices each, re-checked at every
-/// flat collapse next to them: at 32 cells, at res 256, the README's box keeps 7,624 faces
-/// instead of 51,142 at about the same time, but openscad-toomanyvertices takes 11 s instead
-/// of 7.5 for 10,890 faces instead of 31,260, and cura-twotrees235x235_generic 17 s instead
-/// of 14 for 5 % fewer faces (docs/benchmarks.md, "Large faces in flat regions").
-pub const DEFAULT_MAX_FLAT_FACE_EXTENT: u32 = DEFAULT_MAX_FACE_EXTENT;
+/// Default [`SimplifyOptions::max_flat_face_extent`], in finest cells. Large flat faces
+/// answer for hundreds of removed vertices each, re-checked at every collapse next to them,
+/// so they are made in a second flat stage, once every other collapse is done
+/// ([`Simplifier::run_flat`]): openscad-toomanyvertices at res 256 keeps 3,842 faces (31,260
+/// with no large faces) for 27.5 M distance checks of removed vertices (17.6 M with none, 100 M
+/// with large faces allowed from the start; docs/benchmarks.md, "Large flat faces in a second
+/// stage").
+pub const DEFAULT_MAX_FLAT_FACE_EXTENT: u32 = 32;
 
 /// Default [`SimplifyOptions::target_fraction_of_marching_cubes`].
 pub const DEFAULT_TARGET_FRACTION: f64 = 0.45;
@@ -134,10 +135,10 @@ pub struct SimplifyOptions {
     /// Largest extent of a face's bounding box along any axis, in finest cells.
     pub max_face_extent: u32,
     /// The same for the new faces of a collapse whose faces all lie in one plane (a box's
-    /// side, a printer bed): they cover what the old ones did, so only the spatial index's
-    /// work grows with them (they need no intersection check, and their few large faces sit
-    /// in the index's large size classes). At most [`SimplifyOptions::max_face_extent`] has
-    /// no effect.
+    /// side, a printer bed), in the flat phase's last stage ([`Simplifier::run_flat`]): they
+    /// cover what the old ones did, so only the spatial index's work grows with them (they
+    /// need no intersection check, and their few large faces sit in the index's large size
+    /// classes). At most [`SimplifyOptions::max_face_extent`] has no effect.
     pub max_flat_face_extent: u32,
     /// Stop once the face count is at most this fraction of a dense marching cubes' on the same
     /// corner classes (the remesher's [`super::RemeshStats::marching_cubes_faces`]; [`simplify`]
@@ -327,7 +328,7 @@ pub fn simplify_with_planes(
                 }
                 slab.run(Simplifier::slab_target(target_faces, share, foreign));
                 if flat {
-                    slab.run_flat(options.flat_tolerance);
+                    slab.flat_stage(options.flat_tolerance, false);
                 }
             });
             if slabs.is_empty()
@@ -337,7 +338,16 @@ pub fn simplify_with_planes(
             }
             s.run(target_faces);
             if flat {
-                s.run_flat(options.flat_tolerance);
+                // Large flat faces only here, after the slabs: a slab cannot make a face across
+                // its planes, and the strips of large faces it leaves along them are hard to
+                // collapse further — the README's box at res 256 kept 7,698 faces with the
+                // second stage in the slabs, 3,806 with it here, in the same time
+                // (docs/benchmarks.md, "Large flat faces in a second stage").
+                let large = s.max_flat_extent > s.max_extent;
+                if slabs.is_empty() && large {
+                    s.flat_stage(options.flat_tolerance, false);
+                }
+                s.flat_stage(options.flat_tolerance, large);
             }
             if options.relocate {
                 s.relocate();
@@ -398,8 +408,12 @@ pub struct Simplifier {
     /// ([`SimplifyOptions::lattice_cube_cells`] cells).
     cube_ticks: i64,
     max_extent: i64,
-    /// The same for a flat star's new faces ([`SimplifyOptions::max_flat_face_extent`]).
+    /// The same for a flat star's new faces ([`SimplifyOptions::max_flat_face_extent`]), in
+    /// the flat phase's second stage ([`Simplifier::large_flat_faces`]).
     max_flat_extent: i64,
+    /// Whether flat stars may make faces up to `max_flat_extent` now (the second stage of
+    /// [`Simplifier::run_flat`]); otherwise every face keeps within `max_extent`.
+    large_flat_faces: bool,
     /// Squared distance bound, lattice units.
     max_distance2: f64,
     /// While set ([`Simplifier::run_flat`]): the largest quadric error (squared, lattice units)
@@ -575,6 +589,7 @@ impl Simplifier {
             cube_ticks: ticks_per_cell.saturating_mul(i64::from(options.lattice_cube_cells.max(1))),
             max_extent,
             max_flat_extent,
+            large_flat_faces: false,
             max_distance2: (options.max_distance * options.max_distance),
             flat_limit: None,
             slab: None,
@@ -615,14 +630,34 @@ impl Simplifier {
 
     /// More collapses after [`Simplifier::run`], in the same rounds and order, restricted to
     /// those whose quadric error is at most `tolerance` cells (see
-    /// [`SimplifyOptions::flat_tolerance`]), until none is left. Every check applies as in
-    /// [`Simplifier::run`].
+    /// [`SimplifyOptions::flat_tolerance`]), until none is left; then again with flat stars
+    /// allowed to make faces up to [`SimplifyOptions::max_flat_face_extent`]
+    /// (the second stage). Every check applies as in [`Simplifier::run`].
+    ///
+    /// Why two stages: a removed vertex is re-checked at every collapse whose star holds the
+    /// face answering for it, and a large flat face answers for hundreds. Allowed from the
+    /// start, large faces form while the small collapses around them are still to come, and
+    /// each of those re-checks them all (openscad-toomanyvertices at res 256: 100 M distance
+    /// checks in 1.55 M flat plans, 10,890 faces); made last, from faces already 6 cells wide,
+    /// far fewer collapses meet them (27.5 M checks, 3,842 faces).
     pub fn run_flat(&mut self, tolerance: f64) {
+        self.flat_stage(tolerance, false);
+        if self.max_flat_extent > self.max_extent {
+            self.flat_stage(tolerance, true);
+        }
+    }
+
+    /// One stage of [`Simplifier::run_flat`]: the flat collapses, with flat stars allowed to
+    /// make faces up to [`SimplifyOptions::max_flat_face_extent`] if `large_faces` (else every
+    /// face keeps within [`SimplifyOptions::max_face_extent`]).
+    fn flat_stage(&mut self, tolerance: f64, large_faces: bool) {
         if !(tolerance.is_finite() && tolerance > 0.0) {
             return;
         }
         self.flat_limit = Some(tolerance * tolerance);
+        self.large_flat_faces = large_faces;
         self.collapse_rounds(0);
+        self.large_flat_faces = false;
         self.flat_limit = None;
     }
 
@@ -1149,7 +1184,8 @@ impl Simplifier {
             let n = t.map(|x| if x == u { v } else { x });
             let extent = face_extent(n.map(p));
             if extent > self.max_extent
-                && (extent > self.max_flat_extent
+                && (!self.large_flat_faces
+                    || extent > self.max_flat_extent
                     || !*flat_star.get_or_insert_with(|| self.star_is_flat(old)))
             {
                 return Err(Refusal::FaceTooLarge);

@@ -23,9 +23,10 @@
 //! surface draws on the facets in those planes (the other slab's side of the argument) do not
 //! change; and every slab keeps the pass's invariants by the same rules.
 //! The slabs collapse, cheapest first, to their share of the target with [`SLAB_SLACK`] to
-//! spare, then make the flat collapses ([`Simplifier::run_flat`], same checks); the global
-//! collapses ([`Simplifier::run`], then [`Simplifier::run_flat`]) finish in global cost order,
-//! which also takes the vertices within a ring of the planes.
+//! spare, then make the flat collapses with faces of the general size (the first stage of
+//! [`Simplifier::run_flat`], same checks); the global collapses ([`Simplifier::run`], then the
+//! flat ones with large flat faces) finish in global cost order, which also takes the vertices
+//! within a ring of the planes.
 
 use super::{P, Simplifier, SimplifyStats};
 use rayon::prelude::*;
@@ -316,6 +317,7 @@ impl Simplifier {
             cube_ticks: self.cube_ticks,
             max_extent: self.max_extent,
             max_flat_extent: self.max_flat_extent,
+            large_flat_faces: false,
             max_distance2: self.max_distance2,
             flat_limit: None,
             slab: Some(slab),
