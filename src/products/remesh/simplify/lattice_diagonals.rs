@@ -130,8 +130,9 @@ impl CubeFaces {
 
     /// Whether the collapse of `u` into the faces `new` (vertex indices, and `exact` their
     /// points; replacing `old`) breaks a rule of the module documentation, or a new face meets
-    /// another new face or a face of its owner. With `flat_star` (`u`'s faces lie in one plane
-    /// with one orientation: `Simplifier::star_is_flat`) the rules alone: no face can meet.
+    /// another new face or a face of its owner. With `keeps_surface` (the collapse keeps the
+    /// surface as a point set: `Simplifier::collapse_keeps_the_surface`) the rules alone: no
+    /// face can meet.
     pub(super) fn refuses(
         &self,
         s: &Simplifier,
@@ -139,7 +140,7 @@ impl CubeFaces {
         new: &[[u32; 3]],
         exact: &[[P; 3]],
         old: &[u32],
-        flat_star: bool,
+        keeps_surface: bool,
     ) -> bool {
         let ticks = s.cube_ticks;
         let pu = s.points[u as usize];
@@ -176,10 +177,10 @@ impl CubeFaces {
             }
             owners.push(m);
         }
-        if flat_star {
+        if keeps_surface {
             debug_assert!(
                 !self.meets_in_owners(s, exact, old, &owners),
-                "a collapse of the flat star of {u} meets another face"
+                "a collapse of {u} that keeps the surface meets another face"
             );
             return false;
         }

@@ -249,8 +249,9 @@ pub struct SimplifyStats {
     pub relocations_refused: usize,
     /// Collapses refused, by reason: link, face size, flip, distance, intersection.
     pub refused: [usize; 5],
-    /// Of [`SimplifyStats::collapses`], those of vertices whose faces all lay in one plane,
-    /// which need no intersection check (`Simplifier::star_is_flat` says why).
+    /// Of [`SimplifyStats::collapses`], those that kept the surface as a point set (`u`'s
+    /// faces all in one plane, or along a straight crease), which need no intersection check
+    /// (`Simplifier::star_is_flat` and `Simplifier::star_is_a_straight_crease` say why).
     pub flat_star_collapses: usize,
     /// The input was not a closed oriented manifold without collinear faces: left unchanged.
     pub skipped: bool,
@@ -437,8 +438,10 @@ struct Plan {
     v: u32,
     /// The neighbours of `u` (their best collapses change), when known.
     ring: Vec<u32>,
-    /// Whether `u`'s faces all lay in one plane (no intersection check was needed).
-    flat_star: bool,
+    /// Whether the collapse kept the surface as a point set (`u`'s faces in one plane, or a
+    /// straight crease: [`Simplifier::collapse_keeps_the_surface`]; no intersection check was
+    /// needed).
+    keeps_surface: bool,
 }
 
 impl Simplifier {
@@ -1048,7 +1051,7 @@ impl Simplifier {
     /// Makes the collapse `plan` of `u` (computed on the current surface).
     fn apply(&mut self, u: u32, plan: Plan) {
         let v = plan.v;
-        self.stats.flat_star_collapses += usize::from(plan.flat_star);
+        self.stats.flat_star_collapses += usize::from(plan.keeps_surface);
         for &f in &plan.old {
             self.alive[f as usize] = false;
             self.index(f, false);
@@ -1174,8 +1177,9 @@ impl Simplifier {
         }
         let p = |x: u32| self.points[x as usize];
         let mut new = Vec::with_capacity(old.len());
-        // Known once asked: whether `u`'s star is flat (then its new faces may be larger).
-        let mut flat_star = None;
+        // Known once asked: whether the collapse keeps the surface (`u`'s star flat or a
+        // straight crease; then its new faces may be larger).
+        let mut keeps_surface = None;
         for &f in old {
             let t = self.faces[f as usize];
             if t.contains(&v) {
@@ -1186,7 +1190,8 @@ impl Simplifier {
             if extent > self.max_extent
                 && (!self.large_flat_faces
                     || extent > self.max_flat_extent
-                    || !*flat_star.get_or_insert_with(|| self.star_is_flat(old)))
+                    || !*keeps_surface
+                        .get_or_insert_with(|| self.collapse_keeps_the_surface(u, v, old)))
             {
                 return Err(Refusal::FaceTooLarge);
             }
@@ -1200,7 +1205,8 @@ impl Simplifier {
         // Distance: u and every vertex u's faces answer for, to the nearest new face. What the
         // bound needs is that each removed vertex stays within `max_distance` of the face that
         // answers for it (checked again whenever that face changes); the nearest is only the
-        // best guess. In a flat star the new faces cover what the old ones did, and a large
+        // best guess. In a flat star (or a straight crease) the new faces cover what the old
+        // ones did, and a large
         // flat face answers for hundreds of vertices: each first tries the face that replaces
         // its own (one distance instead of a search; the collapse is refused exactly when it
         // was: that face within the bound means the nearest is too), which halved the flat
@@ -1208,7 +1214,8 @@ impl Simplifier {
         let triangles: Vec<[[f64; 3]; 3]> =
             new.iter().map(|t| t.map(|x| self.at[x as usize])).collect();
         let mut support = vec![Vec::new(); new.len()];
-        let flat = *flat_star.get_or_insert_with(|| self.star_is_flat(old));
+        let keeps =
+            *keeps_surface.get_or_insert_with(|| self.collapse_keeps_the_surface(u, v, old));
         let mut replacing = 0;
         let points = std::iter::once((u, None)).chain(old.iter().flat_map(|&f| {
             let r = (!self.faces[f as usize].contains(&v)).then(|| {
@@ -1219,7 +1226,7 @@ impl Simplifier {
         }));
         for (x, r) in points {
             let q = self.at[x as usize];
-            if let Some(r) = r.filter(|_| flat) {
+            if let Some(r) = r.filter(|_| keeps) {
                 if point_triangle_distance2(q, &triangles[r]) <= self.max_distance2 {
                     support[r].push(x);
                     continue;
@@ -1232,25 +1239,24 @@ impl Simplifier {
             support[best].push(x);
         }
         // Intersections: new faces against each other and against the live faces near them,
-        // unless `u`'s star is flat, where the new faces cover what the old ones did.
+        // unless the collapse keeps the surface, where the new faces cover what the old ones did.
         let exact: Vec<[P; 3]> = new.iter().map(|t| t.map(p)).collect();
-        let flat_star = flat;
         let meets = match cubes {
-            None if flat_star => {
+            None if keeps => {
                 debug_assert!(
                     !self.meets_other_faces(&exact, old),
-                    "a collapse of the flat star of {u} meets another face"
+                    "a collapse of {u} that keeps the surface meets another face"
                 );
                 false
             }
             None => self.meets_other_faces(&exact, old),
-            Some(cubes) => cubes.refuses(self, u, &new, &exact, old, flat_star),
+            Some(cubes) => cubes.refuses(self, u, &new, &exact, old, keeps),
         };
         if meets {
             return Err(Refusal::Intersection);
         }
         Ok(Plan {
-            flat_star,
+            keeps_surface: keeps,
             old: old.to_vec(),
             new,
             support,
@@ -1285,20 +1291,88 @@ impl Simplifier {
             return false;
         };
         let n0 = normal(self.faces[first as usize].map(p));
-        let parallel = |n: [i128; 3]| {
-            (0..3).all(|k| {
-                let (i, j) = ((k + 1) % 3, (k + 2) % 3);
-                match (n0[i].checked_mul(n[j]), n0[j].checked_mul(n[i])) {
-                    (Some(a), Some(b)) => a == b,
-                    _ => false,
-                }
-            })
-        };
         n0 != [0; 3]
             && star.iter().all(|&f| {
                 let n = normal(self.faces[f as usize].map(p));
-                parallel(n) && dot_sign(n0, n) > 0
+                same_direction(n0, n)
             })
+    }
+
+    /// Whether the collapse `u → v` (of `u`'s faces `star`) leaves the surface the same point
+    /// set, so that, having passed the flip check, it needs no intersection check and may make
+    /// large faces: `u`'s star is flat ([`Simplifier::star_is_flat`]), or it is a straight
+    /// crease that `u` moves along ([`Simplifier::star_is_a_straight_crease`]).
+    fn collapse_keeps_the_surface(&self, u: u32, v: u32, star: &[u32]) -> bool {
+        self.star_is_flat(star) || self.star_is_a_straight_crease(u, v, star)
+    }
+
+    /// Whether `u`'s faces `star` lie in two planes, each with one orientation (exactly
+    /// parallel normals, positive dot products), meeting along the edges `u v` and `u w` only,
+    /// with `u` strictly inside the segment `v w` (exactly collinear). A box's edge: collapsing
+    /// `u` along it keeps the surface, by the argument of [`Simplifier::star_is_flat`] applied
+    /// to each plane's half of the star, a fan from edge `u v` to edge `u w` that tiles the
+    /// polygon `v, a_1, …, a_k, w` (its boundary runs from `w` back to `v` through `u`, a
+    /// straight segment since `u` lies on it): the new faces `(v, a_i, a_i+1)` and
+    /// `(v, a_k, w)`, positively oriented (the flip check), tile it too; the segment `v w` was
+    /// covered by the edges `v u` and `u w`, whose only faces are in the star, so no face
+    /// outside the star meets it but in `v` or `w`. Conservative like `star_is_flat`.
+    fn star_is_a_straight_crease(&self, u: u32, v: u32, star: &[u32]) -> bool {
+        let p = |x: u32| self.points[x as usize];
+        let normals: Vec<[i128; 3]> = star
+            .iter()
+            .map(|&f| normal(self.faces[f as usize].map(p)))
+            .collect();
+        let Some(&a) = normals.first() else {
+            return false;
+        };
+        let Some(&b) = normals.iter().find(|&&n| !same_direction(a, n)) else {
+            return false;
+        };
+        if a == [0; 3] || b == [0; 3] || parallel(a, b) {
+            return false;
+        }
+        let mut plane = Vec::with_capacity(normals.len());
+        for &n in &normals {
+            match (same_direction(a, n), same_direction(b, n)) {
+                (true, _) => plane.push(false),
+                (false, true) => plane.push(true),
+                (false, false) => return false,
+            }
+        }
+        // The crease edges: `u x` whose two faces (x after u in one, before u in the other)
+        // lie in different planes.
+        let (mut crease, mut count) = ([u32::MAX; 2], 0);
+        for (i, &f) in star.iter().enumerate() {
+            let t = self.faces[f as usize];
+            let Some(k) = t.iter().position(|&y| y == u) else {
+                return false;
+            };
+            let x = t[(k + 1) % 3];
+            let Some(j) = star.iter().position(|&g| {
+                let s = self.faces[g as usize];
+                s.iter()
+                    .position(|&y| y == u)
+                    .is_some_and(|k| s[(k + 2) % 3] == x)
+            }) else {
+                return false;
+            };
+            if plane[i] != plane[j] {
+                if count == 2 {
+                    return false;
+                }
+                crease[count] = x;
+                count += 1;
+            }
+        }
+        let w = match crease {
+            [x, w] if count == 2 && x == v => w,
+            [w, x] if count == 2 && x == v => w,
+            _ => return false,
+        };
+        let (pu, pv, pw) = (p(u), p(v), p(w));
+        let (dv, dw) = (sub(pv, pu), sub(pw, pu));
+        let dot: i128 = (0..3).map(|k| i128::from(dv[k]) * i128::from(dw[k])).sum();
+        cross_exact(dv, dw) == [0; 3] && dot < 0
     }
 
     /// Whether the faces `exact` (replacing the faces `old`) meet each other or any other live
@@ -1488,6 +1562,24 @@ fn sub(a: P, b: P) -> P {
 /// Exact `(b − a) × (c − a)`.
 fn normal(t: [P; 3]) -> [i128; 3] {
     cross_exact(sub(t[1], t[0]), sub(t[2], t[0]))
+}
+
+/// Whether the `i128` vectors are exactly parallel (or one is zero); conservative: `false`
+/// where a product would overflow.
+fn parallel(a: [i128; 3], b: [i128; 3]) -> bool {
+    (0..3).all(|k| {
+        let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+        match (a[i].checked_mul(b[j]), a[j].checked_mul(b[i])) {
+            (Some(x), Some(y)) => x == y,
+            _ => false,
+        }
+    })
+}
+
+/// Whether `b` is exactly a positive multiple of `a` (both nonzero; conservative like
+/// [`parallel`]).
+fn same_direction(a: [i128; 3], b: [i128; 3]) -> bool {
+    parallel(a, b) && dot_sign(a, b) > 0
 }
 
 /// Exact sign of `a · b` for `i128` vectors (components below `2^123`): an `f64` filter, then
