@@ -1753,3 +1753,64 @@ pub fn point_triangle_distance2(p: [f64; 3], t: &[[f64; 3]; 3]) -> f64 {
         a[2] + ab[2] * v + ac[2] * w,
     ])
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A cube 4 ticks wide whose edge from corner 0 to corner 1 is split at its middle, vertex
+    /// 8: its faces lie in the bottom (`z = 0`) and the front (`y = 0`), meeting along the
+    /// edges 8–0 and 8–1.
+    fn cube_with_a_split_edge(middle: P) -> Simplifier {
+        let mut points: Vec<P> = (0..8)
+            .map(|i: i64| [(i & 1) * 4, (i >> 1 & 1) * 4, (i >> 2 & 1) * 4])
+            .collect();
+        points.push(middle);
+        let faces = [
+            [0, 2, 3],
+            [0, 3, 8],
+            [8, 3, 1],
+            [4, 5, 7],
+            [4, 7, 6],
+            [0, 8, 5],
+            [8, 1, 5],
+            [0, 5, 4],
+            [2, 6, 7],
+            [2, 7, 3],
+            [0, 4, 6],
+            [0, 6, 2],
+            [1, 3, 7],
+            [1, 7, 5],
+        ];
+        Simplifier::new(&points, &faces, 1, &SimplifyOptions::default())
+            .expect("a closed oriented manifold")
+    }
+
+    #[test]
+    fn a_collapse_along_a_straight_crease_keeps_the_surface() {
+        let s = cube_with_a_split_edge([2, 0, 0]);
+        let star = |x: u32| s.vertex_faces[x as usize].clone();
+        // Along the edge, either way: the crease.
+        assert!(s.star_is_a_straight_crease(8, 1, &star(8)));
+        assert!(s.star_is_a_straight_crease(8, 0, &star(8)));
+        assert!(s.collapse_keeps_the_surface(8, 1, &star(8)));
+        // Into a vertex of one plane only (the surface would change), from a corner (three
+        // planes), and a flat star is not a crease.
+        assert!(!s.star_is_a_straight_crease(8, 3, &star(8)));
+        assert!(!s.star_is_a_straight_crease(8, 5, &star(8)));
+        assert!(!s.star_is_a_straight_crease(0, 8, &star(0)));
+        assert!(!s.star_is_a_straight_crease(1, 8, &star(1)));
+        assert!(!s.star_is_flat(&star(8)));
+    }
+
+    #[test]
+    fn a_bent_crease_is_not_straight() {
+        // The middle vertex off the edge: its faces no longer lie in two planes.
+        for middle in [[2, 1, 0], [2, 0, 1], [2, 1, 1]] {
+            let s = cube_with_a_split_edge(middle);
+            let star = s.vertex_faces[8].clone();
+            assert!(!s.star_is_a_straight_crease(8, 1, &star), "{middle:?}");
+            assert!(!s.collapse_keeps_the_surface(8, 0, &star), "{middle:?}");
+        }
+    }
+}
