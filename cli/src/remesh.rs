@@ -208,8 +208,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let topology = TopologyReport::of(&out.positions, &out.triangles);
     bar.inc(1);
     bar.set_message("counting self-intersections (exact)");
-    // The broad phase is linear on the remesher's output (every face in one lattice cell); the
-    // budget only guards against a surprise.
+    // The broad phase is linear on the remesher's output (faces of at most 6 cells, flat ones
+    // up to `--simplify-flat-extent` in size classes of their own); the budget only guards
+    // against a surprise.
     let budget = 1000 * out.triangles.len() as u64 + 1_000_000;
     let check_start = std::time::Instant::now();
     let intersections = self_intersections(&out.fixed, &out.triangles, budget);
