@@ -1318,31 +1318,37 @@ impl Simplifier {
     /// outside the star meets it but in `v` or `w`. Conservative like `star_is_flat`.
     fn star_is_a_straight_crease(&self, u: u32, v: u32, star: &[u32]) -> bool {
         let p = |x: u32| self.points[x as usize];
-        let normals: Vec<[i128; 3]> = star
-            .iter()
-            .map(|&f| normal(self.faces[f as usize].map(p)))
-            .collect();
-        let Some(&a) = normals.first() else {
+        let normal_of = |f: u32| normal(self.faces[f as usize].map(p));
+        // No list of normals: this runs for every plan whose star is not flat, and a curved
+        // star leaves at its third face, in neither of the first two planes.
+        let Some(&first) = star.first() else {
             return false;
         };
-        let Some(&b) = normals.iter().find(|&&n| !same_direction(a, n)) else {
+        let a = normal_of(first);
+        let mut b = None;
+        for &f in &star[1..] {
+            let n = normal_of(f);
+            if same_direction(a, n) {
+                continue;
+            }
+            match b {
+                None => b = Some(n),
+                Some(b) if same_direction(b, n) => {}
+                Some(_) => return false,
+            }
+        }
+        let Some(b) = b else {
             return false;
         };
         if a == [0; 3] || b == [0; 3] || parallel(a, b) {
             return false;
         }
-        let mut plane = Vec::with_capacity(normals.len());
-        for &n in &normals {
-            match (same_direction(a, n), same_direction(b, n)) {
-                (true, _) => plane.push(false),
-                (false, true) => plane.push(true),
-                (false, false) => return false,
-            }
-        }
+        // Every face is in plane `a` or plane `b`; `true` for `b`.
+        let plane = |f: u32| !same_direction(a, normal_of(f));
         // The crease edges: `u x` whose two faces (x after u in one, before u in the other)
         // lie in different planes.
         let (mut crease, mut count) = ([u32::MAX; 2], 0);
-        for (i, &f) in star.iter().enumerate() {
+        for &f in star {
             let t = self.faces[f as usize];
             let Some(k) = t.iter().position(|&y| y == u) else {
                 return false;
@@ -1356,7 +1362,7 @@ impl Simplifier {
             }) else {
                 return false;
             };
-            if plane[i] != plane[j] {
+            if plane(f) != plane(star[j]) {
                 if count == 2 {
                     return false;
                 }
