@@ -33,12 +33,14 @@
 //!   faces lying in a cell's face do not count) while its corners agree, and where `w` just off
 //!   one of (up to four of) the crossing triangles, on either side, has the other class: the
 //!   evidence that something no corner sees is there (an inner face of overlapping parts, with
-//!   the corners' class on both sides, is not worth eight children);
+//!   the corners' class on both sides, is not worth eight children); and where that probe's
+//!   `w` is at least [`THIN_PART_MARGIN`] from ½, so that the part is a solid the input
+//!   bounds, not a fold of the level set ½ along an open sheet;
 //! - **propagation**: a leaf next to a cell just split (across a face or an edge) whose shared
 //!   face or edge holds a new point of a class that the corners around it do not explain (an
 //!   edge's midpoint against both ends, a face's centre against its four corners), and that a
-//!   triangle crosses — the thin part goes on into a cell whose corners differ for another
-//!   reason;
+//!   triangle crosses, and whose `w` is at least [`THIN_PART_MARGIN`] from ½ — the thin part
+//!   goes on into a cell whose corners differ for another reason;
 //! - **balance**: every cell around a split cell of level `l ≤ S` is a leaf of level `l` or
 //!   split, so leaves side by side differ by one level at most.
 //!
@@ -520,6 +522,18 @@ const PROBED_TRIANGLES: usize = 4;
 /// the rounding of the probe point, far below any part the lattice could resolve.
 const PROBE_OFFSET: f64 = 1e-3;
 
+/// How far from ½ `w` must be at the probe of the other class for
+/// [`Classified::with_hidden_class`] to call the cell's part thin, and at the unexplained point
+/// for the propagation to follow it (`w ≤ ¼` or `w ≥ ¾`): a solid that the input bounds,
+/// whose `w` jumps by about one across its faces. Next to an open sheet `w` is near ½ on its
+/// inner side, and the level set ½ folds on and off the sheet wherever the sheet bends (a
+/// gently wavy sheet makes blisters a fraction of a cell thick all over it); following those
+/// below the resolution cost up to 9× the time on open inputs (cgal-ALSTOM_TEST4 0.9 → 8.2 s at
+/// two levels, cgal-fold 1.1 → 7.1 s) for a shape that no triangle pins down. Not an
+/// integrality test: a closed input with flipped faces (cura-twotrees235x235_generic) has
+/// fractional `w` over much of its solid and thin parts worth finding there.
+pub const THIN_PART_MARGIN: f64 = 0.25;
+
 impl Classified {
     /// The cells of `cells` (of `level`, corners of one class, crossed by a triangle) in which
     /// `w` has the other class next to a crossing triangle: probed on both sides of up to
@@ -561,7 +575,7 @@ impl Classified {
             let class = self.label(m);
             let found = values[next..next + points.len()]
                 .iter()
-                .any(|&w| super::inside(w) != class);
+                .any(|&w| super::inside(w) != class && far_from_half(w));
             next += points.len();
             if found {
                 hidden.push(m);
@@ -699,7 +713,7 @@ impl Classified {
                 self.label(c)
             });
             let own = self.label(p);
-            if around.clone().all(|x| x != own) {
+            if far_from_half(self.value(p)) && around.clone().all(|x| x != own) {
                 return true;
             }
         }
@@ -807,6 +821,11 @@ impl Classified {
         }
         Some(())
     }
+}
+
+/// Whether `w` is at least [`THIN_PART_MARGIN`] from ½ (NaN, at border points: no).
+fn far_from_half(w: f64) -> bool {
+    (w - 0.5).abs() >= THIN_PART_MARGIN
 }
 
 /// Inverse of [`pack`].
