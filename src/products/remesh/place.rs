@@ -193,18 +193,20 @@ impl Search {
     }
 }
 
-/// The stride, in ticks, of the search on an edge `l` finest cells long when the lattice has
-/// `planar` levels above the resolution: the edges of the largest cubes (`2^planar` cells)
-/// search every tick, shorter ones every `2^planar / l`-th. So every vertex lies on one grid of
-/// `2^planar` fixed-point units (`1 / 2^(steps − planar + 1)` of a resolution cell, the
+/// The stride, in ticks, of the search on an edge `l` finest cells long when the largest
+/// (regular) cubes are `2^regular` finest cells ([`Lattice::sub_levels`]: the planar levels
+/// above the resolution plus the sub-cell levels below it): the edges of the largest cubes
+/// search every tick, shorter ones every `2^regular / l`-th. So every vertex lies on one grid
+/// of `2^regular` fixed-point units (`1 / 2^(steps − planar + 1)` of a resolution cell, the
 /// precision the steps were raised for) along every axis its edge moves along, whatever the
 /// edge's level: a side of the input on an axis-aligned plane gets all its vertices on one
 /// plane of that grid, whose vertex stars are then exactly flat for the simplification
 /// (with a finer grid on the shorter edges, vertices on one side were off by different
-/// fractions of a tick per level, and no star across levels was flat). Fewer steps on the
-/// short edges also cost fewer evaluations of the field.
-fn stride(l: i64, planar: u32) -> i64 {
-    let grid = 1i64 << planar.min(30);
+/// fractions of a tick per level, and no star across levels was flat: the README's cube at
+/// res 128 kept 1,756 faces with one sub-cell level, 920 without). Fewer steps on the short
+/// edges also cost fewer evaluations of the field.
+fn stride(l: i64, regular: u32) -> i64 {
+    let grid = 1i64 << regular.min(30);
     let mut s = 1;
     while s * 2 * l <= grid {
         s *= 2;
@@ -234,7 +236,7 @@ pub fn place_vertices<E: Evaluator + ?Sized>(
             .map(|a| (i64::from(o[a]) - i64::from(i[a])).abs())
             .max()
             .unwrap_or(1);
-        stride(l, lattice.planar_levels).min(ticks / 4).max(1)
+        stride(l, lattice.sub_levels).min(ticks / 4).max(1)
     };
     let units = |e: (Corner, Corner)| ticks / stride_of(e);
     let at = |e: (Corner, Corner), k: i64| -> [f64; 3] {
@@ -505,20 +507,21 @@ mod tests {
             .collect()
     }
 
-    /// Every edge of a lattice with `planar` levels lands on the grid of `2^planar` fixed-point
-    /// units along the axes it moves along: stride × length is that grid wherever the length
-    /// divides it, and the stride is 1 for the largest edges and any longer one.
+    /// Every edge of a lattice whose largest cubes are `2^regular` finest cells lands on the
+    /// grid of `2^regular` fixed-point units along the axes it moves along: stride × length is
+    /// that grid wherever the length divides it, and the stride is 1 for the largest edges and
+    /// any longer one.
     #[test]
     fn strides_put_every_level_on_the_largest_cubes_grid() {
-        for planar in 0..4 {
-            let grid = 1i64 << planar;
-            for l in [1, 2, 4, 8, 16] {
-                let s = stride(l, planar);
-                assert!(s >= 1 && s.count_ones() == 1, "{l} {planar}: {s}");
-                assert_eq!(s * l, grid.max(l), "{l} {planar}");
+        for regular in 0..7 {
+            let grid = 1i64 << regular;
+            for l in [1, 2, 4, 8, 16, 32, 64] {
+                let s = stride(l, regular);
+                assert!(s >= 1 && s.count_ones() == 1, "{l} {regular}: {s}");
+                assert_eq!(s * l, grid.max(l), "{l} {regular}");
             }
             // An odd length (a transition's edge) gets the largest stride that stays within it.
-            assert!(stride(3, planar) * 3 <= grid.max(3) && stride(3, planar) * 6 > grid);
+            assert!(stride(3, regular) * 3 <= grid.max(3) && stride(3, regular) * 6 > grid);
         }
     }
 
