@@ -91,9 +91,10 @@ pub struct Args {
     /// soups only).
     #[arg(long)]
     pub no_plate_refinement: bool,
-    /// Levels of cells below --res (0 to 3): a cell that an input triangle crosses while its
-    /// corners agree (a part thinner than a cell: a tip, a leg, a rib) is cut into eight, down
-    /// to this many levels, with conforming transitions (meshes and soups only).
+    /// Levels of cells below --res (0 to 3; 0: none): a cell that an input triangle crosses
+    /// while its corners agree, with a solid of the other class just off the triangle (a part
+    /// thinner than a cell: a tip, a leg, a rib), is cut into eight, down to this many levels,
+    /// with conforming transitions (meshes and soups only).
     #[arg(long, default_value_t = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS)]
     pub sub_cell_levels: u32,
     /// Levels of cells above --res (0 to 3) kept whole where the input in them is flat (within

@@ -426,9 +426,9 @@ pub fn filter_tets<'py>(
 /// --thicken``; ``EPS`` must be at least one finest cell. ``refine_plates`` (default on) makes
 /// the cells finer (at most 4 times, all axes together) across widespread plates of the input
 /// thinner than two cells, as ``gwn remesh`` does (``--no-plate-refinement``).
-/// ``sub_cell_levels`` (0 to 3) cuts cells that an input triangle crosses while their corners
-/// agree (parts thinner than a cell) into eight, down to that many levels below ``res``, as
-/// ``gwn remesh --sub-cell-levels``. ``planar_levels`` (0 to 3, default 3) keeps cells up to
+/// ``sub_cell_levels`` (0 to 3, default 1) cuts cells that an input triangle crosses while their
+/// corners agree (parts thinner than a cell) into eight, down to that many levels below
+/// ``res``, as ``gwn remesh --sub-cell-levels``. ``planar_levels`` (0 to 3, default 3) keeps cells up to
 /// ``2**planar_levels`` times larger whole where the input in them is flat, as many levels as a
 /// probe of the input finds pay (none on curved inputs), as ``gwn remesh --planar-levels``.
 #[pyfunction]

@@ -476,11 +476,13 @@ fn plate_thinner_than_a_cell_on_a_pedestal_gets_finer_cells_across_it() {
             .count();
         inside as f64 / in_plate.len() as f64
     };
-    // Without the probe: the plate is lost wherever the pedestal does not hold it up.
+    // Without the probe (and without sub-cell levels, which find much of the plate too: 97 %
+    // kept at one level): the plate is lost wherever the pedestal does not hold it up.
     let (coarse, r) = run_with(
         &mesh,
         &RemeshOptions {
             refine_plates: false,
+            sub_cell_levels: 0,
             ..RemeshOptions::with_resolution(res)
         },
     );
@@ -723,9 +725,14 @@ fn guided_placement_matches_bisection_with_far_fewer_evaluations() {
     let mesh = sphere([0.1, -0.2, 0.3], 1.0, 24, false);
     let wn = WindingNumber::new(&mesh).unwrap();
     let bounds = mesh.bounding_box().unwrap();
-    let options = raw(40);
+    // One lattice for both: sub-cell levels need the guide, so only the guided run would have
+    // them.
+    let options = RemeshOptions {
+        sub_cell_levels: 0,
+        ..raw(40)
+    };
     let bisected = remesh(&wn, bounds, &options).unwrap();
-    let (guided, _) = run_raw(&mesh, 40);
+    let (guided, _) = run_with(&mesh, &options);
     // Extraction does not depend on placement: the same triangles over the same lattice edges.
     assert_eq!(guided.triangles, bisected.triangles);
     let vertices = guided.positions.len();
@@ -771,7 +778,10 @@ fn a_misleading_guide_costs_evaluations_not_correctness() {
     let mesh = sphere([0.0; 3], 1.0, 24, false);
     let wn = WindingNumber::new(&mesh).unwrap();
     let bounds = mesh.bounding_box().unwrap();
-    let options = raw(32);
+    let options = RemeshOptions {
+        sub_cell_levels: 0,
+        ..raw(32)
+    };
     let bisected = remesh(&wn, bounds, &options).unwrap();
     let wrong = SegmentBvh::of_mesh(&mesh.translated([3.0 * 2.0 / 32.0, 0.0, 0.0]));
     let out = remesh_guided(&wn, Some(&wrong), bounds, &options, &|_| {}).unwrap();
