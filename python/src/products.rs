@@ -428,8 +428,8 @@ pub fn filter_tets<'py>(
 /// thinner than two cells, as ``gwn remesh`` does (``--no-plate-refinement``).
 /// ``sub_cell_levels`` (0 to 3, default 1) cuts cells that an input triangle crosses while their
 /// corners agree (parts thinner than a cell) into eight, down to that many levels below
-/// ``res``, as ``gwn remesh --sub-cell-levels``. ``planar_levels`` (0 to 3, default 3) keeps cells up to
-/// ``2**planar_levels`` times larger whole where the input in them is flat, as many levels as a
+/// ``res``, as ``gwn remesh --sub-cell-levels``. ``planar_levels`` (0 to 3, default 3) keeps
+/// cells up to ``2**planar_levels`` times larger whole where the input in them is flat, as many levels as a
 /// probe of the input finds pay (none on curved inputs), as ``gwn remesh --planar-levels``.
 #[pyfunction]
 #[pyo3(signature = (V, F, res = 128, *, bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS, simplify = true, method = "exact", beta = None, order = None, tolerance = None, threads = None, thicken = None, refine_plates = true, sub_cell_levels = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS, planar_levels = gwn::products::remesh::DEFAULT_PLANAR_LEVELS))]

@@ -107,10 +107,11 @@ pub const MAX_RESOLUTION: usize = 1 << 16;
 pub const DEFAULT_BISECTION_STEPS: u32 = 8;
 
 /// Default [`RemeshOptions::sub_cell_levels`] (of [`RemeshOptions::with_resolution`], the CLI
-/// and Python): one level, where parts thinner than a cell come back for a median 1.16× the
-/// time (corpus at res 256: Hausdorff distance within a cell on 48 of 58 closed inputs against
-/// 37 without; two levels: 50, at 1.26× and with walls thinner than the finest cell dotted
-/// into hundreds of components; docs/benchmarks.md, "One sub-cell level by default").
+/// and Python): one level, where parts thinner than a cell come back for a median 1.13× the
+/// time (corpus at res 256: Hausdorff distance to the solid's boundary within a cell on 49 of
+/// 60 closed inputs, against 38 without; two levels: 51, at 1.26×, with walls thinner than the
+/// finest cell dotted into hundreds of components; docs/benchmarks.md, "One sub-cell level by
+/// default").
 pub const DEFAULT_SUB_CELL_LEVELS: u32 = 1;
 
 /// Default [`RemeshOptions::planar_levels`] (of [`RemeshOptions::with_resolution`], the CLI and
