@@ -713,7 +713,8 @@ impl Classified {
                 self.label(c)
             });
             let own = self.label(p);
-            if far_from_half(self.value(p)) && around.clone().all(|x| x != own) {
+            // The margin last: one more lookup, only for the rare unexplained point.
+            if around.clone().all(|x| x != own) && far_from_half(self.value(p)) {
                 return true;
             }
         }
