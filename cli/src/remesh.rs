@@ -190,6 +190,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let bar = crate::common::progress(if args.no_simplify { 7 } else { 8 }, "remesh");
     let start = std::time::Instant::now();
     let guide = match input.mesh() {
+        // The input's own `w` is the field unless it was thickened.
+        Some(m) if !args.no_guide && thickened.is_none() => Some(SegmentBvh::of_field_mesh(m)),
         Some(m) if !args.no_guide => Some(SegmentBvh::of_mesh(m)),
         _ => None,
     };

@@ -485,9 +485,9 @@ pub fn remesh<'py>(
     }
     let out = threads::run(py, threads, || {
         let wn = evaluator_for(&mesh, &method)?;
-        let guide = SegmentBvh::of_mesh(&mesh);
         let out = match thicken {
             Some(eps) => {
+                let guide = SegmentBvh::of_mesh(&mesh);
                 let thick = ThickenedSheets::new(&mesh, &wn, eps)?;
                 // The slabs reach `eps` past the input's box (as in `gwn remesh`).
                 let bounds = gwn::BoundingBox {
@@ -496,7 +496,11 @@ pub fn remesh<'py>(
                 };
                 remesh_guided(&thick, Some(&guide), bounds, &options, &|_| {})?
             }
-            None => remesh_guided(&wn, Some(&guide), bounds, &options, &|_| {})?,
+            None => {
+                // The input's own `w` is the field: probes may be screened by an approximation.
+                let guide = SegmentBvh::of_field_mesh(&mesh);
+                remesh_guided(&wn, Some(&guide), bounds, &options, &|_| {})?
+            }
         };
         Ok::<_, Box<dyn std::error::Error + Send + Sync>>(out)
     })?

@@ -5,8 +5,9 @@
 
 use gwn::Mesh;
 use gwn::eval::antipodal::WindingNumber;
+use gwn::products::remesh::crossings::SegmentBvh;
 use gwn::products::remesh::report::hausdorff_distance;
-use gwn::products::remesh::{RemeshError, RemeshOptions, remesh};
+use gwn::products::remesh::{RemeshError, RemeshOptions, remesh, remesh_guided};
 use proptest::prelude::*;
 
 use crate::remesh::{assert_closed_manifold, assert_guarantees_on, run_with, sphere};
@@ -176,4 +177,51 @@ fn a_wavy_open_sheet_cuts_no_cells() {
     assert_closed_manifold(&report);
     assert_eq!(out.stats.refined_cells, 0, "{:?}", out.stats);
     assert_eq!(out.triangles.len(), flat.triangles.len());
+}
+
+/// An inconsistently oriented input (a ball with every other face flipped: half its edges on
+/// the signed boundary) beside a thin tilted plate: the thin-part probes are screened by the
+/// Barnes–Hut approximation (`SegmentBvh::of_field_mesh`) and the exact field is evaluated only
+/// where it leaves a hidden part possible. The screen must find every cell the exact probes
+/// find: the same cells cut, the same output, bit for bit, as with the unscreened guide.
+#[test]
+fn screened_probes_cut_the_cells_exact_probes_cut() {
+    let res = 32;
+    let ball = sphere([0.0, 0.0, 0.0], 1.0, 24, false);
+    let shuffled: Vec<[u32; 3]> = ball
+        .triangles()
+        .iter()
+        .enumerate()
+        .map(|(i, &t)| if i % 2 == 1 { [t[0], t[2], t[1]] } else { t })
+        .collect();
+    let ball = Mesh::new(ball.positions().to_vec(), shuffled).unwrap();
+    let cell = 4.4 / res as f64;
+    let plate = tilted_box([1.6, 1.4, 0.5 * cell], 0.5, 0.7, [2.3, 0.3, 0.1]);
+    let mesh = ball.concatenated(&plate).unwrap();
+    let wn = WindingNumber::new(&mesh).unwrap();
+    let options = with_levels(res, 2);
+    let run = |guide: &SegmentBvh| {
+        remesh_guided(
+            &wn,
+            Some(guide),
+            mesh.bounding_box().unwrap(),
+            &options,
+            &|_| {},
+        )
+        .unwrap()
+    };
+    let screened_guide = SegmentBvh::of_field_mesh(&mesh);
+    assert!(screened_guide.approximate_winding_number().is_some());
+    let exact = run(&SegmentBvh::of_mesh(&mesh));
+    let screened = run(&screened_guide);
+    assert!(exact.stats.refined_cells > 0, "{:?}", exact.stats);
+    assert_eq!(screened.stats.refined_cells, exact.stats.refined_cells);
+    assert_eq!(screened.positions, exact.positions);
+    assert_eq!(screened.triangles, exact.triangles);
+    // A consistently oriented input is not screened: its exact probes are cheap.
+    assert!(
+        SegmentBvh::of_field_mesh(&plate)
+            .approximate_winding_number()
+            .is_none()
+    );
 }
