@@ -87,7 +87,8 @@ impl SegmentBvh {
         let boundary = crate::mesh::geometric_boundary_edges(mesh).len() as f64;
         let edges = 1.5 * mesh.triangles().len() as f64;
         SegmentBvh {
-            approximate: (boundary >= SCREENED_BOUNDARY_FRACTION * edges).then(OnceLock::new),
+            approximate: (edges > 0.0 && boundary >= SCREENED_BOUNDARY_FRACTION * edges)
+                .then(OnceLock::new),
             ..SegmentBvh::of_mesh(mesh)
         }
     }

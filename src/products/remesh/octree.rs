@@ -574,8 +574,10 @@ impl Classified {
             .collect();
         let flat: Vec<[f64; 3]> = probes.iter().flatten().copied().collect();
         let values = match guide.approximate_winding_number() {
-            Some(approximate) => screened(evaluator, approximate, &flat, &classes),
-            None => evaluator.eval_batch(&flat),
+            Some(approximate) if !flat.is_empty() => {
+                screened(evaluator, approximate, &flat, &classes)
+            }
+            _ => evaluator.eval_batch(&flat),
         };
         let mut next = 0;
         let mut hidden = Vec::new();
