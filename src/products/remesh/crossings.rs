@@ -22,6 +22,13 @@ use crate::eval::fast::{FastParams, FastWindingNumber};
 /// 13 %, 2.1 → 11.5 s; cura-voron0_120_bed, closed, 0.03 → 0.79 s.
 pub const SCREENED_BOUNDARY_FRACTION: f64 = 0.25;
 
+/// Signed boundary edges from which [`SegmentBvh::of_field_mesh`] screens probes whatever their
+/// fraction: next to so long a boundary an exact probe costs more than the approximation does
+/// anywhere measured (wall time per probe on 2 threads, exact: pymeshlab-face000, 4,117 edges,
+/// 26 µs; cgal-bunny00 with 10 % of its faces flipped, 20,377 edges, 390 µs; the approximation
+/// at most 15 µs, on cura-predator_platform).
+pub const SCREENED_BOUNDARY_EDGES: usize = 4096;
+
 /// Triangles per leaf.
 const LEAF_SIZE: usize = 4;
 
@@ -79,15 +86,18 @@ impl SegmentBvh {
 
     /// [`SegmentBvh::of_mesh`] for a `mesh` whose own winding number is the field being
     /// remeshed (by any method; not a field derived from it, such as
-    /// [`super::thicken::ThickenedSheets`]). Where that pays (an inconsistently oriented input:
-    /// see [`SCREENED_BOUNDARY_FRACTION`]) the remesher screens its near-surface probes with a
+    /// [`super::thicken::ThickenedSheets`]). Where that pays (an inconsistently oriented input
+    /// or a long signed boundary: [`SCREENED_BOUNDARY_FRACTION`], [`SCREENED_BOUNDARY_EDGES`])
+    /// the remesher screens its near-surface probes with a
     /// Barnes–Hut approximation of `w` ([`SegmentBvh::approximate_winding_number`]) and
     /// evaluates the field only where the approximation leaves the answer open.
     pub fn of_field_mesh(mesh: &crate::Mesh) -> SegmentBvh {
         let boundary = crate::mesh::geometric_boundary_edges(mesh).len() as f64;
         let edges = 1.5 * mesh.triangles().len() as f64;
         SegmentBvh {
-            approximate: (edges > 0.0 && boundary >= SCREENED_BOUNDARY_FRACTION * edges)
+            approximate: (edges > 0.0
+                && (boundary >= SCREENED_BOUNDARY_FRACTION * edges
+                    || boundary >= SCREENED_BOUNDARY_EDGES as f64))
                 .then(OnceLock::new),
             ..SegmentBvh::of_mesh(mesh)
         }
