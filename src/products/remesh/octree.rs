@@ -724,7 +724,7 @@ impl Classified {
             });
             let own = self.label(p);
             // The margin last: one more lookup, only for the rare unexplained point.
-            if around.clone().all(|x| x != own) && far_from_half(self.value(p)) {
+            if around.clone().all(|x| x != own) && far_from_half(self.value(p), THIN_PART_MARGIN) {
                 return true;
             }
         }
@@ -834,15 +834,15 @@ impl Classified {
     }
 }
 
-/// Whether `w` is at least [`THIN_PART_MARGIN`] from ½ (NaN, at border points: no).
-fn far_from_half(w: f64) -> bool {
-    (w - 0.5).abs() >= THIN_PART_MARGIN
+/// Whether `w` is at least `margin` from ½ (NaN, at border points: no).
+fn far_from_half(w: f64, margin: f64) -> bool {
+    (w - 0.5).abs() >= margin
 }
 
 /// Whether `w` at a probe shows a part hidden in a cell whose corners have class `class`: the
 /// other class, at least `margin` from ½.
 fn shows_hidden_part(w: f64, class: bool, margin: f64) -> bool {
-    super::inside(w) != class && (w - 0.5).abs() >= margin
+    super::inside(w) != class && far_from_half(w, margin)
 }
 
 /// How far the Barnes–Hut approximation may be off `w` at a probe for [`screened`] to pass it
