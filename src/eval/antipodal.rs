@@ -202,11 +202,91 @@ impl WindingNumber {
     /// as columns ([`WindingNumber::eval_column`]: one crossing traversal per run and the boundary
     /// loop shared), which gives the same bits as point by point.
     pub fn eval_batch(&self, points: &[[f64; 3]]) -> Vec<f64> {
+        self.batch(points, |q| self.eval(q), |q, ts| self.eval_column(q, ts))
+    }
+
+    /// Winding numbers at many points within `tolerance`, each with a certified bound `b` on
+    /// its distance from [`WindingNumber::eval`]'s value: `(v, b)`, `|v − eval(q)| ≤ b ≤
+    /// tolerance + Options::tolerance`. Far boundary clusters are replaced by their expansions
+    /// at `tolerance` (a second hierarchy, built on first use for that tolerance and kept:
+    /// docs/boundary.md), which costs a fraction of the exact loop next to long signed
+    /// boundaries, where the evaluator's own tolerance leaves the loop to run. The integer part
+    /// is exact as always. A `tolerance` that is not above [`Options::tolerance`] (or NaN)
+    /// gives the values of [`WindingNumber::eval_batch`] with bound 0.
+    ///
+    /// ```
+    /// use gwn::{Mesh, eval::antipodal::WindingNumber};
+    /// let p = [[0.,0.,0.],[1.,0.,0.],[1.,1.,0.],[0.,1.,0.],[0.,0.,1.],[1.,0.,1.],[1.,1.,1.],[0.,1.,1.]];
+    /// let t = [[0,2,1],[0,3,2],[0,1,5],[0,5,4],[1,2,6],[1,6,5],[2,3,7],[2,7,6],[3,0,4],[3,4,7]];
+    /// let w = WindingNumber::new(&Mesh::from_slices(&p, &t)?)?;
+    /// let q = [[0.5, 0.5, 0.5], [0.5, 0.5, 3.0], [4.0, 0.2, 0.3]];
+    /// for ((v, b), exact) in w.eval_batch_within(&q, 1e-3).into_iter().zip(w.eval_batch(&q)) {
+    ///     assert!(b <= 1e-3 + 1e-10 && (v - exact).abs() <= b);
+    /// }
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn eval_batch_within(&self, points: &[[f64; 3]], tolerance: f64) -> Vec<(f64, f64)> {
+        match &self.core {
+            Dispatch::Narrow(c) => self.batch_within(c, points, tolerance),
+            Dispatch::Wide(c) => self.batch_within(c, points, tolerance),
+        }
+    }
+
+    /// [`WindingNumber::eval_batch_within`] on one index.
+    fn batch_within<W: Width>(
+        &self,
+        core: &ExactIndex<W>,
+        points: &[[f64; 3]],
+        tolerance: f64,
+    ) -> Vec<(f64, f64)> {
+        let own = self.options.tolerance;
+        if tolerance.is_nan() || tolerance <= own {
+            return self
+                .eval_batch(points)
+                .into_iter()
+                .map(|w| (w, 0.0))
+                .collect();
+        }
+        let hierarchy = core.hierarchy_within(tolerance);
+        let Some(tree) = hierarchy.tree() else {
+            // No node pays at `tolerance`, so none at the evaluator's own: the flat loop.
+            return self
+                .eval_batch(points)
+                .into_iter()
+                .map(|w| (w, 0.0))
+                .collect();
+        };
+        let tree = Some(tree);
+        // The looser sum is within its bound of the flat loop, and `eval` within `own` of it.
+        let one = |q: [f64; 3]| {
+            if q.iter().any(|c| !c.is_finite()) {
+                return (f64::NAN, 0.0);
+            }
+            let (chi, area, bound) = core.parts_with_bound_using(q, tree);
+            (w_of_parts(chi, area), bound + own)
+        };
+        let column = |q: [f64; 3], ts: &[f64]| {
+            core.column_with_bounds(q, ts, tree)
+                .into_iter()
+                .map(|(w, bound)| (w, bound + own))
+                .collect()
+        };
+        self.batch(points, one, column)
+    }
+
+    /// The batch loop of [`WindingNumber::eval_batch`] with the per-point (`one`) and per-column
+    /// (`column`) evaluations given.
+    fn batch<T: Copy + Default + Send>(
+        &self,
+        points: &[[f64; 3]],
+        one: impl Fn([f64; 3]) -> T + Sync,
+        column: impl Fn([f64; 3], &[f64]) -> Vec<T> + Sync,
+    ) -> Vec<T> {
         let axis = self.options.ray.map()[2].0;
         let same_line = |a: &[f64; 3], b: &[f64; 3]| {
             (0..3).all(|k| k == axis || a[k].to_bits() == b[k].to_bits())
         };
-        let mut out = vec![0.0; points.len()];
+        let mut out = vec![T::default(); points.len()];
         // Parallel over chunks (a run that crosses a chunk's end is simply split), so no
         // allocation grows with the number of runs; small batches still get several chunks per
         // thread.
@@ -224,14 +304,14 @@ impl WindingNumber {
                         end += 1;
                     }
                     if end - start == 1 {
-                        out[start] = self.eval(points[start]);
+                        out[start] = one(points[start]);
                     } else {
                         // The column's own coordinate is replaced by each point's (a non-finite
                         // one gives NaN for that point only).
                         let mut q = points[start];
                         q[axis] = 0.0;
                         let ts: Vec<f64> = points[start..end].iter().map(|p| p[axis]).collect();
-                        out[start..end].copy_from_slice(&self.eval_column(q, &ts));
+                        out[start..end].copy_from_slice(&column(q, &ts));
                     }
                     start = end;
                 }

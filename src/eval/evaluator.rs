@@ -65,6 +65,20 @@ pub trait Evaluator: Send + Sync {
         points.par_iter().map(|&q| self.eval(q)).collect()
     }
 
+    /// Winding numbers at many points, each with a bound `b` on its distance from
+    /// [`Evaluator::eval`]'s value there: `(v, b)`, `|v − eval(q)| ≤ b`, `b` at most about
+    /// `tolerance`. For callers that only compare `w` with levels (the remesher's classes): where
+    /// `[v − b, v + b]` holds no level, `v` decides like the value itself. The default is the
+    /// values with bound 0; the exact evaluator expands far boundary clusters at `tolerance`
+    /// ([`WindingNumber::eval_batch_within`]).
+    fn eval_batch_within(&self, points: &[[f64; 3]], tolerance: f64) -> Vec<(f64, f64)> {
+        let _ = tolerance;
+        self.eval_batch(points)
+            .into_iter()
+            .map(|w| (w, 0.0))
+            .collect()
+    }
+
     /// The world axis (0, 1, 2) along which [`Evaluator::eval_column`] is cheaper than point by
     /// point, if any; grids run their columns along it.
     fn column_axis(&self) -> Option<usize> {
@@ -113,6 +127,9 @@ macro_rules! forward_evaluator {
             fn eval_batch(&self, points: &[[f64; 3]]) -> Vec<f64> {
                 (**self).eval_batch(points)
             }
+            fn eval_batch_within(&self, points: &[[f64; 3]], tolerance: f64) -> Vec<(f64, f64)> {
+                (**self).eval_batch_within(points, tolerance)
+            }
             fn column_axis(&self) -> Option<usize> {
                 (**self).column_axis()
             }
@@ -140,6 +157,9 @@ impl Evaluator for WindingNumber {
     }
     fn eval_batch(&self, points: &[[f64; 3]]) -> Vec<f64> {
         WindingNumber::eval_batch(self, points)
+    }
+    fn eval_batch_within(&self, points: &[[f64; 3]], tolerance: f64) -> Vec<(f64, f64)> {
+        WindingNumber::eval_batch_within(self, points, tolerance)
     }
     /// The ray's axis: one BVH traversal serves a whole column ([`WindingNumber::eval_column`]).
     fn column_axis(&self) -> Option<usize> {

@@ -283,6 +283,50 @@ proptest! {
         check(&flat, &tree, &queries, &format!("ribbon of {} steps, τ={tolerance:e}, {ray:?}", steps.len()));
     }
 
+    /// The batch at a looser tolerance than the evaluator's own
+    /// (`WindingNumber::eval_batch_within`, the remesher's first pass): every value within its
+    /// bound of `eval`'s, the bound within the tolerance plus the evaluator's own, columns (runs
+    /// of points on one line along the ray) and single points alike, and `eval`'s own values
+    /// with bound 0 at a tolerance that is not looser.
+    #[test]
+    fn a_looser_batch_stays_within_its_bound_of_the_values(
+        seed in 0u64..1000,
+        flipped in 0.05f64..0.3,
+        tolerance in prop_oneof![Just(1.0 / 32.0), Just(1e-3), Just(1e-6)],
+        ray in 0usize..6,
+    ) {
+        let mesh = bumpy_hemisphere(40, 20, 0.02, flipped, seed);
+        let ray = RayAxis::ALL[ray];
+        let wn = with_tolerance(&mesh, 1e-10, ray);
+        let mut rng = common::Rng(seed);
+        let mut queries: Vec<[f64; 3]> = (0..30)
+            .map(|_| std::array::from_fn(|_| rng.range(-3.0, 3.0)))
+            .collect();
+        queries.extend(near_surface(&mesh, &mut rng, 30));
+        // Two columns along the ray's axis through near-surface points.
+        let axis = ray.map()[2].0;
+        for q in near_surface(&mesh, &mut rng, 2) {
+            queries.extend((0..12).map(|k| {
+                let mut p = q;
+                p[axis] += 0.05 * (k as f64 - 6.0);
+                p
+            }));
+        }
+        let values = wn.eval_batch(&queries);
+        let looser = wn.eval_batch_within(&queries, tolerance);
+        let mut expanded = 0;
+        for ((q, &w), &(v, b)) in queries.iter().zip(&values).zip(&looser) {
+            prop_assert!(b <= tolerance + 1e-10, "bound {b:e} at {q:?}");
+            // Beyond the bound: the rounding of two long sums, as in `check`.
+            prop_assert!((v - w).abs() <= b + 1e-13, "|{v} − {w}| > {b:e} at {q:?}");
+            expanded += usize::from(b > 1e-10);
+        }
+        // The flips make long boundaries: the looser hierarchy is used.
+        prop_assert!(tolerance < 1e-3 || expanded > 0, "nothing expanded at {tolerance:e}");
+        let same = wn.eval_batch_within(&queries, 1e-10);
+        prop_assert!(same.iter().zip(&values).all(|(&(v, b), &w)| v.to_bits() == w.to_bits() && b == 0.0));
+    }
+
     /// Scan-like surfaces with holes and flipped faces (many small loops and weight-2 edges).
     #[test]
     fn bound_holds_on_holes_and_flips(

@@ -5,6 +5,7 @@
 use super::ExactIndex;
 use crate::base::compensated::NeumaierSum;
 use crate::kernel::boundary_column::ColumnQuery;
+use crate::kernel::boundary_tree::BoundaryTree;
 use crate::kernel::input_predicates::InputPoint;
 use crate::kernel::predicates::{Width, far_query_numerator_sign};
 use crate::kernel::spherical::{EdgeSigns, INV_4PI, antipodal_edge_area, segment_gradient};
@@ -14,8 +15,14 @@ impl<W: Width> ExactIndex<W> {
     /// residual), and the bound (on `w`) of its expanded far part. `z_exact` is false when the
     /// query's frame z lies outside the grid (then `qz` is used in floating point for the
     /// magnitudes). Queries near a boundary edge, or whose residual matters for a sign, take the
-    /// double-double path, never the hierarchy.
-    pub(super) fn boundary_sum(&self, q: &InputPoint, z_exact: bool, qz: f64) -> (f64, f64) {
+    /// double-double path, never the hierarchy `tree`.
+    pub(super) fn boundary_sum(
+        &self,
+        q: &InputPoint,
+        z_exact: bool,
+        qz: f64,
+        tree: Option<&BoundaryTree>,
+    ) -> (f64, f64) {
         let qz_units = self.z_in_cells(qz);
         let (qi, r) = (q.n, q.r);
         // A residual the grid scaling could not hold: every edge on the exact inputs.
@@ -25,7 +32,7 @@ impl<W: Width> ExactIndex<W> {
             let area = self.boundary.area_sum_accurate::<W>(q, z_exact, qz_units);
             return (area, 0.0);
         }
-        match self.tree() {
+        match tree {
             Some(tree) => {
                 let sum = tree.area_sum::<W>(&self.boundary, qi, r, z_exact, qz_units);
                 (sum.area, sum.bound)
@@ -35,8 +42,8 @@ impl<W: Width> ExactIndex<W> {
     }
 
     /// Boundary sum for a query whose ray cannot approach the mesh: plain floating point (and
-    /// the hierarchy, whose every node the ray misses).
-    pub(super) fn far_boundary_sum(&self, qf: [f64; 3]) -> (f64, f64) {
+    /// the hierarchy `tree`, whose every node the ray misses).
+    pub(super) fn far_boundary_sum(&self, qf: [f64; 3], tree: Option<&BoundaryTree>) -> (f64, f64) {
         let term = |a: [i64; 3], b: [i64; 3]| {
             let ra = self.rel_f64(a, qf);
             let rb = self.rel_f64(b, qf);
@@ -48,7 +55,7 @@ impl<W: Width> ExactIndex<W> {
         };
         let limit = self.boundary.limit();
         let q = std::array::from_fn(|k| (qf[k] - self.origin[k]) / self.cell / limit);
-        let Some(tree) = self.tree().filter(|t| t.reaches(q)) else {
+        let Some(tree) = tree.filter(|t| t.reaches(q)) else {
             let mut sum = 0.0;
             for i in 0..self.boundary.len() {
                 let (a, b, weight) = self.boundary.edge(i);
@@ -128,19 +135,18 @@ impl<W: Width> ExactIndex<W> {
     }
 
     /// Whether the boundary sum at `qi + r` (lattice point and exact residual) is the flat loop:
-    /// no edge needs the accurate path and the hierarchy expands nothing there. Such queries of a
-    /// column are batched ([`ExactIndex::column_area_sums`]).
+    /// no edge needs the accurate path and the hierarchy `tree` expands nothing there. Such
+    /// queries of a column are batched ([`ExactIndex::column_area_sums`]).
     pub(super) fn boundary_sum_is_flat(
         &self,
         qi: [i64; 3],
         r: [f64; 3],
         z_exact: bool,
         qz_units: f64,
+        tree: Option<&BoundaryTree>,
     ) -> bool {
         !self.boundary.needs_accurate_sum::<W>(qi, r, z_exact)
-            && self
-                .tree()
-                .is_none_or(|t| t.is_flat_at(&self.boundary, qi, z_exact, qz_units))
+            && tree.is_none_or(|t| t.is_flat_at(&self.boundary, qi, z_exact, qz_units))
     }
 
     /// The query's frame `z` in grid units (the magnitude of a query clamped along the ray).

@@ -5,6 +5,7 @@
 use super::snap::SnappedQuery;
 use super::{ExactIndex, w_of_parts};
 use crate::kernel::boundary_column::ColumnQuery;
+use crate::kernel::boundary_tree::BoundaryTree;
 use crate::kernel::input_predicates::InputPoint;
 use crate::kernel::predicates::Width;
 use crate::kernel::quantize::Snap;
@@ -31,8 +32,22 @@ impl<W: Width> ExactIndex<W> {
     /// Winding numbers along one line parallel to the ray: at the world points `q` with the
     /// coordinate along the ray axis replaced by each `ts[k]` (NaN where that is not finite).
     pub fn column(&self, q: [f64; 3], ts: &[f64]) -> Vec<f64> {
+        self.column_with_bounds(q, ts, self.tree())
+            .into_iter()
+            .map(|(w, _)| w)
+            .collect()
+    }
+
+    /// [`ExactIndex::column`] with the boundary hierarchy `tree`, and each value's bound (on `w`)
+    /// of its expanded boundary (`(NaN, 0)` where not finite).
+    pub fn column_with_bounds(
+        &self,
+        q: [f64; 3],
+        ts: &[f64],
+        tree: Option<&BoundaryTree>,
+    ) -> Vec<(f64, f64)> {
         if q.iter().any(|c| !c.is_finite()) {
-            return vec![f64::NAN; ts.len()];
+            return vec![(f64::NAN, 0.0); ts.len()];
         }
         let axis = self.ray.map()[2].0;
         let world_at = |t: f64| {
@@ -46,10 +61,10 @@ impl<W: Width> ExactIndex<W> {
             ts.iter()
                 .map(|&t| {
                     if t.is_finite() {
-                        let (chi, area, _) = self.parts_in_grid_space(at(t), world_at(t));
-                        w_of_parts(chi, area)
+                        let (chi, area, bound) = self.parts_in_grid_space(at(t), world_at(t), tree);
+                        (w_of_parts(chi, area), bound)
                     } else {
-                        f64::NAN
+                        (f64::NAN, 0.0)
                     }
                 })
                 .collect()
@@ -85,13 +100,13 @@ impl<W: Width> ExactIndex<W> {
         // The boundary term: the points whose boundary sum is the flat loop go through the
         // column loop together (shared x, y work, bit-identical values), the others one by one.
         let mut batch: Vec<(usize, ColumnQuery)> = Vec::new();
-        let mut out = vec![f64::NAN; ts.len()];
+        let mut out = vec![(f64::NAN, 0.0); ts.len()];
         for (k, p) in points.iter().enumerate() {
             let Some(p) = p else { continue };
             let qi = [x, y, p.z];
             let r = [rx, ry, if p.z_exact { p.rz } else { 0.0 }];
             let qz_units = self.z_in_cells(p.qz);
-            if p.rz_exact && self.boundary_sum_is_flat(qi, r, p.z_exact, qz_units) {
+            if p.rz_exact && self.boundary_sum_is_flat(qi, r, p.z_exact, qz_units, tree) {
                 let query = ColumnQuery {
                     z: p.z,
                     z_exact: p.z_exact,
@@ -100,14 +115,14 @@ impl<W: Width> ExactIndex<W> {
                 };
                 batch.push((k, query));
             } else {
-                let area = self.boundary_sum(&input_point(p), p.z_exact, p.qz).0;
-                out[k] = w_of_parts(chis[k], area);
+                let (area, bound) = self.boundary_sum(&input_point(p), p.z_exact, p.qz, tree);
+                out[k] = (w_of_parts(chis[k], area), bound);
             }
         }
         let queries: Vec<ColumnQuery> = batch.iter().map(|&(_, c)| c).collect();
         let areas = self.column_area_sums([x, y], &queries);
         for (&(k, _), area) in batch.iter().zip(areas) {
-            out[k] = w_of_parts(chis[k], area);
+            out[k] = (w_of_parts(chis[k], area), 0.0);
         }
         out
     }

@@ -85,6 +85,8 @@ pub struct ExactIndex<W: Width> {
     /// that the evaluator's precompute is the flat loop's: the tree costs up to as much again on
     /// large boundaries (docs/benchmarks.md), paid by the first query instead.
     tree: std::sync::OnceLock<Option<BoundaryTree>>,
+    /// Hierarchies at looser tolerances ([`ExactIndex::hierarchy_within`]), built on first use.
+    looser: LooserTrees,
     bvh: RayBvh,
     _width: PhantomData<W>,
 }
@@ -222,6 +224,7 @@ impl<W: Width> ExactIndex<W> {
             boundary,
             tolerance,
             tree: std::sync::OnceLock::new(),
+            looser: LooserTrees::default(),
             bvh,
             _width: PhantomData,
         }
@@ -249,6 +252,7 @@ impl<W: Width> ExactIndex<W> {
             boundary: BoundaryEdges::default(),
             tolerance: 0.0,
             tree: std::sync::OnceLock::new(),
+            looser: LooserTrees::default(),
             bvh: RayBvh::default(),
             _width: PhantomData,
         })
@@ -262,7 +266,30 @@ impl<W: Width> ExactIndex<W> {
 
     /// The parts and the bound of the expanded boundary (on `w`) at a finite world query.
     pub fn parts_with_bound(&self, q: [f64; 3]) -> (i64, f64, f64) {
-        self.parts_in_grid_space(self.grid.pull_in_far(self.grid.in_grid_space(q)), q)
+        self.parts_with_bound_using(q, self.tree())
+    }
+
+    /// [`ExactIndex::parts_with_bound`] with the boundary hierarchy `tree` (one of
+    /// [`ExactIndex::hierarchy_within`]; `None`: the flat loop).
+    pub fn parts_with_bound_using(
+        &self,
+        q: [f64; 3],
+        tree: Option<&BoundaryTree>,
+    ) -> (i64, f64, f64) {
+        self.parts_in_grid_space(self.grid.pull_in_far(self.grid.in_grid_space(q)), q, tree)
+    }
+
+    /// The boundary hierarchy at `tolerance` (absolute, on `w`): the evaluator's own when
+    /// `tolerance` is its tolerance, else one built on first use for that tolerance and kept
+    /// (the last [`LOOSER_TREES`] of them). `None` inside: no node could ever pay.
+    pub fn hierarchy_within(&self, tolerance: f64) -> Hierarchy<'_> {
+        if tolerance.to_bits() == self.tolerance.to_bits() {
+            return Hierarchy::Own(self.tree());
+        }
+        Hierarchy::Looser(
+            self.looser
+                .get_or_build(tolerance, || BoundaryTree::build(&self.boundary, tolerance)),
+        )
     }
 
     /// What snapping the vertices to the lattice lost.
@@ -296,10 +323,76 @@ impl<W: Width> ExactIndex<W> {
         (v as f64 * self.to_unit) as f32
     }
 
-    /// The boundary hierarchy, built on first use.
+    /// The boundary hierarchy at the evaluator's tolerance, built on first use.
     fn tree(&self) -> Option<&BoundaryTree> {
         self.tree
             .get_or_init(|| BoundaryTree::build(&self.boundary, self.tolerance))
             .as_ref()
+    }
+}
+
+/// A boundary hierarchy of [`ExactIndex::hierarchy_within`], held for a batch of queries.
+pub enum Hierarchy<'a> {
+    /// The index's own (at its tolerance).
+    Own(Option<&'a BoundaryTree>),
+    /// One at another tolerance.
+    Looser(std::sync::Arc<Option<BoundaryTree>>),
+}
+
+impl Hierarchy<'_> {
+    /// The tree (`None`: no node can pay, the flat loop).
+    pub fn tree(&self) -> Option<&BoundaryTree> {
+        match self {
+            Hierarchy::Own(tree) => *tree,
+            Hierarchy::Looser(tree) => tree.as_ref().as_ref(),
+        }
+    }
+}
+
+/// How many hierarchies at other tolerances an index keeps ([`ExactIndex::hierarchy_within`]):
+/// a caller alternating between more tolerances rebuilds, but memory stays bounded.
+pub const LOOSER_TREES: usize = 2;
+
+/// The hierarchies an index built at tolerances other than its own, newest last.
+#[derive(Default)]
+struct LooserTrees(std::sync::Mutex<Vec<(u64, std::sync::Arc<Option<BoundaryTree>>)>>);
+
+impl LooserTrees {
+    /// The hierarchy at `tolerance`, built by `build` (under the lock: concurrent callers wait
+    /// for one build instead of repeating it; the build runs on scoped threads, not rayon's, so
+    /// a waiting rayon worker cannot be asked to help it) when not kept.
+    fn get_or_build(
+        &self,
+        tolerance: f64,
+        build: impl FnOnce() -> Option<BoundaryTree>,
+    ) -> std::sync::Arc<Option<BoundaryTree>> {
+        let mut kept = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        let key = tolerance.to_bits();
+        if let Some((_, tree)) = kept.iter().find(|(k, _)| *k == key) {
+            return tree.clone();
+        }
+        let tree = std::sync::Arc::new(build());
+        if kept.len() >= LOOSER_TREES {
+            kept.remove(0);
+        }
+        kept.push((key, tree.clone()));
+        tree
+    }
+}
+
+impl Clone for LooserTrees {
+    fn clone(&self) -> Self {
+        LooserTrees(std::sync::Mutex::new(
+            self.0.lock().unwrap_or_else(|e| e.into_inner()).clone(),
+        ))
+    }
+}
+
+impl std::fmt::Debug for LooserTrees {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let kept = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        f.debug_list()
+            .entries(kept.iter().map(|(k, _)| f64::from_bits(*k)))
+            .finish()
     }
 }

@@ -2,6 +2,7 @@
 //! residual and the clamp rule's proxy (module doc of [`super`]).
 
 use super::ExactIndex;
+use crate::kernel::boundary_tree::BoundaryTree;
 use crate::kernel::input_predicates::InputPoint;
 use crate::kernel::predicates::Width;
 use crate::kernel::quantize::{Precision, Snap};
@@ -68,8 +69,13 @@ impl<W: Width> ExactIndex<W> {
 
     /// The parts at a grid-space query already pulled in
     /// ([`crate::kernel::quantize::Grid::pull_in_far`]) from the world query `world`, and the
-    /// bound.
-    pub(super) fn parts_in_grid_space(&self, q: [f64; 3], world: [f64; 3]) -> (i64, f64, f64) {
+    /// bound, with the boundary hierarchy `tree`.
+    pub(super) fn parts_in_grid_space(
+        &self,
+        q: [f64; 3],
+        world: [f64; 3],
+        tree: Option<&BoundaryTree>,
+    ) -> (i64, f64, f64) {
         let qf = self.ray.to_frame(q);
         let SnappedQuery {
             snap,
@@ -77,7 +83,7 @@ impl<W: Width> ExactIndex<W> {
             exact,
         } = self.snap_frame(q, world);
         let (Snap::In(x), Snap::In(y)) = (snap[0], snap[1]) else {
-            let (area, bound) = self.far_boundary_sum(qf);
+            let (area, bound) = self.far_boundary_sum(qf, tree);
             return (0, area, bound);
         };
         let limit = self.grid.limit();
@@ -104,7 +110,7 @@ impl<W: Width> ExactIndex<W> {
         } else {
             self.signed_crossings(&query)
         };
-        let (area, bound) = self.boundary_sum(&query, z_exact, qf[2]);
+        let (area, bound) = self.boundary_sum(&query, z_exact, qf[2], tree);
         (chi, area, bound)
     }
 }

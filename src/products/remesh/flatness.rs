@@ -69,7 +69,7 @@ pub fn probe<E: Evaluator + ?Sized>(
         .iter()
         .flat_map(|(p, n)| [1.0, -1.0].map(|s| [0, 1, 2].map(|a| p[a] + s * offset * n[a])))
         .collect();
-    let w = evaluator.eval_batch(&probes);
+    let w = super::levels::decisive_values(evaluator, &probes);
     // `w` an integer on both sides and different: the triangle is where it changes (not an
     // inner face, a double wall, or a sheet that a thickened field surrounds).
     let integral: Vec<bool> = w

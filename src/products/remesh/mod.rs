@@ -54,6 +54,7 @@ pub mod extract;
 pub mod flatness;
 pub mod intersect;
 pub mod lattice;
+pub mod levels;
 pub mod octree;
 pub mod place;
 pub mod plates;

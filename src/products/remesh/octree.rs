@@ -430,7 +430,7 @@ pub fn classify<E: Evaluator + ?Sized>(
             .par_iter()
             .map(|&p| lattice.corner_position(p))
             .collect();
-        let values = evaluator.eval_batch(&positions);
+        let values = super::levels::decisive_values(evaluator, &positions);
         for (p, w) in interior.iter().zip(values) {
             out.labels.insert(pack(*p), CornerValue::of(w));
         }
@@ -577,7 +577,7 @@ impl Classified {
             Some(approximate) if !flat.is_empty() => {
                 screened(evaluator, approximate, &flat, &classes)
             }
-            _ => evaluator.eval_batch(&flat),
+            _ => super::levels::decisive_values(evaluator, &flat),
         };
         let mut next = 0;
         let mut hidden = Vec::new();
@@ -787,7 +787,7 @@ impl Classified {
                 .par_iter()
                 .map(|&p| lattice.corner_position(p))
                 .collect();
-            let values = evaluator.eval_batch(&positions);
+            let values = super::levels::decisive_values(evaluator, &positions);
             out.labels.reserve(new_points.len());
             for &p in &new_points {
                 out.labels.insert(pack(p), CornerValue::BORDER);
@@ -871,7 +871,10 @@ fn screened<E: Evaluator + ?Sized>(
     let open: Vec<usize> = (0..points.len())
         .filter(|&i| shows_hidden_part(rough[i], classes[i], THIN_PART_MARGIN - SCREEN_SLACK))
         .collect();
-    let exact = evaluator.eval_batch(&open.iter().map(|&i| points[i]).collect::<Vec<_>>());
+    let exact = super::levels::decisive_values(
+        evaluator,
+        &open.iter().map(|&i| points[i]).collect::<Vec<_>>(),
+    );
     let mut values = vec![f64::NAN; points.len()];
     for (&i, w) in open.iter().zip(exact) {
         values[i] = w;

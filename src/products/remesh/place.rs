@@ -344,7 +344,7 @@ pub fn place_vertices<E: Evaluator + ?Sized>(
             .par_iter()
             .map(|&(j, k)| at(edges[j as usize], k))
             .collect();
-        let w = evaluator.eval_batch(&points);
+        let w = super::levels::decisive_values(evaluator, &points);
         evaluations += points.len();
         for (&(j, k), w) in probes.iter().zip(w) {
             let s = &mut searches[j as usize];

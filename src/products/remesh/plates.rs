@@ -203,7 +203,7 @@ fn plate_runs<E: Evaluator + ?Sized>(
             points.push(m);
         }
     }
-    let w = evaluator.eval_batch(&points);
+    let w = super::levels::decisive_values(evaluator, &points);
     let mut next = 0;
     let mut runs = Vec::new();
     for (_, crossings) in &lines {
