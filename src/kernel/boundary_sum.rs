@@ -79,6 +79,10 @@ pub struct BoundaryEdges {
     link: Vec<f64>,
     /// The edge (index into `a`, `b`) of each linked slot, for the exact fallback.
     edge_of: Vec<u32>,
+    /// The linked slots of each edge: `edge_slots[edge_slots_start[e]..edge_slots_start[e + 1]]`
+    /// (the inverse of `edge_of`, for [`BoundaryEdges::area_sum_with_accurate_edges`]).
+    edge_slots_start: Vec<u32>,
+    edge_slots: Vec<u32>,
     /// Number of slots (`j → j + 1` pairs) to visit.
     slots: usize,
     /// Edges of weight above [`MAX_CHAINED_WEIGHT`]: one exact term each, times the weight.
@@ -296,6 +300,24 @@ impl BoundaryEdges {
             }
         }
         let slots = xs.len();
+        let mut edge_slots_start = vec![0u32; a.len() + 1];
+        for j in 0..slots {
+            if link[j] != 0.0 {
+                edge_slots_start[edge_of[j] as usize + 1] += 1;
+            }
+        }
+        for e in 0..a.len() {
+            edge_slots_start[e + 1] += edge_slots_start[e];
+        }
+        let mut edge_slots = vec![0u32; edge_slots_start[a.len()] as usize];
+        let mut next = edge_slots_start.clone();
+        for j in 0..slots {
+            if link[j] != 0.0 {
+                let e = edge_of[j] as usize;
+                edge_slots[next[e] as usize] = j as u32;
+                next[e] += 1;
+            }
+        }
         // Padding: the loop reads up to 7 vertices past the last slot.
         let pad = 8;
         let (lx, ly, lz) = (
@@ -339,6 +361,8 @@ impl BoundaryEdges {
             zs,
             link,
             edge_of,
+            edge_slots_start,
+            edge_slots,
             slots,
             heavy,
             limit,
@@ -477,8 +501,39 @@ impl BoundaryEdges {
     /// Otherwise the lattice evaluation has every sign of the exact query, and magnitudes within
     /// half a cell: `≤ 2^-60·E/d` relative, negligible at `d ≥` the near-edge distance.
     pub fn needs_accurate_sum<W: Width>(&self, qi: [i64; 3], r: [f64; 3], z_exact: bool) -> bool {
+        let mut flagged = false;
+        self.for_each_flagged_edge(qi, r, z_exact, |_| {
+            flagged = true;
+            false
+        });
+        flagged
+    }
+
+    /// The edges of [`BoundaryEdges::needs_accurate_sum`]'s tests at `qi + r`, each once, in no
+    /// particular order: the only terms [`BoundaryEdges::area_sum_with_accurate_edges`] computes
+    /// apart from the loop.
+    pub fn accurate_edges<W: Width>(&self, qi: [i64; 3], r: [f64; 3], z_exact: bool) -> Vec<u32> {
+        let mut edges = Vec::new();
+        self.for_each_flagged_edge(qi, r, z_exact, |e| {
+            edges.push(e);
+            true
+        });
+        edges.sort_unstable();
+        edges.dedup();
+        edges
+    }
+
+    /// Calls `f` with each edge whose term the lattice loop may get wrong at `qi + r` (the tests
+    /// of [`BoundaryEdges::needs_accurate_sum`]) until it returns false.
+    fn for_each_flagged_edge(
+        &self,
+        qi: [i64; 3],
+        r: [f64; 3],
+        z_exact: bool,
+        mut f: impl FnMut(u32) -> bool,
+    ) {
         if self.a.is_empty() {
-            return false;
+            return;
         }
         let residual = r != [0.0; 3];
         let tube = ray_tube(self.limit);
@@ -488,26 +543,94 @@ impl BoundaryEdges {
         } else {
             u(qi[2])
         };
-        let mut flagged = false;
+        let mut going = true;
         self.near.for_each_on_ray(u(qi[0]), u(qi[1]), z_min, |e| {
-            if flagged {
+            if !going {
                 return;
             }
             let (a, b) = (self.a[e as usize], self.b[e as usize]);
-            if ill_conditioned(a, b, qi, z_exact, tube, FLAG_PADS) {
-                flagged = true;
-                return;
-            }
-            if residual {
-                let (u0, u1, v0, v1) = (a[0] - qi[0], a[1] - qi[1], b[0] - qi[0], b[1] - qi[1]);
-                let lattice = i128::from(u0) * i128::from(v1) - i128::from(u1) * i128::from(v0);
-                // |D(q + r) − D(q)| ≤ |e_x||r_y| + |e_y||r_x|; generous margins (a soft test).
-                let slack =
-                    ((b[0] - a[0]) as f64 * r[1]).abs() + ((b[1] - a[1]) as f64 * r[0]).abs();
-                flagged = (lattice as f64).abs() <= 2.0 * slack + 2.0;
+            let flagged = ill_conditioned(a, b, qi, z_exact, tube, FLAG_PADS)
+                || residual && {
+                    let (u0, u1, v0, v1) = (a[0] - qi[0], a[1] - qi[1], b[0] - qi[0], b[1] - qi[1]);
+                    let lattice = i128::from(u0) * i128::from(v1) - i128::from(u1) * i128::from(v0);
+                    // |D(q + r) − D(q)| ≤ |e_x||r_y| + |e_y||r_x|; generous margins (a soft
+                    // test).
+                    let slack =
+                        ((b[0] - a[0]) as f64 * r[1]).abs() + ((b[1] - a[1]) as f64 * r[0]).abs();
+                    (lattice as f64).abs() <= 2.0 * slack + 2.0
+                };
+            if flagged {
+                going = f(e);
             }
         });
-        flagged
+    }
+
+    /// [`BoundaryEdges::area_sum_accurate`] at a query whose residual is exact, with the edges
+    /// that need it (`accurate`, from [`BoundaryEdges::accurate_edges`]) computed as there and
+    /// every other edge by the loop: the loop is right for an edge that no test flags (the
+    /// argument of [`BoundaryEdges::needs_accurate_sum`] is edge by edge), and on a long
+    /// boundary the scalar path over every edge cost ~7× the loop for a query next to one of
+    /// them (docs/benchmarks.md, "Decisive values"). The loop runs over whole blocks of 4 slots,
+    /// so a block holding a flagged edge takes the accurate terms for all its edges.
+    pub fn area_sum_with_accurate_edges<W: Width>(
+        &self,
+        q: &InputPoint,
+        z_exact: bool,
+        qz_units: f64,
+        accurate: &[u32],
+    ) -> f64 {
+        let (qi, r) = (q.n, q.r);
+        let mut blocks: Vec<usize> = accurate
+            .iter()
+            .flat_map(|&e| self.slots_of_edge(e as usize))
+            .map(|j| j / 4)
+            .collect();
+        blocks.sort_unstable();
+        blocks.dedup();
+        let mut angles: Option<AngleSum> = None;
+        let mut scalar = 0.0;
+        let mut terms = NeumaierSum::new();
+        let mut run = |range: std::ops::Range<usize>, angles: &mut Option<AngleSum>| {
+            if range.is_empty() {
+                return;
+            }
+            let (a, s) = self.range_area_sum::<W>(qi, r, z_exact, qz_units, range);
+            match angles {
+                Some(acc) => acc.absorb(&a),
+                None => *angles = Some(a),
+            }
+            scalar += s;
+        };
+        let mut start = 0;
+        for &block in &blocks {
+            let j0 = 4 * block;
+            run(start..j0, &mut angles);
+            for j in j0..j0 + 4 {
+                if let Some(e) = self.slot_edge(j) {
+                    terms.add(self.accurate_edge_area::<W>(e, q, z_exact, qz_units));
+                }
+            }
+            start = j0 + 4;
+        }
+        run(start..self.slots.max(start), &mut angles);
+        for &e in &self.heavy {
+            let e = e as usize;
+            let term = if accurate.binary_search(&(e as u32)).is_ok() {
+                self.accurate_edge_area::<W>(e, q, z_exact, qz_units)
+            } else {
+                self.exact_edge_area::<W>(e, qi, r, z_exact, qz_units)
+            };
+            terms.add(self.weight[e] * term);
+        }
+        angles.map_or(0.0, |a| 2.0 * a.total()) + scalar + terms.value()
+    }
+
+    /// The slots holding edge `e` (one per unit of weight; none for heavy or parallel edges).
+    fn slots_of_edge(&self, e: usize) -> impl Iterator<Item = usize> + '_ {
+        let (from, to) = (self.edge_slots_start[e], self.edge_slots_start[e + 1]);
+        self.edge_slots[from as usize..to as usize]
+            .iter()
+            .map(|&j| j as usize)
     }
 
     /// `Σ w·Area` at the exact query `q = qi + r` (see [`BoundaryEdges::needs_accurate_sum`]):
@@ -518,6 +641,21 @@ impl BoundaryEdges {
     /// in `f64` from those offsets for the rest (a query near one edge of a long boundary paid
     /// ~30× the loop on every edge before). `O(B)` scalar.
     pub fn area_sum_accurate<W: Width>(&self, q: &InputPoint, z_exact: bool, qz_units: f64) -> f64 {
+        let mut sum = NeumaierSum::new();
+        for i in 0..self.a.len() {
+            sum.add(self.weight[i] * self.accurate_edge_area::<W>(i, q, z_exact, qz_units));
+        }
+        sum.value()
+    }
+
+    /// The term of edge `i` (weight 1) of [`BoundaryEdges::area_sum_accurate`].
+    fn accurate_edge_area<W: Width>(
+        &self,
+        i: usize,
+        q: &InputPoint,
+        z_exact: bool,
+        qz_units: f64,
+    ) -> f64 {
         let (qi, r) = (q.n, q.r);
         let lattice_query = q.residual_exact();
         // `p − q` in double-double: the lattice difference is exact, the residuals' difference is
@@ -534,47 +672,42 @@ impl BoundaryEdges {
             [along(0), along(1), z]
         };
         let tube = ray_tube(self.limit);
-        let mut sum = NeumaierSum::new();
-        for i in 0..self.a.len() {
-            let (a, b) = (self.a[i], self.b[i]);
-            let off_lattice = self.inputs.as_ref().filter(|x| x.off_lattice[i]);
-            let (signs, ra, rb) = if off_lattice.is_some() || !lattice_query {
-                let (pa, pb) = match off_lattice {
-                    Some(x) => (x.a[i], x.b[i]),
-                    None => (InputPoint::lattice(a), InputPoint::lattice(b)),
-                };
-                let o = input_orient2d(q, &pa, &pb, &self.lattice);
-                let signs = EdgeSigns {
-                    numerator: -o.sign,
-                    query_inside_segment: o.degenerate
-                        && z_exact
-                        && input_inside_segment(q, &pa, &pb, &self.lattice),
-                };
-                (signs, offset(pa.n, pa.r), offset(pb.n, pb.r))
-            } else {
-                let o = perturbed_orient2d_at::<W>(
-                    [qi[0], qi[1]],
-                    [r[0], r[1]],
-                    [a[0], a[1]],
-                    [b[0], b[1]],
-                );
-                let signs = EdgeSigns {
-                    numerator: -o.sign,
-                    query_inside_segment: o.degenerate
-                        && z_exact
-                        && query_inside_segment_at(qi, r, a, b),
-                };
-                (signs, offset(a, [0.0; 3]), offset(b, [0.0; 3]))
+        let (a, b) = (self.a[i], self.b[i]);
+        let off_lattice = self.inputs.as_ref().filter(|x| x.off_lattice[i]);
+        let (signs, ra, rb) = if off_lattice.is_some() || !lattice_query {
+            let (pa, pb) = match off_lattice {
+                Some(x) => (x.a[i], x.b[i]),
+                None => (InputPoint::lattice(a), InputPoint::lattice(b)),
             };
-            let term = if ill_conditioned(a, b, qi, z_exact, tube, ACCURATE_TERM_PADS) {
-                antipodal_edge_area_accurate(ra, rb, signs)
-            } else {
-                // `hi` is the offset rounded once (normalized pairs): the loop's error model.
-                antipodal_edge_area(ra.map(|x| x.hi), rb.map(|x| x.hi), signs)
+            let o = input_orient2d(q, &pa, &pb, &self.lattice);
+            let signs = EdgeSigns {
+                numerator: -o.sign,
+                query_inside_segment: o.degenerate
+                    && z_exact
+                    && input_inside_segment(q, &pa, &pb, &self.lattice),
             };
-            sum.add(self.weight[i] * term);
+            (signs, offset(pa.n, pa.r), offset(pb.n, pb.r))
+        } else {
+            let o = perturbed_orient2d_at::<W>(
+                [qi[0], qi[1]],
+                [r[0], r[1]],
+                [a[0], a[1]],
+                [b[0], b[1]],
+            );
+            let signs = EdgeSigns {
+                numerator: -o.sign,
+                query_inside_segment: o.degenerate
+                    && z_exact
+                    && query_inside_segment_at(qi, r, a, b),
+            };
+            (signs, offset(a, [0.0; 3]), offset(b, [0.0; 3]))
+        };
+        if ill_conditioned(a, b, qi, z_exact, tube, ACCURATE_TERM_PADS) {
+            antipodal_edge_area_accurate(ra, rb, signs)
+        } else {
+            // `hi` is the offset rounded once (normalized pairs): the loop's error model.
+            antipodal_edge_area(ra.map(|x| x.hi), rb.map(|x| x.hi), signs)
         }
-        sum.value()
     }
 
     /// The bound constants of the `f64` orientation filter: error of an offset: conversions of a
@@ -855,6 +988,86 @@ mod tests {
             }
         }
         assert_eq!(checked, 6250);
+    }
+
+    /// The split accurate path (the loop for every edge no test flags, the accurate terms for
+    /// the flagged ones' blocks) agrees with the accurate path over every edge, on boundaries
+    /// with heavy, vertical and repeated edges, at queries next to edges, on and above vertices,
+    /// with and without residuals.
+    #[test]
+    fn accurate_edges_alone_give_the_accurate_sum() {
+        use crate::kernel::input_predicates::InputPoint;
+        use crate::kernel::predicates::W128;
+        let mut rng = crate::kernel::test_rng::TestRng::new(29);
+        // Vertices across the grid, as a mesh's are: the loop's magnitudes are those of the
+        // lattice point, `2^-60·E/d` relative off those of `qi + r` (the model of
+        // `needs_accurate_sum`), far below the bound only where `E` is the grid's extent.
+        let scale = 1_i64 << 53;
+        let mut split = 0;
+        for case in 0..60 {
+            let (mut a, mut b, mut weight) = (Vec::new(), Vec::new(), Vec::new());
+            for _ in 0..(3 + rng.below(12)) {
+                // A closed loop (or an open path) of 3 to 8 vertices, some steps vertical.
+                let n = 3 + rng.below(6) as usize;
+                let mut pts: Vec<[i64; 3]> = Vec::new();
+                for _ in 0..n {
+                    let p = std::array::from_fn(|_| (rng.below(64) as i64 - 32) * scale);
+                    if rng.below(4) == 0
+                        && let Some(&last) = pts.last()
+                    {
+                        pts.push([last[0], last[1], p[2]]);
+                    }
+                    pts.push(p);
+                }
+                let closed = rng.below(3) != 0;
+                let w = [1.0, 1.0, 2.0, 5.0][rng.below(4) as usize];
+                for k in 0..pts.len() - usize::from(!closed) {
+                    a.push(pts[k]);
+                    b.push(pts[(k + 1) % pts.len()]);
+                    weight.push(w);
+                }
+            }
+            let edges = BoundaryEdges::new(a.clone(), b.clone(), weight, 60);
+            for _ in 0..40 {
+                let e = rng.below(a.len() as u64) as usize;
+                let t = rng.below(1001) as f64 / 1000.0;
+                let pad = near_edge_pad(a[e], b[e]) as f64;
+                let off = [1.0, -0.7, 0.4].map(|d: f64| d * pad * rng.below(40) as f64 / 10.0);
+                let q: [i64; 3] = match rng.below(4) {
+                    // On a vertex, or straight above one.
+                    0 => a[e],
+                    1 => [a[e][0], a[e][1], a[e][2] - 3 * scale],
+                    _ => std::array::from_fn(|k| {
+                        (a[e][k] as f64 + t * (b[e][k] - a[e][k]) as f64 + off[k]).round() as i64
+                    }),
+                };
+                let r = if rng.below(2) == 0 {
+                    [0.0; 3]
+                } else {
+                    std::array::from_fn(|_| (rng.below(1001) as f64 - 500.0) / 1000.0)
+                };
+                let input = InputPoint {
+                    n: q,
+                    r,
+                    world: [0.0; 3],
+                    exact: [true; 3],
+                };
+                let accurate = edges.accurate_edges::<W128>(q, r, true);
+                if accurate.is_empty() {
+                    continue;
+                }
+                split += 1;
+                let all = edges.area_sum_accurate::<W128>(&input, true, 0.0);
+                let parts =
+                    edges.area_sum_with_accurate_edges::<W128>(&input, true, 0.0, &accurate);
+                assert!(
+                    (all - parts).abs() <= 1e-11,
+                    "case {case}: q {q:?} r {r:?}: {all} vs {parts} ({} flagged)",
+                    accurate.len()
+                );
+            }
+        }
+        assert!(split > 500, "{split} queries took the split path");
     }
 
     /// The near-edge test is a tube around the segment, not its box: a query in the box of a

@@ -14,8 +14,8 @@ impl<W: Width> ExactIndex<W> {
     /// `Σ k·Area(A, B, x1)` with exact branch signs at the query `qi + r` (lattice point and
     /// residual), and the bound (on `w`) of its expanded far part. `z_exact` is false when the
     /// query's frame z lies outside the grid (then `qz` is used in floating point for the
-    /// magnitudes). Queries near a boundary edge, or whose residual matters for a sign, take the
-    /// double-double path, never the hierarchy `tree`.
+    /// magnitudes). The edges a query is near, or whose sign its residual may change, take the
+    /// double-double terms (the rest the loop), and such a query never the hierarchy `tree`.
     pub(super) fn boundary_sum(
         &self,
         q: &InputPoint,
@@ -25,12 +25,19 @@ impl<W: Width> ExactIndex<W> {
     ) -> (f64, f64) {
         let qz_units = self.z_in_cells(qz);
         let (qi, r) = (q.n, q.r);
-        // A residual the grid scaling could not hold: every edge on the exact inputs.
-        if !self.boundary.is_empty()
-            && (!q.residual_exact() || self.boundary.needs_accurate_sum::<W>(qi, r, z_exact))
-        {
-            let area = self.boundary.area_sum_accurate::<W>(q, z_exact, qz_units);
-            return (area, 0.0);
+        if !self.boundary.is_empty() {
+            // A residual the grid scaling could not hold: every edge on the exact inputs.
+            if !q.residual_exact() {
+                let area = self.boundary.area_sum_accurate::<W>(q, z_exact, qz_units);
+                return (area, 0.0);
+            }
+            let accurate = self.boundary.accurate_edges::<W>(qi, r, z_exact);
+            if !accurate.is_empty() {
+                let area = self
+                    .boundary
+                    .area_sum_with_accurate_edges::<W>(q, z_exact, qz_units, &accurate);
+                return (area, 0.0);
+            }
         }
         match tree {
             Some(tree) => {
