@@ -20,6 +20,7 @@
 
 use super::octree::{INTEGRAL_W_SLACK, THIN_PART_MARGIN};
 use crate::eval::Evaluator;
+use crate::grid::GridSpec;
 
 /// The tolerance of the first pass of [`decisive_values`]. The hierarchy's certified bound is
 /// pessimistic (the values measured within `1e-5` of the exact loop at this tolerance on a
@@ -82,6 +83,31 @@ pub fn decisive_values<E: Evaluator + ?Sized>(evaluator: &E, points: &[[f64; 3]]
         values[i] = w;
     }
     values
+}
+
+/// [`decisive_values`] at the sample points of `spec`, in its storage order. The points go to
+/// the evaluator column by column along its [`crate::grid::column_axis`], so the exact evaluator
+/// still shares one ray per column ([`crate::eval::antipodal::WindingNumber::eval_batch`]).
+pub fn decisive_grid_values<E: Evaluator + ?Sized>(evaluator: &E, spec: &GridSpec) -> Vec<f64> {
+    let axis = crate::grid::column_axis(evaluator);
+    let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+    let mut order = Vec::with_capacity(spec.len());
+    for a in 0..spec.dims[u] {
+        for b in 0..spec.dims[v] {
+            for c in 0..spec.dims[axis] {
+                let mut ijk = [0; 3];
+                (ijk[u], ijk[v], ijk[axis]) = (a, b, c);
+                order.push(ijk);
+            }
+        }
+    }
+    let points: Vec<[f64; 3]> = order.iter().map(|&[i, j, k]| spec.point(i, j, k)).collect();
+    let values = decisive_values(evaluator, &points);
+    let mut out = vec![f64::NAN; spec.len()];
+    for (&[i, j, k], w) in order.iter().zip(values) {
+        out[spec.index(i, j, k)] = w;
+    }
+    out
 }
 
 #[cfg(test)]

@@ -64,7 +64,7 @@ use super::crossings::SegmentBvh;
 use super::lattice::{Corner, KeyMap, KeySet, Lattice, pack};
 use super::transition;
 use crate::eval::Evaluator;
-use crate::grid::{GridSpec, evaluate};
+use crate::grid::GridSpec;
 
 /// An octree cell: level (`2^level` finest cells wide) and packed minimum corner.
 pub type Cell = (u32, u64);
@@ -240,7 +240,7 @@ pub fn classify<E: Evaluator + ?Sized>(
     if spec.len() > max_points {
         return None;
     }
-    let values = evaluate(evaluator, &spec);
+    let values = super::levels::decisive_grid_values(evaluator, &spec);
     for k in 0..dims[2] {
         for j in 0..dims[1] {
             for i in 0..dims[0] {
