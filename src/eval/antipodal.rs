@@ -240,16 +240,11 @@ impl WindingNumber {
         tolerance: f64,
     ) -> Vec<(f64, f64)> {
         let own = self.options.tolerance;
-        if tolerance.is_nan() || tolerance <= own {
-            return self
-                .eval_batch(points)
-                .into_iter()
-                .map(|w| (w, 0.0))
-                .collect();
-        }
-        let hierarchy = core.hierarchy_within(tolerance);
-        let Some(tree) = hierarchy.tree() else {
-            // No node pays at `tolerance`, so none at the evaluator's own: the flat loop.
+        // (False for a NaN tolerance.)
+        let hierarchy = (tolerance > own).then(|| core.hierarchy_within(tolerance));
+        let Some(tree) = hierarchy.as_ref().and_then(|h| h.tree()) else {
+            // Not looser, or no node pays at `tolerance` (so none at the evaluator's own): the
+            // values themselves.
             return self
                 .eval_batch(points)
                 .into_iter()
