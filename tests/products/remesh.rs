@@ -26,6 +26,18 @@ impl Evaluator for Noise {
     }
 }
 
+/// `mesh` with the faces whose index `flip` selects turned around (an inconsistently oriented
+/// input: its signed boundary runs around every flipped patch).
+pub(crate) fn with_flipped_faces(mesh: &Mesh, flip: impl Fn(usize) -> bool) -> Mesh {
+    let triangles: Vec<[u32; 3]> = mesh
+        .triangles()
+        .iter()
+        .enumerate()
+        .map(|(i, &t)| if flip(i) { [t[0], t[2], t[1]] } else { t })
+        .collect();
+    Mesh::new(mesh.positions().to_vec(), triangles).unwrap()
+}
+
 /// UV sphere of radius `r` centred at `c`, outward (`flip`: inward), `n` segments.
 pub(crate) fn sphere(c: [f64; 3], r: f64, n: usize, flip: bool) -> Mesh {
     let (rings, segs) = (n, 2 * n);

@@ -11,7 +11,7 @@ use gwn::products::remesh::crossings::SegmentBvh;
 use gwn::products::remesh::levels::SCREENING_TOLERANCE;
 use gwn::products::remesh::{RemeshOptions, Remeshed, remesh_guided};
 
-use crate::remesh::sphere;
+use crate::remesh::{sphere, with_flipped_faces};
 
 /// The exact evaluator without its certified batch: the first pass gets the field's own values
 /// (bound 0), so nothing is approximated.
@@ -57,14 +57,7 @@ impl Evaluator for FarEndOfTheBound<'_> {
 /// A ball with a tenth of its faces flipped (`w` about 0.8 inside, fractional next to the flips),
 /// a consistent box (integral `w`, flat sides for the planar levels) and a consistent small ball.
 fn mixed_input() -> Mesh {
-    let ball = sphere([0.0, 0.0, 0.0], 1.0, 20, false);
-    let flipped: Vec<[u32; 3]> = ball
-        .triangles()
-        .iter()
-        .enumerate()
-        .map(|(i, &t)| if i % 10 == 3 { [t[0], t[2], t[1]] } else { t })
-        .collect();
-    let ball = Mesh::new(ball.positions().to_vec(), flipped).unwrap();
+    let ball = with_flipped_faces(&sphere([0.0, 0.0, 0.0], 1.0, 20, false), |i| i % 10 == 3);
     let cube = crate::common::unit_cube();
     let shifted: Vec<[f64; 3]> = cube
         .positions()

@@ -10,7 +10,9 @@ use gwn::products::remesh::report::hausdorff_distance;
 use gwn::products::remesh::{RemeshError, RemeshOptions, remesh, remesh_guided};
 use proptest::prelude::*;
 
-use crate::remesh::{assert_closed_manifold, assert_guarantees_on, run_with, sphere};
+use crate::remesh::{
+    assert_closed_manifold, assert_guarantees_on, run_with, sphere, with_flipped_faces,
+};
 
 fn with_levels(res: usize, levels: u32) -> RemeshOptions {
     RemeshOptions {
@@ -187,14 +189,7 @@ fn a_wavy_open_sheet_cuts_no_cells() {
 #[test]
 fn screened_probes_cut_the_cells_exact_probes_cut() {
     let res = 32;
-    let ball = sphere([0.0, 0.0, 0.0], 1.0, 24, false);
-    let shuffled: Vec<[u32; 3]> = ball
-        .triangles()
-        .iter()
-        .enumerate()
-        .map(|(i, &t)| if i % 2 == 1 { [t[0], t[2], t[1]] } else { t })
-        .collect();
-    let ball = Mesh::new(ball.positions().to_vec(), shuffled).unwrap();
+    let ball = with_flipped_faces(&sphere([0.0, 0.0, 0.0], 1.0, 24, false), |i| i % 2 == 1);
     let cell = 4.4 / res as f64;
     let plate = tilted_box([1.6, 1.4, 0.5 * cell], 0.5, 0.7, [2.3, 0.3, 0.1]);
     let mesh = ball.concatenated(&plate).unwrap();

@@ -855,8 +855,9 @@ fn shows_hidden_part(w: f64, class: bool, margin: f64) -> bool {
 /// and every guarantee would still hold.
 const SCREEN_SLACK: f64 = 0.125;
 
-/// `w` at `points` as far as [`Classified::with_hidden_class`] needs it: the field where the
-/// approximation shows a hidden part within [`SCREEN_SLACK`], NaN (no part) elsewhere. The
+/// `w` at `points` as far as [`Classified::with_hidden_class`] needs it: the field (its
+/// decisive values, [`super::levels`]) where the approximation shows a hidden part within
+/// [`SCREEN_SLACK`], NaN (no part) elsewhere. The
 /// exact field costs `O(B)` per point near the surface of an input whose signed boundary has
 /// `B` edges (every edge of an inconsistently oriented one: cgal-blobby-shuffled at res 256
 /// spent 6.9 s in 300k such probes, none of which found a part); the approximation costs
