@@ -121,7 +121,7 @@ fn first_passes_at_the_far_end_of_their_bound_decide_like_the_field() {
     let mesh = mixed_input();
     let wn = WindingNumber::new(&mesh).unwrap();
     assert!(wn.boundary_edge_count() > 100);
-    for (res, probe) in [(24, true), (40, false)] {
+    for (res, probe) in [(24, true), (40, false), (128, true)] {
         let own = run(&OwnValues(&wn), &mesh, res, probe);
         assert!(probe || own.stats.planar_levels > 0, "{:?}", own.stats);
         let far = run(&FarEndOfTheBound(&wn), &mesh, res, probe);

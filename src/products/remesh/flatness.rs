@@ -19,6 +19,7 @@
 
 use super::crossings::SegmentBvh;
 use super::lattice::Lattice;
+use super::levels::Comparisons;
 use super::octree::{INTEGRAL_W_SLACK, MAX_PLANAR_LEVELS, PLANAR_MAX_TRIANGLES, PLANAR_TOLERANCE};
 use crate::eval::Evaluator;
 
@@ -69,7 +70,7 @@ pub fn probe<E: Evaluator + ?Sized>(
         .iter()
         .flat_map(|(p, n)| [1.0, -1.0].map(|s| [0, 1, 2].map(|a| p[a] + s * offset * n[a])))
         .collect();
-    let w = super::levels::decisive_values(evaluator, &probes);
+    let w = super::levels::decisive_values(evaluator, &probes, Comparisons::Integrality);
     // `w` an integer on both sides and different: the triangle is where it changes (not an
     // inner face, a double wall, or a sheet that a thickened field surrounds).
     let integral: Vec<bool> = w

@@ -62,6 +62,7 @@ use rayon::prelude::*;
 
 use super::crossings::SegmentBvh;
 use super::lattice::{Corner, KeyMap, KeySet, Lattice, pack};
+use super::levels::Comparisons;
 use super::transition;
 use crate::eval::Evaluator;
 use crate::grid::GridSpec;
@@ -74,23 +75,31 @@ pub type Cell = (u32, u64);
 pub struct CornerValue {
     /// `w > ½` (border corners: `false`).
     pub inside: bool,
-    /// `w` rounded to `f32`; NaN at border corners, which are declared outside, never
-    /// evaluated. Only placement's interpolation reads it; the class is `inside`, which the
-    /// rounding could flip next to ½. (The pair takes the 16 bytes a hash entry of a `u64` key
-    /// and a `bool` took already.)
+    /// Whether `w` also decides integrality ([`super::levels::decisive_corner_values`]): the
+    /// field's own value, or a first pass clear of an integer's slack. The planar levels and
+    /// the lent transitions ask the field for the others ([`Classified::settle`]) before
+    /// reading their integrality.
+    pub settled: bool,
+    /// `w` rounded to `f32` (within the first pass's bound where not `settled`); NaN at border
+    /// corners, which are declared outside, never evaluated. Placement's interpolation reads
+    /// it, and the margin and integrality tests; the class is `inside`, which the rounding
+    /// could flip next to ½. (The three take the 16 bytes a hash entry of a `u64` key and a
+    /// `bool` took already.)
     pub w: f32,
 }
 
 impl CornerValue {
-    fn of(w: f64) -> CornerValue {
+    fn of((w, settled): (f64, bool)) -> CornerValue {
         CornerValue {
             inside: super::inside(w),
+            settled,
             w: w as f32,
         }
     }
 
     const BORDER: CornerValue = CornerValue {
         inside: false,
+        settled: true,
         w: f32::NAN,
     };
 }
@@ -296,6 +305,17 @@ pub fn classify<E: Evaluator + ?Sized>(
             // elsewhere.
             let mut curved: Vec<(u32, Corner)> = Vec::new();
             if level > resolution {
+                // `flat` reads the integrality of the corners of these cells: the field's.
+                let open: Vec<Corner> = cells_at(&out, level)
+                    .into_par_iter()
+                    .filter(|&m| {
+                        !out.split.contains(&(level, pack(m)))
+                            && out.corners_mixed(level, m)
+                            && out.corners_integral(level, m).is_none()
+                    })
+                    .flat_map_iter(|m| out.unsettled_corners(level, m).collect::<Vec<_>>())
+                    .collect();
+                out.settle(evaluator, lattice, open);
                 curved = cells_at(&out, level)
                     .into_par_iter()
                     .filter(|&m| {
@@ -402,7 +422,7 @@ pub fn classify<E: Evaluator + ?Sized>(
     transition.sort_unstable_by_key(|&(l, c)| (l, c[2], c[1], c[0]));
     transition.dedup();
     if let Some(guide) = guide {
-        out.lend_untouched_transitions(lattice, guide, &mut transition);
+        out.lend_untouched_transitions(evaluator, lattice, guide, &mut transition);
     }
     if !transition.is_empty() {
         let split = &out.split;
@@ -430,7 +450,7 @@ pub fn classify<E: Evaluator + ?Sized>(
             .par_iter()
             .map(|&p| lattice.corner_position(p))
             .collect();
-        let values = super::levels::decisive_values(evaluator, &positions);
+        let values = super::levels::decisive_corner_values(evaluator, &positions);
         for (p, w) in interior.iter().zip(values) {
             out.labels.insert(pack(*p), CornerValue::of(w));
         }
@@ -577,7 +597,7 @@ impl Classified {
             Some(approximate) if !flat.is_empty() => {
                 screened(evaluator, approximate, &flat, &classes)
             }
-            _ => super::levels::decisive_values(evaluator, &flat),
+            _ => super::levels::decisive_values(evaluator, &flat, Comparisons::ThinPart),
         };
         let mut next = 0;
         let mut hidden = Vec::new();
@@ -595,12 +615,54 @@ impl Classified {
     }
 
     /// Whether `w` is within [`INTEGRAL_W_SLACK`] of an integer at the 8 corners of the cell
-    /// `(level, m)` (NaN at border corners: no).
-    fn corners_integral(&self, level: u32, m: Corner) -> bool {
-        (0..8).all(|b| {
-            let w = self.value(offset(m, b, 1 << level));
-            (w - w.round()).abs() <= INTEGRAL_W_SLACK
-        })
+    /// `(level, m)` (NaN at border corners: no); `None` while a corner that could make it so is
+    /// not [`CornerValue::settled`].
+    fn corners_integral(&self, level: u32, m: Corner) -> Option<bool> {
+        let mut open = false;
+        for b in 0..8 {
+            let Some(v) = self.labels.get(&pack(offset(m, b, 1 << level))) else {
+                return Some(false);
+            };
+            let w = f64::from(v.w);
+            if !v.settled {
+                open = true;
+            } else if (w - w.round()).abs() > INTEGRAL_W_SLACK || w.is_nan() {
+                return Some(false);
+            }
+        }
+        (!open).then_some(true)
+    }
+
+    /// The corners of the cell `(level, m)` whose integrality is not settled.
+    fn unsettled_corners(&self, level: u32, m: Corner) -> impl Iterator<Item = Corner> + '_ {
+        (0..8)
+            .map(move |b| offset(m, b, 1 << level))
+            .filter(|c| self.labels.get(&pack(*c)).is_some_and(|v| !v.settled))
+    }
+
+    /// Asks the field for `w` at `corners` (classified, not settled; any order, repeats
+    /// allowed), so that their integrality is the field's. Their class was decided already and
+    /// does not change.
+    fn settle<E: Evaluator + ?Sized>(
+        &mut self,
+        evaluator: &E,
+        lattice: &Lattice,
+        mut corners: Vec<Corner>,
+    ) {
+        corners.par_sort_unstable_by_key(|&c| pack(c));
+        corners.dedup();
+        if corners.is_empty() {
+            return;
+        }
+        let positions: Vec<[f64; 3]> = corners
+            .par_iter()
+            .map(|&c| lattice.corner_position(c))
+            .collect();
+        for (c, w) in corners.iter().zip(evaluator.eval_batch(&positions)) {
+            let value = CornerValue::of((w, true));
+            let old = self.labels.insert(pack(*c), value);
+            debug_assert!(old.is_some_and(|o| o.inside == value.inside), "{c:?}");
+        }
     }
 
     /// Whether the cell `(level, m)` may stay whole above the resolution's cell: `w` is within
@@ -613,7 +675,7 @@ impl Classified {
     /// triangles' (thickened sheets: two planes at `±eps` from one).
     fn flat(&self, lattice: &Lattice, guide: &SegmentBvh, level: u32, m: Corner) -> bool {
         let size = 1u32 << level;
-        if !self.corners_integral(level, m) {
+        if self.corners_integral(level, m) != Some(true) {
             return false;
         }
         let lo = lattice.corner_position(m);
@@ -649,18 +711,31 @@ impl Classified {
     /// A lent point is labelled once, so every split that holds it reads one class, and the
     /// surface stays closed whatever the field (a leaf whose lent class would put an inside
     /// point on the lattice's border, which is outside, keeps its transition split).
-    fn lend_untouched_transitions(
+    fn lend_untouched_transitions<E: Evaluator + ?Sized>(
         &mut self,
+        evaluator: &E,
         lattice: &Lattice,
         guide: &SegmentBvh,
         transition: &mut Vec<(u32, Corner)>,
     ) {
+        // The field's integrality at the corners of the leaves that pass every other test.
+        let this = &*self;
+        let open: Vec<Corner> = transition
+            .par_iter()
+            .filter(|&&(l, m)| {
+                this.corners_integral(l, m).is_none()
+                    && !this.closed_box_mixed(l, m)
+                    && !touched(Some(guide), lattice, l, m)
+            })
+            .flat_map_iter(|&(l, m)| this.unsettled_corners(l, m))
+            .collect();
+        self.settle(evaluator, lattice, open);
         let this = &*self;
         // Per leaf: the points to lend, or `None` to keep its split.
         let lent: Vec<Option<(CornerValue, Vec<Corner>)>> = transition
             .par_iter()
             .map(|&(l, m)| {
-                if !this.corners_integral(l, m)
+                if this.corners_integral(l, m) != Some(true)
                     || this.closed_box_mixed(l, m)
                     || touched(Some(guide), lattice, l, m)
                 {
@@ -787,7 +862,7 @@ impl Classified {
                 .par_iter()
                 .map(|&p| lattice.corner_position(p))
                 .collect();
-            let values = super::levels::decisive_values(evaluator, &positions);
+            let values = super::levels::decisive_corner_values(evaluator, &positions);
             out.labels.reserve(new_points.len());
             for &p in &new_points {
                 out.labels.insert(pack(p), CornerValue::BORDER);
@@ -841,7 +916,7 @@ fn far_from_half(w: f64, margin: f64) -> bool {
 
 /// Whether `w` at a probe shows a part hidden in a cell whose corners have class `class`: the
 /// other class, at least `margin` from ½.
-fn shows_hidden_part(w: f64, class: bool, margin: f64) -> bool {
+pub(super) fn shows_hidden_part(w: f64, class: bool, margin: f64) -> bool {
     super::inside(w) != class && far_from_half(w, margin)
 }
 
@@ -875,6 +950,7 @@ fn screened<E: Evaluator + ?Sized>(
     let exact = super::levels::decisive_values(
         evaluator,
         &open.iter().map(|&i| points[i]).collect::<Vec<_>>(),
+        Comparisons::ThinPart,
     );
     let mut values = vec![f64::NAN; points.len()];
     for (&i, w) in open.iter().zip(exact) {

@@ -37,6 +37,7 @@ use rayon::prelude::*;
 
 use super::crossings::SegmentBvh;
 use super::lattice::{Corner, Lattice};
+use super::levels::Comparisons;
 use crate::eval::Evaluator;
 
 /// ITP's truncation constant `κ1`, times the bracket's width when the field steps begin (the
@@ -344,7 +345,7 @@ pub fn place_vertices<E: Evaluator + ?Sized>(
             .par_iter()
             .map(|&(j, k)| at(edges[j as usize], k))
             .collect();
-        let w = super::levels::decisive_values(evaluator, &points);
+        let w = super::levels::decisive_values(evaluator, &points, Comparisons::Class);
         evaluations += points.len();
         for (&(j, k), w) in probes.iter().zip(w) {
             let s = &mut searches[j as usize];

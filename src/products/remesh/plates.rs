@@ -28,6 +28,7 @@
 //! axis (the side walls of a bed: about the refinement factor times theirs).
 
 use super::crossings::SegmentBvh;
+use super::levels::Comparisons;
 use crate::base::bounding_box::BoundingBox;
 use crate::eval::Evaluator;
 
@@ -203,7 +204,7 @@ fn plate_runs<E: Evaluator + ?Sized>(
             points.push(m);
         }
     }
-    let w = super::levels::decisive_values(evaluator, &points);
+    let w = super::levels::decisive_values(evaluator, &points, Comparisons::Class);
     let mut next = 0;
     let mut runs = Vec::new();
     for (_, crossings) in &lines {
