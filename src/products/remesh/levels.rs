@@ -253,7 +253,8 @@ mod tests {
                 .chain([margin(w), margin(f)])
                 .collect()
         }
-        let callers: [(Comparisons, fn(f64) -> Vec<bool>); 4] = [
+        type Reads = fn(f64) -> Vec<bool>;
+        let callers: [(Comparisons, Reads); 4] = [
             (Class, class),
             (ThinPart, thin_part),
             (Integrality, |w| {
