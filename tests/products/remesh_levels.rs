@@ -4,6 +4,8 @@
 //! the same corners classified, cells split and refined, planar levels and triangles — even when
 //! the evaluator answers the first pass at the far end of its bound.
 
+use std::sync::atomic::{AtomicUsize, Ordering};
+
 use gwn::Mesh;
 use gwn::eval::Evaluator;
 use gwn::eval::antipodal::WindingNumber;
@@ -14,8 +16,8 @@ use gwn::products::remesh::{RemeshOptions, Remeshed, remesh_guided};
 use crate::remesh::{sphere, with_flipped_faces};
 
 /// The exact evaluator without its certified batch: the first pass gets the field's own values
-/// (bound 0), so nothing is approximated.
-struct OwnValues<'a>(&'a WindingNumber);
+/// (bound 0), so nothing is approximated. Counts the points of the first pass.
+struct OwnValues<'a>(&'a WindingNumber, AtomicUsize);
 
 impl Evaluator for OwnValues<'_> {
     fn eval(&self, q: [f64; 3]) -> f64 {
@@ -24,11 +26,20 @@ impl Evaluator for OwnValues<'_> {
     fn eval_batch(&self, points: &[[f64; 3]]) -> Vec<f64> {
         self.0.eval_batch(points)
     }
+    fn eval_batch_within(&self, points: &[[f64; 3]], _tolerance: f64) -> Vec<(f64, f64)> {
+        self.1.fetch_add(points.len(), Ordering::Relaxed);
+        self.0
+            .eval_batch(points)
+            .into_iter()
+            .map(|w| (w, 0.0))
+            .collect()
+    }
 }
 
 /// An evaluator whose first pass is as wrong as its bound allows: each value moved by 0.99 of
-/// the bound (the screening tolerance), up or down by a hash of the point.
-struct FarEndOfTheBound<'a>(&'a WindingNumber);
+/// the bound (the screening tolerance), up or down by a hash of the point. Counts the points
+/// of the first pass.
+struct FarEndOfTheBound<'a>(&'a WindingNumber, AtomicUsize);
 
 impl Evaluator for FarEndOfTheBound<'_> {
     fn eval(&self, q: [f64; 3]) -> f64 {
@@ -38,6 +49,7 @@ impl Evaluator for FarEndOfTheBound<'_> {
         self.0.eval_batch(points)
     }
     fn eval_batch_within(&self, points: &[[f64; 3]], tolerance: f64) -> Vec<(f64, f64)> {
+        self.1.fetch_add(points.len(), Ordering::Relaxed);
         let b = tolerance;
         self.0
             .eval_batch(points)
@@ -122,10 +134,23 @@ fn first_passes_at_the_far_end_of_their_bound_decide_like_the_field() {
     let wn = WindingNumber::new(&mesh).unwrap();
     assert!(wn.boundary_edge_count() > 100);
     for (res, probe) in [(24, true), (40, false), (128, true)] {
-        let own = run(&OwnValues(&wn), &mesh, res, probe);
+        let own_values = OwnValues(&wn, AtomicUsize::new(0));
+        let own = run(&own_values, &mesh, res, probe);
         assert!(probe || own.stats.planar_levels > 0, "{:?}", own.stats);
-        let far = run(&FarEndOfTheBound(&wn), &mesh, res, probe);
+        let far_end = FarEndOfTheBound(&wn, AtomicUsize::new(0));
+        let far = run(&far_end, &mesh, res, probe);
         assert_same_decisions(&own, &far, &format!("far end of the bound, res {res}"));
+        // The same points evaluated outside placement (whose interpolation may probe
+        // elsewhere): the same transition leaves lent, their corners' integrality settled by
+        // the field rather than their splits evaluated (which would give the same classes).
+        let outside_placement = |first_pass: &AtomicUsize, r: &Remeshed| {
+            first_pass.load(Ordering::Relaxed) - r.stats.placement_evaluations
+        };
+        assert_eq!(
+            outside_placement(&own_values.1, &own),
+            outside_placement(&far_end.1, &far),
+            "points evaluated outside placement, res {res}"
+        );
         // The exact evaluator's own first pass (its hierarchy at the screening tolerance).
         let exact = run(&wn, &mesh, res, probe);
         assert_same_decisions(&own, &exact, &format!("exact evaluator, res {res}"));
