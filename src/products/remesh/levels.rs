@@ -12,9 +12,13 @@
 //!
 //! [`decisive_values`] asks the evaluator for such values ([`Evaluator::eval_batch_within`] at
 //! [`SCREENING_TOLERANCE`]: for the exact evaluator, its boundary hierarchy at that tolerance)
-//! and evaluates the field itself only where an interval holds a level. Inputs whose signed
-//! boundary is everywhere (inconsistently oriented faces, shuffled soups) pay the exact loop over
-//! all of it for every near-surface point, and most of those points are far from every level.
+//! and evaluates the field itself only where an interval holds a level of the caller's own
+//! comparisons ([`Comparisons`]: placement reads the class alone). The octree's corners are
+//! held to the class and the margin, and carry a flag for integrality, which the planar levels
+//! and the lent transitions settle with the field for the few cells they test
+//! ([`decisive_corner_values`]). Inputs whose signed boundary is everywhere (inconsistently
+//! oriented faces, shuffled soups) pay the exact loop over all of it for every near-surface
+//! point, and most of those points are far from every level they are compared with.
 //!
 //! [`inside`]: super::inside
 
@@ -148,9 +152,9 @@ fn values_with_bounds<E: Evaluator + ?Sized>(
     values
 }
 
-/// [`decisive_corner_values`] at the sample points of `spec`, in its storage order. The points go to
-/// the evaluator column by column along its [`crate::grid::column_axis`], so the exact evaluator
-/// still shares one ray per column ([`crate::eval::antipodal::WindingNumber::eval_batch`]).
+/// [`decisive_corner_values`] at the sample points of `spec`, in its storage order. The points
+/// go to the evaluator column by column along its [`crate::grid::column_axis`], so the exact
+/// evaluator still shares one ray per column ([`crate::eval::antipodal::WindingNumber::eval_batch`]).
 pub fn decisive_grid_values<E: Evaluator + ?Sized>(
     evaluator: &E,
     spec: &GridSpec,
