@@ -77,7 +77,7 @@ pub struct CornerValue {
     pub inside: bool,
     /// Whether `w` also decides integrality ([`super::levels::decisive_corner_values`]): the
     /// field's own value, or a first pass clear of an integer's slack. The planar levels and
-    /// the lent transitions ask the field for the others ([`Classified::settle`]) before
+    /// the lent transitions ask the field for the others (`Classified::settle`) before
     /// reading their integrality.
     pub settled: bool,
     /// `w` rounded to `f32` (within the first pass's bound where not `settled`); NaN at border
