@@ -15,43 +15,37 @@ use gwn::products::remesh::{RemeshOptions, Remeshed, remesh_guided};
 
 use crate::remesh::{sphere, with_flipped_faces};
 
-/// The exact evaluator without its certified batch: the first pass gets the field's own values
-/// (bound 0), so nothing is approximated. Counts the points of the first pass.
-struct OwnValues<'a>(&'a WindingNumber, AtomicUsize);
+/// The exact evaluator with a first pass that answers as the test asks, counting its points:
+/// with `far_end` false, the field's own values (bound 0: nothing approximated); with it true,
+/// as wrong as the bound (the screening tolerance) allows — each value moved by 0.99 of it, up
+/// or down by a hash of the point.
+struct FirstPass<'a> {
+    field: &'a WindingNumber,
+    far_end: bool,
+    points: AtomicUsize,
+}
 
-impl Evaluator for OwnValues<'_> {
-    fn eval(&self, q: [f64; 3]) -> f64 {
-        self.0.eval(q)
-    }
-    fn eval_batch(&self, points: &[[f64; 3]]) -> Vec<f64> {
-        self.0.eval_batch(points)
-    }
-    fn eval_batch_within(&self, points: &[[f64; 3]], _tolerance: f64) -> Vec<(f64, f64)> {
-        self.1.fetch_add(points.len(), Ordering::Relaxed);
-        self.0
-            .eval_batch(points)
-            .into_iter()
-            .map(|w| (w, 0.0))
-            .collect()
+impl<'a> FirstPass<'a> {
+    fn new(field: &'a WindingNumber, far_end: bool) -> Self {
+        FirstPass {
+            field,
+            far_end,
+            points: AtomicUsize::new(0),
+        }
     }
 }
 
-/// An evaluator whose first pass is as wrong as its bound allows: each value moved by 0.99 of
-/// the bound (the screening tolerance), up or down by a hash of the point. Counts the points
-/// of the first pass.
-struct FarEndOfTheBound<'a>(&'a WindingNumber, AtomicUsize);
-
-impl Evaluator for FarEndOfTheBound<'_> {
+impl Evaluator for FirstPass<'_> {
     fn eval(&self, q: [f64; 3]) -> f64 {
-        self.0.eval(q)
+        self.field.eval(q)
     }
     fn eval_batch(&self, points: &[[f64; 3]]) -> Vec<f64> {
-        self.0.eval_batch(points)
+        self.field.eval_batch(points)
     }
     fn eval_batch_within(&self, points: &[[f64; 3]], tolerance: f64) -> Vec<(f64, f64)> {
-        self.1.fetch_add(points.len(), Ordering::Relaxed);
-        let b = tolerance;
-        self.0
+        self.points.fetch_add(points.len(), Ordering::Relaxed);
+        let b = if self.far_end { tolerance } else { 0.0 };
+        self.field
             .eval_batch(points)
             .into_iter()
             .zip(points)
@@ -134,10 +128,10 @@ fn first_passes_at_the_far_end_of_their_bound_decide_like_the_field() {
     let wn = WindingNumber::new(&mesh).unwrap();
     assert!(wn.boundary_edge_count() > 100);
     for (res, probe) in [(24, true), (40, false), (128, true)] {
-        let own_values = OwnValues(&wn, AtomicUsize::new(0));
+        let own_values = FirstPass::new(&wn, false);
         let own = run(&own_values, &mesh, res, probe);
         assert!(probe || own.stats.planar_levels > 0, "{:?}", own.stats);
-        let far_end = FarEndOfTheBound(&wn, AtomicUsize::new(0));
+        let far_end = FirstPass::new(&wn, true);
         let far = run(&far_end, &mesh, res, probe);
         assert_same_decisions(&own, &far, &format!("far end of the bound, res {res}"));
         // The same points evaluated outside placement (whose interpolation may probe
@@ -147,8 +141,8 @@ fn first_passes_at_the_far_end_of_their_bound_decide_like_the_field() {
             first_pass.load(Ordering::Relaxed) - r.stats.placement_evaluations
         };
         assert_eq!(
-            outside_placement(&own_values.1, &own),
-            outside_placement(&far_end.1, &far),
+            outside_placement(&own_values.points, &own),
+            outside_placement(&far_end.points, &far),
             "points evaluated outside placement, res {res}"
         );
         // The exact evaluator's own first pass (its hierarchy at the screening tolerance).
