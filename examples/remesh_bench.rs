@@ -84,7 +84,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 &band.edges,
                 &classified.edge_values(&band.edges),
                 DEFAULT_BISECTION_STEPS,
-                if guided { Some(&guide) } else { None },
+                if guided {
+                    place::CrossingSource::Triangles(&guide)
+                } else {
+                    place::CrossingSource::None
+                },
             );
             let t3 = Instant::now();
             let (positions, triangles) = if simplified {

@@ -49,7 +49,7 @@ fn build(mesh_path: &PathBuf, res: usize) -> Result<Surface, Box<dyn std::error:
         &band.edges,
         &classified.edge_values(&band.edges),
         DEFAULT_BISECTION_STEPS,
-        Some(&guide),
+        place::CrossingSource::Triangles(&guide),
     );
     let planes = placed
         .planes_in_lattice_units(&lattice)

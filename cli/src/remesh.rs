@@ -47,8 +47,9 @@ pub struct Args {
     /// per surface for the Hausdorff distance (0: skip both).
     #[arg(long, default_value_t = 10_000)]
     pub samples: usize,
-    /// Place every vertex by bisection, without the input triangles' crossings as a guide (same
-    /// guarantees, more evaluations; for comparison).
+    /// Place every vertex by searching the field, without the input triangles' crossings (or a
+    /// STEP model's surface hits) as a guide (same guarantees, more evaluations; for
+    /// comparison).
     #[arg(long)]
     pub no_guide: bool,
     /// Close open sheets (cloth, leaves, single walls: w near 1/2 on both sides, no volume) into
@@ -184,6 +185,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         sub_cell_levels: args.sub_cell_levels,
         planar_levels: args.planar_levels,
         probe_flatness: !args.no_flatness_probe,
+        evaluator_crossings: !args.no_guide,
     };
     // Phases: classify, extract, place, [simplify,] write, self-intersections, Hausdorff,
     // agreement.

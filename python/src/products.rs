@@ -470,6 +470,7 @@ pub fn remesh<'py>(
         sub_cell_levels,
         planar_levels,
         probe_flatness: true,
+        evaluator_crossings: true,
     };
     if let Some(eps) = thicken {
         let extent = (0..3)

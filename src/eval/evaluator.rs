@@ -44,6 +44,15 @@ impl std::fmt::Display for NoGradient {
 
 impl std::error::Error for NoGradient {}
 
+/// Where a segment crosses the evaluator's surface ([`Evaluator::segment_crossings`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceCrossing {
+    /// Fraction along the segment, `0 ≤ t ≤ 1`.
+    pub t: f64,
+    /// The surface's unit normal there (either orientation); zero where it is not known.
+    pub normal: [f64; 3],
+}
+
 /// A winding-number field `w(q)`, built once and queried from many threads.
 ///
 /// Only [`Evaluator::eval`] is required. The provided methods are the per-point loop
@@ -98,6 +107,16 @@ pub trait Evaluator: Send + Sync {
             .collect()
     }
 
+    /// Where the segment `a → b` crosses the surface, in order along it, when this evaluator
+    /// can find that for much less than evaluating `w` along the segment; `None` (the default)
+    /// when it cannot. Proposals, not decisions: a caller that needs the class change
+    /// (the remesher's vertex placement) verifies each with evaluations of `w` on either side,
+    /// so a crossing missed or misplaced costs evaluations, never a wrong answer. The trimmed
+    /// B-rep evaluator answers with its ray-surface hits inside the faces' loops.
+    fn segment_crossings(&self, a: [f64; 3], b: [f64; 3]) -> Option<Vec<SurfaceCrossing>> {
+        let _ = (a, b);
+        None
+    }
     /// Gradient `∇w(q)`, or `Err` when this evaluator has no gradient (the answer does not
     /// depend on `q`).
     fn try_gradient(&self, q: [f64; 3]) -> Result<[f64; 3], NoGradient> {
@@ -135,6 +154,13 @@ macro_rules! forward_evaluator {
             }
             fn eval_column(&self, q: [f64; 3], axis: usize, ts: &[f64]) -> Vec<f64> {
                 (**self).eval_column(q, axis, ts)
+            }
+            fn segment_crossings(
+                &self,
+                a: [f64; 3],
+                b: [f64; 3],
+            ) -> Option<Vec<SurfaceCrossing>> {
+                (**self).segment_crossings(a, b)
             }
             fn try_gradient(&self, q: [f64; 3]) -> Result<[f64; 3], NoGradient> {
                 (**self).try_gradient(q)

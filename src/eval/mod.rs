@@ -11,7 +11,7 @@ mod evaluator;
 pub mod fast;
 pub mod fossil;
 
-pub use evaluator::{Evaluator, NoGradient};
+pub use evaluator::{Evaluator, NoGradient, SurfaceCrossing};
 
 /// How many times, since the process started, an input predicate of the exact evaluator could
 /// not be decided by its `f64` filter and ran in exact big-integer arithmetic (`gwn bench`

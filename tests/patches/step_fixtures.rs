@@ -54,6 +54,141 @@ fn capped_cylinder_is_an_exact_solid() {
     }
 }
 
+/// The crossings of the segment `a → b` with the capped cylinder (radius 1, `0 ≤ z ≤ 2`) in
+/// closed form, as `(t, unit normal)`; `None` when one lies within `margin` of a rim, grazes,
+/// or an end lies within `margin` of the surface (where a proposal may rightly differ).
+fn capped_cylinder_crossings(
+    a: [f64; 3],
+    b: [f64; 3],
+    margin: f64,
+) -> Option<Vec<(f64, [f64; 3])>> {
+    let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let at = |t: f64| [a[0] + t * d[0], a[1] + t * d[1], a[2] + t * d[2]];
+    let mut out = Vec::new();
+    let (qa, qb, qc) = (
+        d[0] * d[0] + d[1] * d[1],
+        2.0 * (a[0] * d[0] + a[1] * d[1]),
+        a[0] * a[0] + a[1] * a[1] - 1.0,
+    );
+    if qa > 0.0 && qb * qb - 4.0 * qa * qc > 0.0 {
+        let root = (qb * qb - 4.0 * qa * qc).sqrt();
+        for t in [(-qb - root) / (2.0 * qa), (-qb + root) / (2.0 * qa)] {
+            let p = at(t);
+            if (0.0..=1.0).contains(&t) && (-margin..=2.0 + margin).contains(&p[2]) {
+                if p[2].abs() < margin || (p[2] - 2.0).abs() < margin {
+                    return None;
+                }
+                let n = [p[0], p[1], 0.0];
+                let cosine =
+                    (n[0] * d[0] + n[1] * d[1]) / (d.iter().map(|x| x * x).sum::<f64>()).sqrt();
+                if cosine.abs() < 0.05 {
+                    return None;
+                }
+                out.push((t, n));
+            }
+        }
+    }
+    for cap in [0.0, 2.0] {
+        if d[2] != 0.0 {
+            let t = (cap - a[2]) / d[2];
+            let p = at(t);
+            let r = p[0].hypot(p[1]);
+            if (0.0..=1.0).contains(&t) && r <= 1.0 + margin {
+                if (r - 1.0).abs() < margin {
+                    return None;
+                }
+                out.push((t, [0.0, 0.0, 1.0]));
+            }
+        }
+    }
+    let off_surface = |p: [f64; 3]| {
+        let r = p[0].hypot(p[1]);
+        (r - 1.0).abs() > margin && p[2].abs() > margin && (p[2] - 2.0).abs() > margin
+    };
+    if !off_surface(a) || !off_surface(b) {
+        return None;
+    }
+    out.sort_by(|x, y| x.0.total_cmp(&y.0));
+    Some(out)
+}
+
+/// A STEP model's segment crossings, which the remesher verifies in place of searching the
+/// field: on the capped cylinder, short segments along the axes, the face diagonals and
+/// oblique directions (the remesher's lattice edges, and others) get exactly the closed-form
+/// crossings, normals included, and none past their end although the ray goes on to the
+/// surface.
+#[test]
+fn segment_crossings_are_the_closed_form_ones() {
+    let m = load_step(&fixture("capped_cylinder.step")).unwrap();
+    let wn = StepWindingNumber::new(&m);
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let directions: Vec<[f64; 3]> = vec![
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, -1.0],
+        [1.0, -1.0, 1.0],
+        [0.3, 0.7, -0.2],
+    ];
+    let (mut checked, mut crossings) = (0, 0);
+    for k in 0..5000 {
+        let a = [3.0 * next() - 1.5, 3.0 * next() - 1.5, 3.0 * next() - 0.5];
+        let d = directions[k % directions.len()];
+        let length = 0.05 + 0.4 * next();
+        let scale = length / d.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let b = [
+            a[0] + scale * d[0],
+            a[1] + scale * d[1],
+            a[2] + scale * d[2],
+        ];
+        let Some(expected) = capped_cylinder_crossings(a, b, 1e-3) else {
+            continue;
+        };
+        let found = wn.segment_crossings(a, b);
+        assert_eq!(
+            found.len(),
+            expected.len(),
+            "{a:?} → {b:?}: {found:?} vs {expected:?}"
+        );
+        for (f, (t, n)) in found.iter().zip(&expected) {
+            assert!((f.t - t).abs() < 1e-9, "{a:?} → {b:?}: t {} vs {t}", f.t);
+            let along = f.normal.iter().zip(n).map(|(x, y)| x * y).sum::<f64>();
+            assert!(
+                (along.abs() - 1.0).abs() < 1e-9,
+                "{a:?} → {b:?}: normal {:?} vs {n:?}",
+                f.normal
+            );
+        }
+        checked += 1;
+        crossings += expected.len();
+    }
+    assert!(
+        checked > 2500 && crossings > 300,
+        "{checked} segments, {crossings} crossings"
+    );
+    // Inside the cylinder, towards the wall: nothing before it, one crossing once it reaches.
+    assert!(
+        wn.segment_crossings([0.0, 0.0, 1.0], [0.5, 0.0, 1.0])
+            .is_empty()
+    );
+    let through = wn.segment_crossings([0.0, 0.0, 1.0], [1.5, 0.0, 1.0]);
+    assert_eq!(through.len(), 1, "{through:?}");
+    assert!((through[0].t - 2.0 / 3.0).abs() < 1e-9);
+    // Degenerate and non-finite segments have none.
+    assert!(wn.segment_crossings([0.5; 3], [0.5; 3]).is_empty());
+    assert!(
+        wn.segment_crossings([f64::NAN, 0.0, 1.0], [1.5, 0.0, 1.0])
+            .is_empty()
+    );
+}
+
 /// `w` on the axis of the plate: `−sign(h) (Ω_square − Ω_disk) / 4π`, the normal being `+z`.
 fn plate_on_axis(h: f64) -> f64 {
     let a = h.abs();

@@ -28,6 +28,7 @@
 //! (the query is on the surface, within the margin of an edge, or surrounded by boundary
 //! curves), a relaxed second pass runs and the result is flagged `uncertified`.
 
+use crate::eval::SurfaceCrossing;
 use crate::kernel::spherical::FOUR_PI;
 
 use rayon::prelude::*;
@@ -363,7 +364,16 @@ impl StepWindingNumber {
         let mut out = Vec::new();
         for (face, edges) in self.model.faces.iter().zip(&self.surface_edges) {
             let dedup = 1e-9 * self.model.diagonal();
-            let hits = face_hits(face, edges, q, &frame, dedup, self.edge_gap()).hits;
+            let hits = face_hits(
+                face,
+                edges,
+                q,
+                &frame,
+                f64::INFINITY,
+                dedup,
+                self.edge_gap(),
+            )
+            .hits;
             for h in hits {
                 let side = face.trim.classify(h.uv, h.su, h.sv, self.margin);
                 // Distance to the loops, to a factor of 2 (first smallest margin that is near).
@@ -378,6 +388,46 @@ impl StepWindingNumber {
                 out.push((face.id, h.point, h.uv, side, dist));
             }
         }
+        out
+    }
+
+    /// Where the segment `a → b` crosses the trimmed faces, in order along it, with the
+    /// surface's unit normal there: the hits of its ray at most `|b − a|` along it (pieces of
+    /// patches beyond the segment are culled, so this costs a fraction of a ray's hits),
+    /// inside a face's loops or within [`COLUMN_HIT_MARGIN`] of them. Proposals for a caller
+    /// that verifies them ([`crate::eval::Evaluator::segment_crossings`]): a hit near a loop
+    /// is kept, a span the subdivision left unresolved is not reported. Empty for a degenerate
+    /// or non-finite segment.
+    pub fn segment_crossings(&self, a: [f64; 3], b: [f64; 3]) -> Vec<SurfaceCrossing> {
+        let d = sub(b, a);
+        let length = norm(d);
+        if !(length.is_finite() && length > 0.0) || a.iter().any(|c| !c.is_finite()) {
+            return Vec::new();
+        }
+        let frame = RayFrame::new(d.map(|x| x / length));
+        let margin = COLUMN_HIT_MARGIN * self.model.diagonal();
+        let mut out = Vec::new();
+        for (face, found) in self.hits_by_face(a, &frame, length) {
+            for h in found.hits {
+                if !(0.0..=length).contains(&h.tau)
+                    || face.trim.classify(h.uv, h.su, h.sv, margin) == Side::Outside
+                {
+                    continue;
+                }
+                let n = cross(h.su, h.sv);
+                let nn = norm(n);
+                let normal = if nn > 0.0 && nn.is_finite() {
+                    n.map(|x| x / nn)
+                } else {
+                    [0.0; 3]
+                };
+                out.push(SurfaceCrossing {
+                    t: h.tau / length,
+                    normal,
+                });
+            }
+        }
+        out.sort_by(|x, y| x.t.total_cmp(&y.t));
         out
     }
 
@@ -580,6 +630,7 @@ impl StepWindingNumber {
         &'a self,
         q: [f64; 3],
         frame: &'a RayFrame,
+        reach: f64,
     ) -> impl Iterator<Item = (&'a Face, FaceHits)> + 'a {
         let dedup = 1e-9 * self.model.diagonal();
         let gap = self.edge_gap();
@@ -588,8 +639,12 @@ impl StepWindingNumber {
             .iter()
             .zip(&self.face_boxes)
             .zip(&self.surface_edges)
-            .filter(move |((_, (lo, hi)), _)| ray_meets_box(q, frame.d, *lo, *hi, dedup.max(gap)))
-            .map(move |((face, _), edges)| (face, face_hits(face, edges, q, frame, dedup, gap)))
+            .filter(move |((_, (lo, hi)), _)| {
+                ray_meets_box(q, frame.d, reach, *lo, *hi, dedup.max(gap))
+            })
+            .map(move |((face, _), edges)| {
+                (face, face_hits(face, edges, q, frame, reach, dedup, gap))
+            })
     }
 
     /// Every hit of the ray from `q` along `frame.d` on the trimmed faces, classified once:
@@ -598,7 +653,7 @@ impl StepWindingNumber {
     fn line_hits(&self, q: [f64; 3], frame: &RayFrame) -> Vec<LineHit> {
         let mut out = Vec::new();
         let column_margin = COLUMN_HIT_MARGIN * self.model.diagonal();
-        for (face, found) in self.hits_by_face(q, frame) {
+        for (face, found) in self.hits_by_face(q, frame, f64::INFINITY) {
             // A span where a crossing may hide blocks the line's rays through it, as an
             // ambiguous hit at each of its ends would.
             for [a, b] in found.unresolved {
@@ -646,7 +701,7 @@ impl StepWindingNumber {
         let mut chi = 0i64;
         let mut clear = true;
         let clear_margin = CLEAR_MARGIN * self.model.diagonal();
-        for (face, found) in self.hits_by_face(q, frame) {
+        for (face, found) in self.hits_by_face(q, frame, f64::INFINITY) {
             if strict && found.unresolved.iter().any(|&[_, hi]| hi >= -margin) {
                 return Err(Reject::Hit);
             }
@@ -868,7 +923,7 @@ impl StepWindingNumber {
         let dedup = 1e-9 * self.model.diagonal();
         let gap = ON_BOUNDARY_GAP * self.model.diagonal();
         for (face, edges) in self.model.faces.iter().zip(&self.surface_edges) {
-            let found = face_hits(face, edges, c, frame, dedup, self.edge_gap());
+            let found = face_hits(face, edges, c, frame, f64::INFINITY, dedup, self.edge_gap());
             if found.unresolved.iter().any(|&[_, hi]| hi > gap) {
                 return None;
             }
@@ -1016,20 +1071,21 @@ fn face_hits(
     edges: &[[bool; 4]],
     q: [f64; 3],
     frame: &RayFrame,
+    reach: f64,
     dedup: f64,
     gap: f64,
 ) -> FaceHits {
     let mut hits: Vec<Hit> = Vec::new();
     let mut unresolved = Vec::new();
     for (fp, &edges) in face.patches.iter().zip(edges) {
-        if ray_meets_box(q, frame.d, fp.lo, fp.hi, dedup) {
+        if ray_meets_box(q, frame.d, reach, fp.lo, fp.hi, dedup) {
             let edges = SurfaceEdges {
                 sides: edges,
                 gap,
                 only: false,
             };
-            patch_hits(fp, edges, q, frame, &mut hits, &mut unresolved);
-        } else if edges.contains(&true) && ray_meets_box(q, frame.d, fp.lo, fp.hi, gap) {
+            patch_hits(fp, edges, q, frame, reach, &mut hits, &mut unresolved);
+        } else if edges.contains(&true) && ray_meets_box(q, frame.d, reach, fp.lo, fp.hi, gap) {
             // Only near the patch: what it can hold is a gap at an edge, not a hit ahead (a
             // hit behind `q` within the margin would reject the ray only because of the
             // padding).
@@ -1038,7 +1094,7 @@ fn face_hits(
                 gap,
                 only: true,
             };
-            patch_hits(fp, edges, q, frame, &mut Vec::new(), &mut unresolved);
+            patch_hits(fp, edges, q, frame, reach, &mut Vec::new(), &mut unresolved);
         }
     }
     let mut kept: Vec<Hit> = Vec::new();
@@ -1099,9 +1155,17 @@ struct SurfaceEdges {
     only: bool,
 }
 
-/// Slab test of the ray `q + τ d, τ ≥ 0` against a box grown by `pad`.
-fn ray_meets_box(q: [f64; 3], d: [f64; 3], lo: [f64; 3], hi: [f64; 3], pad: f64) -> bool {
-    let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
+/// Slab test of the ray `q + τ d, 0 ≤ τ ≤ reach` (`reach` infinite for a ray) against a box
+/// grown by `pad`.
+fn ray_meets_box(
+    q: [f64; 3],
+    d: [f64; 3],
+    reach: f64,
+    lo: [f64; 3],
+    hi: [f64; 3],
+    pad: f64,
+) -> bool {
+    let (mut t0, mut t1) = (0.0f64, reach);
     for k in 0..3 {
         let (a, b) = (lo[k] - pad - q[k], hi[k] + pad - q[k]);
         if d[k] == 0.0 {
@@ -1167,6 +1231,7 @@ fn patch_hits(
     edges: SurfaceEdges,
     q: [f64; 3],
     frame: &RayFrame,
+    reach: f64,
     out: &mut Vec<Hit>,
     unresolved: &mut Vec<[f64; 2]>,
 ) {
@@ -1214,7 +1279,13 @@ fn patch_hits(
             continue;
         }
         let pad_xy = if on_edge { pad.max(edges.gap) } else { pad };
-        if lo[0] > pad_xy || hi[0] < -pad_xy || lo[1] > pad_xy || hi[1] < -pad_xy || hi[2] < -pad {
+        if lo[0] > pad_xy
+            || hi[0] < -pad_xy
+            || lo[1] > pad_xy
+            || hi[1] < -pad_xy
+            || hi[2] < -pad
+            || lo[2] > reach + pad
+        {
             continue;
         }
         // The box in the ray's plane is loose for a piece beside the ray and slanted to it;
@@ -1462,5 +1533,8 @@ impl crate::eval::Evaluator for StepWindingNumber {
             .into_iter()
             .map(|e| e.value)
             .collect()
+    }
+    fn segment_crossings(&self, a: [f64; 3], b: [f64; 3]) -> Option<Vec<SurfaceCrossing>> {
+        Some(StepWindingNumber::segment_crossings(self, a, b))
     }
 }

@@ -172,6 +172,11 @@ pub struct RemeshOptions {
     /// Use only as many of [`RemeshOptions::planar_levels`] as the [`flatness`] probe finds
     /// pay (none on an input curved everywhere, where they only cost time); `false`: all.
     pub probe_flatness: bool,
+    /// Without input triangles: let the evaluator propose where each lattice edge crosses the
+    /// surface ([`crate::eval::Evaluator::segment_crossings`]; trimmed B-rep models), verified
+    /// like the triangles' crossings, instead of searching the field alone. Same guarantees,
+    /// fewer evaluations; `false` for comparison.
+    pub evaluator_crossings: bool,
 }
 
 impl RemeshOptions {
@@ -186,6 +191,7 @@ impl RemeshOptions {
             sub_cell_levels: DEFAULT_SUB_CELL_LEVELS,
             planar_levels: DEFAULT_PLANAR_LEVELS,
             probe_flatness: true,
+            evaluator_crossings: true,
         }
     }
 }
@@ -507,7 +513,11 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
         // The precision is per lattice edge: a cell `2^planar` times larger takes as many
         // more steps, so vertices stay as close to the class change in resolution cells.
         options.bisection_steps + planar,
-        guide,
+        match guide {
+            Some(bvh) => place::CrossingSource::Triangles(bvh),
+            None if options.evaluator_crossings => place::CrossingSource::Evaluator,
+            None => place::CrossingSource::None,
+        },
     );
     let mut stats = RemeshStats {
         lattice_cells: lattice.cells,

@@ -13,14 +13,16 @@
 //! `|edge| / 2^(steps+1)`, of a point where the class changes. Every evaluation is at a tick
 //! strictly inside the bracket and only ever narrows it, so how a probe is chosen costs
 //! evaluations, never the guarantee. Rounds of probes, one parallel batch each, choose per edge:
-//! - **a crossing** (when the input triangles are given): the segment's crossings with the
-//!   input triangles ([`SegmentBvh`]), rounded to ticks, are where `w` may jump. With one of
+//! - **a crossing** (when the input triangles are given, or the evaluator proposes them:
+//!   [`CrossingSource`]): the segment's crossings with the input triangles ([`SegmentBvh`]),
+//!   or with the surface as the evaluator finds them ([`Evaluator::segment_crossings`]: a STEP
+//!   model's ray hits), rounded to ticks, are where `w` may jump. With one of
 //!   them, `k`, inside the bracket, two evaluations at `k − 1` and `k + 1` (fewer next to a
 //!   known end) *verify* it; with several (thin parts, double walls), one evaluation between the
 //!   middle two says on which side of it the change is. A crossing that does not verify leaves
 //!   the bracket on one side of it.
 //! - **the field** (no crossing inside the bracket: a hole, an inconsistently oriented sheet, a
-//!   point cloud): away from the triangles `w` is harmonic, hence smooth, and the bracket's ends
+//!   point cloud, a Bézier patch set): away from the triangles `w` is harmonic, hence smooth, and the bracket's ends
 //!   carry its values (the corners' from [`super::octree`]), so the probe is the ITP step
 //!   (interpolate, truncate, project; Oliveira & Takahashi 2020) on `w − ½`: regula falsi where
 //!   `w` is smooth, and never more than one evaluation over bisection's count where it is not.
@@ -95,6 +97,23 @@ fn plane_of(t: &[[f64; 3]; 3]) -> Plane {
         n[2],
         -(n[0] * t[0][0] + n[1] * t[0][1] + n[2] * t[0][2]),
     ]
+}
+
+/// Where [`place_vertices`] takes the crossings it verifies.
+#[derive(Clone, Copy, Debug)]
+pub enum CrossingSource<'a> {
+    /// None: every vertex is found by the field's search.
+    None,
+    /// The input triangles' crossings with each edge.
+    Triangles(&'a SegmentBvh),
+    /// The evaluator's own ([`Evaluator::segment_crossings`]: the trimmed B-rep evaluator's
+    /// segment hits); edges where it answers `None` have none.
+    Evaluator,
+}
+
+/// The plane through `p` with unit normal `n` (zero for a zero normal, like [`plane_of`]).
+fn plane_through(p: [f64; 3], n: [f64; 3]) -> Plane {
+    [n[0], n[1], n[2], -(n[0] * p[0] + n[1] * p[1] + n[2] * p[2])]
 }
 
 /// One edge's search: the bracket, `w` at its ends, and the ITP state.
@@ -227,7 +246,7 @@ pub fn place_vertices<E: Evaluator + ?Sized>(
     edges: &[(Corner, Corner)],
     corner_w: &[[f64; 2]],
     steps: u32,
-    guide: Option<&SegmentBvh>,
+    guide: CrossingSource,
 ) -> Placement {
     assert_eq!(edges.len(), corner_w.len());
     let ticks: i64 = 1 << (steps + 1);
@@ -248,10 +267,28 @@ pub fn place_vertices<E: Evaluator + ?Sized>(
     };
     // Each edge's crossing ticks, sorted and distinct, as ranges of one list, with the plane of
     // a triangle crossed there (the first in the hierarchy's order).
+    // A crossing at fraction `t` of the segment `a → b` with the plane of the surface there.
+    let crossings_of = |a: [f64; 3], b: [f64; 3], out: &mut dyn FnMut(f64, Plane)| match guide {
+        CrossingSource::None => {}
+        CrossingSource::Triangles(bvh) => {
+            bvh.for_each_crossing(a, b, |t, tri| out(t, plane_of(tri)));
+        }
+        CrossingSource::Evaluator => {
+            for c in evaluator.segment_crossings(a, b).unwrap_or_default() {
+                let p = [0, 1, 2].map(|k| a[k] + c.t * (b[k] - a[k]));
+                out(c.t, plane_through(p, c.normal));
+            }
+        }
+    };
+    let proposes = match guide {
+        CrossingSource::None => false,
+        CrossingSource::Triangles(bvh) => !bvh.is_empty(),
+        CrossingSource::Evaluator => true,
+    };
     let (crossings, crossing_planes, crossing_ranges): (Vec<i64>, Vec<Plane>, Vec<(u32, u32)>) =
-        match guide.filter(|b| !b.is_empty()) {
-            None => (Vec::new(), Vec::new(), vec![(0, 0); edges.len()]),
-            Some(bvh) => {
+        match proposes {
+            false => (Vec::new(), Vec::new(), vec![(0, 0); edges.len()]),
+            true => {
                 // By chunks of edges (a `Vec` per edge cost ~100 bytes each at the peak).
                 let chunks: Vec<(Vec<i64>, Vec<Plane>, Vec<u32>)> = edges
                     .par_chunks(4096)
@@ -261,9 +298,11 @@ pub fn place_vertices<E: Evaluator + ?Sized>(
                         for &e in chunk {
                             hits.clear();
                             let n = units(e);
-                            bvh.for_each_crossing(at(e, 0), at(e, n), |t, tri| {
-                                let k = ((t * n as f64).round() as i64).clamp(1, n - 1);
-                                hits.push((k, plane_of(tri)));
+                            crossings_of(at(e, 0), at(e, n), &mut |t, plane| {
+                                if t.is_finite() {
+                                    let k = ((t * n as f64).round() as i64).clamp(1, n - 1);
+                                    hits.push((k, plane));
+                                }
                             });
                             // Stable: the first triangle in the hierarchy's order keeps its tick.
                             hits.sort_by_key(|&(k, _)| k);
@@ -496,7 +535,7 @@ mod tests {
         field: &E,
         lattice: &Lattice,
         edges: &[((Corner, Corner), [f64; 2])],
-        guide: Option<&SegmentBvh>,
+        guide: CrossingSource,
     ) -> Vec<usize> {
         edges
             .iter()
@@ -536,7 +575,7 @@ mod tests {
         let lattice = lattice();
         let edges = band_edges(&field, &lattice);
         assert!(edges.len() > 100, "{}", edges.len());
-        let evaluations = place_one_by_one(&field, &lattice, &edges, None);
+        let evaluations = place_one_by_one(&field, &lattice, &edges, CrossingSource::None);
         let total: usize = evaluations.iter().sum();
         // 4.6 per edge here, against bisection's 8 (the first step is nearly always the
         // midpoint: ITP's truncation hedges against a poor interpolation).
@@ -548,10 +587,99 @@ mod tests {
         );
         // All at once gives the same vertices as one by one (each edge's search is its own).
         let (e, w): (Vec<_>, Vec<_>) = edges.iter().copied().unzip();
-        let together = place_vertices(&field, &lattice, &e, &w, STEPS, None);
+        let together = place_vertices(&field, &lattice, &e, &w, STEPS, CrossingSource::None);
         assert_eq!(together.evaluations, total);
         for (&edge, &fixed) in e.iter().zip(&together.fixed) {
             assert_within_a_tick_of_a_change(&field, &lattice, edge, fixed);
+        }
+    }
+
+    /// A ball of radius `r` about the cube's centre (`w` 1 inside, 0 outside, a closed sheet)
+    /// whose evaluator proposes where segments cross the sphere, each proposal moved by
+    /// `error` along the segment (world units).
+    struct BallWithCrossings {
+        r: f64,
+        error: f64,
+    }
+
+    impl Evaluator for BallWithCrossings {
+        fn eval(&self, q: [f64; 3]) -> f64 {
+            let r2: f64 = q.iter().map(|x| (x - 0.5) * (x - 0.5)).sum();
+            f64::from(u8::from(r2 < self.r * self.r))
+        }
+        fn segment_crossings(
+            &self,
+            a: [f64; 3],
+            b: [f64; 3],
+        ) -> Option<Vec<crate::eval::SurfaceCrossing>> {
+            // |a − c + t (b − a)|² = r²: the roots in [0, 1].
+            let (d, m) = ([0, 1, 2].map(|k| b[k] - a[k]), a.map(|x| x - 0.5));
+            let dot = |u: [f64; 3], v: [f64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+            let (qa, qb, qc) = (dot(d, d), 2.0 * dot(m, d), dot(m, m) - self.r * self.r);
+            let disc = qb * qb - 4.0 * qa * qc;
+            if disc < 0.0 {
+                return Some(Vec::new());
+            }
+            let shift = self.error / qa.sqrt();
+            Some(
+                [-1.0, 1.0]
+                    .map(|s| (-qb + s * disc.sqrt()) / (2.0 * qa))
+                    .into_iter()
+                    .filter(|t| (0.0..=1.0).contains(t))
+                    .map(|t| {
+                        let p = [0, 1, 2].map(|k| a[k] + t * d[k] - 0.5);
+                        let n = p.map(|x| x / self.r);
+                        crate::eval::SurfaceCrossing {
+                            t: (t + shift).clamp(0.0, 1.0),
+                            normal: n,
+                        }
+                    })
+                    .collect(),
+            )
+        }
+    }
+
+    #[test]
+    fn the_evaluators_crossings_are_verified_like_the_triangles() {
+        let lattice = lattice();
+        let exact = BallWithCrossings {
+            r: 0.31,
+            error: 0.0,
+        };
+        let edges = band_edges(&exact, &lattice);
+        assert!(edges.len() > 100, "{}", edges.len());
+        let (e, w): (Vec<_>, Vec<_>) = edges.iter().copied().unzip();
+        // Right proposals: two evaluations per vertex (one next to an end of the edge), every
+        // vertex verified, with the sphere's tangent plane (the normal at the crossing, and
+        // the plane through it).
+        let p = place_vertices(&exact, &lattice, &e, &w, STEPS, CrossingSource::Evaluator);
+        assert_eq!(p.guided, e.len());
+        assert!(p.evaluations <= 2 * e.len(), "{}", p.evaluations);
+        for ((&edge, &fixed), plane) in e.iter().zip(&p.fixed).zip(&p.planes) {
+            assert_within_a_tick_of_a_change(&exact, &lattice, edge, fixed);
+            let [a, b, c, d] = plane.expect("a verified crossing has a plane");
+            assert!(((a * a + b * b + c * c).sqrt() - 1.0).abs() < 1e-12);
+            // The plane touches the sphere: its distance from the centre is the radius.
+            assert!((((a + b + c) * 0.5 + d).abs() - 0.31).abs() < 1e-9);
+        }
+        // Without them, the field's search: bisection across a closed sheet, 8 per vertex.
+        let none = place_vertices(&exact, &lattice, &e, &w, STEPS, CrossingSource::None);
+        assert_eq!(
+            (none.guided, none.evaluations),
+            (0, STEPS as usize * e.len())
+        );
+        // Proposals off by 3 ticks' length: none verifies, and every vertex is still within a
+        // tick of the change, at a bounded cost (the probes next to the proposal narrow the
+        // bracket, and the field's search takes over).
+        let tick = lattice.h[0] / TICKS as f64;
+        for error in [3.0 * tick, -3.0 * tick] {
+            let off = BallWithCrossings { r: 0.31, error };
+            let p = place_vertices(&off, &lattice, &e, &w, STEPS, CrossingSource::Evaluator);
+            assert!(p.guided < e.len() / 10, "{} of {}", p.guided, e.len());
+            assert!(p.evaluations <= (STEPS as usize + 2) * e.len());
+            for (&edge, &fixed) in e.iter().zip(&p.fixed) {
+                assert_within_a_tick_of_a_change(&off, &lattice, edge, fixed);
+            }
         }
     }
 
@@ -563,7 +691,7 @@ mod tests {
         let lattice = lattice();
         let edges = band_edges(&field, &lattice);
         assert!(!edges.is_empty());
-        for n in place_one_by_one(&field, &lattice, &edges, None) {
+        for n in place_one_by_one(&field, &lattice, &edges, CrossingSource::None) {
             assert_eq!(n, STEPS as usize);
         }
     }
@@ -593,7 +721,7 @@ mod tests {
             let lattice = lattice();
             let edges = band_edges(&field, &lattice);
             assert!(edges.len() > 50, "{}", edges.len());
-            let n = place_one_by_one(&field, &lattice, &edges, None);
+            let n = place_one_by_one(&field, &lattice, &edges, CrossingSource::None);
             most = most.max(n.into_iter().max().unwrap());
         }
         assert!(most <= (STEPS + ITP_SLACK) as usize, "{most} evaluations");
@@ -606,14 +734,28 @@ mod tests {
         let field = Field(|_: [f64; 3]| 0.7);
         let lattice = lattice();
         let edge = ([3, 4, 4], [4, 4, 4]);
-        let p = place_vertices(&field, &lattice, &[edge], &[[0.7, f64::NAN]], STEPS, None);
+        let p = place_vertices(
+            &field,
+            &lattice,
+            &[edge],
+            &[[0.7, f64::NAN]],
+            STEPS,
+            CrossingSource::None,
+        );
         assert_eq!(p.evaluations, 1);
         assert_eq!(p.fixed[0][0], 4 * TICKS - 1);
         // With the change inside the edge after all (at its middle), the search goes on from
         // that probe.
         let (x0, h) = (lattice.corner_position(edge.0)[0], lattice.h[0]);
         let field = Field(move |q: [f64; 3]| 0.7 - 0.4 * (q[0] - x0) / h);
-        let p = place_vertices(&field, &lattice, &[edge], &[[0.7, f64::NAN]], STEPS, None);
+        let p = place_vertices(
+            &field,
+            &lattice,
+            &[edge],
+            &[[0.7, f64::NAN]],
+            STEPS,
+            CrossingSource::None,
+        );
         let k = p.fixed[0][0] - 3 * TICKS;
         assert!((k - TICKS / 2).abs() <= 1, "{k}");
         assert!(p.evaluations <= 4, "{}", p.evaluations);
@@ -647,7 +789,7 @@ mod tests {
             &[edge],
             &[[1.0, 0.0]],
             STEPS,
-            Some(&guide),
+            CrossingSource::Triangles(&guide),
         );
         assert_eq!((p.evaluations, p.guided), (3, 1));
         assert_within_a_tick_of_a_change(&field, &lattice, edge, p.fixed[0]);
@@ -658,7 +800,14 @@ mod tests {
         assert_eq!((a.abs(), b, c), (1.0, 0.0, 0.0));
         assert!((d / a + walls[1]).abs() < 1e-12, "{d}");
         // Without a guide no vertex has a plane.
-        let p = place_vertices(&field, &lattice, &[edge], &[[1.0, 0.0]], STEPS, None);
+        let p = place_vertices(
+            &field,
+            &lattice,
+            &[edge],
+            &[[1.0, 0.0]],
+            STEPS,
+            CrossingSource::None,
+        );
         assert_eq!(p.planes, vec![None]);
     }
 }

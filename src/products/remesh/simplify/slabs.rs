@@ -439,7 +439,7 @@ mod tests {
             &band.edges,
             &classified.edge_values(&band.edges),
             8,
-            Some(&guide),
+            place::CrossingSource::Triangles(&guide),
         );
         let planes = placed.planes_in_lattice_units(&lattice);
         assert!(planes.iter().filter(|p| p.is_some()).count() * 2 > planes.len());
