@@ -198,8 +198,9 @@ impl Patch {
     /// The point `S(s, t)` and the partial derivatives `∂S/∂s`, `∂S/∂t`.
     pub fn eval_with_partials(&self, s: f64, t: f64) -> ([f64; 3], [f64; 3], [f64; 3]) {
         let (m, n) = self.degree;
-        let (bs, dbs) = bernstein_with_derivative(m, s);
-        let (bt, dbt) = bernstein_with_derivative(n, t);
+        let [mut bs, mut dbs, mut bt, mut dbt] = [[0.0; MAX_DEGREE + 1]; 4];
+        bernstein_with_derivative_into(m, s, &mut bs, &mut dbs);
+        bernstein_with_derivative_into(n, t, &mut bt, &mut dbt);
         // Homogeneous sums H = Σ B B w P (xyz) and W = Σ B B w, with their partials.
         let mut h = [[0.0f64; 4]; 3]; // value, d/ds, d/dt
         for i in 0..=m {
@@ -290,12 +291,17 @@ impl Patch {
     }
 }
 
-/// The Bernstein basis `B_i^d(x)`, `i = 0..=d`, and its derivative.
-pub(crate) fn bernstein_with_derivative(d: usize, x: f64) -> (Vec<f64>, Vec<f64>) {
-    let b = bernstein(d, x);
-    let mut db = vec![0.0; d + 1];
+/// The Bernstein basis `B_i^d(x)`, `i = 0..=d`, and its derivative, into `b[..=d]` and
+/// `db[..=d]` (`d ≤ MAX_DEGREE`). No allocation: a surface point with its partials
+/// ([`Patch::eval_with_partials`]) runs at every Newton step of a ray hit, where six `Vec`s per
+/// call (with the net halvings' own) made the allocator a third of a STEP model's remeshing
+/// time.
+pub(crate) fn bernstein_with_derivative_into(d: usize, x: f64, b: &mut [f64], db: &mut [f64]) {
+    bernstein_into(d, x, b);
+    db[..=d].fill(0.0);
     if d > 0 {
-        let lower = bernstein(d - 1, x);
+        let mut lower = [0.0; MAX_DEGREE + 1];
+        bernstein_into(d - 1, x, &mut lower);
         let df = d as f64;
         for i in 0..=d {
             let left = if i > 0 { lower[i - 1] } else { 0.0 };
@@ -303,12 +309,13 @@ pub(crate) fn bernstein_with_derivative(d: usize, x: f64) -> (Vec<f64>, Vec<f64>
             db[i] = df * (left - right);
         }
     }
-    (b, db)
 }
 
-/// The Bernstein basis by the triangular recurrence (stable on `[0, 1]`, exact 0/1 at the ends).
-pub(crate) fn bernstein(d: usize, x: f64) -> Vec<f64> {
-    let mut b = vec![0.0; d + 1];
+/// The Bernstein basis into `b[..=d]`, by the triangular recurrence (stable on `[0, 1]`, exact
+/// 0/1 at the ends).
+fn bernstein_into(d: usize, x: f64, b: &mut [f64]) {
+    let b = &mut b[..=d];
+    b.fill(0.0);
     b[0] = 1.0;
     let y = 1.0 - x;
     for k in 1..=d {
@@ -319,7 +326,6 @@ pub(crate) fn bernstein(d: usize, x: f64) -> Vec<f64> {
             prev = cur;
         }
     }
-    b
 }
 
 /// A set of patches with the surface they form.
@@ -364,6 +370,18 @@ impl PatchSet {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn bernstein(d: usize, x: f64) -> Vec<f64> {
+        let mut b = vec![0.0; d + 1];
+        bernstein_into(d, x, &mut b);
+        b
+    }
+
+    fn bernstein_with_derivative(d: usize, x: f64) -> (Vec<f64>, Vec<f64>) {
+        let (mut b, mut db) = (vec![0.0; d + 1], vec![0.0; d + 1]);
+        bernstein_with_derivative_into(d, x, &mut b, &mut db);
+        (b, db)
+    }
 
     #[test]
     fn bernstein_partition_of_unity_and_ends() {

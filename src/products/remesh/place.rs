@@ -22,10 +22,11 @@
 //!   middle two says on which side of it the change is. A crossing that does not verify leaves
 //!   the bracket on one side of it.
 //! - **the field** (no crossing inside the bracket: a hole, an inconsistently oriented sheet, a
-//!   point cloud, a Bézier patch set): away from the triangles `w` is harmonic, hence smooth, and the bracket's ends
-//!   carry its values (the corners' from [`super::octree`]), so the probe is the ITP step
-//!   (interpolate, truncate, project; Oliveira & Takahashi 2020) on `w − ½`: regula falsi where
-//!   `w` is smooth, and never more than one evaluation over bisection's count where it is not.
+//!   point cloud, a Bézier patch set): away from the triangles `w` is harmonic, hence smooth,
+//!   and the bracket's ends carry its values (the corners' from [`super::octree`]), so the
+//!   probe is the ITP step (interpolate, truncate, project; Oliveira & Takahashi 2020) on
+//!   `w − ½`: regula falsi where `w` is smooth, and never more than one evaluation over
+//!   bisection's count where it is not.
 //!   Across a closed sheet (`w` = 1 and 0 at the ends) regula falsi *is* bisection.
 //!
 //! Ticks are dyadic, so each vertex is exact in fixed point: lattice units times `T`
@@ -265,9 +266,7 @@ pub fn place_vertices<E: Evaluator + ?Sized>(
         lattice
             .position([0, 1, 2].map(|a| f64::from(i[a]) + t * (f64::from(o[a]) - f64::from(i[a]))))
     };
-    // Each edge's crossing ticks, sorted and distinct, as ranges of one list, with the plane of
-    // a triangle crossed there (the first in the hierarchy's order).
-    // A crossing at fraction `t` of the segment `a → b` with the plane of the surface there.
+    // The crossings of the segment `a → b`: fraction `t` along it, plane of the surface there.
     let crossings_of = |a: [f64; 3], b: [f64; 3], out: &mut dyn FnMut(f64, Plane)| match guide {
         CrossingSource::None => {}
         CrossingSource::Triangles(bvh) => {
@@ -285,6 +284,8 @@ pub fn place_vertices<E: Evaluator + ?Sized>(
         CrossingSource::Triangles(bvh) => !bvh.is_empty(),
         CrossingSource::Evaluator => true,
     };
+    // Each edge's crossing ticks, sorted and distinct, as ranges of one list, with the plane of
+    // the surface crossed there (a triangle's: the first in the hierarchy's order).
     let (crossings, crossing_planes, crossing_ranges): (Vec<i64>, Vec<Plane>, Vec<(u32, u32)>) =
         match proposes {
             false => (Vec::new(), Vec::new(), vec![(0, 0); edges.len()]),
