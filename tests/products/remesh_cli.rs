@@ -221,8 +221,9 @@ fn remesh_thickens_an_open_sheet_on_request() {
 }
 
 /// Trimmed B-rep STEP models (the paper's dataset in `../shared/parametric/step`) remesh like
-/// meshes: closed, manifold, oriented, genus 0, no exact self-intersection, and agreeing with the
-/// model's own `w > ½` at the seeded samples.
+/// meshes: closed, manifold, oriented, genus 0, no exact self-intersection, agreeing with the
+/// model's own `w > ½` at the seeded samples, and with vertices placed at the model's surface
+/// hits.
 #[test]
 fn remesh_reads_step_models() {
     let Some(dir) = crate::common::shared_file("parametric/step") else {
@@ -237,6 +238,14 @@ fn remesh_reads_step_models() {
         );
         let agreement = report_number(&json, "occupancy_agreement");
         assert!(agreement >= min_agreement, "{model}: agreement {agreement}");
+        // Placed at the model's own surface hits: about two evaluations per vertex (eight for
+        // the field search).
+        let guided = report_number(&json, "guided_vertices");
+        let evaluations = report_number(&json, "placement_evaluations");
+        assert!(
+            guided > 0.0 && evaluations < 3.0 * guided,
+            "{model}: {guided} guided vertices, {evaluations} evaluations"
+        );
     }
 }
 
