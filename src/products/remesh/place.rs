@@ -735,28 +735,23 @@ mod tests {
         let field = Field(|_: [f64; 3]| 0.7);
         let lattice = lattice();
         let edge = ([3, 4, 4], [4, 4, 4]);
-        let p = place_vertices(
-            &field,
-            &lattice,
-            &[edge],
-            &[[0.7, f64::NAN]],
-            STEPS,
-            CrossingSource::None,
-        );
+        // The edge with `w` 0.7 at its inside corner and its outside corner not evaluated.
+        fn place_from_border<E: Evaluator>(
+            field: &E,
+            lattice: &Lattice,
+            edge: (Corner, Corner),
+        ) -> Placement {
+            let w = [[0.7, f64::NAN]];
+            place_vertices(field, lattice, &[edge], &w, STEPS, CrossingSource::None)
+        }
+        let p = place_from_border(&field, &lattice, edge);
         assert_eq!(p.evaluations, 1);
         assert_eq!(p.fixed[0][0], 4 * TICKS - 1);
         // With the change inside the edge after all (at its middle), the search goes on from
         // that probe.
         let (x0, h) = (lattice.corner_position(edge.0)[0], lattice.h[0]);
         let field = Field(move |q: [f64; 3]| 0.7 - 0.4 * (q[0] - x0) / h);
-        let p = place_vertices(
-            &field,
-            &lattice,
-            &[edge],
-            &[[0.7, f64::NAN]],
-            STEPS,
-            CrossingSource::None,
-        );
+        let p = place_from_border(&field, &lattice, edge);
         let k = p.fixed[0][0] - 3 * TICKS;
         assert!((k - TICKS / 2).abs() <= 1, "{k}");
         assert!(p.evaluations <= 4, "{}", p.evaluations);
@@ -784,14 +779,9 @@ mod tests {
                 0.0
             }
         });
-        let p = place_vertices(
-            &field,
-            &lattice,
-            &[edge],
-            &[[1.0, 0.0]],
-            STEPS,
-            CrossingSource::Triangles(&guide),
-        );
+        let place =
+            |source| place_vertices(&field, &lattice, &[edge], &[[1.0, 0.0]], STEPS, source);
+        let p = place(CrossingSource::Triangles(&guide));
         assert_eq!((p.evaluations, p.guided), (3, 1));
         assert_within_a_tick_of_a_change(&field, &lattice, edge, p.fixed[0]);
         let k = p.fixed[0][0] - 3 * TICKS;
@@ -801,14 +791,6 @@ mod tests {
         assert_eq!((a.abs(), b, c), (1.0, 0.0, 0.0));
         assert!((d / a + walls[1]).abs() < 1e-12, "{d}");
         // Without a guide no vertex has a plane.
-        let p = place_vertices(
-            &field,
-            &lattice,
-            &[edge],
-            &[[1.0, 0.0]],
-            STEPS,
-            CrossingSource::None,
-        );
-        assert_eq!(p.planes, vec![None]);
+        assert_eq!(place(CrossingSource::None).planes, vec![None]);
     }
 }
