@@ -1065,7 +1065,9 @@ fn certify(
 /// skipped), with hits closer than `dedup` to an earlier one dropped (a hit on the seam of two
 /// patches is one hit), and the spans `[τ_lo, τ_hi]` along the ray of the pieces whose
 /// crossings are unknown, among them where the ray passes within `gap` of the edge of the
-/// face's untrimmed surface (`edges`: [`surface_edges`]; [`patch_hits`]).
+/// face's untrimmed surface (`edges`: [`surface_edges`]; [`patch_hits`]). The ray stops at
+/// `τ = reach` (infinite for a ray; a segment's length for
+/// [`StepWindingNumber::segment_crossings`]): patches and pieces wholly beyond it are skipped.
 fn face_hits(
     face: &Face,
     edges: &[[bool; 4]],
@@ -1224,8 +1226,9 @@ struct Piece {
 }
 
 /// Ray hits on one patch: subdivision culls pieces whose control hull misses the ray's line
-/// (xy box not containing the origin) or lies behind `q`; at depth [`HIT_DEPTH`] or once a piece
-/// is small, Newton's method from its centre; a root counts for the piece containing it.
+/// (xy box not containing the origin) or lies behind `q` or beyond `reach`; at depth
+/// [`HIT_DEPTH`] or once a piece is small, Newton's method from its centre; a root counts for
+/// the piece containing it.
 fn patch_hits(
     fp: &FacePatch,
     edges: SurfaceEdges,
