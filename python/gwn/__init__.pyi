@@ -179,8 +179,8 @@ def voxelize(
     """Winding numbers (exact by default) on a voxel grid: (values (D, H, W) indexed [z, y, x], origin, spacing)."""
 
 def remesh(
-    V: _Floats,
-    F: _Indices,
+    V: Union[_Floats, StepModel],
+    F: Optional[_Indices] = None,
     res: int = 128,
     *,
     bisect: int = 8,
@@ -193,7 +193,7 @@ def remesh(
     thicken: Optional[float] = None,
     refine_plates: bool = True,
 ) -> Tuple[_F64, _I64]:
-    """A closed, manifold, oriented surface of the solid w > 1/2 as (V float64 (n, 3), F int64 (m, 3)); simplify=False: the raw marching-tetrahedra surface; refine_plates=False keeps the lattice of res alone."""
+    """A closed, manifold, oriented surface of the solid w > 1/2 as (V float64 (n, 3), F int64 (m, 3)); simplify=False: the raw marching-tetrahedra surface; refine_plates=False keeps the lattice of res alone. remesh(model, res=...) of a StepModel takes no F."""
 
 def sdf(
     V: _Floats,

@@ -109,10 +109,7 @@ impl Evaluator {
     /// Builds the STEP evaluator `spec` describes (checked by the library for STEP models: only
     /// the exact method, no `ray=`, `precision=` or fast options).
     pub fn for_step(model: &StepModel, spec: &EvaluatorSpec) -> Result<Self, SpecError> {
-        spec.check(InputKind::Step)?;
-        let wn = StepWindingNumber::with_options(model, spec.step_options())
-            .map_err(|e| SpecError::refused_tolerance(e, InputKind::Step))?;
-        Ok(Evaluator::Step(Box::new(wn)))
+        Ok(Evaluator::Step(Box::new(step_evaluator(model, spec)?)))
     }
 
     /// What `Unsupported` calls this evaluator.
@@ -202,4 +199,15 @@ impl Evaluator {
             _ => self.exact().map(WindingNumber::boundary_edge_count),
         }
     }
+}
+
+/// The STEP evaluator `spec` describes (checked by the library for STEP models: only the exact
+/// method, no `ray=`, `precision=` or fast options): `WindingNumber(model)` and `remesh(model)`.
+pub fn step_evaluator(
+    model: &StepModel,
+    spec: &EvaluatorSpec,
+) -> Result<StepWindingNumber, SpecError> {
+    spec.check(InputKind::Step)?;
+    StepWindingNumber::with_options(model, spec.step_options())
+        .map_err(|e| SpecError::refused_tolerance(e, InputKind::Step))
 }

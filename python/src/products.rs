@@ -431,13 +431,17 @@ pub fn filter_tets<'py>(
 /// ``res``, as ``gwn remesh --sub-cell-levels``. ``planar_levels`` (0 to 3, default 3) keeps
 /// cells up to ``2**planar_levels`` times larger whole where the input in them is flat, as many levels as a
 /// probe of the input finds pay (none on curved inputs), as ``gwn remesh --planar-levels``.
+/// ``gwn.remesh(model, res=...)`` remeshes a :class:`StepModel` (``gwn.load("part.step")``)
+/// the way ``gwn remesh part.step`` does: no ``F``, exact method only (``tolerance=`` as in
+/// :class:`WindingNumber`), vertices placed at the model's own surface hits; ``thicken`` is
+/// refused.
 #[pyfunction]
-#[pyo3(signature = (V, F, res = 128, *, bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS, simplify = true, method = "exact", beta = None, order = None, tolerance = None, threads = None, thicken = None, refine_plates = true, sub_cell_levels = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS, planar_levels = gwn::products::remesh::DEFAULT_PLANAR_LEVELS))]
+#[pyo3(signature = (V, F = None, res = 128, *, bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS, simplify = true, method = "exact", beta = None, order = None, tolerance = None, threads = None, thicken = None, refine_plates = true, sub_cell_levels = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS, planar_levels = gwn::products::remesh::DEFAULT_PLANAR_LEVELS))]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub fn remesh<'py>(
     py: Python<'py>,
     V: &Bound<'py, PyAny>,
-    F: &Bound<'py, PyAny>,
+    F: Option<&Bound<'py, PyAny>>,
     res: usize,
     bisect: u32,
     simplify: bool,
@@ -455,12 +459,6 @@ pub fn remesh<'py>(
         RemeshOptions, crossings::SegmentBvh, remesh_guided, thicken::ThickenedSheets,
     };
     let method = spec_of(method, beta, order, tolerance)?;
-    let mesh = mesh_from(V, F, "V", "F")?;
-    let Some(bounds) = mesh.bounding_box() else {
-        return Err(PyValueError::new_err(
-            "remesh needs a mesh with at least one vertex",
-        ));
-    };
     let options = RemeshOptions {
         resolution: res,
         bisection_steps: bisect,
@@ -471,6 +469,28 @@ pub fn remesh<'py>(
         planar_levels,
         probe_flatness: true,
         evaluator_crossings: true,
+    };
+    if let Ok(model) = V.downcast::<crate::step::PyStepModel>() {
+        return remesh_step(
+            py,
+            &model.get().model,
+            F,
+            &method,
+            &options,
+            threads,
+            thicken,
+        );
+    }
+    let Some(F) = F else {
+        return Err(PyValueError::new_err(
+            "remesh(V, F): F is required for a mesh (only a gwn.StepModel comes alone)",
+        ));
+    };
+    let mesh = mesh_from(V, F, "V", "F")?;
+    let Some(bounds) = mesh.bounding_box() else {
+        return Err(PyValueError::new_err(
+            "remesh needs a mesh with at least one vertex",
+        ));
     };
     if let Some(eps) = thicken {
         let extent = (0..3)
@@ -503,6 +523,40 @@ pub fn remesh<'py>(
                 remesh_guided(&wn, Some(&guide), bounds, &options, &|_| {})?
             }
         };
+        Ok::<_, Box<dyn std::error::Error + Send + Sync>>(out)
+    })?
+    .map_err(value_error)?;
+    let triangles: Vec<[i64; 3]> = out.triangles.iter().map(|t| t.map(i64::from)).collect();
+    Ok((array2(py, out.positions)?, array2(py, triangles)?))
+}
+
+/// [`remesh`] of a STEP model (`gwn remesh part.step`): the model's trimmed B-rep evaluator
+/// with the spec's options, vertices placed at its own surface hits, the model's box.
+#[allow(non_snake_case)]
+fn remesh_step<'py>(
+    py: Python<'py>,
+    model: &gwn::patch::step::StepModel,
+    F: Option<&Bound<'py, PyAny>>,
+    method: &EvaluatorSpec,
+    options: &gwn::products::remesh::RemeshOptions,
+    threads: Option<Threads>,
+    thicken: Option<f64>,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    if F.is_some_and(|f| !f.is_none()) {
+        return Err(PyValueError::new_err(
+            "remesh(model): a gwn.StepModel takes no F (pass res= by name)",
+        ));
+    }
+    if thicken.is_some() {
+        return Err(PyValueError::new_err(
+            "thicken= needs triangles (a mesh or soup), not a STEP model",
+        ));
+    }
+    let (lo, hi) = model.bounding_box();
+    let bounds = gwn::BoundingBox { min: lo, max: hi };
+    let out = threads::run(py, threads, || {
+        let wn = crate::evaluator::step_evaluator(model, method)?;
+        let out = gwn::products::remesh::remesh_guided(&wn, None, bounds, options, &|_| {})?;
         Ok::<_, Box<dyn std::error::Error + Send + Sync>>(out)
     })?
     .map_err(value_error)?;

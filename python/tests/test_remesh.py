@@ -1,10 +1,12 @@
 """gwn.remesh: a closed, manifold, oriented surface of w > 1/2 (closed forms on cubes)."""
 
+import subprocess
+
 import numpy as np
 import pytest
 
 import gwn
-from conftest import CUBE_F, CUBE_V, OPEN_BOX_F, random_points
+from conftest import CUBE_F, CUBE_V, FIXTURES, OPEN_BOX_F, random_points
 
 
 def edge_census(F):
@@ -142,3 +144,34 @@ def test_planar_levels_keep_a_box_closed_and_on_its_faces():
         assert off.max() < 1e-3, off.max()
     with pytest.raises(ValueError, match="planar levels"):
         gwn.remesh(CUBE_V, CUBE_F, res=64, planar_levels=4)
+
+
+def test_a_step_model_remeshes_like_the_cli(cli, tmp_path):
+    """gwn.remesh(model) of a gwn.StepModel: the capped cylinder (radius 1, height 2) comes out
+    closed, oriented, genus 0 and within a cell of the cylinder, the same surface as `gwn
+    remesh`; F, thicken= and fast methods are refused."""
+    path = FIXTURES / "step" / "capped_cylinder.step"
+    model = gwn.load(path)
+    V, F = gwn.remesh(model, res=12)
+    once, twice, edges = edge_census(F)
+    assert once and twice and len(F) > 0
+    assert len(np.unique(F)) - edges + len(F) == 2
+    cell = 2.0 / 12
+    wall = np.abs(np.hypot(V[:, 0], V[:, 1]) - 1.0)
+    caps = np.minimum(np.abs(V[:, 2]), np.abs(V[:, 2] - 2.0))
+    assert np.all(np.minimum(wall, caps) <= cell)
+    assert abs(volume(V, F) - 2.0 * np.pi) < 0.1 * 2.0 * np.pi
+    out = tmp_path / "o.ply"
+    subprocess.run([str(cli), "remesh", str(path), "--res", "12", "--samples", "0", "--out",
+                    str(out)], check=True, capture_output=True)
+    Vc, Fc = gwn.load(out)
+    np.testing.assert_array_equal(Fc, F)
+    np.testing.assert_array_equal(Vc, V)  # the PLY holds float64
+    with pytest.raises(ValueError, match="takes no F"):
+        gwn.remesh(model, F)
+    with pytest.raises(ValueError, match="thicken"):
+        gwn.remesh(model, res=8, thicken=0.5)
+    with pytest.raises(ValueError):
+        gwn.remesh(model, res=8, method="fast")
+    with pytest.raises(ValueError, match="F is required"):
+        gwn.remesh(V)
