@@ -526,6 +526,14 @@ pub fn remesh<'py>(
         Ok::<_, Box<dyn std::error::Error + Send + Sync>>(out)
     })?
     .map_err(value_error)?;
+    surface_arrays(py, out)
+}
+
+/// A remeshed surface as `(V, F)`: float64 (n, 3) and int64 (m, 3).
+fn surface_arrays<'py>(
+    py: Python<'py>,
+    out: gwn::products::remesh::Remeshed,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
     let triangles: Vec<[i64; 3]> = out.triangles.iter().map(|t| t.map(i64::from)).collect();
     Ok((array2(py, out.positions)?, array2(py, triangles)?))
 }
@@ -560,6 +568,5 @@ fn remesh_step<'py>(
         Ok::<_, Box<dyn std::error::Error + Send + Sync>>(out)
     })?
     .map_err(value_error)?;
-    let triangles: Vec<[i64; 3]> = out.triangles.iter().map(|t| t.map(i64::from)).collect();
-    Ok((array2(py, out.positions)?, array2(py, triangles)?))
+    surface_arrays(py, out)
 }

@@ -287,50 +287,49 @@ pub fn place_vertices<E: Evaluator + ?Sized>(
     // Each edge's crossing ticks, sorted and distinct, as ranges of one list, with the plane of
     // the surface crossed there (a triangle's: the first in the hierarchy's order).
     let (crossings, crossing_planes, crossing_ranges): (Vec<i64>, Vec<Plane>, Vec<(u32, u32)>) =
-        match proposes {
-            false => (Vec::new(), Vec::new(), vec![(0, 0); edges.len()]),
-            true => {
-                // By chunks of edges (a `Vec` per edge cost ~100 bytes each at the peak).
-                let chunks: Vec<(Vec<i64>, Vec<Plane>, Vec<u32>)> = edges
-                    .par_chunks(4096)
-                    .map(|chunk| {
-                        let (mut ks, mut planes, mut counts) = (Vec::new(), Vec::new(), Vec::new());
-                        let mut hits: Vec<(i64, Plane)> = Vec::new();
-                        for &e in chunk {
-                            hits.clear();
-                            let n = units(e);
-                            crossings_of(at(e, 0), at(e, n), &mut |t, plane| {
-                                if t.is_finite() {
-                                    let k = ((t * n as f64).round() as i64).clamp(1, n - 1);
-                                    hits.push((k, plane));
-                                }
-                            });
-                            // Stable: the first triangle in the hierarchy's order keeps its tick.
-                            hits.sort_by_key(|&(k, _)| k);
-                            hits.dedup_by_key(|&mut (k, _)| k);
-                            counts.push(hits.len() as u32);
-                            for &(k, plane) in &hits {
-                                ks.push(k);
-                                planes.push(plane);
+        if !proposes {
+            (Vec::new(), Vec::new(), vec![(0, 0); edges.len()])
+        } else {
+            // By chunks of edges (a `Vec` per edge cost ~100 bytes each at the peak).
+            let chunks: Vec<(Vec<i64>, Vec<Plane>, Vec<u32>)> = edges
+                .par_chunks(4096)
+                .map(|chunk| {
+                    let (mut ks, mut planes, mut counts) = (Vec::new(), Vec::new(), Vec::new());
+                    let mut hits: Vec<(i64, Plane)> = Vec::new();
+                    for &e in chunk {
+                        hits.clear();
+                        let n = units(e);
+                        crossings_of(at(e, 0), at(e, n), &mut |t, plane| {
+                            if t.is_finite() {
+                                let k = ((t * n as f64).round() as i64).clamp(1, n - 1);
+                                hits.push((k, plane));
                             }
+                        });
+                        // Stable: the first triangle in the hierarchy's order keeps its tick.
+                        hits.sort_by_key(|&(k, _)| k);
+                        hits.dedup_by_key(|&mut (k, _)| k);
+                        counts.push(hits.len() as u32);
+                        for &(k, plane) in &hits {
+                            ks.push(k);
+                            planes.push(plane);
                         }
-                        (ks, planes, counts)
-                    })
-                    .collect();
-                let n = chunks.iter().map(|c| c.0.len()).sum();
-                let (mut all, mut planes) = (Vec::with_capacity(n), Vec::with_capacity(n));
-                let mut ranges = Vec::with_capacity(edges.len());
-                for (ks, ps, counts) in chunks {
-                    let mut start = all.len() as u32;
-                    for c in counts {
-                        ranges.push((start, start + c));
-                        start += c;
                     }
-                    all.extend(ks);
-                    planes.extend(ps);
+                    (ks, planes, counts)
+                })
+                .collect();
+            let n = chunks.iter().map(|c| c.0.len()).sum();
+            let (mut all, mut planes) = (Vec::with_capacity(n), Vec::with_capacity(n));
+            let mut ranges = Vec::with_capacity(edges.len());
+            for (ks, ps, counts) in chunks {
+                let mut start = all.len() as u32;
+                for c in counts {
+                    ranges.push((start, start + c));
+                    start += c;
                 }
-                (all, planes, ranges)
+                all.extend(ks);
+                planes.extend(ps);
             }
+            (all, planes, ranges)
         };
     let mut searches: Vec<Search> = edges
         .iter()
