@@ -24,6 +24,7 @@ pub mod eval;
 pub mod io;
 pub mod model;
 pub mod quadrature;
+mod ray_hits;
 pub mod samples;
 #[cfg(feature = "io")]
 pub mod step;

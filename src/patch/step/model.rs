@@ -7,6 +7,7 @@ use std::collections::{BTreeMap, HashMap};
 
 use super::super::curve::{Homogeneous, eval_with_derivative};
 use super::super::model::Patch;
+use super::super::ray_hits::BoxedPatch;
 use super::StepError;
 use super::brep::{EdgePcurve, Reader, Topology, reverse};
 use super::nurbs::{euc, point_at};
@@ -56,6 +57,15 @@ pub struct FacePatch {
 }
 
 impl FacePatch {
+    /// The patch with its box, for the hit search (`crate::patch::ray_hits`).
+    pub(in crate::patch) fn boxed(&self) -> BoxedPatch<'_> {
+        BoxedPatch {
+            patch: &self.patch,
+            lo: self.lo,
+            hi: self.hi,
+        }
+    }
+
     /// `(u, v)` of the patch parameters `(s, t)`, with `du/ds` and `dv/dt`.
     pub fn uv_at(&self, st: [f64; 2]) -> ([f64; 2], [f64; 2]) {
         let (u, du) = self.map[0].at(self.u, st[0]);
