@@ -48,8 +48,8 @@ pub struct Args {
     #[arg(long, default_value_t = 10_000)]
     pub samples: usize,
     /// Place every vertex by searching the field, without the input triangles' crossings (or a
-    /// STEP model's surface hits) as a guide (same guarantees, more evaluations; for
-    /// comparison).
+    /// STEP model's or patch set's surface hits) as a guide (same guarantees, more evaluations;
+    /// for comparison).
     #[arg(long)]
     pub no_guide: bool,
     /// Close open sheets (cloth, leaves, single walls: w near 1/2 on both sides, no volume) into

@@ -112,7 +112,8 @@ pub trait Evaluator: Send + Sync {
     /// when it cannot. Proposals, not decisions: a caller that needs the class change
     /// (the remesher's vertex placement) verifies each with evaluations of `w` on either side,
     /// so a crossing missed or misplaced costs evaluations, never a wrong answer. The trimmed
-    /// B-rep evaluator answers with its ray-surface hits inside the faces' loops.
+    /// B-rep evaluator answers with its ray-surface hits inside the faces' loops, the Bézier
+    /// patch set evaluator with the same hit search on its patches.
     fn segment_crossings(&self, a: [f64; 3], b: [f64; 3]) -> Option<Vec<SurfaceCrossing>> {
         let _ = (a, b);
         None

@@ -30,8 +30,11 @@ use super::curve::{
 };
 use super::model::{Patch, PatchSet};
 use super::quadrature::{Budget, GK_EVALUATIONS, integrate, integrate_dyadic};
+use super::ray_hits::{BoxedPatch, PatchHit, RayFrame, SurfaceEdges, patch_hits, ray_meets_box};
 use super::samples::{CACHE_LEVELS, CurveSamples};
 use crate::base::compensated::NeumaierSum;
+use crate::base::vec3::{cross, norm, sub};
+use crate::eval::SurfaceCrossing;
 use crate::kernel::frame::RayAxis;
 
 /// Separation margin `μ`: a plane certifies a net only if every control point makes an angle of
@@ -245,6 +248,65 @@ impl PatchWindingNumber {
     /// Winding numbers at many points, in parallel.
     pub fn eval_batch(&self, points: &[[f64; 3]]) -> Vec<f64> {
         points.par_iter().map(|&q| self.eval(q)).collect()
+    }
+
+    /// Where the segment `a → b` crosses the patches, sorted along it, each with the unit normal
+    /// `S_s × S_t` there: the ray hit search of the trimmed B-rep evaluator
+    /// (`StepWindingNumber::segment_crossings`, without the trimming), on every patch whose box the
+    /// segment meets, up to the segment's end. Proposals for a caller that verifies them with
+    /// the field ([`crate::eval::Evaluator::segment_crossings`]; the remesher's placement): a
+    /// crossing on the shared edge of two patches is listed once; one the search cannot
+    /// resolve (a tangency, a collapsed patch edge such as a sphere's pole) is not listed.
+    /// Empty for a degenerate or non-finite segment.
+    pub fn segment_crossings(&self, a: [f64; 3], b: [f64; 3]) -> Vec<SurfaceCrossing> {
+        // In the scaled set's coordinates: a power of two, exact, so the hits are the world
+        // set's, scaled (the boxes are the scaled set's).
+        let [a, b] = [a, b].map(|p| p.map(|c| scale_by_pow2(c, -self.coord_exp)));
+        let d = sub(b, a);
+        let length = norm(d);
+        if !(length.is_finite() && length > 0.0) || a.iter().any(|c| !c.is_finite()) {
+            return Vec::new();
+        }
+        let frame = RayFrame::new(d.map(|x| x / length));
+        let mut hits = Vec::new();
+        let mut diagonal = 0.0f64;
+        for (patch, &(lo, hi)) in self.scaled.patches().iter().zip(&self.boxes) {
+            // The pad of the STEP faces' box test, relative to the patch.
+            let size = norm(sub(hi, lo));
+            diagonal = diagonal.max(size);
+            if ray_meets_box(a, frame.d, length, lo, hi, 1e-9 * size) {
+                let patch = BoxedPatch { patch, lo, hi };
+                let edges = SurfaceEdges::NONE;
+                patch_hits(patch, edges, a, &frame, length, &mut hits, &mut Vec::new());
+            }
+        }
+        hits.retain(|h| (0.0..=length).contains(&h.tau));
+        hits.sort_by(|x, y| x.tau.total_cmp(&y.tau));
+        // A crossing on the shared edge of two patches is found by both: one crossing (the
+        // STEP faces' rule, a point within 1e-9 of the largest patch's size).
+        let mut kept: Vec<PatchHit> = Vec::with_capacity(hits.len());
+        for h in hits {
+            if kept
+                .last()
+                .is_none_or(|k| norm(sub(k.point, h.point)) > 1e-9 * diagonal)
+            {
+                kept.push(h);
+            }
+        }
+        kept.into_iter()
+            .map(|h| {
+                let n = cross(h.ds, h.dt);
+                let l = norm(n);
+                SurfaceCrossing {
+                    t: h.tau / length,
+                    normal: if l > 0.0 && l.is_finite() {
+                        n.map(|x| x / l)
+                    } else {
+                        [0.0; 3]
+                    },
+                }
+            })
+            .collect()
     }
 
     /// [`evaluate`](Self::evaluate) at many points, in parallel.
@@ -1132,5 +1194,8 @@ impl crate::eval::Evaluator for PatchWindingNumber {
     }
     fn eval_batch(&self, points: &[[f64; 3]]) -> Vec<f64> {
         PatchWindingNumber::eval_batch(self, points)
+    }
+    fn segment_crossings(&self, a: [f64; 3], b: [f64; 3]) -> Option<Vec<SurfaceCrossing>> {
+        Some(PatchWindingNumber::segment_crossings(self, a, b))
     }
 }

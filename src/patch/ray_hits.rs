@@ -21,6 +21,8 @@ pub(in crate::patch) struct BoxedPatch<'a> {
 /// the partial derivatives there, and the distance `τ` along the ray.
 pub(in crate::patch) struct PatchHit {
     pub(in crate::patch) point: [f64; 3],
+    // Read by the STEP evaluator (feature `io`), which maps it to its face's `(u, v)`.
+    #[cfg_attr(not(feature = "io"), allow(dead_code))]
     pub(in crate::patch) st: [f64; 2],
     pub(in crate::patch) ds: [f64; 3],
     pub(in crate::patch) dt: [f64; 3],
@@ -54,11 +56,6 @@ impl RayFrame {
     pub(in crate::patch) fn map(&self, r: [f64; 3]) -> [f64; 3] {
         [dot(self.e1, r), dot(self.e2, r), dot(self.d, r)]
     }
-    pub(in crate::patch) fn hom(&self, h: Homogeneous, q: [f64; 3]) -> Homogeneous {
-        let r = [h[0] - h[3] * q[0], h[1] - h[3] * q[1], h[2] - h[3] * q[2]];
-        let f = self.map(r);
-        [f[0], f[1], f[2], h[3]]
-    }
 }
 
 /// Where [`patch_hits`] looks for gaps: the patch's sides on an edge of the untrimmed surface
@@ -69,6 +66,15 @@ pub(in crate::patch) struct SurfaceEdges {
     pub(in crate::patch) sides: [bool; 4],
     pub(in crate::patch) gap: f64,
     pub(in crate::patch) only: bool,
+}
+
+impl SurfaceEdges {
+    /// No side on an edge: an untrimmed patch set's patches, whose crossings all count.
+    pub(in crate::patch) const NONE: SurfaceEdges = SurfaceEdges {
+        sides: [false; 4],
+        gap: 0.0,
+        only: false,
+    };
 }
 
 /// Slab test of the ray `q + τ d, 0 ≤ τ ≤ reach` (`reach` infinite for a ray) against a box

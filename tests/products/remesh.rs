@@ -1044,9 +1044,14 @@ fn step_models_place_vertices_at_their_own_surface_crossings() {
     );
 }
 
-/// Patch sets go through the same pipeline as meshes (bisection placement: no triangles to
-/// guide it): the exact rational sphere comes out a closed genus-0 manifold whose vertices lie
-/// within a cell of the unit sphere, with the ball's volume and no self-intersection.
+/// Patch sets go through the same pipeline as meshes: the exact rational sphere comes out a
+/// closed genus-0 manifold whose vertices lie within a cell of the unit sphere, with the ball's
+/// volume and no self-intersection. Its vertices are placed at the patches' own segment
+/// crossings (`PatchWindingNumber::segment_crossings`, verified like a mesh's triangle
+/// crossings): at res 16 at least 99 % of them (3,512 of 3,518 when written; the poles, where
+/// the patches' collapsed edges propose nothing, are left to the field search), for under a
+/// third of the field search's evaluations (7,024 against 28,024), with the same topology
+/// without them.
 #[test]
 fn rational_sphere_patches_remesh_to_a_closed_sphere() {
     use gwn::patch::{PatchSet, PatchWindingNumber};
@@ -1054,8 +1059,13 @@ fn rational_sphere_patches_remesh_to_a_closed_sphere() {
     let wn = PatchWindingNumber::new(&set);
     let (lo, hi) = set.bounding_box();
     let bounds = gwn::BoundingBox { min: lo, max: hi };
-    for res in [8, 16] {
-        let out = remesh(&wn, bounds, &raw(res)).unwrap();
+    let mut runs = Vec::new();
+    for (res, evaluator_crossings) in [(8, true), (16, true), (16, false)] {
+        let options = RemeshOptions {
+            evaluator_crossings,
+            ..raw(res)
+        };
+        let out = remesh(&wn, bounds, &options).unwrap();
         assert_no_self_intersections(&out);
         let r = TopologyReport::of(&out.positions, &out.triangles);
         assert_closed_manifold(&r);
@@ -1065,5 +1075,22 @@ fn rational_sphere_patches_remesh_to_a_closed_sphere() {
             "res {res}: {r}"
         );
         assert_unit_sphere_like(&out, [0.0; 3], 0.06, res);
+        runs.push((
+            out.stats.guided_vertices,
+            out.stats.placement_evaluations,
+            out.stats.extracted_vertices,
+        ));
     }
+    let [_, (guided, evaluations, vertices), (unguided, searched, _)] = runs[..] else {
+        unreachable!()
+    };
+    assert_eq!(unguided, 0);
+    assert!(
+        100 * guided >= 99 * vertices,
+        "{guided} of {vertices} verified"
+    );
+    assert!(
+        3 * evaluations <= searched,
+        "{evaluations} evaluations against {searched}"
+    );
 }

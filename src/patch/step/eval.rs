@@ -138,6 +138,15 @@ pub struct StepWindingNumber {
     boundary_samples: Vec<CurveSamples>,
 }
 
+impl RayFrame {
+    /// The homogeneous point `h` relative to `q`, in this frame (weight kept).
+    fn hom(&self, h: Homogeneous, q: [f64; 3]) -> Homogeneous {
+        let r = [h[0] - h[3] * q[0], h[1] - h[3] * q[1], h[2] - h[3] * q[2]];
+        let f = self.map(r);
+        [f[0], f[1], f[2], h[3]]
+    }
+}
+
 /// 14 directions: the axes and the cube diagonals, turned by a fixed irrational rotation so
 /// that none is parallel to the coordinate planes CAD models are full of.
 fn directions() -> Vec<[f64; 3]> {

@@ -173,7 +173,7 @@ pub struct RemeshOptions {
     /// pay (none on an input curved everywhere, where they only cost time); `false`: all.
     pub probe_flatness: bool,
     /// Without input triangles: let the evaluator propose where each lattice edge crosses the
-    /// surface ([`crate::eval::Evaluator::segment_crossings`]; trimmed B-rep models), verified
+    /// surface ([`crate::eval::Evaluator::segment_crossings`]; STEP models, Bézier patch sets), verified
     /// like the triangles' crossings, instead of searching the field alone. Same guarantees,
     /// fewer evaluations; `false` for comparison.
     pub evaluator_crossings: bool,

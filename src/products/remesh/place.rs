@@ -16,13 +16,13 @@
 //! - **a crossing** (when the input triangles are given, or the evaluator proposes them:
 //!   [`CrossingSource`]): the segment's crossings with the input triangles ([`SegmentBvh`]),
 //!   or with the surface as the evaluator finds them ([`Evaluator::segment_crossings`]: a STEP
-//!   model's ray hits), rounded to ticks, are where `w` may jump. With one of
+//!   model's or a Bézier patch set's ray hits), rounded to ticks, are where `w` may jump. With one of
 //!   them, `k`, inside the bracket, two evaluations at `k − 1` and `k + 1` (fewer next to a
 //!   known end) *verify* it; with several (thin parts, double walls), one evaluation between the
 //!   middle two says on which side of it the change is. A crossing that does not verify leaves
 //!   the bracket on one side of it.
 //! - **the field** (no crossing inside the bracket: a hole, an inconsistently oriented sheet, a
-//!   point cloud, a Bézier patch set): away from the triangles `w` is harmonic, hence smooth,
+//!   point cloud, a patch's collapsed edge): away from the triangles `w` is harmonic, hence smooth,
 //!   and the bracket's ends carry its values (the corners' from [`super::octree`]), so the
 //!   probe is the ITP step (interpolate, truncate, project; Oliveira & Takahashi 2020) on
 //!   `w − ½`: regula falsi where `w` is smooth, and never more than one evaluation over
@@ -107,8 +107,8 @@ pub enum CrossingSource<'a> {
     None,
     /// The input triangles' crossings with each edge.
     Triangles(&'a SegmentBvh),
-    /// The evaluator's own ([`Evaluator::segment_crossings`]: the trimmed B-rep evaluator's
-    /// segment hits); edges where it answers `None` have none.
+    /// The evaluator's own ([`Evaluator::segment_crossings`]: the trimmed B-rep and Bézier
+    /// patch set evaluators' segment hits); edges where it answers `None` have none.
     Evaluator,
 }
 
