@@ -6,7 +6,8 @@ use clap::Args as ClapArgs;
 use gwn::products::remesh::crossings::SegmentBvh;
 use gwn::products::remesh::intersect::self_intersections;
 use gwn::products::remesh::report::{
-    NoSurface, TopologyReport, hausdorff_distance, hausdorff_to_solid_boundary, occupancy_agreement,
+    NoSurface, TopologyReport, hausdorff_distance, hausdorff_to_solid_boundary,
+    occupancy_agreement, patch_surface_for_distance,
 };
 use gwn::products::remesh::simplify::SimplifyOptions;
 use gwn::products::remesh::thicken::ThickenedSheets;
@@ -228,9 +229,24 @@ pub fn run(args: Args) -> Result<(), CliError> {
     // With the input's side also kept where it bounds the solid (a hundredth of a cell to
     // each side of the face; the plain distance comes with it, on the same samples); not for
     // thickened sheets, which bound nothing.
-    let boundary_hausdorff = match input.mesh() {
-        Some(m) if args.samples > 0 && thickened.is_none() => {
+    let boundary_hausdorff = match (input.mesh(), &input) {
+        (Some(m), _) if args.samples > 0 && thickened.is_none() => {
             hausdorff_to_solid_boundary(m, wn, &mesh, args.samples, 0x4a5d, 0.01 * out.cell_size)
+        }
+        // A patch set by a tessellation within a small fraction of a cell, its side tests by
+        // the tessellation's own `w` (the samples lie on its faces).
+        (None, gwn::input::Input::Patches(set)) if args.samples > 0 => {
+            patch_surface_for_distance(set, out.cell_size).and_then(|t| {
+                let tw = gwn::eval::antipodal::WindingNumber::new(&t).ok()?;
+                hausdorff_to_solid_boundary(
+                    &t,
+                    &tw,
+                    &mesh,
+                    args.samples,
+                    0x4a5d,
+                    0.01 * out.cell_size,
+                )
+            })
         }
         _ => None,
     };
@@ -365,8 +381,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
         Err(e) => outln!("self-intersections: not counted: {e}")?,
     }
     if let Some(d) = hausdorff {
+        // A patch set's distance is to its tessellation (`patch_surface_for_distance`).
+        let to = if input.mesh().is_none() {
+            "the input's patches tessellated to half-cell segments"
+        } else {
+            "the input"
+        };
         outln!(
-            "Hausdorff distance to the input (sampled, {} points per surface): {:.4e} = {:.3} cells",
+            "Hausdorff distance to {to} (sampled, {} points per surface): {:.4e} = {:.3} cells",
             args.samples,
             d,
             d / cell_size

@@ -987,6 +987,38 @@ fn thicken_turns_open_sheets_into_slabs_and_leaves_solids_alone() {
     assert!(ThickenedSheets::new(&both, &wn, f64::NAN).is_err());
 }
 
+/// A patch set's Hausdorff distance is measured to a tessellation that stands for it:
+/// on the exact rational sphere every vertex and triangle centre of that tessellation is
+/// within 1/32 of a res-16 cell of the unit sphere; the remeshed sphere is within a cell of it
+/// (all of the tessellation bounds the solid); a cell so small that the tessellation would
+/// exceed the budget gives none, and so does a nonsensical cell size.
+#[test]
+fn patch_sets_get_a_hausdorff_distance_to_a_fine_tessellation() {
+    use gwn::patch::{PatchSet, PatchWindingNumber};
+    use gwn::products::remesh::report::patch_surface_for_distance;
+    let set = PatchSet::new(common::rational_sphere_patches()).unwrap();
+    let wn = PatchWindingNumber::new(&set);
+    let (lo, hi) = set.bounding_box();
+    let out = remesh(&wn, gwn::BoundingBox { min: lo, max: hi }, &raw(16)).unwrap();
+    let cell = out.cell_size;
+    let t = patch_surface_for_distance(&set, cell).expect("a tessellation within budget");
+    let off_sphere = |p: [f64; 3]| ((p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt() - 1.0).abs();
+    for f in 0..t.triangles().len() {
+        let c = t.triangle_positions(f);
+        let centre = std::array::from_fn(|k| (c[0][k] + c[1][k] + c[2][k]) / 3.0);
+        assert!(off_sphere(c[0]) < 1e-12, "{:?}", c[0]);
+        assert!(off_sphere(centre) < cell / 32.0, "{centre:?}");
+    }
+    let tw = WindingNumber::new(&t).unwrap();
+    let output = Mesh::new(out.positions.clone(), out.triangles.clone()).unwrap();
+    let d = hausdorff_to_solid_boundary(&t, &tw, &output, 20_000, 3, 0.01 * cell).unwrap();
+    assert!(d.distance <= cell, "{} cells", d.distance / cell);
+    assert!(d.boundary_fraction > 0.999, "{}", d.boundary_fraction);
+    assert!(patch_surface_for_distance(&set, 1e-5).is_none());
+    assert!(patch_surface_for_distance(&set, 0.0).is_none());
+    assert!(patch_surface_for_distance(&set, f64::NAN).is_none());
+}
+
 /// A STEP model's own segment crossings guide the placement as the input triangles do a
 /// mesh's: the capped cylinder (radius 1, height 2; `tests/fixtures/step`) at res 16 has at
 /// least 99 % of its vertices placed at a verified crossing (all 4,618 when written), for under

@@ -249,6 +249,27 @@ fn remesh_reads_step_models() {
     }
 }
 
+/// A Bézier patch set (the Utah teapot of the shared data) through the CLI: closed, manifold,
+/// oriented, one component, its vertices placed at the patches' own segment hits (about two
+/// evaluations per vertex), and a Hausdorff distance in the report, measured to a
+/// tessellation of the patches: within a cell where the teapot bounds the solid at res 32.
+#[test]
+fn remesh_reads_patch_sets_and_reports_their_distance() {
+    let Some(teapot) = crate::common::shared_file("parametric/teapot.bpt") else {
+        return;
+    };
+    let json = remesh_report(&teapot, "32", "4000", &[]);
+    let guided = report_number(&json, "guided_vertices");
+    let evaluations = report_number(&json, "placement_evaluations");
+    assert!(
+        guided > 0.0 && evaluations < 3.0 * guided,
+        "{guided} guided vertices, {evaluations} evaluations"
+    );
+    let distance = report_number(&json, "hausdorff_boundary_cells");
+    assert!(distance <= 1.0, "{distance} cells");
+    assert!(report_number(&json, "hausdorff_cells") >= distance);
+}
+
 /// A printer part thinner than a cube cell of `extent / res` (`prusa-helper_disk.stl` of the
 /// shared corpus: a disk 15 mm across and 0.2 mm thick, cubes of 0.47 mm at res 32) was empty;
 /// with cells sized for the thin axis it is a closed, manifold disk that agrees with the input.

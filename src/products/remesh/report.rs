@@ -413,6 +413,50 @@ pub fn hausdorff_to_solid_boundary<E: crate::eval::Evaluator + ?Sized>(
     })
 }
 
+/// A triangle mesh that stands for a Bézier patch set in [`hausdorff_to_solid_boundary`]
+/// (`input` and `input_w`, the mesh's own exact winding number: its samples' side tests, a
+/// hundredth of a cell off its faces, must be of the surface they lie on): `k × k` quads per
+/// patch ([`crate::patch::tessellate::tessellate`]) with `k` such that every patch's segments
+/// are at most half a cell (`k ≥ 2 ×` its box diagonal in cells). A chord of length `L` on a
+/// curvature radius `R` is `L²/8R` off the surface: at `L = ½` cell, under 1/32 of a cell
+/// where `R` is above a cell. `None` where that would take more than
+/// [`MAX_PATCH_DISTANCE_TRIANGLES`] (a coarser one would report its chord error as
+/// distance), or the tessellation is not a mesh (a set of only degenerate patches).
+#[cfg(feature = "patch")]
+pub fn patch_surface_for_distance(
+    set: &crate::patch::PatchSet,
+    cell_size: f64,
+) -> Option<crate::Mesh> {
+    if !(cell_size.is_finite() && cell_size > 0.0) || set.patches().is_empty() {
+        return None;
+    }
+    let largest = set
+        .patches()
+        .iter()
+        .map(|p| {
+            let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+            for x in p.points() {
+                for a in 0..3 {
+                    lo[a] = lo[a].min(x[a]);
+                    hi[a] = hi[a].max(x[a]);
+                }
+            }
+            (0..3).map(|a| (hi[a] - lo[a]).powi(2)).sum::<f64>().sqrt()
+        })
+        .fold(0.0f64, f64::max);
+    let k = (2.0 * largest / cell_size).ceil().max(1.0);
+    if !k.is_finite()
+        || 2.0 * k * k * set.patches().len() as f64 > MAX_PATCH_DISTANCE_TRIANGLES as f64
+    {
+        return None;
+    }
+    crate::patch::tessellate::tessellate(set, k as usize).ok()
+}
+
+/// Most triangles [`patch_surface_for_distance`] builds (~0.5 GB with its exact evaluator).
+#[cfg(feature = "patch")]
+pub const MAX_PATCH_DISTANCE_TRIANGLES: usize = 4_000_000;
+
 /// The result of [`hausdorff_to_solid_boundary`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BoundaryHausdorff {
