@@ -7,7 +7,7 @@ use gwn::products::remesh::crossings::SegmentBvh;
 use gwn::products::remesh::intersect::self_intersections;
 use gwn::products::remesh::report::{
     NoSurface, TopologyReport, hausdorff_distance, hausdorff_to_solid_boundary,
-    occupancy_agreement, patch_surface_for_distance,
+    occupancy_agreement, patch_surface_for_distance, step_surface_for_distance,
 };
 use gwn::products::remesh::simplify::SimplifyOptions;
 use gwn::products::remesh::thicken::ThickenedSheets;
@@ -229,27 +229,33 @@ pub fn run(args: Args) -> Result<(), CliError> {
     // With the input's side also kept where it bounds the solid (a hundredth of a cell to
     // each side of the face; the plain distance comes with it, on the same samples); not for
     // thickened sheets, which bound nothing.
-    let boundary_hausdorff = match (input.mesh(), &input) {
+    // Curved inputs by a tessellation within a small fraction of a cell
+    // (`patch_surface_for_distance`, `step_surface_for_distance`), whose own `w` makes the side
+    // tests (the samples lie on its faces, and its chords can be farther from the true surface
+    // than the tests' offset).
+    let curved_surface = match &input {
+        _ if args.samples == 0 => None,
+        gwn::input::Input::Patches(set) => patch_surface_for_distance(set, out.cell_size),
+        gwn::input::Input::Step(model) => step_surface_for_distance(model, out.cell_size),
+        _ => None,
+    };
+    let boundary_hausdorff = match (input.mesh(), &curved_surface) {
         (Some(m), _) if args.samples > 0 && thickened.is_none() => {
             hausdorff_to_solid_boundary(m, wn, &mesh, args.samples, 0x4a5d, 0.01 * out.cell_size)
         }
-        // A patch set by a tessellation within a small fraction of a cell, its side tests by
-        // the tessellation's own `w` (the samples lie on its faces).
-        (None, gwn::input::Input::Patches(set)) if args.samples > 0 => {
-            patch_surface_for_distance(set, out.cell_size).and_then(|t| {
-                let tw = gwn::eval::antipodal::WindingNumber::new(&t).ok()?;
-                hausdorff_to_solid_boundary(
-                    &t,
-                    &tw,
-                    &mesh,
-                    args.samples,
-                    0x4a5d,
-                    0.01 * out.cell_size,
-                )
-            })
+        (None, Some(curved)) => {
+            let t = &curved.mesh;
+            // Barnes–Hut (β = 2, order 2): a STEP model's tessellation is open along every
+            // trimming curve, and the exact evaluator's side tests next to those edges loop over
+            // all of them; the tests only ask whether `w` is above ½ a hundredth of a cell off
+            // a face, where it is near 0 or 1 but for open rims.
+            let tw = gwn::eval::fast::FastWindingNumber::new(t);
+            hausdorff_to_solid_boundary(t, &tw, &mesh, args.samples, 0x4a5d, 0.01 * out.cell_size)
         }
         _ => None,
     };
+    let reference_segment = curved_surface.as_ref().map(|c| c.segment);
+    drop(curved_surface);
     let hausdorff = match (input.mesh(), boundary_hausdorff) {
         (_, Some(b)) => Some(b.plain),
         (Some(m), None) if args.samples > 0 => hausdorff_distance(m, &mesh, args.samples, 0x4a5d),
@@ -381,11 +387,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
         Err(e) => outln!("self-intersections: not counted: {e}")?,
     }
     if let Some(d) = hausdorff {
-        // A patch set's distance is to its tessellation (`patch_surface_for_distance`).
-        let to = if input.mesh().is_none() {
-            "the input's patches tessellated to half-cell segments"
-        } else {
-            "the input"
+        // A curved input's distance is to its tessellation (`patch_surface_for_distance`).
+        let to = match reference_segment {
+            Some(segment) => format!(
+                "the input's surfaces tessellated to segments of at most {:.2} cells",
+                segment / cell_size
+            ),
+            None => "the input".to_string(),
         };
         outln!(
             "Hausdorff distance to {to} (sampled, {} points per surface): {:.4e} = {:.3} cells",
@@ -502,6 +510,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
             extra.push((
                 "hausdorff_boundary_fraction",
                 format!("{:?}", b.boundary_fraction),
+            ));
+        }
+        if let (Some(segment), Some(_)) = (reference_segment, hausdorff) {
+            extra.push((
+                "hausdorff_reference_segment_cells",
+                format!("{:?}", segment / cell_size),
             ));
         }
         if let Some(t) = &thickened {

@@ -990,18 +990,26 @@ fn thicken_turns_open_sheets_into_slabs_and_leaves_solids_alone() {
 /// A patch set's Hausdorff distance is measured to a tessellation that stands for it:
 /// on the exact rational sphere every vertex and triangle centre of that tessellation is
 /// within 1/32 of a res-16 cell of the unit sphere; the remeshed sphere is within a cell of it
-/// (all of the tessellation bounds the solid); a cell so small that the tessellation would
-/// exceed the budget gives none, and so does a nonsensical cell size.
+/// (all of the tessellation bounds the solid); a cell so small that half-cell segments would
+/// exceed the triangle budget gets longer segments within it; a nonsensical cell size, none.
 #[test]
 fn patch_sets_get_a_hausdorff_distance_to_a_fine_tessellation() {
     use gwn::patch::{PatchSet, PatchWindingNumber};
-    use gwn::products::remesh::report::patch_surface_for_distance;
+    use gwn::products::remesh::report::{
+        MAX_CURVED_DISTANCE_TRIANGLES, patch_surface_for_distance,
+    };
     let set = PatchSet::new(common::rational_sphere_patches()).unwrap();
     let wn = PatchWindingNumber::new(&set);
     let (lo, hi) = set.bounding_box();
     let out = remesh(&wn, gwn::BoundingBox { min: lo, max: hi }, &raw(16)).unwrap();
     let cell = out.cell_size;
-    let t = patch_surface_for_distance(&set, cell).expect("a tessellation within budget");
+    let curved = patch_surface_for_distance(&set, cell).expect("a tessellation");
+    assert!(
+        curved.segment <= 0.5 * cell,
+        "{} cells",
+        curved.segment / cell
+    );
+    let t = curved.mesh;
     let off_sphere = |p: [f64; 3]| ((p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt() - 1.0).abs();
     for f in 0..t.triangles().len() {
         let c = t.triangle_positions(f);
@@ -1014,9 +1022,77 @@ fn patch_sets_get_a_hausdorff_distance_to_a_fine_tessellation() {
     let d = hausdorff_to_solid_boundary(&t, &tw, &output, 20_000, 3, 0.01 * cell).unwrap();
     assert!(d.distance <= cell, "{} cells", d.distance / cell);
     assert!(d.boundary_fraction > 0.999, "{}", d.boundary_fraction);
-    assert!(patch_surface_for_distance(&set, 1e-5).is_none());
+    // A cell so small that half-cell segments would pass the budget: longer segments, within it.
+    let coarse = patch_surface_for_distance(&set, 1e-5).unwrap();
+    assert!(coarse.mesh.triangles().len() <= MAX_CURVED_DISTANCE_TRIANGLES);
+    assert!(coarse.segment > 0.5e-5);
     assert!(patch_surface_for_distance(&set, 0.0).is_none());
     assert!(patch_surface_for_distance(&set, f64::NAN).is_none());
+}
+
+/// A trimmed B-rep model's Hausdorff distance is measured to its trimmed tessellation: on the
+/// capped cylinder (radius 1, height 2; `tests/fixtures/step`) every vertex of a kept triangle
+/// lies on the wall or a cap's plane within a segment and a half of the disk (the staircase
+/// along the trimming circle), every triangle centre within 1/32 of a cell of them, the
+/// tessellation's own `w` is the cylinder's away from the surface, and the remesh at res 16 is
+/// within a cell of it, nearly all of it bounding the solid.
+#[test]
+fn step_models_get_a_hausdorff_distance_to_their_trimmed_tessellation() {
+    use gwn::patch::step::{StepWindingNumber, load_step};
+    use gwn::products::remesh::report::step_surface_for_distance;
+    let model = load_step(&common::fixture("step/capped_cylinder.step")).unwrap();
+    let wn = StepWindingNumber::new(&model);
+    let bounds = gwn::BoundingBox {
+        min: [-1.013, -1.007, -0.011],
+        max: [1.0, 1.0, 2.0],
+    };
+    let out = remesh(&wn, bounds, &raw(16)).unwrap();
+    let cell = out.cell_size;
+    let curved = step_surface_for_distance(&model, cell).expect("a tessellation");
+    assert!(curved.segment <= 0.5 * cell);
+    let t = &curved.mesh;
+    // Distance to the wall or the caps' planes, within the staircase of the caps.
+    let staircase = 1.0 + 1.5 * curved.segment;
+    let off = |p: [f64; 3]| {
+        let r = p[0].hypot(p[1]);
+        let wall = if (0.0..=2.0).contains(&p[2]) {
+            (r - 1.0).abs()
+        } else {
+            f64::INFINITY
+        };
+        let cap = |z: f64| {
+            if r <= staircase {
+                (p[2] - z).abs()
+            } else {
+                f64::INFINITY
+            }
+        };
+        wall.min(cap(0.0)).min(cap(2.0))
+    };
+    assert!(t.triangles().len() > 100);
+    for f in 0..t.triangles().len() {
+        let c = t.triangle_positions(f);
+        let centre: [f64; 3] = std::array::from_fn(|k| (c[0][k] + c[1][k] + c[2][k]) / 3.0);
+        assert!(off(centre) < cell / 32.0, "{centre:?}");
+        for p in c {
+            assert!(off(p) < 1e-9, "{p:?}");
+            // A cap's staircase ends within a segment outside the trimming circle.
+            assert!(p[0].hypot(p[1]) < staircase, "{p:?}");
+        }
+    }
+    let tw = WindingNumber::new(t).unwrap();
+    for (q, w) in [
+        ([0.1, 0.2, 1.0], 1.0),
+        ([0.0, 0.0, 2.5], 0.0),
+        ([1.5, 0.0, 1.0], 0.0),
+    ] {
+        assert!((tw.eval(q) - w).abs() < 0.01, "{q:?}: {}", tw.eval(q));
+    }
+    let output = Mesh::new(out.positions.clone(), out.triangles.clone()).unwrap();
+    let d = hausdorff_to_solid_boundary(t, &tw, &output, 20_000, 3, 0.01 * cell).unwrap();
+    assert!(d.distance <= cell, "{} cells", d.distance / cell);
+    assert!(d.boundary_fraction > 0.99, "{}", d.boundary_fraction);
+    assert!(step_surface_for_distance(&model, f64::NAN).is_none());
 }
 
 /// A STEP model's own segment crossings guide the placement as the input triangles do a

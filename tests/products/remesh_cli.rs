@@ -222,8 +222,8 @@ fn remesh_thickens_an_open_sheet_on_request() {
 
 /// Trimmed B-rep STEP models (the paper's dataset in `../shared/parametric/step`) remesh like
 /// meshes: closed, manifold, oriented, genus 0, no exact self-intersection, agreeing with the
-/// model's own `w > ½` at the seeded samples, and with vertices placed at the model's surface
-/// hits.
+/// model's own `w > ½` at the seeded samples, with vertices placed at the model's surface
+/// hits, and within a cell of the model (its trimmed tessellation at half-cell segments).
 #[test]
 fn remesh_reads_step_models() {
     let Some(dir) = crate::common::shared_file("parametric/step") else {
@@ -238,6 +238,13 @@ fn remesh_reads_step_models() {
         );
         let agreement = report_number(&json, "occupancy_agreement");
         assert!(agreement >= min_agreement, "{model}: agreement {agreement}");
+        // Measured to the trimmed tessellation (0.69 and 0.60 cells when written).
+        let distance = report_number(&json, "hausdorff_boundary_cells");
+        assert!(distance <= 1.0, "{model}: {distance} cells");
+        assert_eq!(
+            report_number(&json, "hausdorff_reference_segment_cells"),
+            0.5
+        );
         // Placed at the model's own surface hits: about two evaluations per vertex (eight for
         // the field search).
         let guided = report_number(&json, "guided_vertices");

@@ -15,6 +15,7 @@ pub mod model;
 pub mod nurbs;
 pub mod part21;
 pub mod surface;
+pub mod tessellate;
 pub mod trim;
 
 use std::fmt;

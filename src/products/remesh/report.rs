@@ -413,49 +413,98 @@ pub fn hausdorff_to_solid_boundary<E: crate::eval::Evaluator + ?Sized>(
     })
 }
 
-/// A triangle mesh that stands for a Bézier patch set in [`hausdorff_to_solid_boundary`]
-/// (`input` and `input_w`, the mesh's own exact winding number: its samples' side tests, a
-/// hundredth of a cell off its faces, must be of the surface they lie on): `k × k` quads per
-/// patch ([`crate::patch::tessellate::tessellate`]) with `k` such that every patch's segments
-/// are at most half a cell (`k ≥ 2 ×` its box diagonal in cells). A chord of length `L` on a
-/// curvature radius `R` is `L²/8R` off the surface: at `L = ½` cell, under 1/32 of a cell
-/// where `R` is above a cell. `None` where that would take more than
-/// [`MAX_PATCH_DISTANCE_TRIANGLES`] (a coarser one would report its chord error as
-/// distance), or the tessellation is not a mesh (a set of only degenerate patches).
+/// A triangle mesh that stands for a curved input (a Bézier patch set or a trimmed B-rep model)
+/// in [`hausdorff_to_solid_boundary`], with the longest parameter-grid segment it was built
+/// with. A chord of length `L` on a curvature radius `R` is `L²/8R` off the surface: at half a
+/// cell, under 1/32 of a cell where `R` is above a cell.
+#[cfg(feature = "patch")]
+#[derive(Clone, Debug)]
+pub struct CurvedSurface {
+    /// The tessellation (its own `w` makes the side tests: the samples lie on its faces, and
+    /// its chords can be farther from the true surface than the tests' offset).
+    pub mesh: crate::Mesh,
+    /// Longest grid segment on a patch (world units): half a cell, or longer where that would
+    /// take more than [`MAX_CURVED_DISTANCE_TRIANGLES`].
+    pub segment: f64,
+}
+
+/// Most triangles a [`CurvedSurface`] has: with the distance queries' hierarchy and the side
+/// tests' evaluator a triangle costs ~700 bytes at the peak (the teapot at res 128, 0.92 M
+/// triangles: 851 MB peak against the remesh's 84 MB; spring.step with half-cell segments,
+/// 3.6 M: 1.45 GB against 0.19 GB), so finer tessellations get longer segments instead.
+#[cfg(feature = "patch")]
+pub const MAX_CURVED_DISTANCE_TRIANGLES: usize = 300_000;
+
+/// The largest diagonal of a patch's control-point box.
+#[cfg(feature = "patch")]
+fn box_diagonal(points: &[[f64; 3]]) -> f64 {
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for x in points {
+        for a in 0..3 {
+            lo[a] = lo[a].min(x[a]);
+            hi[a] = hi[a].max(x[a]);
+        }
+    }
+    (0..3).map(|a| (hi[a] - lo[a]).powi(2)).sum::<f64>().sqrt()
+}
+
+/// A Bézier patch set's [`CurvedSurface`]: `k × k` quads per patch
+/// ([`crate::patch::tessellate::tessellate`], welded) with `k` such that the largest patch's
+/// segments are at most half a cell, fewer where the budget says so. `None` for a cell size
+/// that is not finite and positive, or a tessellation that is not a mesh.
 #[cfg(feature = "patch")]
 pub fn patch_surface_for_distance(
     set: &crate::patch::PatchSet,
     cell_size: f64,
-) -> Option<crate::Mesh> {
+) -> Option<CurvedSurface> {
     if !(cell_size.is_finite() && cell_size > 0.0) || set.patches().is_empty() {
         return None;
     }
     let largest = set
         .patches()
         .iter()
-        .map(|p| {
-            let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-            for x in p.points() {
-                for a in 0..3 {
-                    lo[a] = lo[a].min(x[a]);
-                    hi[a] = hi[a].max(x[a]);
-                }
-            }
-            (0..3).map(|a| (hi[a] - lo[a]).powi(2)).sum::<f64>().sqrt()
-        })
+        .map(|p| box_diagonal(p.points()))
         .fold(0.0f64, f64::max);
-    let k = (2.0 * largest / cell_size).ceil().max(1.0);
-    if !k.is_finite()
-        || 2.0 * k * k * set.patches().len() as f64 > MAX_PATCH_DISTANCE_TRIANGLES as f64
-    {
-        return None;
-    }
-    crate::patch::tessellate::tessellate(set, k as usize).ok()
+    let fine = (2.0 * largest / cell_size).ceil().max(1.0);
+    let budget = (MAX_CURVED_DISTANCE_TRIANGLES as f64 / (2.0 * set.patches().len() as f64))
+        .sqrt()
+        .floor()
+        .max(1.0);
+    let k = fine.min(budget);
+    let mesh = crate::patch::tessellate::tessellate(set, k as usize).ok()?;
+    Some(CurvedSurface {
+        mesh,
+        segment: largest / k,
+    })
 }
 
-/// Most triangles [`patch_surface_for_distance`] builds (~0.5 GB with its exact evaluator).
-#[cfg(feature = "patch")]
-pub const MAX_PATCH_DISTANCE_TRIANGLES: usize = 4_000_000;
+/// A trimmed B-rep model's [`CurvedSurface`]: every face's patches with segments of at most
+/// half a cell (longer where the budget says so), the grid triangles whose centres are inside
+/// the face's loops ([`crate::patch::step::tessellate::trimmed_triangles`]; along a trimming
+/// curve a staircase up to a segment off it, so distances there are known to within a
+/// segment). `None` as for a patch set.
+#[cfg(all(feature = "patch", feature = "io"))]
+pub fn step_surface_for_distance(
+    model: &crate::patch::step::StepModel,
+    cell_size: f64,
+) -> Option<CurvedSurface> {
+    use crate::patch::step::tessellate::{grid_triangles, trimmed_triangles};
+    if !(cell_size.is_finite() && cell_size > 0.0) {
+        return None;
+    }
+    let budget = MAX_CURVED_DISTANCE_TRIANGLES as f64;
+    let mut segment = 0.5 * cell_size;
+    // The count falls as the segment's inverse square, rounded up per patch: a few rounds.
+    for _ in 0..8 {
+        let count = grid_triangles(model, segment);
+        if count <= budget {
+            let mesh = trimmed_triangles(model, segment, MAX_CURVED_DISTANCE_TRIANGLES)?.ok()?;
+            return Some(CurvedSurface { mesh, segment });
+        }
+        segment *= 1.05 * (count / budget).sqrt();
+    }
+    None
+}
 
 /// The result of [`hausdorff_to_solid_boundary`].
 #[derive(Clone, Copy, Debug, PartialEq)]
