@@ -69,6 +69,40 @@ impl BoundingBox {
     }
 }
 
+/// Whether the segment `q + τ d`, `0 ≤ τ ≤ reach` (`reach` infinite for a ray), meets the box
+/// `lo..hi` grown by `pad` on every side: the slab test (an axis with `d = 0` needs `q` inside
+/// the slab). With `pad = 0`, `lo − pad − q` is `lo − q` exactly, so the unpadded callers (the
+/// remesher's segment hierarchy) get the plain test.
+pub fn segment_meets_box(
+    q: [f64; 3],
+    d: [f64; 3],
+    reach: f64,
+    lo: [f64; 3],
+    hi: [f64; 3],
+    pad: f64,
+) -> bool {
+    let (mut t0, mut t1) = (0.0f64, reach);
+    for k in 0..3 {
+        let (a, b) = (lo[k] - pad - q[k], hi[k] + pad - q[k]);
+        if d[k] == 0.0 {
+            if a > 0.0 || b < 0.0 {
+                return false;
+            }
+            continue;
+        }
+        let (mut ta, mut tb) = (a / d[k], b / d[k]);
+        if ta > tb {
+            std::mem::swap(&mut ta, &mut tb);
+        }
+        t0 = t0.max(ta);
+        t1 = t1.min(tb);
+        if t0 > t1 {
+            return false;
+        }
+    }
+    true
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

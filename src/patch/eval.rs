@@ -30,8 +30,9 @@ use super::curve::{
 };
 use super::model::{Patch, PatchSet};
 use super::quadrature::{Budget, GK_EVALUATIONS, integrate, integrate_dyadic};
-use super::ray_hits::{BoxedPatch, PatchHit, RayFrame, SurfaceEdges, patch_hits, ray_meets_box};
+use super::ray_hits::{BoxedPatch, PatchHit, RayFrame, SurfaceEdges, patch_hits};
 use super::samples::{CACHE_LEVELS, CurveSamples};
+use crate::base::bounding_box::segment_meets_box;
 use crate::base::compensated::NeumaierSum;
 use crate::base::vec3::{cross, norm, sub};
 use crate::eval::SurfaceCrossing;
@@ -274,7 +275,7 @@ impl PatchWindingNumber {
             // The pad of the STEP faces' box test, relative to the patch.
             let size = norm(sub(hi, lo));
             diagonal = diagonal.max(size);
-            if ray_meets_box(a, frame.d, length, lo, hi, 1e-9 * size) {
+            if segment_meets_box(a, frame.d, length, lo, hi, 1e-9 * size) {
                 let patch = BoxedPatch { patch, lo, hi };
                 let edges = SurfaceEdges::NONE;
                 patch_hits(patch, edges, a, &frame, length, &mut hits, &mut Vec::new());

@@ -116,7 +116,8 @@ fn rational_sphere_is_one_inside_and_zero_outside() {
     }
 }
 
-/// The crossings of the segment `a → b` with the unit sphere (`t` and the outward normal),
+/// The crossings of the segment `a → b` with the unit sphere (`t` and the point, which is the
+/// outward normal),
 /// or `None` where a closed form and a hit search may fairly disagree: a tangent segment, a
 /// crossing within `margin` of an end, or one within `margin` of a pole (the patches'
 /// collapsed edges, where the search proposes nothing).
@@ -157,15 +158,7 @@ fn segment_crossings_of_a_patch_set_are_the_closed_form_ones() {
     let set = sphere();
     let wn = PatchWindingNumber::new(&set);
     let mut rng = Rng(29);
-    let directions: [[f64; 3]; 7] = [
-        [1.0, 0.0, 0.0],
-        [0.0, 1.0, 0.0],
-        [0.0, 0.0, 1.0],
-        [1.0, 1.0, 0.0],
-        [0.0, 1.0, -1.0],
-        [1.0, -1.0, 1.0],
-        [0.3, 0.7, -0.2],
-    ];
+    let directions = crate::step_fixtures::SEGMENT_DIRECTIONS;
     let (mut checked, mut crossings) = (0, 0);
     for k in 0..5000 {
         let a = rng.point(-1.3, 1.3);
@@ -176,21 +169,8 @@ fn segment_crossings_of_a_patch_set_are_the_closed_form_ones() {
         let Some(expected) = unit_sphere_crossings(a, b, 1e-3) else {
             continue;
         };
-        let found = wn.segment_crossings(a, b);
-        assert_eq!(
-            found.len(),
-            expected.len(),
-            "{a:?} → {b:?}: {found:?} vs {expected:?}"
-        );
-        for (f, (t, p)) in found.iter().zip(&expected) {
-            assert!((f.t - t).abs() < 1e-9, "{a:?} → {b:?}: t {} vs {t}", f.t);
-            let along: f64 = (0..3).map(|i| f.normal[i] * p[i]).sum();
-            assert!(
-                (along.abs() - 1.0).abs() < 1e-9,
-                "{a:?} → {b:?}: normal {:?} at {p:?}",
-                f.normal
-            );
-        }
+        // On the unit sphere the crossing point is its own unit normal.
+        crate::step_fixtures::assert_crossings_are(a, b, &wn.segment_crossings(a, b), &expected);
         checked += 1;
         crossings += expected.len();
     }

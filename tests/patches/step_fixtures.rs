@@ -117,6 +117,42 @@ fn capped_cylinder_crossings(
 /// oblique directions (the remesher's lattice edges, and others) get exactly the closed-form
 /// crossings, normals included, and none past their end although the ray goes on to the
 /// surface.
+/// Directions of the segment-crossing tests: the axes, face and body diagonals, and an oblique
+/// one.
+pub(crate) const SEGMENT_DIRECTIONS: [[f64; 3]; 7] = [
+    [1.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0],
+    [0.0, 0.0, 1.0],
+    [1.0, 1.0, 0.0],
+    [0.0, 1.0, -1.0],
+    [1.0, -1.0, 1.0],
+    [0.3, 0.7, -0.2],
+];
+
+/// `found`, the segment `a → b`'s crossings, are `expected` (`t` and the unit normal, either
+/// sign): `t` within 1e-9, normals parallel within 1e-9.
+pub(crate) fn assert_crossings_are(
+    a: [f64; 3],
+    b: [f64; 3],
+    found: &[gwn::eval::SurfaceCrossing],
+    expected: &[(f64, [f64; 3])],
+) {
+    assert_eq!(
+        found.len(),
+        expected.len(),
+        "{a:?} → {b:?}: {found:?} vs {expected:?}"
+    );
+    for (f, (t, n)) in found.iter().zip(expected) {
+        assert!((f.t - t).abs() < 1e-9, "{a:?} → {b:?}: t {} vs {t}", f.t);
+        let along = f.normal.iter().zip(n).map(|(x, y)| x * y).sum::<f64>();
+        assert!(
+            (along.abs() - 1.0).abs() < 1e-9,
+            "{a:?} → {b:?}: normal {:?} vs {n:?}",
+            f.normal
+        );
+    }
+}
+
 #[test]
 fn segment_crossings_are_the_closed_form_ones() {
     let m = load_step(&fixture("capped_cylinder.step")).unwrap();
@@ -128,15 +164,7 @@ fn segment_crossings_are_the_closed_form_ones() {
         state ^= state << 17;
         (state >> 11) as f64 / (1u64 << 53) as f64
     };
-    let directions: Vec<[f64; 3]> = vec![
-        [1.0, 0.0, 0.0],
-        [0.0, 1.0, 0.0],
-        [0.0, 0.0, 1.0],
-        [1.0, 1.0, 0.0],
-        [0.0, 1.0, -1.0],
-        [1.0, -1.0, 1.0],
-        [0.3, 0.7, -0.2],
-    ];
+    let directions = SEGMENT_DIRECTIONS;
     let (mut checked, mut crossings) = (0, 0);
     for k in 0..5000 {
         let a = [3.0 * next() - 1.5, 3.0 * next() - 1.5, 3.0 * next() - 0.5];
@@ -151,21 +179,7 @@ fn segment_crossings_are_the_closed_form_ones() {
         let Some(expected) = capped_cylinder_crossings(a, b, 1e-3) else {
             continue;
         };
-        let found = wn.segment_crossings(a, b);
-        assert_eq!(
-            found.len(),
-            expected.len(),
-            "{a:?} → {b:?}: {found:?} vs {expected:?}"
-        );
-        for (f, (t, n)) in found.iter().zip(&expected) {
-            assert!((f.t - t).abs() < 1e-9, "{a:?} → {b:?}: t {} vs {t}", f.t);
-            let along = f.normal.iter().zip(n).map(|(x, y)| x * y).sum::<f64>();
-            assert!(
-                (along.abs() - 1.0).abs() < 1e-9,
-                "{a:?} → {b:?}: normal {:?} vs {n:?}",
-                f.normal
-            );
-        }
+        assert_crossings_are(a, b, &wn.segment_crossings(a, b), &expected);
         checked += 1;
         crossings += expected.len();
     }

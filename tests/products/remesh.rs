@@ -1030,6 +1030,37 @@ fn patch_sets_get_a_hausdorff_distance_to_a_fine_tessellation() {
     assert!(patch_surface_for_distance(&set, f64::NAN).is_none());
 }
 
+/// A curved input's own segment crossings placed at least 99 % of the `vertices` (`guided`),
+/// with `evaluations` under a third of the field search's (`searched`, which guided none).
+fn assert_guided_for_a_third(
+    guided: usize,
+    vertices: usize,
+    evaluations: usize,
+    (unguided, searched): (usize, usize),
+) {
+    assert_eq!(unguided, 0);
+    assert!(
+        100 * guided >= 99 * vertices,
+        "{guided} of {vertices} verified"
+    );
+    assert!(
+        3 * evaluations <= searched,
+        "{evaluations} evaluations against {searched}"
+    );
+}
+
+/// The capped cylinder of `tests/fixtures/step` (radius 1, height 2) and a box off the model's
+/// own (the grown lattice would otherwise have corners on the caps and the wall's extreme
+/// lines: a change at a corner is placed next to it, unverified).
+fn capped_cylinder_step() -> (gwn::patch::step::StepModel, gwn::BoundingBox) {
+    let model = gwn::patch::step::load_step(&common::fixture("step/capped_cylinder.step")).unwrap();
+    let bounds = gwn::BoundingBox {
+        min: [-1.013, -1.007, -0.011],
+        max: [1.0, 1.0, 2.0],
+    };
+    (model, bounds)
+}
+
 /// A trimmed B-rep model's Hausdorff distance is measured to its trimmed tessellation: on the
 /// capped cylinder (radius 1, height 2; `tests/fixtures/step`) every vertex of a kept triangle
 /// lies on the wall or a cap's plane within a segment and a half of the disk (the staircase
@@ -1038,14 +1069,10 @@ fn patch_sets_get_a_hausdorff_distance_to_a_fine_tessellation() {
 /// within a cell of it, nearly all of it bounding the solid.
 #[test]
 fn step_models_get_a_hausdorff_distance_to_their_trimmed_tessellation() {
-    use gwn::patch::step::{StepWindingNumber, load_step};
+    use gwn::patch::step::StepWindingNumber;
     use gwn::products::remesh::report::step_surface_for_distance;
-    let model = load_step(&common::fixture("step/capped_cylinder.step")).unwrap();
+    let (model, bounds) = capped_cylinder_step();
     let wn = StepWindingNumber::new(&model);
-    let bounds = gwn::BoundingBox {
-        min: [-1.013, -1.007, -0.011],
-        max: [1.0, 1.0, 2.0],
-    };
     let out = remesh(&wn, bounds, &raw(16)).unwrap();
     let cell = out.cell_size;
     let curved = step_surface_for_distance(&model, cell).expect("a tessellation");
@@ -1102,15 +1129,9 @@ fn step_models_get_a_hausdorff_distance_to_their_trimmed_tessellation() {
 /// are closed genus-0 manifolds without a self-intersection, within a cell of the cylinder.
 #[test]
 fn step_models_place_vertices_at_their_own_surface_crossings() {
-    use gwn::patch::step::{StepWindingNumber, load_step};
-    let model = load_step(&common::fixture("step/capped_cylinder.step")).unwrap();
+    use gwn::patch::step::StepWindingNumber;
+    let (model, bounds) = capped_cylinder_step();
     let wn = StepWindingNumber::new(&model);
-    // A box off the model's own (the grown lattice would otherwise have corners on the caps
-    // and the wall's extreme lines: a change at a corner is placed next to it, unverified).
-    let bounds = gwn::BoundingBox {
-        min: [-1.013, -1.007, -0.011],
-        max: [1.0, 1.0, 2.0],
-    };
     let mut runs = Vec::new();
     for evaluator_crossings in [true, false] {
         let options = RemeshOptions {
@@ -1141,15 +1162,7 @@ fn step_models_place_vertices_at_their_own_surface_crossings() {
     let [(guided, evaluations, vertices), (unguided, searched, _)] = runs[..] else {
         unreachable!()
     };
-    assert_eq!(unguided, 0);
-    assert!(
-        100 * guided >= 99 * vertices,
-        "{guided} of {vertices} verified"
-    );
-    assert!(
-        3 * evaluations <= searched,
-        "{evaluations} evaluations against {searched}"
-    );
+    assert_guided_for_a_third(guided, vertices, evaluations, (unguided, searched));
 }
 
 /// Patch sets go through the same pipeline as meshes: the exact rational sphere comes out a
@@ -1192,13 +1205,5 @@ fn rational_sphere_patches_remesh_to_a_closed_sphere() {
     let [_, (guided, evaluations, vertices), (unguided, searched, _)] = runs[..] else {
         unreachable!()
     };
-    assert_eq!(unguided, 0);
-    assert!(
-        100 * guided >= 99 * vertices,
-        "{guided} of {vertices} verified"
-    );
-    assert!(
-        3 * evaluations <= searched,
-        "{evaluations} evaluations against {searched}"
-    );
+    assert_guided_for_a_third(guided, vertices, evaluations, (unguided, searched));
 }

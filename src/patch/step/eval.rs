@@ -38,10 +38,11 @@ use super::super::curve::{
 };
 use super::super::eval::MAX_EVALUATIONS;
 use super::super::quadrature::{Budget, integrate, integrate_dyadic};
-use super::super::ray_hits::{PatchHit, RayFrame, SurfaceEdges, patch_hits, ray_meets_box};
+use super::super::ray_hits::{PatchHit, RayFrame, SurfaceEdges, patch_hits};
 use super::super::samples::CurveSamples;
 use super::model::{Face, FacePatch, HIT_MARGIN, StepModel};
 use super::trim::Side;
+use crate::base::bounding_box::segment_meets_box;
 use crate::base::compensated::NeumaierSum;
 use crate::base::vec3::{cross, dot, norm, sub};
 
@@ -617,7 +618,7 @@ impl StepWindingNumber {
             .zip(&self.face_boxes)
             .zip(&self.surface_edges)
             .filter(move |((_, (lo, hi)), _)| {
-                ray_meets_box(q, frame.d, reach, *lo, *hi, dedup.max(gap))
+                segment_meets_box(q, frame.d, reach, *lo, *hi, dedup.max(gap))
             })
             .map(move |((face, _), edges)| {
                 (face, face_hits(face, edges, q, frame, reach, dedup, gap))
@@ -1057,7 +1058,7 @@ fn face_hits(
     let mut hits: Vec<Hit> = Vec::new();
     let mut unresolved = Vec::new();
     for (fp, &edges) in face.patches.iter().zip(edges) {
-        if ray_meets_box(q, frame.d, reach, fp.lo, fp.hi, dedup) {
+        if segment_meets_box(q, frame.d, reach, fp.lo, fp.hi, dedup) {
             let edges = SurfaceEdges {
                 sides: edges,
                 gap,
@@ -1074,7 +1075,7 @@ fn face_hits(
                 &mut unresolved,
             );
             hits.extend(found.into_iter().map(|h| face_hit(fp, h)));
-        } else if edges.contains(&true) && ray_meets_box(q, frame.d, reach, fp.lo, fp.hi, gap) {
+        } else if edges.contains(&true) && segment_meets_box(q, frame.d, reach, fp.lo, fp.hi, gap) {
             // Only near the patch: what it can hold is a gap at an edge, not a hit ahead (a
             // hit behind `q` within the margin would reject the ray only because of the
             // padding).

@@ -10,6 +10,7 @@
 
 use std::sync::OnceLock;
 
+use crate::base::bounding_box::segment_meets_box;
 use crate::eval::fast::{FastParams, FastWindingNumber};
 
 /// Signed boundary edges, as a fraction of a closed mesh's edge count (`3F / 2`), from which
@@ -148,7 +149,7 @@ impl SegmentBvh {
         while top > 0 {
             top -= 1;
             let node = self.nodes[stack[top] as usize];
-            if !segment_hits_box(p, d, node.lo, node.hi) {
+            if !segment_meets_box(p, d, 1.0, node.lo, node.hi, 0.0) {
                 continue;
             }
             if node.count > 0 {
@@ -484,30 +485,6 @@ fn build(triangles: &mut [[[f64; 3]; 3]], offset: usize, nodes: &mut Vec<Node>) 
     nodes[index].second = second;
     nodes[index].count = 0;
     index as u32
-}
-
-/// Whether the segment `p + t d`, `t ∈ [0, 1]`, meets the box (slab test; an axis with `d = 0`
-/// needs `p` inside the slab).
-fn segment_hits_box(p: [f64; 3], d: [f64; 3], lo: [f64; 3], hi: [f64; 3]) -> bool {
-    let (mut t0, mut t1) = (0.0f64, 1.0f64);
-    for a in 0..3 {
-        if d[a] == 0.0 {
-            if p[a] < lo[a] || p[a] > hi[a] {
-                return false;
-            }
-            continue;
-        }
-        let (mut ta, mut tb) = ((lo[a] - p[a]) / d[a], (hi[a] - p[a]) / d[a]);
-        if ta > tb {
-            std::mem::swap(&mut ta, &mut tb);
-        }
-        t0 = t0.max(ta);
-        t1 = t1.min(tb);
-        if t0 > t1 {
-            return false;
-        }
-    }
-    true
 }
 
 /// Where the segment `p + t d` crosses the triangle (Möller–Trumbore, with a small slack on the
