@@ -58,8 +58,9 @@ pub fn trimmed_triangles(
     // Each face's grids in parallel (the loops' indicator is most of the work), then one
     // pass that welds the points the faces' patches share (positions rounded to `2^-36` of the
     // diagonal, as `crate::patch::tessellate::tessellate` does): unwelded, every patch border
-    // is a boundary edge of the mesh, and its exact evaluator's side tests next to them loop
-    // over all of them (boxed_sphere at res 64: 6 s instead of 0.5 s).
+    // is a boundary edge of the mesh, and a winding number of it pays for each near them
+    // (boxed_sphere at res 64 with exact side tests: 16.5 s for the whole run unwelded, 14.7 s
+    // welded).
     let faces: Vec<FaceGrid> = model
         .faces
         .par_iter()

@@ -423,8 +423,9 @@ pub struct CurvedSurface {
     /// The tessellation (its own `w` makes the side tests: the samples lie on its faces, and
     /// its chords can be farther from the true surface than the tests' offset).
     pub mesh: crate::Mesh,
-    /// Longest grid segment on a patch (world units): half a cell, or longer where that would
-    /// take more than [`MAX_CURVED_DISTANCE_TRIANGLES`].
+    /// The grid's spacing (world units): no patch's box diagonal over its grid steps exceeds it
+    /// (a bound on the grid's segments unless a patch's arc is much longer than its box). Half
+    /// a cell, or more where that would take more than [`MAX_CURVED_DISTANCE_TRIANGLES`].
     pub segment: f64,
 }
 
