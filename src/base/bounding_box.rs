@@ -73,6 +73,7 @@ impl BoundingBox {
 /// `lo..hi` grown by `pad` on every side: the slab test (an axis with `d = 0` needs `q` inside
 /// the slab). With `pad = 0`, `lo − pad − q` is `lo − q` exactly, so the unpadded callers (the
 /// remesher's segment hierarchy) get the plain test.
+#[cfg(any(feature = "patch", feature = "products"))]
 pub fn segment_meets_box(
     q: [f64; 3],
     d: [f64; 3],
