@@ -1057,6 +1057,8 @@ fn face_hits(
 ) -> FaceHits {
     let mut hits: Vec<Hit> = Vec::new();
     let mut unresolved = Vec::new();
+    // One buffer for the patches' own hits (this runs for every face every ray meets).
+    let mut found = Vec::new();
     for (fp, &edges) in face.patches.iter().zip(edges) {
         if segment_meets_box(q, frame.d, reach, fp.lo, fp.hi, dedup) {
             let edges = SurfaceEdges {
@@ -1064,7 +1066,6 @@ fn face_hits(
                 gap,
                 only: false,
             };
-            let mut found = Vec::new();
             patch_hits(
                 fp.boxed(),
                 edges,
@@ -1074,7 +1075,7 @@ fn face_hits(
                 &mut found,
                 &mut unresolved,
             );
-            hits.extend(found.into_iter().map(|h| face_hit(fp, h)));
+            hits.extend(found.drain(..).map(|h| face_hit(fp, h)));
         } else if edges.contains(&true) && segment_meets_box(q, frame.d, reach, fp.lo, fp.hi, gap) {
             // Only near the patch: what it can hold is a gap at an edge, not a hit ahead (a
             // hit behind `q` within the margin would reject the ray only because of the
@@ -1090,9 +1091,10 @@ fn face_hits(
                 q,
                 frame,
                 reach,
-                &mut Vec::new(),
+                &mut found,
                 &mut unresolved,
             );
+            found.clear();
         }
     }
     let mut kept: Vec<Hit> = Vec::new();
