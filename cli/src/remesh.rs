@@ -4,10 +4,9 @@ use std::path::PathBuf;
 
 use clap::Args as ClapArgs;
 use gwn::products::remesh::crossings::SegmentBvh;
-use gwn::products::remesh::intersect::self_intersections;
 use gwn::products::remesh::report::{
-    NoSurface, TopologyReport, hausdorff_distance, hausdorff_to_solid_boundary,
-    occupancy_agreement, patch_surface_for_distance, step_surface_for_distance,
+    DistanceReference, RemeshReport, ReportPhase, patch_surface_for_distance,
+    step_surface_for_distance,
 };
 use gwn::products::remesh::simplify::SimplifyOptions;
 use gwn::products::remesh::thicken::ThickenedSheets;
@@ -204,76 +203,51 @@ pub fn run(args: Args) -> Result<(), CliError> {
             bar.inc(1);
         }
     };
-    let out = remesh_guided(wn, guide.as_ref(), bounds, &options, &announce)
+    let mut out = remesh_guided(wn, guide.as_ref(), bounds, &options, &announce)
         .map_err(|e| CliError(format!("{}: {e}", args.mesh.display())))?;
     let secs = start.elapsed().as_secs_f64();
     bar.inc(1);
     bar.set_message("writing");
     let file = std::fs::File::create(&args.out)
         .map_err(|e| CliError(format!("{}: {e}", args.out.display())))?;
-    let topology = TopologyReport::of(&out.positions, &out.triangles);
-    bar.inc(1);
-    bar.set_message("counting self-intersections (exact)");
-    // The broad phase is linear on the remesher's output (faces of at most 6 cells, flat ones
-    // up to `--simplify-flat-extent` in size classes of their own); the budget only guards
-    // against a surprise.
-    let budget = 1000 * out.triangles.len() as u64 + 1_000_000;
-    let check_start = std::time::Instant::now();
-    let intersections = self_intersections(&out.fixed, &out.triangles, budget);
-    let check_secs = check_start.elapsed().as_secs_f64();
-    let mesh = gwn::Mesh::new(out.positions, out.triangles)?;
+    let positions = std::mem::take(&mut out.positions);
+    let triangles = std::mem::take(&mut out.triangles);
+    let mesh = gwn::Mesh::new(positions, triangles)?;
     write_surface(std::io::BufWriter::new(file), format, &mesh)
         .map_err(|e| CliError(format!("{}: {e}", args.out.display())))?;
-    bar.inc(1);
-    bar.set_message("sampling the Hausdorff distance");
-    // With the input's side also kept where it bounds the solid (a hundredth of a cell to
-    // each side of the face; the plain distance comes with it, on the same samples); not for
-    // thickened sheets, which bound nothing.
-    // Curved inputs by a tessellation within a small fraction of a cell
-    // (`patch_surface_for_distance`, `step_surface_for_distance`), whose own `w` makes the side
-    // tests (the samples lie on its faces, and its chords can be farther from the true surface
-    // than the tests' offset).
+    // Curved inputs are measured against a tessellation within a small fraction of a cell
+    // (`patch_surface_for_distance`, `step_surface_for_distance`).
     let curved_surface = match &input {
         _ if args.samples == 0 => None,
         gwn::input::Input::Patches(set) => patch_surface_for_distance(set, out.cell_size),
         gwn::input::Input::Step(model) => step_surface_for_distance(model, out.cell_size),
         _ => None,
     };
-    let boundary_hausdorff = match (input.mesh(), &curved_surface) {
-        (Some(m), _) if args.samples > 0 && thickened.is_none() => {
-            hausdorff_to_solid_boundary(m, wn, &mesh, args.samples, 0x4a5d, 0.01 * out.cell_size)
-        }
-        (None, Some(curved)) => {
-            let t = &curved.mesh;
-            // Barnes–Hut (β = 2, order 2): a STEP model's tessellation is open along every
-            // trimming curve, and the exact evaluator's side tests next to those edges loop over
-            // all of them; the tests only ask whether `w` is above ½ a hundredth of a cell off
-            // a face, where it is near 0 or 1 but for open rims.
-            let tw = gwn::eval::fast::FastWindingNumber::new(t);
-            hausdorff_to_solid_boundary(t, &tw, &mesh, args.samples, 0x4a5d, 0.01 * out.cell_size)
-        }
-        _ => None,
+    // Thickened sheets bound nothing of the slabs' solid: their distance counts every sample.
+    let reference = match (input.mesh(), &curved_surface) {
+        (Some(m), _) if thickened.is_none() => DistanceReference::BoundingMesh(m),
+        (Some(m), _) => DistanceReference::Mesh(m),
+        (None, Some(curved)) => DistanceReference::Curved(curved),
+        (None, None) => DistanceReference::None,
     };
-    let reference_segment = curved_surface.as_ref().map(|c| c.segment);
+    let measure_phase = |phase: ReportPhase| {
+        bar.inc(1);
+        bar.set_message(phase.name());
+    };
+    let mut report = RemeshReport::measure(
+        &out,
+        &mesh,
+        &options,
+        wn,
+        reference,
+        bounds,
+        args.samples,
+        &measure_phase,
+    );
+    report.seconds = secs;
+    report.thicken = thickened.as_ref().map(|t| t.eps());
     drop(curved_surface);
-    let hausdorff = match (input.mesh(), boundary_hausdorff) {
-        (_, Some(b)) => Some(b.plain),
-        (Some(m), None) if args.samples > 0 => hausdorff_distance(m, &mesh, args.samples, 0x4a5d),
-        _ => None,
-    };
-    bar.inc(1);
-    bar.set_message("occupancy agreement");
-    // The agreement compares against the written surface's own exact winding number; an empty
-    // output's is 0 everywhere, and its agreement says whether empty was right (an open sheet:
-    // 100 %) or a solid was lost.
-    let agreement = if args.samples == 0 {
-        None
-    } else if mesh.is_empty() {
-        occupancy_agreement(wn, &NoSurface, bounds, args.samples, 0x9e57)
-    } else {
-        let output = gwn::eval::antipodal::WindingNumber::new(&mesh)?;
-        occupancy_agreement(wn, &output, bounds, args.samples, 0x9e57)
-    };
+    let topology = report.topology;
     bar.finish_and_clear();
     let s = out.stats;
     let cell_size = out.cell_size;
@@ -375,20 +349,20 @@ pub fn run(args: Args) -> Result<(), CliError> {
         s.extracted_vertices,
         s.placement_evaluations
     )?;
-    match &intersections {
+    match &report.self_intersections {
         Ok(r) => outln!(
             "self-intersections (exact): {} face pairs ({} pairs tested, {} degenerate faces, \
              {:.2} s)",
             r.pairs,
             r.tested_pairs,
             r.degenerate_faces,
-            check_secs
+            report.self_intersection_seconds
         )?,
         Err(e) => outln!("self-intersections: not counted: {e}")?,
     }
-    if let Some(d) = hausdorff {
+    if let Some(d) = report.hausdorff {
         // A curved input's distance is to its tessellation (`patch_surface_for_distance`).
-        let to = match reference_segment {
+        let to = match report.reference_segment {
             Some(segment) => format!(
                 "the input's surfaces tessellated to segments of at most {:.2} cells",
                 segment / cell_size
@@ -402,7 +376,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             d / cell_size
         )?;
     }
-    if let Some(b) = boundary_hausdorff {
+    if let Some(b) = report.boundary_hausdorff {
         outln!(
             "  to the input where it bounds the solid (w > 1/2 on one side only: {:.1} % of its \
              samples): {:.4e} = {:.3} cells",
@@ -419,7 +393,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             t.eps() / cell_size
         )?;
     }
-    if let Some(a) = agreement {
+    if let Some(a) = report.occupancy_agreement {
         outln!(
             "occupancy agreement {:.3} % of {} samples in the box",
             100.0 * a,
@@ -427,105 +401,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         )?;
     }
     if let Some(path) = &args.report {
-        let mut extra = vec![
-            ("resolution", args.res.to_string()),
-            ("cell_size", format!("{:?}", cell_size)),
-            (
-                "cell_sizes",
-                format!(
-                    "[{:?}, {:?}, {:?}]",
-                    out.cell_sizes[0], out.cell_sizes[1], out.cell_sizes[2]
-                ),
-            ),
-            (
-                "plate_refinement",
-                format!(
-                    "[{:?}, {:?}, {:?}]",
-                    s.plates.refinement[0], s.plates.refinement[1], s.plates.refinement[2]
-                ),
-            ),
-            (
-                "plate_thickness",
-                format!(
-                    "[{}]",
-                    s.plates
-                        .thickness
-                        .map(|t| t.map_or("null".to_string(), |t| format!("{t:?}")))
-                        .join(", ")
-                ),
-            ),
-            (
-                "plate_thin_fraction",
-                format!(
-                    "[{:?}, {:?}, {:?}]",
-                    s.plates.thin_fraction[0], s.plates.thin_fraction[1], s.plates.thin_fraction[2]
-                ),
-            ),
-            ("seconds", format!("{secs:.3}")),
-            ("classified_points", s.classified_points.to_string()),
-            ("band_cells", s.band_cells.to_string()),
-            ("sub_cell_levels", options.sub_cell_levels.to_string()),
-            ("refined_cells", s.refined_cells.to_string()),
-            ("planar_levels", s.planar_levels.to_string()),
-            (
-                "flat_fraction",
-                format!(
-                    "[{:?}, {:?}, {:?}]",
-                    s.flatness.flat_fraction[1],
-                    s.flatness.flat_fraction[2],
-                    s.flatness.flat_fraction[3]
-                ),
-            ),
-            ("method", format!("\"{}\"", gwn::eval::Evaluator::name(&wn))),
-            ("guided_vertices", s.guided_vertices.to_string()),
-            ("placement_evaluations", s.placement_evaluations.to_string()),
-            ("simplified", options.simplify.is_some().to_string()),
-            ("marching_tetrahedra_faces", s.extracted_faces.to_string()),
-            ("marching_cubes_faces", s.marching_cubes_faces.to_string()),
-            ("collapses", s.simplify.collapses.to_string()),
-            (
-                "diagonal_collapses",
-                s.simplify.diagonal_collapses.to_string(),
-            ),
-            ("diagonals_kept", s.simplify.diagonals_left.to_string()),
-            ("relocated_vertices", s.simplify.relocated.to_string()),
-        ];
-        match &intersections {
-            Ok(r) => {
-                extra.push(("self_intersections", r.pairs.to_string()));
-                extra.push(("collinear_faces", r.degenerate_faces.to_string()));
-            }
-            Err(e) => extra.push(("self_intersections_error", format!("{:?}", e.to_string()))),
-        }
-        if let Some(d) = hausdorff {
-            extra.push(("hausdorff", format!("{d:?}")));
-            extra.push(("hausdorff_cells", format!("{:?}", d / cell_size)));
-        }
-        if let Some(b) = boundary_hausdorff {
-            extra.push(("hausdorff_boundary", format!("{:?}", b.distance)));
-            extra.push((
-                "hausdorff_boundary_cells",
-                format!("{:?}", b.distance / cell_size),
-            ));
-            extra.push((
-                "hausdorff_boundary_fraction",
-                format!("{:?}", b.boundary_fraction),
-            ));
-        }
-        if let (Some(segment), Some(_)) = (reference_segment, hausdorff) {
-            extra.push((
-                "hausdorff_reference_segment_cells",
-                format!("{:?}", segment / cell_size),
-            ));
-        }
-        if let Some(t) = &thickened {
-            extra.push(("thicken", format!("{:?}", t.eps())));
-        }
-        if let Some(a) = agreement {
-            extra.push(("occupancy_agreement", format!("{a:?}")));
-            extra.push(("occupancy_samples", args.samples.to_string()));
-        }
-        std::fs::write(path, topology.to_json(&extra) + "\n")
+        std::fs::write(path, report.to_json() + "\n")
             .map_err(|e| CliError(format!("{}: {e}", path.display())))?;
     }
     Ok(())

@@ -178,6 +178,7 @@ def voxelize(
 ) -> _Grid:
     """Winding numbers (exact by default) on a voxel grid: (values (D, H, W) indexed [z, y, x], origin, spacing)."""
 
+@overload
 def remesh(
     V: Union[_Floats, StepModel],
     F: Optional[_Indices] = None,
@@ -192,8 +193,34 @@ def remesh(
     threads: Optional[int] = None,
     thicken: Optional[float] = None,
     refine_plates: bool = True,
+    sub_cell_levels: int = 1,
+    planar_levels: int = 3,
+    report: Literal[False] = False,
+    samples: int = 10000,
 ) -> Tuple[_F64, _I64]:
     """A closed, manifold, oriented surface of the solid w > 1/2 as (V float64 (n, 3), F int64 (m, 3)); simplify=False: the raw marching-tetrahedra surface; refine_plates=False keeps the lattice of res alone. remesh(model, res=...) of a StepModel takes no F."""
+
+@overload
+def remesh(
+    V: Union[_Floats, StepModel],
+    F: Optional[_Indices] = None,
+    res: int = 128,
+    *,
+    bisect: int = 8,
+    simplify: bool = True,
+    method: Literal["exact", "direct", "fast"] = "exact",
+    beta: Optional[float] = None,
+    order: Optional[int] = None,
+    tolerance: Optional[float] = None,
+    threads: Optional[int] = None,
+    thicken: Optional[float] = None,
+    refine_plates: bool = True,
+    sub_cell_levels: int = 1,
+    planar_levels: int = 3,
+    report: Literal[True],
+    samples: int = 10000,
+) -> Tuple[_F64, _I64, dict]:
+    """(V, F, report): the report a dict of what ``gwn remesh --report`` writes (closed, edge_manifold, vertex_manifold, oriented, euler_characteristic, components, self_intersections, hausdorff_boundary_cells, occupancy_agreement, seconds, ...); samples per surface and in the box for the distance and the agreement (0: neither)."""
 
 def sdf(
     V: _Floats,

@@ -14,7 +14,7 @@ use gwn::spec::{EvaluatorSpec, Method};
 use numpy::PyArray1;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyBytes;
+use pyo3::types::{PyBytes, PyTuple};
 
 use crate::arrays::{array_nd, array1, array2, indices_vec, with_points};
 use crate::errors::value_error;
@@ -434,9 +434,14 @@ pub fn filter_tets<'py>(
 /// ``gwn.remesh(model, res=...)`` remeshes a :class:`StepModel` (``gwn.load("part.step")``)
 /// the way ``gwn remesh part.step`` does: no ``F``, exact method only (``tolerance=`` as in
 /// :class:`WindingNumber`), vertices placed at the model's own surface hits; ``thicken`` is
-/// refused.
+/// refused. ``report=True`` returns ``(V, F, report)``, ``report`` a dict of the members
+/// ``gwn remesh --report`` writes, measured the same way (topology, exact self-intersection
+/// count, sampled Hausdorff distance to the input and to where it bounds the solid, in world
+/// units and cells, occupancy agreement, the run's counters and ``seconds``), with ``samples``
+/// points per surface and in the box (default 10,000; 0 measures neither the distance nor
+/// the agreement).
 #[pyfunction]
-#[pyo3(signature = (V, F = None, res = 128, *, bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS, simplify = true, method = "exact", beta = None, order = None, tolerance = None, threads = None, thicken = None, refine_plates = true, sub_cell_levels = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS, planar_levels = gwn::products::remesh::DEFAULT_PLANAR_LEVELS))]
+#[pyo3(signature = (V, F = None, res = 128, *, bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS, simplify = true, method = "exact", beta = None, order = None, tolerance = None, threads = None, thicken = None, refine_plates = true, sub_cell_levels = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS, planar_levels = gwn::products::remesh::DEFAULT_PLANAR_LEVELS, report = false, samples = 10_000))]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub fn remesh<'py>(
     py: Python<'py>,
@@ -454,7 +459,10 @@ pub fn remesh<'py>(
     refine_plates: bool,
     sub_cell_levels: u32,
     planar_levels: u32,
-) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    report: bool,
+    samples: usize,
+) -> PyResult<Bound<'py, PyTuple>> {
+    use gwn::products::remesh::report::{DistanceReference, RemeshReport};
     use gwn::products::remesh::{
         RemeshOptions, crossings::SegmentBvh, remesh_guided, thicken::ThickenedSheets,
     };
@@ -470,16 +478,58 @@ pub fn remesh<'py>(
         probe_flatness: true,
         evaluator_crossings: true,
     };
+    let samples = if report { samples } else { 0 };
     if let Ok(model) = V.downcast::<crate::step::PyStepModel>() {
-        return remesh_step(
-            py,
-            &model.get().model,
-            F,
-            &method,
-            &options,
-            threads,
-            thicken,
-        );
+        if F.is_some_and(|f| !f.is_none()) {
+            return Err(PyValueError::new_err(
+                "remesh(model): a gwn.StepModel takes no F (pass res= by name)",
+            ));
+        }
+        if thicken.is_some() {
+            return Err(PyValueError::new_err(
+                "thicken= needs triangles (a mesh or soup), not a STEP model",
+            ));
+        }
+        let model = &model.get().model;
+        let (lo, hi) = model.bounding_box();
+        let bounds = gwn::BoundingBox { min: lo, max: hi };
+        // The model's trimmed B-rep evaluator, vertices placed at its own surface hits (as
+        // `gwn remesh part.step`); measured against its trimmed tessellation.
+        let out = threads::run(py, threads, || {
+            let wn = crate::evaluator::step_evaluator(model, &method)?;
+            let start = std::time::Instant::now();
+            let mut out = remesh_guided(&wn, None, bounds, &options, &|_| {})?;
+            let seconds = start.elapsed().as_secs_f64();
+            let surface = take_surface(&mut out)?;
+            let measured = report.then(|| {
+                let curved = (samples > 0)
+                    .then(|| {
+                        gwn::products::remesh::report::step_surface_for_distance(
+                            model,
+                            out.cell_size,
+                        )
+                    })
+                    .flatten();
+                let reference = curved
+                    .as_ref()
+                    .map_or(DistanceReference::None, DistanceReference::Curved);
+                let mut r = RemeshReport::measure(
+                    &out,
+                    &surface,
+                    &options,
+                    &wn,
+                    reference,
+                    bounds,
+                    samples,
+                    &|_| {},
+                );
+                r.seconds = seconds;
+                r
+            });
+            Ok::<_, Box<dyn std::error::Error + Send + Sync>>((surface, measured))
+        })?
+        .map_err(value_error)?;
+        return surface_tuple(py, out);
     }
     let Some(F) = F else {
         return Err(PyValueError::new_err(
@@ -506,7 +556,8 @@ pub fn remesh<'py>(
     }
     let out = threads::run(py, threads, || {
         let wn = evaluator_for(&mesh, &method)?;
-        let out = match thicken {
+        let start = std::time::Instant::now();
+        let measured = match thicken {
             Some(eps) => {
                 let guide = SegmentBvh::of_mesh(&mesh);
                 let thick = ThickenedSheets::new(&mesh, &wn, eps)?;
@@ -515,58 +566,88 @@ pub fn remesh<'py>(
                     min: bounds.min.map(|x| x - eps),
                     max: bounds.max.map(|x| x + eps),
                 };
-                remesh_guided(&thick, Some(&guide), bounds, &options, &|_| {})?
+                let mut out = remesh_guided(&thick, Some(&guide), bounds, &options, &|_| {})?;
+                let seconds = start.elapsed().as_secs_f64();
+                let surface = take_surface(&mut out)?;
+                // The input bounds nothing of the slabs' solid: every sample counts.
+                let r = report.then(|| {
+                    let reference = DistanceReference::Mesh(&mesh);
+                    let mut r = RemeshReport::measure(
+                        &out,
+                        &surface,
+                        &options,
+                        &thick,
+                        reference,
+                        bounds,
+                        samples,
+                        &|_| {},
+                    );
+                    r.seconds = seconds;
+                    r.thicken = Some(eps);
+                    r
+                });
+                (surface, r)
             }
             None => {
                 // The input's own `w` is the field: probes may be screened by an approximation.
                 let guide = SegmentBvh::of_field_mesh(&mesh);
-                remesh_guided(&wn, Some(&guide), bounds, &options, &|_| {})?
+                let mut out = remesh_guided(&wn, Some(&guide), bounds, &options, &|_| {})?;
+                let seconds = start.elapsed().as_secs_f64();
+                let surface = take_surface(&mut out)?;
+                let r = report.then(|| {
+                    let reference = DistanceReference::BoundingMesh(&mesh);
+                    let mut r = RemeshReport::measure(
+                        &out,
+                        &surface,
+                        &options,
+                        &wn,
+                        reference,
+                        bounds,
+                        samples,
+                        &|_| {},
+                    );
+                    r.seconds = seconds;
+                    r
+                });
+                (surface, r)
             }
         };
-        Ok::<_, Box<dyn std::error::Error + Send + Sync>>(out)
+        Ok::<_, Box<dyn std::error::Error + Send + Sync>>(measured)
     })?
     .map_err(value_error)?;
-    surface_arrays(py, out)
+    surface_tuple(py, out)
 }
 
-/// A remeshed surface as `(V, F)`: float64 (n, 3) and int64 (m, 3).
-fn surface_arrays<'py>(
-    py: Python<'py>,
-    out: gwn::products::remesh::Remeshed,
-) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
-    let triangles: Vec<[i64; 3]> = out.triangles.iter().map(|t| t.map(i64::from)).collect();
-    Ok((array2(py, out.positions)?, array2(py, triangles)?))
+/// The remeshed surface as a mesh, taken out of `out` (whose other fields the report reads).
+fn take_surface(
+    out: &mut gwn::products::remesh::Remeshed,
+) -> Result<gwn::Mesh, gwn::error::MeshError> {
+    let positions = std::mem::take(&mut out.positions);
+    let triangles = std::mem::take(&mut out.triangles);
+    gwn::Mesh::new(positions, triangles)
 }
 
-/// [`remesh`] of a STEP model (`gwn remesh part.step`): the model's trimmed B-rep evaluator
-/// with the spec's options, vertices placed at its own surface hits, the model's box.
-#[allow(non_snake_case)]
-fn remesh_step<'py>(
+/// `(V, F)`: float64 (n, 3) and int64 (m, 3); with a report, `(V, F, report)`, the report a
+/// dict of the members `gwn remesh --report` writes.
+fn surface_tuple<'py>(
     py: Python<'py>,
-    model: &gwn::patch::step::StepModel,
-    F: Option<&Bound<'py, PyAny>>,
-    method: &EvaluatorSpec,
-    options: &gwn::products::remesh::RemeshOptions,
-    threads: Option<Threads>,
-    thicken: Option<f64>,
-) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
-    if F.is_some_and(|f| !f.is_none()) {
-        return Err(PyValueError::new_err(
-            "remesh(model): a gwn.StepModel takes no F (pass res= by name)",
-        ));
+    (surface, report): (
+        gwn::Mesh,
+        Option<gwn::products::remesh::report::RemeshReport>,
+    ),
+) -> PyResult<Bound<'py, PyTuple>> {
+    let triangles: Vec<[i64; 3]> = surface
+        .triangles()
+        .iter()
+        .map(|t| t.map(i64::from))
+        .collect();
+    let v = array2(py, surface.positions().to_vec())?;
+    let f = array2(py, triangles)?;
+    match report {
+        None => PyTuple::new(py, [v, f]),
+        Some(r) => {
+            let dict = py.import("json")?.call_method1("loads", (r.to_json(),))?;
+            PyTuple::new(py, [v, f, dict])
+        }
     }
-    if thicken.is_some() {
-        return Err(PyValueError::new_err(
-            "thicken= needs triangles (a mesh or soup), not a STEP model",
-        ));
-    }
-    let (lo, hi) = model.bounding_box();
-    let bounds = gwn::BoundingBox { min: lo, max: hi };
-    let out = threads::run(py, threads, || {
-        let wn = crate::evaluator::step_evaluator(model, method)?;
-        let out = gwn::products::remesh::remesh_guided(&wn, None, bounds, options, &|_| {})?;
-        Ok::<_, Box<dyn std::error::Error + Send + Sync>>(out)
-    })?
-    .map_err(value_error)?;
-    surface_arrays(py, out)
 }

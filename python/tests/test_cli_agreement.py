@@ -1,5 +1,6 @@
 """Bit-for-bit agreement with the `gwn` command-line tool (same library calls, same values)."""
 
+import json
 import subprocess
 
 import numpy as np
@@ -207,3 +208,21 @@ def test_same_error_for_the_same_bad_option(cli, tmp_path, cli_args, kwargs):
     with pytest.raises(ValueError) as info:
         gwn.WindingNumber(*gwn.load(LION_HEAD), **kwargs)
     assert str(info.value) == cli_message
+
+
+def test_remesh_and_its_report_equal_cli(cli, tmp_path, lion):
+    # Same surface, same report (the library measures both): every member but the timing.
+    out, report_path = tmp_path / "r.ply", tmp_path / "r.json"
+    run(cli, "remesh", LION_HEAD, "--res", 32, "--samples", 3000, "--out", out,
+        "--report", report_path)
+    V, F, report = gwn.remesh(*lion, res=32, report=True, samples=3000)
+    Vc, Fc = gwn.load(out)
+    np.testing.assert_array_equal(F, Fc)
+    np.testing.assert_allclose(V, Vc, rtol=0, atol=1e-9 * np.abs(V).max())
+    want = json.loads(report_path.read_text())
+    assert report.pop("seconds") > 0
+    want.pop("seconds")
+    assert report == want
+    # The lion head is open: the output closes it where w crosses 1/2, off its rim.
+    assert report["closed"] and report["self_intersections"] == 0
+    assert report["occupancy_samples"] == 3000 and report["hausdorff_boundary_fraction"] > 0.9

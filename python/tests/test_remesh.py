@@ -1,5 +1,6 @@
 """gwn.remesh: a closed, manifold, oriented surface of w > 1/2 (closed forms on cubes)."""
 
+import json
 import subprocess
 
 import numpy as np
@@ -167,6 +168,17 @@ def test_a_step_model_remeshes_like_the_cli(cli, tmp_path):
     Vc, Fc = gwn.load(out)
     np.testing.assert_array_equal(Fc, F)
     np.testing.assert_array_equal(Vc, V)  # the PLY holds float64
+    # The report against the model's trimmed tessellation, as the CLI's.
+    json_path = tmp_path / "o.json"
+    subprocess.run([str(cli), "remesh", str(path), "--res", "12", "--samples", "2000", "--out",
+                    str(out), "--report", str(json_path)], check=True, capture_output=True)
+    _, Fr, report = gwn.remesh(model, res=12, report=True, samples=2000)
+    np.testing.assert_array_equal(Fr, F)
+    want = json.loads(json_path.read_text())
+    report.pop("seconds"), want.pop("seconds")
+    assert report == want
+    assert report["hausdorff_reference_segment_cells"] <= 0.5
+    assert report["hausdorff_boundary_cells"] < 1 and report["closed"]
     with pytest.raises(ValueError, match="takes no F"):
         gwn.remesh(model, F)
     with pytest.raises(ValueError, match="thicken"):
@@ -175,3 +187,56 @@ def test_a_step_model_remeshes_like_the_cli(cli, tmp_path):
         gwn.remesh(model, res=8, method="fast")
     with pytest.raises(ValueError, match="F is required"):
         gwn.remesh(V)
+
+
+def test_report_measures_the_surface_it_returns():
+    V, F, report = gwn.remesh(CUBE_V, CUBE_F, res=16, report=True, samples=4000)
+    once, twice, edges = edge_census(F)
+    assert (report["faces"], report["vertices"], report["edges"]) == (len(F), len(V), edges)
+    assert report["closed"] and report["edge_manifold"] and report["vertex_manifold"]
+    assert report["oriented"] and report["euler_characteristic"] == 2
+    assert report["components"] == 1 and report["self_intersections"] == 0
+    cell = report["cell_size"]
+    assert abs(cell - 1 / 16) < 1e-12 and report["resolution"] == 16
+    # Every cube face bounds the solid; the output's chords stay within a cell of it.
+    assert report["hausdorff_boundary_fraction"] == 1.0
+    assert report["hausdorff"] == report["hausdorff_boundary"] < cell
+    assert abs(report["hausdorff_cells"] * cell - report["hausdorff"]) < 1e-15
+    assert report["occupancy_agreement"] > 0.99 and report["occupancy_samples"] == 4000
+    assert report["method"] == "exact" and report["simplified"] is True
+    # The same call without a report gives the same surface.
+    V2, F2 = gwn.remesh(CUBE_V, CUBE_F, res=16)
+    np.testing.assert_array_equal(V, V2)
+    np.testing.assert_array_equal(F, F2)
+
+
+def test_report_distances_see_cavities_and_inner_faces():
+    # Two nested cubes, the inner one flipped: w is 0 inside it, so the output is a shell
+    # with a cavity (two components, Euler characteristic 4), and its distance to the input
+    # where it bounds the solid is small; with samples=0 neither is measured.
+    inner = 0.25 + 0.5 * CUBE_V
+    V = np.vstack([CUBE_V, inner])
+    F = np.vstack([CUBE_F, CUBE_F[:, ::-1] + 8])
+    _, _, report = gwn.remesh(V, F, res=24, report=True, samples=2000)
+    assert report["components"] == 2 and report["euler_characteristic"] == 4
+    assert report["hausdorff_boundary_cells"] < 1 and report["occupancy_agreement"] > 0.99
+    # The inner cube not flipped: w = 2 inside it, the same solid as the outer cube alone;
+    # the inner faces bound nothing, so the plain distance sees them and the boundary one not.
+    F_same = np.vstack([CUBE_F, CUBE_F + 8])
+    _, _, same = gwn.remesh(V, F_same, res=24, report=True, samples=2000)
+    assert same["components"] == 1 and same["euler_characteristic"] == 2
+    assert same["hausdorff_cells"] > 5 and same["hausdorff_boundary_cells"] < 1
+    assert 0.4 < same["hausdorff_boundary_fraction"] < 0.9
+    _, _, bare = gwn.remesh(V, F_same, res=24, report=True, samples=0)
+    assert "hausdorff" not in bare and "occupancy_agreement" not in bare
+    assert bare["self_intersections"] == 0
+
+
+def test_report_of_thickened_sheets_counts_the_whole_input():
+    V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], dtype=np.float64)
+    F = np.array([[0, 1, 2], [0, 2, 3]])
+    _, F2, report = gwn.remesh(V, F, res=24, thicken=0.08, report=True, samples=2000)
+    assert report["thicken"] == 0.08 and report["faces"] == len(F2)
+    # The slab's faces are EPS off the sheet: the plain distance, no boundary part.
+    assert "hausdorff_boundary" not in report
+    assert 0.05 < report["hausdorff"] < 0.2

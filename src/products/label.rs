@@ -33,6 +33,7 @@ use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 
+use super::json::json_string;
 use super::npz::NpzWriter;
 use super::sdf::SignedDistance;
 use crate::base::splitmix::SplitMix64;
@@ -480,24 +481,6 @@ impl ManifestRow {
                 .map_or("null".to_string(), json_string),
         )
     }
-}
-
-fn json_string(s: &str) -> String {
-    let mut out = String::with_capacity(s.len() + 2);
-    out.push('"');
-    for c in s.chars() {
-        match c {
-            '"' => out.push_str("\\\""),
-            '\\' => out.push_str("\\\\"),
-            '\n' => out.push_str("\\n"),
-            '\r' => out.push_str("\\r"),
-            '\t' => out.push_str("\\t"),
-            c if (c as u32) < 0x20 => out.push_str(&format!("\\u{:04x}", c as u32)),
-            c => out.push(c),
-        }
-    }
-    out.push('"');
-    out
 }
 
 /// `path` made absolute, with `.` and `..` applied to the text: `a/../d/m.obj` is `d/m.obj`, so
@@ -978,10 +961,5 @@ mod tests {
             common_root(&[PathBuf::from("/d/a/x.obj")]),
             PathBuf::from("/d/a")
         );
-    }
-
-    #[test]
-    fn json_escapes() {
-        assert_eq!(json_string("a\"b\\c\nd\u{1}"), "\"a\\\"b\\\\c\\nd\\u0001\"");
     }
 }

@@ -6,6 +6,7 @@
 
 pub mod classify;
 pub mod colormap;
+mod json;
 pub mod label;
 pub mod npy;
 pub mod npz;

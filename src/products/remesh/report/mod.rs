@@ -1,8 +1,17 @@
-//! Topology report of a triangle surface: closed, edge- and vertex-manifold, oriented, Euler
-//! characteristic, components. Computed from the triangles alone (it checks the output of the
-//! remesher, and serves any other mesh as well).
+//! What is measured about a remeshed surface: its topology (closed, edge- and vertex-manifold,
+//! oriented, Euler characteristic, components; from the triangles alone, so it serves any other
+//! mesh as well), the sampled Hausdorff distance to the input (to where the input bounds the
+//! solid, and to a tessellation standing for a curved input) and the occupancy agreement; and
+//! the whole report of one run, [`RemeshReport`] (`measure.rs`), which `gwn remesh` prints and
+//! the Python module returns.
 
 use rayon::prelude::*;
+
+mod measure;
+pub use measure::{
+    AGREEMENT_SEED, DistanceReference, HAUSDORFF_SEED, RemeshReport, ReportPhase,
+    SIDE_TEST_OFFSET_CELLS,
+};
 
 /// The topology of a triangle surface.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
