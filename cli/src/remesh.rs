@@ -44,7 +44,7 @@ pub struct Args {
     #[arg(long)]
     pub report: Option<PathBuf>,
     /// Uniform samples in the box for the occupancy agreement of output and input, and samples
-    /// per surface for the Hausdorff distance (0: skip both).
+    /// per surface for the Hausdorff distance (0: skip both; at most 10,000,000).
     #[arg(long, default_value_t = 10_000)]
     pub samples: usize,
     /// Place every vertex by searching the field, without the input triangles' crossings (or a
@@ -123,6 +123,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
             args.out.display()
         ))
     })?;
+    RemeshReport::check_samples(args.samples)
+        .map_err(|e| CliError::msg(format!("--samples: {e}")))?;
     let method = args.method.spec(args.tolerance, args.weld);
     method.validate()?;
     let input = crate::method::load_input(&args.mesh, args.weld)?;
@@ -243,7 +245,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
         bounds,
         args.samples,
         &measure_phase,
-    );
+    )
+    .map_err(|e| CliError::msg(format!("--samples: {e}")))?;
     report.seconds = secs;
     report.thicken = thickened.as_ref().map(|t| t.eps());
     drop(curved_surface);

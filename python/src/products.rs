@@ -438,8 +438,8 @@ pub fn filter_tets<'py>(
 /// ``gwn remesh --report`` writes, measured the same way (topology, exact self-intersection
 /// count, sampled Hausdorff distance to the input and to where it bounds the solid, in world
 /// units and cells, occupancy agreement, the run's counters and ``seconds``), with ``samples``
-/// points per surface and in the box (default 10,000; 0 measures neither the distance nor
-/// the agreement).
+/// points per surface and in the box (default 10,000, at most 10,000,000; 0 measures neither
+/// the distance nor the agreement).
 #[pyfunction]
 #[pyo3(signature = (V, F = None, res = 128, *, bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS, simplify = true, method = "exact", beta = None, order = None, tolerance = None, threads = None, thicken = None, refine_plates = true, sub_cell_levels = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS, planar_levels = gwn::products::remesh::DEFAULT_PLANAR_LEVELS, report = false, samples = 10_000))]
 #[allow(non_snake_case, clippy::too_many_arguments)]
@@ -479,6 +479,8 @@ pub fn remesh<'py>(
         evaluator_crossings: true,
     };
     let samples = if report { samples } else { 0 };
+    RemeshReport::check_samples(samples)
+        .map_err(|e| PyValueError::new_err(format!("samples={samples}: {e}")))?;
     if let Ok(model) = V.downcast::<crate::step::PyStepModel>() {
         if F.is_some_and(|f| !f.is_none()) {
             return Err(PyValueError::new_err(
@@ -501,7 +503,7 @@ pub fn remesh<'py>(
             let mut out = remesh_guided(&wn, None, bounds, &options, &|_| {})?;
             let seconds = start.elapsed().as_secs_f64();
             let surface = take_surface(&mut out)?;
-            let measured = report.then(|| {
+            let measured = if report {
                 let curved = (samples > 0)
                     .then(|| {
                         gwn::products::remesh::report::step_surface_for_distance(
@@ -522,10 +524,12 @@ pub fn remesh<'py>(
                     bounds,
                     samples,
                     &|_| {},
-                );
+                )?;
                 r.seconds = seconds;
-                r
-            });
+                Some(r)
+            } else {
+                None
+            };
             Ok::<_, Box<dyn std::error::Error + Send + Sync>>((surface, measured))
         })?
         .map_err(value_error)?;
@@ -570,7 +574,7 @@ pub fn remesh<'py>(
                 let seconds = start.elapsed().as_secs_f64();
                 let surface = take_surface(&mut out)?;
                 // The input bounds nothing of the slabs' solid: every sample counts.
-                let r = report.then(|| {
+                let r = if report {
                     let reference = DistanceReference::Mesh(&mesh);
                     let mut r = RemeshReport::measure(
                         &out,
@@ -581,11 +585,13 @@ pub fn remesh<'py>(
                         bounds,
                         samples,
                         &|_| {},
-                    );
+                    )?;
                     r.seconds = seconds;
                     r.thicken = Some(eps);
-                    r
-                });
+                    Some(r)
+                } else {
+                    None
+                };
                 (surface, r)
             }
             None => {
@@ -594,7 +600,7 @@ pub fn remesh<'py>(
                 let mut out = remesh_guided(&wn, Some(&guide), bounds, &options, &|_| {})?;
                 let seconds = start.elapsed().as_secs_f64();
                 let surface = take_surface(&mut out)?;
-                let r = report.then(|| {
+                let r = if report {
                     let reference = DistanceReference::BoundingMesh(&mesh);
                     let mut r = RemeshReport::measure(
                         &out,
@@ -605,10 +611,12 @@ pub fn remesh<'py>(
                         bounds,
                         samples,
                         &|_| {},
-                    );
+                    )?;
                     r.seconds = seconds;
-                    r
-                });
+                    Some(r)
+                } else {
+                    None
+                };
                 (surface, r)
             }
         };

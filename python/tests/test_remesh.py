@@ -75,6 +75,10 @@ def test_bad_arguments_are_value_errors():
         gwn.remesh(CUBE_V, CUBE_F, res=8, bisect=99)
     with pytest.raises(ValueError):
         gwn.remesh(CUBE_V, CUBE_F, res=8, method="nope")
+    with pytest.raises(ValueError, match="above the limit 10000000"):
+        gwn.remesh(CUBE_V, CUBE_F, res=8, report=True, samples=10**11)
+    # Without a report, samples= measures nothing and is not looked at.
+    assert len(gwn.remesh(CUBE_V, CUBE_F, res=8, samples=10**11)) == 2
 
 
 def test_thicken_turns_an_open_square_into_a_slab():

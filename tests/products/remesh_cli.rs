@@ -121,7 +121,7 @@ fn remesh_errors_are_one_line() {
     let input = input.to_str().unwrap();
     let out = dir.join("o.obj");
     let out = out.to_str().unwrap();
-    let cases: [(&[&str], &str); 5] = [
+    let cases: [(&[&str], &str); 6] = [
         (
             &["remesh", input, "--out", "x.vtk"],
             "unknown output extension",
@@ -138,6 +138,11 @@ fn remesh_errors_are_one_line() {
         (
             &["remesh", input, "--simplify-distance=-1", "--out", out],
             "simplification option",
+        ),
+        // Refused before the remesh: 10^11 samples would be terabytes (an abort, once).
+        (
+            &["remesh", input, "--samples", "100000000000", "--out", out],
+            "--samples: 100000000000 report samples is above the limit 10000000",
         ),
     ];
     for (args, needle) in cases {

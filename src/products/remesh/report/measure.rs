@@ -22,6 +22,30 @@ pub const AGREEMENT_SEED: u64 = 0x9e57;
 /// off a face for `w` to be decided by it, close enough that no other sheet is nearer.
 pub const SIDE_TEST_OFFSET_CELLS: f64 = 0.01;
 
+/// Most samples [`RemeshReport::measure`] takes: about 100 bytes each at the peak (the input's
+/// samples with their two side points, values and distances), so a typo cannot ask for
+/// terabytes; 10⁷ is a gigabyte, and a thousand times the default.
+pub const MAX_SAMPLES: usize = 10_000_000;
+
+/// More samples than [`MAX_SAMPLES`] were asked for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TooManySamples {
+    /// The count asked for.
+    pub samples: usize,
+}
+
+impl std::fmt::Display for TooManySamples {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} report samples is above the limit {MAX_SAMPLES}",
+            self.samples
+        )
+    }
+}
+
+impl std::error::Error for TooManySamples {}
+
 /// What a remeshed surface's Hausdorff distance is measured to.
 #[derive(Clone, Copy, Debug)]
 pub enum DistanceReference<'a> {
@@ -105,11 +129,19 @@ pub struct RemeshReport {
 }
 
 impl RemeshReport {
+    /// Whether [`RemeshReport::measure`] takes `samples`: callers check before a long remesh.
+    pub fn check_samples(samples: usize) -> Result<(), TooManySamples> {
+        if samples > MAX_SAMPLES {
+            return Err(TooManySamples { samples });
+        }
+        Ok(())
+    }
+
     /// Measures `out` (whose surface `surface` is, as a mesh) against the `field` it was
     /// extracted from, in `bounds` (the box the remesh was given), with `samples` samples per
     /// surface and in the box (0: no distance, no agreement). The distances and the agreement
     /// are seeded ([`HAUSDORFF_SEED`], [`AGREEMENT_SEED`]): the same inputs give the same
-    /// report on every run and thread count.
+    /// report on every run and thread count. More than [`MAX_SAMPLES`] is refused.
     ///
     /// ```
     /// use gwn::eval::antipodal::WindingNumber;
@@ -128,7 +160,8 @@ impl RemeshReport {
     ///     std::mem::take(&mut out.triangles),
     /// )?;
     /// let reference = DistanceReference::BoundingMesh(&tet);
-    /// let report = RemeshReport::measure(&out, &surface, &options, &wn, reference, bounds, 2000, &|_| {});
+    /// let report =
+    ///     RemeshReport::measure(&out, &surface, &options, &wn, reference, bounds, 2000, &|_| {})?;
     /// assert!(report.topology.closed && report.self_intersections?.pairs == 0);
     /// assert!(report.boundary_hausdorff.unwrap().distance < out.cell_size);
     /// assert!(report.occupancy_agreement.unwrap() > 0.99);
@@ -145,7 +178,8 @@ impl RemeshReport {
         bounds: crate::BoundingBox,
         samples: usize,
         progress: &dyn Fn(ReportPhase),
-    ) -> RemeshReport {
+    ) -> Result<RemeshReport, TooManySamples> {
+        Self::check_samples(samples)?;
         let topology = TopologyReport::of(surface.positions(), surface.triangles());
         progress(ReportPhase::SelfIntersections);
         // The broad phase is linear on the remesher's output (faces of at most 6 cells, flat
@@ -195,7 +229,7 @@ impl RemeshReport {
                 Err(_) => None,
             }
         };
-        RemeshReport {
+        Ok(RemeshReport {
             topology,
             self_intersections: intersections,
             self_intersection_seconds,
@@ -213,7 +247,7 @@ impl RemeshReport {
             method: field.name().to_string(),
             seconds: 0.0,
             thicken: None,
-        }
+        })
     }
 
     /// The report as one JSON object: the topology's members ([`TopologyReport::to_json`]),

@@ -9,8 +9,8 @@ use rayon::prelude::*;
 
 mod measure;
 pub use measure::{
-    AGREEMENT_SEED, DistanceReference, HAUSDORFF_SEED, RemeshReport, ReportPhase,
-    SIDE_TEST_OFFSET_CELLS,
+    AGREEMENT_SEED, DistanceReference, HAUSDORFF_SEED, MAX_SAMPLES, RemeshReport, ReportPhase,
+    SIDE_TEST_OFFSET_CELLS, TooManySamples,
 };
 
 /// The topology of a triangle surface.
