@@ -122,6 +122,16 @@ const RELOCATION_STIFFNESS: f64 = 0.01;
 /// 2.735e-2), and the bunny's occupancy agreement at res 128 is within 10⁻⁴.
 const MIN_RELOCATION: f64 = 0.01;
 
+/// Rounds of [`Simplifier::run`] with fewer collapses (or vertices to re-cost) than this
+/// are planned on the calling thread, the same plans: flat regions' rounds are small (their
+/// cheapest collapses are neighbours, which wait for each other), and handing them to the
+/// thread pool cost more than it gained — the cube at res 512 spent ~17 % of its time in the
+/// kernel's thread wake-ups. Threshold 1 (always parallel) / 64 / 256, two runs each, 2
+/// threads: the cube at res 512 6.2 / 5.2 / 4.9 s, cura-ultimaker3_platform at res 256 7.9 /
+/// 8.1 / 7.5 s, cgal-armadillo within ±3 % (docs/benchmarks.md, "Small rounds on the calling
+/// thread").
+const PARALLEL_ROUND: usize = 256;
+
 /// Most collapses planned together (in parallel) in one round of [`Simplifier::run`]. A
 /// constant, so that the result does not depend on the thread count; small enough that a
 /// round stays close to the global cost order.
@@ -720,8 +730,11 @@ impl Simplifier {
                 break;
             }
             self.stats.rounds += 1;
-            let plans: Vec<(Option<Plan>, [usize; 5])> =
-                selected.par_iter().map(|&u| self.plan_best(u)).collect();
+            let plans: Vec<(Option<Plan>, [usize; 5])> = if selected.len() < PARALLEL_ROUND {
+                selected.iter().map(|&u| self.plan_best(u)).collect()
+            } else {
+                selected.par_iter().map(|&u| self.plan_best(u)).collect()
+            };
             touched.clear();
             for (&u, (plan, refused)) in selected.iter().zip(plans) {
                 for (a, b) in self.stats.refused.iter_mut().zip(refused) {
@@ -734,10 +747,12 @@ impl Simplifier {
             }
             touched.sort_unstable();
             touched.dedup();
-            let best: Vec<Option<u64>> = touched
-                .par_iter()
-                .map(|&x| self.best_cost(x).map(f64::to_bits))
-                .collect();
+            let best_of = |x: &u32| self.best_cost(*x).map(f64::to_bits);
+            let best: Vec<Option<u64>> = if touched.len() < PARALLEL_ROUND {
+                touched.iter().map(best_of).collect()
+            } else {
+                touched.par_iter().map(best_of).collect()
+            };
             for (&x, best) in touched.iter().zip(best) {
                 if best != queued[x as usize] || best.is_none() {
                     version[x as usize] += 1;
