@@ -17,12 +17,34 @@ use gwn::{BoundingBox, Mesh};
 
 // ---------------------------------------------------------------- helpers
 
-/// A fresh empty directory under the system temp dir.
-fn temp_dir(name: &str) -> PathBuf {
+/// A fresh empty directory under the system temp dir, removed when dropped (the tests left
+/// five per run behind).
+fn temp_dir(name: &str) -> TempDir {
     let d = std::env::temp_dir().join(format!("gwn-products-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
-    d
+    TempDir(d)
+}
+
+struct TempDir(PathBuf);
+
+impl std::ops::Deref for TempDir {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<Path> for TempDir {
+    fn as_ref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
 }
 
 fn write_cube_obj(path: &Path, mesh: &Mesh) {

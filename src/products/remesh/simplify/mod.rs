@@ -125,11 +125,10 @@ const MIN_RELOCATION: f64 = 0.01;
 /// Rounds of [`Simplifier::run`] with fewer collapses (or vertices to re-cost) than this
 /// are planned on the calling thread, the same plans: flat regions' rounds are small (their
 /// cheapest collapses are neighbours, which wait for each other), and handing them to the
-/// thread pool cost more than it gained — the cube at res 512 spent ~17 % of its time in the
-/// kernel's thread wake-ups. Threshold 1 (always parallel) / 64 / 256, two runs each, 2
-/// threads: the cube at res 512 6.2 / 5.2 / 4.9 s, cura-ultimaker3_platform at res 256 7.9 /
-/// 8.1 / 7.5 s, cgal-armadillo within ±3 % (docs/benchmarks.md, "Small rounds on the calling
-/// thread").
+/// thread pool cost more than it gained (the cube at res 1024: 17 % of the profile's samples
+/// in the kernel's thread switches). Always parallel / below 64 / below 256, 2 threads: the
+/// cube at res 512 6.2 / 5.2 / 4.9 s; curved inputs within the machine's noise either way
+/// (docs/benchmarks.md, "Small rounds on the calling thread").
 const PARALLEL_ROUND: usize = 256;
 
 /// Most collapses planned together (in parallel) in one round of [`Simplifier::run`]. A
