@@ -560,67 +560,51 @@ pub fn remesh<'py>(
     }
     let out = threads::run(py, threads, || {
         let wn = evaluator_for(&mesh, &method)?;
+        let thick = thicken
+            .map(|eps| ThickenedSheets::new(&mesh, &wn, eps))
+            .transpose()?;
         let start = std::time::Instant::now();
-        let measured = match thicken {
-            Some(eps) => {
-                let guide = SegmentBvh::of_mesh(&mesh);
-                let thick = ThickenedSheets::new(&mesh, &wn, eps)?;
-                // The slabs reach `eps` past the input's box (as in `gwn remesh`).
-                let bounds = gwn::BoundingBox {
-                    min: bounds.min.map(|x| x - eps),
-                    max: bounds.max.map(|x| x + eps),
-                };
-                let mut out = remesh_guided(&thick, Some(&guide), bounds, &options, &|_| {})?;
-                let seconds = start.elapsed().as_secs_f64();
-                let surface = take_surface(&mut out)?;
-                // The input bounds nothing of the slabs' solid: every sample counts.
-                let r = if report {
-                    let reference = DistanceReference::Mesh(&mesh);
-                    let mut r = RemeshReport::measure(
-                        &out,
-                        &surface,
-                        &options,
-                        &thick,
-                        reference,
-                        bounds,
-                        samples,
-                        &|_| {},
-                    )?;
-                    r.seconds = seconds;
-                    r.thicken = Some(eps);
-                    Some(r)
-                } else {
-                    None
-                };
-                (surface, r)
-            }
-            None => {
-                // The input's own `w` is the field: probes may be screened by an approximation.
-                let guide = SegmentBvh::of_field_mesh(&mesh);
-                let mut out = remesh_guided(&wn, Some(&guide), bounds, &options, &|_| {})?;
-                let seconds = start.elapsed().as_secs_f64();
-                let surface = take_surface(&mut out)?;
-                let r = if report {
-                    let reference = DistanceReference::BoundingMesh(&mesh);
-                    let mut r = RemeshReport::measure(
-                        &out,
-                        &surface,
-                        &options,
-                        &wn,
-                        reference,
-                        bounds,
-                        samples,
-                        &|_| {},
-                    )?;
-                    r.seconds = seconds;
-                    Some(r)
-                } else {
-                    None
-                };
-                (surface, r)
-            }
+        let (field, guide, bounds, reference): (&dyn gwn::eval::Evaluator, _, _, _) = match &thick {
+            // The slabs reach `eps` past the input's box (as in `gwn remesh`), and the input
+            // bounds nothing of their solid: every sample of the distance counts.
+            Some(t) => (
+                t,
+                SegmentBvh::of_mesh(&mesh),
+                gwn::BoundingBox {
+                    min: bounds.min.map(|x| x - t.eps()),
+                    max: bounds.max.map(|x| x + t.eps()),
+                },
+                DistanceReference::Mesh(&mesh),
+            ),
+            // The input's own `w` is the field: probes may be screened by an approximation.
+            None => (
+                &wn,
+                SegmentBvh::of_field_mesh(&mesh),
+                bounds,
+                DistanceReference::BoundingMesh(&mesh),
+            ),
         };
-        Ok::<_, Box<dyn std::error::Error + Send + Sync>>(measured)
+        let mut out = remesh_guided(field, Some(&guide), bounds, &options, &|_| {})?;
+        let seconds = start.elapsed().as_secs_f64();
+        let surface = take_surface(&mut out)?;
+        let measured = if report {
+            let mut r = RemeshReport::measure(
+                &out,
+                &surface,
+                &options,
+                field,
+                reference,
+                bounds,
+                samples,
+                &|_| {},
+            )?;
+            r.seconds = seconds;
+            r.thicken = thicken;
+            Some(r)
+        } else {
+            None
+        };
+        Ok::<_, Box<dyn std::error::Error + Send + Sync>>((surface, measured))
     })?
     .map_err(value_error)?;
     surface_tuple(py, out)
