@@ -463,6 +463,7 @@ pub fn remesh<'py>(
     samples: usize,
 ) -> PyResult<Bound<'py, PyTuple>> {
     use gwn::products::remesh::report::{DistanceReference, RemeshReport};
+
     use gwn::products::remesh::{
         RemeshOptions, crossings::SegmentBvh, remesh_guided, thicken::ThickenedSheets,
     };
@@ -500,37 +501,25 @@ pub fn remesh<'py>(
         let out = threads::run(py, threads, || {
             let wn = crate::evaluator::step_evaluator(model, &method)?;
             let start = std::time::Instant::now();
-            let mut out = remesh_guided(&wn, None, bounds, &options, &|_| {})?;
+            let out = remesh_guided(&wn, None, bounds, &options, &|_| {})?;
             let seconds = start.elapsed().as_secs_f64();
-            let surface = take_surface(&mut out)?;
-            let measured = if report {
-                let curved = (samples > 0)
-                    .then(|| {
-                        gwn::products::remesh::report::step_surface_for_distance(
-                            model,
-                            out.cell_size,
-                        )
-                    })
-                    .flatten();
-                let reference = curved
-                    .as_ref()
-                    .map_or(DistanceReference::None, DistanceReference::Curved);
-                let mut r = RemeshReport::measure(
-                    &out,
-                    &surface,
-                    &options,
-                    &wn,
-                    reference,
-                    bounds,
-                    samples,
-                    &|_| {},
-                )?;
-                r.seconds = seconds;
-                Some(r)
-            } else {
-                None
-            };
-            Ok::<_, Box<dyn std::error::Error + Send + Sync>>((surface, measured))
+            let curved = (report && samples > 0)
+                .then(|| {
+                    gwn::products::remesh::report::step_surface_for_distance(model, out.cell_size)
+                })
+                .flatten();
+            let reference = curved
+                .as_ref()
+                .map_or(DistanceReference::None, DistanceReference::Curved);
+            let request = report.then_some(ReportRequest {
+                options: &options,
+                reference,
+                bounds,
+                samples,
+                seconds,
+                thicken: None,
+            });
+            measured(out, &wn, request)
         })?
         .map_err(value_error)?;
         return surface_tuple(py, out);
@@ -584,56 +573,79 @@ pub fn remesh<'py>(
                 DistanceReference::BoundingMesh(&mesh),
             ),
         };
-        let mut out = remesh_guided(field, Some(&guide), bounds, &options, &|_| {})?;
+        let out = remesh_guided(field, Some(&guide), bounds, &options, &|_| {})?;
         let seconds = start.elapsed().as_secs_f64();
-        let surface = take_surface(&mut out)?;
-        let measured = if report {
-            let mut r = RemeshReport::measure(
-                &out,
-                &surface,
-                &options,
-                field,
-                reference,
-                bounds,
-                samples,
-                &|_| {},
-            )?;
-            r.seconds = seconds;
-            r.thicken = thicken;
-            Some(r)
-        } else {
-            None
-        };
-        Ok::<_, Box<dyn std::error::Error + Send + Sync>>((surface, measured))
+        let request = report.then_some(ReportRequest {
+            options: &options,
+            reference,
+            bounds,
+            samples,
+            seconds,
+            thicken,
+        });
+        measured(out, field, request)
     })?
     .map_err(value_error)?;
     surface_tuple(py, out)
 }
 
-/// The remeshed surface as a mesh, taken out of `out` (whose other fields the report reads).
-fn take_surface(
-    out: &mut gwn::products::remesh::Remeshed,
-) -> Result<gwn::Mesh, gwn::error::MeshError> {
+/// What [`measured`] measures a remesh against, and the run's facts the report carries.
+struct ReportRequest<'a> {
+    options: &'a gwn::products::remesh::RemeshOptions,
+    reference: gwn::products::remesh::report::DistanceReference<'a>,
+    bounds: gwn::BoundingBox,
+    samples: usize,
+    seconds: f64,
+    thicken: Option<f64>,
+}
+
+/// A remeshed surface: its vertices, triangles and, when requested, its report
+/// ([`gwn::products::remesh::report::RemeshReport::measure`] against `field`, which needs the
+/// surface as a mesh too; without a report the arrays are moved out, not copied).
+type Measured = (
+    Vec<[f64; 3]>,
+    Vec<[u32; 3]>,
+    Option<gwn::products::remesh::report::RemeshReport>,
+);
+
+fn measured<E: gwn::eval::Evaluator + ?Sized>(
+    mut out: gwn::products::remesh::Remeshed,
+    field: &E,
+    request: Option<ReportRequest<'_>>,
+) -> Result<Measured, Box<dyn std::error::Error + Send + Sync>> {
     let positions = std::mem::take(&mut out.positions);
     let triangles = std::mem::take(&mut out.triangles);
-    gwn::Mesh::new(positions, triangles)
+    let Some(r) = request else {
+        return Ok((positions, triangles, None));
+    };
+    let surface = gwn::Mesh::new(positions, triangles)?;
+    let mut report = gwn::products::remesh::report::RemeshReport::measure(
+        &out,
+        &surface,
+        r.options,
+        field,
+        r.reference,
+        r.bounds,
+        r.samples,
+        &|_| {},
+    )?;
+    report.seconds = r.seconds;
+    report.thicken = r.thicken;
+    Ok((
+        surface.positions().to_vec(),
+        surface.triangles().to_vec(),
+        Some(report),
+    ))
 }
 
 /// `(V, F)`: float64 (n, 3) and int64 (m, 3); with a report, `(V, F, report)`, the report a
 /// dict of the members `gwn remesh --report` writes.
 fn surface_tuple<'py>(
     py: Python<'py>,
-    (surface, report): (
-        gwn::Mesh,
-        Option<gwn::products::remesh::report::RemeshReport>,
-    ),
+    (positions, triangles, report): Measured,
 ) -> PyResult<Bound<'py, PyTuple>> {
-    let triangles: Vec<[i64; 3]> = surface
-        .triangles()
-        .iter()
-        .map(|t| t.map(i64::from))
-        .collect();
-    let v = array2(py, surface.positions().to_vec())?;
+    let triangles: Vec<[i64; 3]> = triangles.iter().map(|t| t.map(i64::from)).collect();
+    let v = array2(py, positions)?;
     let f = array2(py, triangles)?;
     match report {
         None => PyTuple::new(py, [v, f]),
