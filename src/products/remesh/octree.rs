@@ -162,23 +162,79 @@ impl Classified {
         }
     }
 
-    /// Whether the classified points on the closed box of the cell `(level, m)` differ.
-    fn closed_box_mixed(&self, level: u32, m: Corner) -> bool {
+    /// Whether the classified points on the closed box of the cell `(level, m)` (not split)
+    /// differ.
+    ///
+    /// Found from the split cells, not by scanning the box: before the transition split, the
+    /// classified points are the coarse corners and the 27 points of each split cell (its
+    /// children's corners). On the closed box of a cell of edge `2^level` such a point is one
+    /// of its corners, or one of the 27 of a split cell of at most its level whose closed box
+    /// meets it (larger ones' points are spaced at least its edge apart). That cell is not
+    /// inside the unsplit cell itself, so it is inside one of the 26 neighbours of its level,
+    /// and every split cell is a child of a split cell or coarse: descending from the split
+    /// neighbours through the split children that meet the box visits every such point. The
+    /// cost grows with the points found, where a scan of the box grew with its area (quadratic
+    /// in the cell's edge: at `--res 65536` the coarse cells are 1024 finest cells wide, and
+    /// the scan never finished).
+    fn closed_box_mixed(&self, lattice: &Lattice, level: u32, m: Corner) -> bool {
+        debug_assert!(!self.split.contains(&(level, pack(m))));
+        let size = 1u32 << level;
+        let first = self.label(m);
+        let differs = |p: Corner| self.labels.get(&pack(p)).is_some_and(|v| v.inside != first);
+        if (1..8).any(|b| differs(offset(m, b, size))) {
+            return true;
+        }
+        let hi = m.map(|x| x + size);
+        let meets_box = |c: Corner, edge: u32| (0..3).all(|a| c[a] <= hi[a] && c[a] + edge >= m[a]);
+        let on_box = |p: Corner| {
+            (0..3).all(|a| p[a] >= m[a] && p[a] <= hi[a])
+                && (0..3).any(|a| p[a] == m[a] || p[a] == hi[a])
+        };
+        let mut stack: Vec<(u32, Corner)> = neighbours(lattice, m, size)
+            .filter(|&n| self.split.contains(&(level, pack(n))))
+            .map(|n| (level, n))
+            .collect();
+        while let Some((l, c)) = stack.pop() {
+            let half = 1u32 << (l - 1);
+            for i in 0..27u32 {
+                let p = [0, 1, 2].map(|a| c[a] + [i % 3, i / 3 % 3, i / 9][a] * half);
+                if on_box(p) && differs(p) {
+                    return true;
+                }
+            }
+            if l > 1 {
+                stack.extend(
+                    (0..8)
+                        .map(|b| offset(c, b, half))
+                        .filter(|&child| {
+                            meets_box(child, half) && self.split.contains(&(l - 1, pack(child)))
+                        })
+                        .map(|child| (l - 1, child)),
+                );
+            }
+        }
+        debug_assert!(
+            level > 5 || !self.closed_box_mixed_by_scan(level, m),
+            "{level} {m:?}"
+        );
+        false
+    }
+
+    /// [`Classified::closed_box_mixed`] by visiting every lattice point of the closed box: the
+    /// definition, which debug builds check the descent against on small cells.
+    fn closed_box_mixed_by_scan(&self, level: u32, m: Corner) -> bool {
         let size = 1u32 << level;
         let first = self.label(m);
         for dz in 0..=size {
             for dy in 0..=size {
-                let y_or_z_face = dz == 0 || dz == size || dy == 0 || dy == size;
                 for dx in 0..=size {
-                    // Interior points of an unsplit cell are never classified.
-                    if !y_or_z_face && dx != 0 && dx != size {
+                    let d = [dx, dy, dz];
+                    if d.iter().all(|&x| x != 0 && x != size) {
                         continue;
                     }
-                    let p = [m[0] + dx, m[1] + dy, m[2] + dz];
-                    if let Some(v) = self.labels.get(&pack(p)) {
-                        if v.inside != first {
-                            return true;
-                        }
+                    let p = [0, 1, 2].map(|a| m[a] + d[a]);
+                    if self.labels.get(&pack(p)).is_some_and(|v| v.inside != first) {
+                        return true;
                     }
                 }
             }
@@ -724,7 +780,7 @@ impl Classified {
             .par_iter()
             .filter(|&&(l, m)| {
                 this.corners_integral(l, m).is_none()
-                    && !this.closed_box_mixed(l, m)
+                    && !this.closed_box_mixed(lattice, l, m)
                     && !touched(Some(guide), lattice, l, m)
             })
             .flat_map_iter(|&(l, m)| this.unsettled_corners(l, m))
@@ -736,7 +792,7 @@ impl Classified {
             .par_iter()
             .map(|&(l, m)| {
                 if this.corners_integral(l, m) != Some(true)
-                    || this.closed_box_mixed(l, m)
+                    || this.closed_box_mixed(lattice, l, m)
                     || touched(Some(guide), lattice, l, m)
                 {
                     return None;
@@ -880,7 +936,7 @@ impl Classified {
                     let half = 1u32 << (level - 1);
                     (0..8).filter_map(move |b| {
                         let child = offset(m, b, half);
-                        (reader.closed_box_mixed(level - 1, child)
+                        (reader.closed_box_mixed(lattice, level - 1, child)
                             || touched(guide, lattice, level - 1, child))
                         .then_some((level - 1, child))
                     })
@@ -963,4 +1019,103 @@ fn screened<E: Evaluator + ?Sized>(
 pub fn unpack(key: u64) -> Corner {
     let mask = (1u64 << 21) - 1;
     [key & mask, (key >> 21) & mask, (key >> 42) & mask].map(|x| x as u32)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small xorshift: the trees below need many random choices and no distribution.
+    struct Random(u64);
+
+    impl Random {
+        fn below(&mut self, n: u64) -> u64 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            self.0 % n
+        }
+    }
+
+    /// Splits the cell `(level, m)` as `classify` does (its 27 points labelled where they were
+    /// not), then each child with probability `percent`.
+    fn split(out: &mut Classified, random: &mut Random, level: u32, m: Corner, percent: u64) {
+        out.split.insert((level, pack(m)));
+        let half = 1u32 << (level - 1);
+        for i in 0..27u32 {
+            let p = [0, 1, 2].map(|a| m[a] + [i % 3, i / 3 % 3, i / 9][a] * half);
+            let inside = random.below(40) == 0;
+            out.labels
+                .entry(pack(p))
+                .or_insert(CornerValue::of((f64::from(u8::from(inside)), true)));
+        }
+        if level > 1 {
+            for b in 0..8 {
+                if random.below(100) < percent {
+                    split(out, random, level - 1, offset(m, b, half), percent);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn closed_box_mixed_finds_what_a_scan_of_the_box_finds() {
+        // Random trees over 3×2×2 coarse cells of edge 16, with labels mostly of one class so
+        // that most boxes agree and a point of the other class deep in a neighbour's subtree
+        // is what decides; every unsplit tree cell asked both ways.
+        let lattice = Lattice {
+            origin: [0.0; 3],
+            h: [1.0; 3],
+            cells: [48, 32, 32],
+            levels: 4,
+            sub_levels: 0,
+            planar_levels: 0,
+        };
+        let (mut mixed, mut agreeing) = (0, 0);
+        for seed in 1..=60u64 {
+            let mut random = Random(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15));
+            let mut out = Classified::default();
+            for k in 0..=2u32 {
+                for j in 0..=2u32 {
+                    for i in 0..=3u32 {
+                        let inside = random.below(40) == 0;
+                        let value = CornerValue::of((f64::from(u8::from(inside)), true));
+                        out.labels.insert(pack([i * 16, j * 16, k * 16]), value);
+                    }
+                }
+            }
+            let coarse: Vec<Corner> = (0..2u32)
+                .flat_map(|k| (0..2u32).flat_map(move |j| (0..3u32).map(move |i| [i, j, k])))
+                .map(|c| c.map(|x| x * 16))
+                .collect();
+            let percent = 20 + seed % 50;
+            for &m in &coarse {
+                if random.below(100) < 70 {
+                    split(&mut out, &mut random, 4, m, percent);
+                }
+            }
+            let mut cells: Vec<(u32, Corner)> = coarse.iter().map(|&m| (4, m)).collect();
+            for level in (1..=4).rev() {
+                cells.extend(out.children_of_split(level).map(|m| (level - 1, m)));
+            }
+            for (level, m) in cells {
+                if out.split.contains(&(level, pack(m))) {
+                    continue;
+                }
+                let by_scan = out.closed_box_mixed_by_scan(level, m);
+                assert_eq!(
+                    out.closed_box_mixed(&lattice, level, m),
+                    by_scan,
+                    "seed {seed}, cell {level} {m:?}"
+                );
+                if by_scan {
+                    mixed += 1;
+                } else {
+                    agreeing += 1;
+                }
+            }
+        }
+        // Both answers common, so the comparison could fail either way.
+        assert!(mixed > 1000 && agreeing > 1000, "{mixed} {agreeing}");
+    }
 }
