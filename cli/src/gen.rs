@@ -32,7 +32,7 @@ pub struct Args {
     /// Seed of the first case; case i uses seed + i.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Number of cases per kind.
+    /// Number of cases per kind (at most 1000000: four files each).
     #[arg(long, default_value_t = 10)]
     pub count: u64,
     /// Output directory (created if missing).
@@ -45,8 +45,18 @@ pub struct Args {
     pub ray: RayAxis,
 }
 
+/// Most cases per kind: four files each, so a million is four million files of a few
+/// kilobytes; more is a typo (a count in the hundreds of billions filled the disk).
+pub const MAX_COUNT: u64 = 1_000_000;
+
 /// Runs `gwn gen`.
 pub fn run(args: Args) -> Result<(), CliError> {
+    if args.count > MAX_COUNT {
+        return Err(CliError(format!(
+            "--count: {} cases per kind is above the limit {MAX_COUNT}",
+            args.count
+        )));
+    }
     let kinds: Vec<Kind> = if args.kind == "all" {
         Kind::ALL.to_vec()
     } else {
@@ -67,7 +77,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
         ))
     })?;
     let ray = args.ray;
-    let mut manifest = String::from("name,kind,seed,vertices,triangles,queries,undecided\n");
+    // Written as the cases are, so that its size does not grow in memory with `--count`.
+    let manifest_path = args.out.join("manifest.csv");
+    let manifest_err =
+        |e: std::io::Error| CliError(format!("{}: cannot write: {e}", manifest_path.display()));
+    let mut manifest = BufWriter::new(File::create(&manifest_path).map_err(manifest_err)?);
+    manifest
+        .write_all(b"name,kind,seed,vertices,triangles,queries,undecided\n")
+        .map_err(manifest_err)?;
     for kind in kinds {
         for i in 0..args.count {
             let seed = args.seed.wrapping_add(i);
@@ -91,19 +108,18 @@ pub fn run(args: Args) -> Result<(), CliError> {
             write(&args.out, &format!("{name}.queries.csv"), |w| {
                 export::write_queries_csv(w, &case.queries, &values)
             })?;
-            manifest.push_str(&format!(
-                "{name},{},{seed},{},{},{},{undecided}\n",
+            writeln!(
+                manifest,
+                "{name},{},{seed},{},{},{},{undecided}",
                 kind.name(),
                 case.mesh.positions().len(),
                 case.mesh.triangles().len(),
                 case.queries.len()
-            ));
+            )
+            .map_err(manifest_err)?;
         }
     }
-    write(&args.out, "manifest.csv", |w| {
-        w.write_all(manifest.as_bytes())
-    })?;
-    Ok(())
+    manifest.flush().map_err(manifest_err)
 }
 
 fn write(

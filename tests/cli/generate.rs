@@ -104,7 +104,21 @@ fn gen_output_reloads_and_reproduces_bit_for_bit() {
         .unwrap();
     assert!(!st.status.success());
     assert!(String::from_utf8_lossy(&st.stderr).contains("unknown kind"));
-    for d in [a, b, c] {
+    // An absurd count is refused before anything is written, in one line.
+    let d = temp_dir("d");
+    let st = std::process::Command::new(env!("CARGO_BIN_EXE_gwn"))
+        .args(["gen", "--kind", "all", "--count", "100000000000", "--out"])
+        .arg(&d)
+        .output()
+        .unwrap();
+    assert!(!st.status.success());
+    let stderr = String::from_utf8_lossy(&st.stderr);
+    assert_eq!(
+        stderr.trim(),
+        "gwn: --count: 100000000000 cases per kind is above the limit 1000000"
+    );
+    assert!(read_dir_sorted(&d).is_empty());
+    for d in [a, b, c, d] {
         std::fs::remove_dir_all(d).unwrap();
     }
 }
