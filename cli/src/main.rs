@@ -9,6 +9,7 @@ mod bench;
 mod classify;
 mod common;
 mod curve;
+mod dataset;
 mod eval;
 mod filter_tets;
 mod r#gen;
@@ -16,6 +17,7 @@ mod info;
 mod label;
 mod method;
 mod remesh;
+mod remesh_dataset;
 mod sdf;
 mod slice;
 mod voxelize;
@@ -57,6 +59,8 @@ enum Command {
     Label(label::Args),
     /// A closed, manifold, oriented surface of the solid w > 1/2 (marching tetrahedra, octree).
     Remesh(remesh::Args),
+    /// Remesh a dataset: one closed surface per mesh and a manifest (gwn remesh over folders).
+    RemeshDataset(remesh_dataset::Args),
     /// Signed distance on a voxel grid, signed by the winding number (inside where w > 1/2).
     Sdf(sdf::Args),
     /// Write a PNG slice of the winding-number field (the default job when no subcommand is given).
@@ -94,6 +98,7 @@ fn run(cli: Cli) -> Result<(), common::CliError> {
         Some(Command::Info(a)) => info::run(a),
         Some(Command::Label(a)) => label::run(a),
         Some(Command::Remesh(a)) => remesh::run(a),
+        Some(Command::RemeshDataset(a)) => remesh_dataset::run(a),
         Some(Command::Sdf(a)) => sdf::run(a),
         Some(Command::Slice(a)) => slice::run(a),
         Some(Command::Voxelize(a)) => voxelize::run(a),

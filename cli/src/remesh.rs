@@ -37,9 +37,6 @@ pub struct Args {
     /// Output surface: `.obj`, `.ply` (binary), `.stl` (binary) or `.glb` (binary glTF).
     #[arg(long, short)]
     pub out: PathBuf,
-    /// Bisection steps per vertex along its lattice edge.
-    #[arg(long, default_value_t = DEFAULT_BISECTION_STEPS)]
-    pub bisect: u32,
     /// Write the report as JSON here.
     #[arg(long)]
     pub report: Option<PathBuf>,
@@ -57,56 +54,8 @@ pub struct Args {
     /// surface is open; solids are left as they are. Meshes and soups only. Off by default.
     #[arg(long, value_name = "EPS")]
     pub thicken: Option<f64>,
-    /// Keep the raw marching-tetrahedra surface: no edge collapses (about 12x the faces of the
-    /// simplified surface, vertices within one tick of the class change).
-    #[arg(long)]
-    pub no_simplify: bool,
-    /// Simplification tolerance: every removed vertex stays within this many finest cells of
-    /// the simplified surface.
-    #[arg(long, default_value_t = gwn::products::remesh::simplify::DEFAULT_MAX_DISTANCE)]
-    pub simplify_distance: f64,
-    /// Stop simplifying at this fraction of a dense marching cubes' face count (0: as far as
-    /// the tolerance allows).
-    #[arg(long, default_value_t = gwn::products::remesh::simplify::DEFAULT_TARGET_FRACTION)]
-    pub simplify_target: f64,
-    /// After the target, keep collapsing where the quadric error is at most this many finest
-    /// cells (flat regions end with few faces; 0: stop at the target).
-    #[arg(long, default_value_t = gwn::products::remesh::simplify::DEFAULT_FLAT_TOLERANCE)]
-    pub simplify_flat: f64,
-    /// Largest face, in finest cells along an axis, that a collapse of a flat vertex star (all
-    /// its faces in one plane) may make, in a last flat stage; other collapses keep faces within
-    /// 6 cells. 6: no large flat faces (box-like inputs keep several times more faces, in less
-    /// time on large flat regions).
-    #[arg(long, default_value_t = gwn::products::remesh::simplify::DEFAULT_MAX_FLAT_FACE_EXTENT)]
-    pub simplify_flat_extent: u32,
-    /// Keep every simplified vertex on its marching-tetrahedra position (no move towards the
-    /// quadric minimum after the collapses).
-    #[arg(long)]
-    pub no_relocate: bool,
-    /// Relocate vertices by the planes of the marching-tetrahedra faces, not by the input
-    /// triangles' planes at the vertices placed on them.
-    #[arg(long)]
-    pub no_input_planes: bool,
-    /// Keep the lattice of --res alone: do not make the cells finer across widespread plates of
-    /// the input thinner than two cells (at most 4 times finer, all axes together; meshes and
-    /// soups only).
-    #[arg(long)]
-    pub no_plate_refinement: bool,
-    /// Levels of cells below --res (0 to 3; 0: none): a cell that an input triangle crosses
-    /// while its corners agree, with a solid of the other class just off the triangle (a part
-    /// thinner than a cell: a tip, a leg, a rib), is cut into eight, down to this many levels,
-    /// with conforming transitions (meshes and soups only).
-    #[arg(long, default_value_t = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS)]
-    pub sub_cell_levels: u32,
-    /// Levels of cells above --res (0 to 3) kept whole where the input in them is flat (within
-    /// a tenth of a cell of one plane, with an integer winding number at their corners): a flat
-    /// face costs cells by its area in cells up to 2^N times larger. At most N: a probe of the
-    /// input says how many pay (meshes and soups only).
-    #[arg(long, default_value_t = gwn::products::remesh::DEFAULT_PLANAR_LEVELS)]
-    pub planar_levels: u32,
-    /// Use all --planar-levels, whatever the flatness probe finds.
-    #[arg(long)]
-    pub no_flatness_probe: bool,
+    #[command(flatten)]
+    pub knobs: RemeshKnobs,
     #[command(flatten)]
     pub method: MethodArgs,
     #[command(flatten)]
@@ -170,28 +119,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
         Some(t) => t,
         None => &*built,
     };
-    let options = RemeshOptions {
-        resolution: args.res,
-        bisection_steps: args.bisect,
-        max_classified_points: None,
-        simplify: (!args.no_simplify).then_some(SimplifyOptions {
-            max_distance: args.simplify_distance,
-            target_fraction_of_marching_cubes: args.simplify_target,
-            relocate: !args.no_relocate,
-            input_planes: !args.no_input_planes,
-            flat_tolerance: args.simplify_flat,
-            max_flat_face_extent: args.simplify_flat_extent,
-            ..SimplifyOptions::default()
-        }),
-        refine_plates: !args.no_plate_refinement,
-        sub_cell_levels: args.sub_cell_levels,
-        planar_levels: args.planar_levels,
-        probe_flatness: !args.no_flatness_probe,
-        evaluator_crossings: !args.no_guide,
-    };
+    let options = args.knobs.options(args.res, !args.no_guide);
     // Phases: classify, extract, place, [simplify,] write, self-intersections, Hausdorff,
     // agreement.
-    let bar = crate::common::progress(if args.no_simplify { 7 } else { 8 }, "remesh");
+    let bar = crate::common::progress(if args.knobs.no_simplify { 7 } else { 8 }, "remesh");
     let start = std::time::Instant::now();
     let guide = match input.mesh() {
         // The input's own `w` is the field unless it was thickened.
@@ -408,6 +339,90 @@ pub fn run(args: Args) -> Result<(), CliError> {
             .map_err(|e| CliError(format!("{}: {e}", path.display())))?;
     }
     Ok(())
+}
+
+/// The remesher's knobs, shared by `gwn remesh` and `gwn remesh-dataset`.
+#[derive(ClapArgs, Debug)]
+pub struct RemeshKnobs {
+    /// Bisection steps per vertex along its lattice edge.
+    #[arg(long, default_value_t = DEFAULT_BISECTION_STEPS)]
+    pub bisect: u32,
+    /// Keep the raw marching-tetrahedra surface: no edge collapses (about 12x the faces of the
+    /// simplified surface, vertices within one tick of the class change).
+    #[arg(long)]
+    pub no_simplify: bool,
+    /// Simplification tolerance: every removed vertex stays within this many finest cells of
+    /// the simplified surface.
+    #[arg(long, default_value_t = gwn::products::remesh::simplify::DEFAULT_MAX_DISTANCE)]
+    pub simplify_distance: f64,
+    /// Stop simplifying at this fraction of a dense marching cubes' face count (0: as far as
+    /// the tolerance allows).
+    #[arg(long, default_value_t = gwn::products::remesh::simplify::DEFAULT_TARGET_FRACTION)]
+    pub simplify_target: f64,
+    /// After the target, keep collapsing where the quadric error is at most this many finest
+    /// cells (flat regions end with few faces; 0: stop at the target).
+    #[arg(long, default_value_t = gwn::products::remesh::simplify::DEFAULT_FLAT_TOLERANCE)]
+    pub simplify_flat: f64,
+    /// Largest face, in finest cells along an axis, that a collapse of a flat vertex star (all
+    /// its faces in one plane) may make, in a last flat stage; other collapses keep faces within
+    /// 6 cells. 6: no large flat faces (box-like inputs keep several times more faces, in less
+    /// time on large flat regions).
+    #[arg(long, default_value_t = gwn::products::remesh::simplify::DEFAULT_MAX_FLAT_FACE_EXTENT)]
+    pub simplify_flat_extent: u32,
+    /// Keep every simplified vertex on its marching-tetrahedra position (no move towards the
+    /// quadric minimum after the collapses).
+    #[arg(long)]
+    pub no_relocate: bool,
+    /// Relocate vertices by the planes of the marching-tetrahedra faces, not by the input
+    /// triangles' planes at the vertices placed on them.
+    #[arg(long)]
+    pub no_input_planes: bool,
+    /// Keep the lattice of --res alone: do not make the cells finer across widespread plates of
+    /// the input thinner than two cells (at most 4 times finer, all axes together; meshes and
+    /// soups only).
+    #[arg(long)]
+    pub no_plate_refinement: bool,
+    /// Levels of cells below --res (0 to 3; 0: none): a cell that an input triangle crosses
+    /// while its corners agree, with a solid of the other class just off the triangle (a part
+    /// thinner than a cell: a tip, a leg, a rib), is cut into eight, down to this many levels,
+    /// with conforming transitions (meshes and soups only).
+    #[arg(long, default_value_t = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS)]
+    pub sub_cell_levels: u32,
+    /// Levels of cells above --res (0 to 3) kept whole where the input in them is flat (within
+    /// a tenth of a cell of one plane, with an integer winding number at their corners): a flat
+    /// face costs cells by its area in cells up to 2^N times larger. At most N: a probe of the
+    /// input says how many pay (meshes and soups only).
+    #[arg(long, default_value_t = gwn::products::remesh::DEFAULT_PLANAR_LEVELS)]
+    pub planar_levels: u32,
+    /// Use all --planar-levels, whatever the flatness probe finds.
+    #[arg(long)]
+    pub no_flatness_probe: bool,
+}
+
+impl RemeshKnobs {
+    /// The library's options at resolution `res`; `guided`: vertices placed at the input's
+    /// crossings where two evaluations confirm them.
+    pub fn options(&self, res: usize, guided: bool) -> RemeshOptions {
+        RemeshOptions {
+            resolution: res,
+            bisection_steps: self.bisect,
+            max_classified_points: None,
+            simplify: (!self.no_simplify).then_some(SimplifyOptions {
+                max_distance: self.simplify_distance,
+                target_fraction_of_marching_cubes: self.simplify_target,
+                relocate: !self.no_relocate,
+                input_planes: !self.no_input_planes,
+                flat_tolerance: self.simplify_flat,
+                max_flat_face_extent: self.simplify_flat_extent,
+                ..SimplifyOptions::default()
+            }),
+            refine_plates: !self.no_plate_refinement,
+            sub_cell_levels: self.sub_cell_levels,
+            planar_levels: self.planar_levels,
+            probe_flatness: !self.no_flatness_probe,
+            evaluator_crossings: guided,
+        }
+    }
 }
 
 /// `bounds` grown by `d` on every side.

@@ -7,6 +7,7 @@ use std::sync::mpsc;
 use std::time::Duration;
 
 use gwn::io::LoadOptions;
+use gwn::products::dataset;
 use gwn::products::label::{self, JobOptions, SamplingOptions};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -155,22 +156,23 @@ pub fn label_file(
     })
 }
 
-/// The output of every mesh below ``root`` (relative paths, input order); ``ValueError`` naming
-/// the first two inputs that would share one.
+/// The output of every mesh below ``root`` (relative paths with ``extension`` appended, input
+/// order); ``ValueError`` naming the first two inputs that would share one.
 #[pyfunction]
-pub fn plan_outputs(paths: Vec<PathBuf>, root: PathBuf) -> PyResult<Vec<PathBuf>> {
-    label::plan_outputs(&paths, &root).map_err(value_error)
+#[pyo3(signature = (paths, root, extension = "npz"))]
+pub fn plan_outputs(paths: Vec<PathBuf>, root: PathBuf, extension: &str) -> PyResult<Vec<PathBuf>> {
+    dataset::plan_outputs(&paths, &root, extension).map_err(value_error)
 }
 
 /// Removes the temporary files a killed run left below ``out_dir``; returns how many.
 #[pyfunction]
 pub fn remove_partial_files(out_dir: PathBuf) -> PyResult<usize> {
-    label::remove_partial_files(&out_dir)
+    dataset::remove_partial_files(&out_dir)
         .map_err(|e| pyo3::exceptions::PyOSError::new_err(format!("{}: {e}", out_dir.display())))
 }
 
 /// The deepest folder holding every path (absolute): the default ``root`` of a dataset.
 #[pyfunction]
 pub fn common_root(paths: Vec<PathBuf>) -> PathBuf {
-    label::common_root(&paths)
+    dataset::common_root(&paths)
 }

@@ -20,6 +20,16 @@ pub(crate) fn json_string(s: &str) -> String {
     out
 }
 
+/// `x` as a JSON number (shortest round-trip digits), `null` when it is not finite (JSON has
+/// no NaN or infinity).
+pub(crate) fn json_number(x: f64) -> String {
+    if x.is_finite() {
+        format!("{x:?}")
+    } else {
+        "null".to_string()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::json_string;

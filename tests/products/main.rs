@@ -13,6 +13,7 @@ mod label;
 mod products;
 mod remesh;
 mod remesh_cli;
+mod remesh_dataset;
 mod remesh_levels;
 mod remesh_planar;
 mod remesh_report;

@@ -50,6 +50,7 @@
 //! ```
 
 pub mod crossings;
+pub mod dataset;
 pub mod extract;
 pub mod flatness;
 pub mod intersect;

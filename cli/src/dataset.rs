@@ -1,0 +1,113 @@
+//! What the dataset jobs (`gwn label`, `gwn remesh-dataset`) share on the command line: the
+//! inputs (files, folders walked, a list file) and the report of failed and redone meshes.
+
+use std::collections::{HashSet, VecDeque};
+use std::path::{Path, PathBuf};
+
+use clap::Args as ClapArgs;
+use gwn::products::dataset::ManifestRow;
+
+use crate::common::CliError;
+
+/// The meshes of a dataset job.
+#[derive(ClapArgs, Debug)]
+pub struct DatasetInputs {
+    /// Mesh files or folders (every .obj/.stl/.off/.ply/.gltf/.glb below, recursively, sorted).
+    pub inputs: Vec<PathBuf>,
+    /// A text file with one mesh path per line (added to INPUTS; blank lines and # comments skipped).
+    #[arg(long)]
+    pub list: Option<PathBuf>,
+    /// Outputs mirror the inputs' paths below this folder (default: the deepest folder holding
+    /// every input).
+    #[arg(long)]
+    pub root: Option<PathBuf>,
+}
+
+impl DatasetInputs {
+    /// The mesh files, folders walked in sorted order, then the list's; an error when none.
+    pub fn meshes(&self) -> Result<Vec<PathBuf>, CliError> {
+        let mut meshes = Vec::new();
+        let mut walked = HashSet::new();
+        for p in &self.inputs {
+            if p.is_dir() {
+                let mut linked = VecDeque::from([p.clone()]);
+                while let Some(dir) = linked.pop_front() {
+                    collect_meshes(&dir, &mut meshes, &mut walked, &mut linked)?;
+                }
+            } else {
+                meshes.push(p.clone());
+            }
+        }
+        if let Some(list) = &self.list {
+            let text = std::fs::read_to_string(list)
+                .map_err(|e| CliError(format!("{}: {e}", list.display())))?;
+            meshes.extend(
+                text.lines()
+                    .map(str::trim)
+                    .filter(|l| !l.is_empty() && !l.starts_with('#'))
+                    .map(PathBuf::from),
+            );
+        }
+        if meshes.is_empty() {
+            return Err(CliError::msg("no meshes given (INPUTS or --list)"));
+        }
+        Ok(meshes)
+    }
+}
+
+/// One stderr line per mesh redone (and why) and per mesh that failed or timed out.
+pub fn print_problems(command: &str, rows: &[ManifestRow]) {
+    for r in rows.iter().filter(|r| r.redone.is_some()) {
+        eprintln!(
+            "gwn {command}: redone {}: {}",
+            r.mesh.display(),
+            r.redone.as_deref().unwrap_or_default()
+        );
+    }
+    for r in rows.iter().filter(|r| r.error.is_some()) {
+        eprintln!(
+            "gwn {command}: {} {}: {}",
+            r.status.as_str(),
+            r.mesh.display(),
+            r.error.as_deref().unwrap_or_default()
+        );
+    }
+}
+
+/// Every mesh file below `dir` (known extensions), recursively, sorted; folders reached through a
+/// symlink are put on `linked` for later, so a file is named by its real path when the walk
+/// reaches it both ways. Each real folder is walked once (`walked` holds canonical paths): a link
+/// to an ancestor cannot loop, and two links to one folder do not list its files twice. Files
+/// that are not regular (FIFOs, devices) are listed too: the job makes each a failed row without
+/// opening it.
+fn collect_meshes(
+    dir: &Path,
+    out: &mut Vec<PathBuf>,
+    walked: &mut HashSet<PathBuf>,
+    linked: &mut VecDeque<PathBuf>,
+) -> Result<(), CliError> {
+    let real =
+        std::fs::canonicalize(dir).map_err(|e| CliError(format!("{}: {e}", dir.display())))?;
+    if !walked.insert(real) {
+        return Ok(());
+    }
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|e| CliError(format!("{}: {e}", dir.display())))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .collect();
+    entries.sort();
+    for p in entries {
+        if p.is_dir() {
+            if p.symlink_metadata()
+                .is_ok_and(|m| m.file_type().is_symlink())
+            {
+                linked.push_back(p);
+            } else {
+                collect_meshes(&p, out, walked, linked)?;
+            }
+        } else if gwn::io::format_from_extension(&p).is_some() {
+            out.push(p);
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,110 @@
+//! `gwn remesh-dataset`: `gwn remesh` over a dataset (one closed surface per mesh, a manifest;
+//! `gwn::products::remesh::dataset`).
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::Args as ClapArgs;
+use gwn::products::dataset::{Status, run_dataset};
+use gwn::products::remesh::dataset::RemeshJob;
+use gwn::products::remesh::write::SurfaceFormat;
+
+use crate::common::{CliError, outln, progress};
+use crate::dataset::{DatasetInputs, print_problems};
+use crate::remesh::RemeshKnobs;
+
+/// Remesh a dataset at w = 1/2: per mesh, the closed, edge- and vertex-manifold, oriented surface
+/// of `gwn remesh` (exact w, the input triangles as the guide), written to
+/// OUT/<path below the root>.FORMAT. OUT/manifest.jsonl gets one JSON line per mesh: status
+/// ok / done / failed, the error, the input's faces and vertices, the output's, whether it is
+/// valid (closed, manifold, oriented, no exact self-intersection), its components, the
+/// self-intersecting face pairs, the Hausdorff distance in finest cells to where the input bounds
+/// the solid and the occupancy agreement (both sampled; null with --samples 0), seconds.
+///
+/// Meshes run one after the other, each on every thread. Resumable as `gwn label` is: an
+/// existing output is reused only when its record (.meta.json beside it) shows the same options
+/// and input size and time; otherwise it is redone and the manifest says why. Broken files,
+/// FIFOs and devices are manifest rows; two inputs with one output are refused up front; the exit
+/// code is 0 unless the job itself cannot run. No time limit: a remesh cannot stop halfway (its
+/// memory is bounded: a mesh that needs more than the machine has is a failed row).
+///
+/// Example: gwn remesh-dataset ../shared/meshes --out closed --res 128 --samples 0
+#[derive(ClapArgs, Debug)]
+#[command(verbatim_doc_comment)]
+pub struct Args {
+    #[command(flatten)]
+    pub inputs: DatasetInputs,
+    /// Output folder.
+    #[arg(long, short, default_value = "remeshed")]
+    pub out: PathBuf,
+    /// Finest equivalent resolution per mesh (cells of edge: longest extent / res).
+    #[arg(long, default_value_t = 128)]
+    pub res: usize,
+    /// Output format: obj, ply (binary), stl (binary) or glb; the extension appended to each
+    /// input's name.
+    #[arg(long, default_value = "ply")]
+    pub format: String,
+    /// Report samples per mesh (occupancy agreement, Hausdorff distance; 0: skip both).
+    #[arg(long, default_value_t = 10_000)]
+    pub samples: usize,
+    /// Close open sheets into slabs of this half-thickness, in finest cells (at least 1): in
+    /// cells, since a dataset's meshes come at any scale. Off by default.
+    #[arg(long, value_name = "CELLS")]
+    pub thicken_cells: Option<f64>,
+    /// Do not weld STL and glTF vertices.
+    #[arg(long)]
+    pub no_weld: bool,
+    #[command(flatten)]
+    pub knobs: RemeshKnobs,
+}
+
+/// Runs `gwn remesh-dataset`.
+pub fn run(args: Args) -> Result<(), CliError> {
+    let format = SurfaceFormat::of_path(std::path::Path::new(&format!("x.{}", args.format)))
+        .ok_or_else(|| {
+            CliError::msg(format!(
+                "--format {}: expected obj, ply, stl or glb",
+                args.format
+            ))
+        })?;
+    let job = RemeshJob {
+        options: args.knobs.options(args.res, true),
+        format,
+        samples: args.samples,
+        thicken_cells: args.thicken_cells,
+        load: gwn::io::LoadOptions {
+            weld: if args.no_weld { Some(false) } else { None },
+        },
+    };
+    let meshes = args.inputs.meshes()?;
+    let pb = progress(meshes.len() as u64, "remesh");
+    let start = Instant::now();
+    let rows = run_dataset(
+        &job,
+        &meshes,
+        &args.out,
+        args.inputs.root.as_deref(),
+        |row| {
+            pb.set_message(row.mesh.display().to_string());
+            pb.inc(1);
+        },
+    )?;
+    pb.finish_and_clear();
+    let secs = start.elapsed().as_secs_f64();
+    let count = |s: Status| rows.iter().filter(|r| r.status == s).count();
+    let valid = rows
+        .iter()
+        .filter(|r| r.status != Status::Failed && r.stats.get("valid") == Some("true"))
+        .count();
+    let redone = rows.iter().filter(|r| r.redone.is_some()).count();
+    outln!(
+        "remeshed {} meshes ({} done before, {redone} redone, {} failed) in {secs:.3} s; {valid} \
+         outputs valid (closed, manifold, oriented, no self-intersection); manifest: {}",
+        count(Status::Ok),
+        count(Status::Done),
+        count(Status::Failed),
+        args.out.join("manifest.jsonl").display()
+    )?;
+    print_problems("remesh-dataset", &rows);
+    Ok(())
+}

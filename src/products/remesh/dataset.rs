@@ -1,0 +1,264 @@
+//! Remeshing a dataset: [`RemeshJob`], the [`MeshJob`] that writes one closed, manifold,
+//! oriented surface per input mesh (what [`super::remesh_guided`] makes of its exact `w`, with
+//! the input triangles as the guide) and a manifest row with its report's main numbers — the
+//! job ML pipelines run over ShapeNet or Objaverse before computing occupancy or SDF labels.
+//!
+//! Meshes run one after the other, each on every thread (a remesh is parallel inside and takes
+//! the memory it finds: two side by side could each count on all of it). Everything else —
+//! outputs mirroring the inputs' layout, atomic writes, resuming, broken files as rows — is
+//! [`crate::products::dataset`]'s.
+//!
+//! ```
+//! use gwn::products::dataset::{run_dataset, Status};
+//! use gwn::products::remesh::dataset::RemeshJob;
+//! let dir = std::env::temp_dir().join(format!("gwn-remesh-dataset-doc-{}", std::process::id()));
+//! std::fs::create_dir_all(&dir)?;
+//! let tet = dir.join("tet.obj");
+//! std::fs::write(&tet, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n")?;
+//! let job = RemeshJob { samples: 1000, ..RemeshJob::new(32) };
+//! let rows = run_dataset(&job, &[tet], &dir.join("out"), None, |_| {})?;
+//! assert_eq!(rows[0].status, Status::Ok);
+//! assert_eq!(rows[0].stats.get("valid"), Some("true"));
+//! assert!(dir.join("out/tet.obj.ply").is_file());
+//! # std::fs::remove_dir_all(&dir)?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use super::crossings::SegmentBvh;
+use super::report::{DistanceReference, RemeshReport};
+use super::thicken::ThickenedSheets;
+use super::write::{SurfaceFormat, write_surface};
+use super::{RemeshOptions, remesh_guided};
+use crate::io::{LoadOptions, load_mesh_with};
+use crate::mesh::Mesh;
+use crate::products::dataset::{MeshJob, Stats};
+use crate::products::json::json_number;
+use crate::spec::EvaluatorSpec;
+
+/// Options of the remeshing job.
+#[derive(Clone, Debug)]
+pub struct RemeshJob {
+    /// The remesher's options (resolution, simplification, levels).
+    pub options: RemeshOptions,
+    /// The outputs' format (and extension: `m.obj` → `m.obj.ply`).
+    pub format: SurfaceFormat,
+    /// Report samples per mesh ([`RemeshReport::measure`]: the occupancy agreement and the
+    /// Hausdorff distance; 0 measures neither). At most [`super::report::MAX_SAMPLES`].
+    pub samples: usize,
+    /// Close open sheets into slabs of this half-thickness in finest cells (at least 1): in
+    /// cells, not world units, since a dataset's meshes come at any scale.
+    pub thicken_cells: Option<f64>,
+    /// Loader options (welding).
+    pub load: LoadOptions,
+}
+
+impl RemeshJob {
+    /// The defaults of `gwn remesh` at `resolution`, written as binary PLY, with 10,000 report
+    /// samples.
+    pub fn new(resolution: usize) -> RemeshJob {
+        RemeshJob {
+            options: RemeshOptions::with_resolution(resolution),
+            format: SurfaceFormat::Ply,
+            samples: 10_000,
+            thicken_cells: None,
+            load: LoadOptions::default(),
+        }
+    }
+}
+
+/// Why one mesh could not be remeshed (one line; the manifest row names the mesh).
+pub type RemeshJobError = Box<dyn std::error::Error + Send + Sync>;
+
+impl MeshJob for RemeshJob {
+    type Error = RemeshJobError;
+    const RECORD: &'static str = "gwn_remesh";
+    const STATS: &'static [(&'static str, &'static str)] = &[
+        ("faces", "null"),
+        ("vertices", "null"),
+        ("output_faces", "null"),
+        ("output_vertices", "null"),
+        ("valid", "null"),
+        ("components", "null"),
+        ("self_intersections", "null"),
+        ("hausdorff_cells", "null"),
+        ("occupancy_agreement", "null"),
+    ];
+    const INPUT_STATS: &'static [&'static str] = &["faces", "vertices"];
+    const MESHES_IN_PARALLEL: bool = false;
+
+    fn extension(&self) -> &'static str {
+        match self.format {
+            SurfaceFormat::Obj => "obj",
+            SurfaceFormat::Ply => "ply",
+            SurfaceFormat::Stl => "stl",
+            SurfaceFormat::Glb => "glb",
+        }
+    }
+
+    fn option_fields(&self) -> Vec<(&'static str, String)> {
+        let o = &self.options;
+        let or_null = |v: Option<String>| v.unwrap_or_else(|| "null".into());
+        let mut fields = vec![
+            ("res", o.resolution.to_string()),
+            ("samples", self.samples.to_string()),
+            (
+                "thicken_cells",
+                or_null(self.thicken_cells.map(json_number)),
+            ),
+            ("weld", or_null(self.load.weld.map(|w| w.to_string()))),
+            ("bisection_steps", o.bisection_steps.to_string()),
+            (
+                "max_classified_points",
+                or_null(o.max_classified_points.map(|n| n.to_string())),
+            ),
+            ("refine_plates", o.refine_plates.to_string()),
+            ("sub_cell_levels", o.sub_cell_levels.to_string()),
+            ("planar_levels", o.planar_levels.to_string()),
+            ("probe_flatness", o.probe_flatness.to_string()),
+            ("evaluator_crossings", o.evaluator_crossings.to_string()),
+            ("simplify", o.simplify.is_some().to_string()),
+        ];
+        // Every simplification knob, so that a change to any of them redoes the output and
+        // the manifest names it.
+        if let Some(s) = &o.simplify {
+            fields.extend([
+                ("simplify_max_distance", json_number(s.max_distance)),
+                ("simplify_max_face_extent", s.max_face_extent.to_string()),
+                (
+                    "simplify_max_flat_face_extent",
+                    s.max_flat_face_extent.to_string(),
+                ),
+                (
+                    "simplify_target",
+                    json_number(s.target_fraction_of_marching_cubes),
+                ),
+                ("simplify_relocate", s.relocate.to_string()),
+                ("simplify_input_planes", s.input_planes.to_string()),
+                ("simplify_flat_tolerance", json_number(s.flat_tolerance)),
+                (
+                    "simplify_lattice_diagonals",
+                    s.lattice_diagonals.to_string(),
+                ),
+                (
+                    "simplify_lattice_diagonal_error",
+                    json_number(s.lattice_diagonal_error),
+                ),
+                (
+                    "simplify_lattice_cube_cells",
+                    s.lattice_cube_cells.to_string(),
+                ),
+                ("simplify_slab_cells", s.slab_cells.to_string()),
+            ]);
+        }
+        fields
+    }
+
+    fn validate(&self) -> Result<(), String> {
+        let res = self.options.resolution;
+        if res == 0 || res > super::MAX_RESOLUTION {
+            return Err(format!(
+                "resolution {res} is outside 1..={}",
+                super::MAX_RESOLUTION
+            ));
+        }
+        RemeshReport::check_samples(self.samples).map_err(|e| format!("samples: {e}"))?;
+        match self.thicken_cells {
+            Some(k) if !(k.is_finite() && k >= 1.0) => {
+                Err(format!("thicken: {k} cells: use at least one finest cell"))
+            }
+            _ => Ok(()),
+        }
+    }
+
+    fn time_limit(&self) -> Option<Duration> {
+        // A remesh cannot stop halfway; its memory is bounded instead (`RemeshError::OutOfMemory`).
+        None
+    }
+
+    fn run(
+        &self,
+        path: &Path,
+        _key: &str,
+        _deadline: Option<(Instant, Duration)>,
+        stats: &mut Stats,
+    ) -> Result<Vec<u8>, RemeshJobError> {
+        let mesh = load_mesh_with(path, &self.load)?.mesh;
+        stats.set("faces", mesh.triangles().len());
+        stats.set("vertices", mesh.positions().len());
+        let bounds = mesh.bounding_box().ok_or("the mesh has no vertices")?;
+        let wn = EvaluatorSpec::default().build_mesh(&mesh)?;
+        let extent = (0..3)
+            .map(|k| bounds.max[k] - bounds.min[k])
+            .fold(0.0, f64::max);
+        let cell = extent / self.options.resolution as f64;
+        let thick = self
+            .thicken_cells
+            .map(|k| ThickenedSheets::new(&mesh, &*wn, k * cell))
+            .transpose()?;
+        // As `gwn remesh` does: the input's own `w` is the field (the guide may screen probes
+        // by an approximation) unless it was thickened; slabs reach `eps` past the box, and the
+        // input bounds nothing of their solid.
+        let (field, guide, bounds, reference): (&dyn crate::eval::Evaluator, _, _, _) = match &thick
+        {
+            Some(t) => (
+                t,
+                SegmentBvh::of_mesh(&mesh),
+                crate::BoundingBox {
+                    min: bounds.min.map(|x| x - t.eps()),
+                    max: bounds.max.map(|x| x + t.eps()),
+                },
+                DistanceReference::Mesh(&mesh),
+            ),
+            None => (
+                &*wn,
+                SegmentBvh::of_field_mesh(&mesh),
+                bounds,
+                DistanceReference::BoundingMesh(&mesh),
+            ),
+        };
+        let mut out = remesh_guided(field, Some(&guide), bounds, &self.options, &|_| {})?;
+        let positions = std::mem::take(&mut out.positions);
+        let triangles = std::mem::take(&mut out.triangles);
+        let surface = Mesh::new(positions, triangles)?;
+        let report = RemeshReport::measure(
+            &out,
+            &surface,
+            &self.options,
+            field,
+            reference,
+            bounds,
+            self.samples,
+            &|_| {},
+        )?;
+        let mut bytes = Vec::new();
+        write_surface(&mut bytes, self.format, &surface)?;
+        let t = report.topology;
+        stats.set("output_faces", t.faces);
+        stats.set("output_vertices", t.vertices);
+        let intersections = report.self_intersections.as_ref().ok().map(|r| r.pairs);
+        let valid = t.closed && t.edge_manifold && t.vertex_manifold && t.oriented;
+        stats.set("valid", valid && intersections == Some(0));
+        stats.set("components", t.components);
+        let or_null = |v: Option<String>| v.unwrap_or_else(|| "null".into());
+        stats.set(
+            "self_intersections",
+            or_null(intersections.map(|n| n.to_string())),
+        );
+        // The distance to where the input bounds the solid (the plain one for thickened
+        // sheets), in finest cells, and the agreement: JSON numbers or null.
+        let hausdorff = report
+            .boundary_hausdorff
+            .map(|b| b.distance)
+            .or(report.hausdorff)
+            .map(|d| json_number(d / out.cell_size));
+        stats.set("hausdorff_cells", or_null(hausdorff));
+        stats.set(
+            "occupancy_agreement",
+            or_null(report.occupancy_agreement.map(json_number)),
+        );
+        Ok(bytes)
+    }
+}

@@ -1,0 +1,223 @@
+//! `gwn remesh-dataset` and `products::remesh::dataset::RemeshJob`: one closed surface per mesh,
+//! the same bytes `gwn remesh` writes, a manifest, resuming, failures as rows.
+
+use std::path::{Path, PathBuf};
+
+use gwn::products::dataset::{DatasetError, Status, run_dataset};
+use gwn::products::remesh::dataset::RemeshJob;
+
+use crate::cli::gwn;
+use crate::common::fixture;
+
+/// A fresh scratch directory for one test, removed by `Drop`.
+struct Scratch(PathBuf);
+
+impl Scratch {
+    fn new(name: &str) -> Scratch {
+        let d =
+            std::env::temp_dir().join(format!("gwn-remesh-dataset-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        Scratch(d)
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// The inputs below `dir/in`: the cube, two cubes (glb), a sub-folder with a lone open triangle
+/// (no solid: an empty surface) and a file with a NaN coordinate.
+fn inputs(dir: &Path) -> Vec<PathBuf> {
+    let input = dir.join("in");
+    std::fs::create_dir_all(input.join("sub")).unwrap();
+    for name in ["cube.off", "two_cubes.glb", "broken_nan.off"] {
+        std::fs::copy(fixture(name), input.join(name)).unwrap();
+    }
+    std::fs::write(
+        input.join("sub/triangle.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    [
+        "cube.off",
+        "two_cubes.glb",
+        "sub/triangle.obj",
+        "broken_nan.off",
+    ]
+    .iter()
+    .map(|n| input.join(n))
+    .collect()
+}
+
+#[test]
+fn remesh_dataset_writes_what_gwn_remesh_writes_and_resumes() {
+    let scratch = Scratch::new("library");
+    let dir = &scratch.0;
+    let meshes = inputs(dir);
+    let out = dir.join("out");
+    let job = RemeshJob {
+        samples: 2000,
+        ..RemeshJob::new(32)
+    };
+    let rows = run_dataset(&job, &meshes, &out, None, |_| {}).unwrap();
+    let status: Vec<Status> = rows.iter().map(|r| r.status).collect();
+    assert_eq!(
+        status,
+        [Status::Ok, Status::Ok, Status::Ok, Status::Failed],
+        "{rows:?}"
+    );
+    let stat = |i: usize, name: &str| rows[i].stats.get(name).unwrap().to_string();
+    // The cube: one closed component; two cubes: two; the lone triangle bounds nothing.
+    assert_eq!(stat(0, "faces"), "12");
+    assert_eq!(stat(0, "valid"), "true");
+    assert_eq!(stat(0, "components"), "1");
+    assert_eq!(stat(0, "self_intersections"), "0");
+    assert!(stat(0, "hausdorff_cells").parse::<f64>().unwrap() < 1.0);
+    assert!(stat(0, "occupancy_agreement").parse::<f64>().unwrap() > 0.99);
+    assert_eq!(stat(1, "components"), "2");
+    assert_eq!(stat(2, "output_faces"), "0");
+    assert_eq!(stat(2, "valid"), "true");
+    // A failure keeps nothing it did not learn, and says why in one line.
+    assert_eq!(stat(3, "faces"), "null");
+    let error = rows[3].error.as_deref().unwrap();
+    assert!(
+        error.contains("broken_nan.off") && error.contains("NaN"),
+        "{error}"
+    );
+    // The outputs mirror the inputs, and are the bytes `gwn remesh` writes at the same options
+    // (the job's defaults are the CLI's).
+    let ply = out.join("cube.off.ply");
+    let single = dir.join("single.ply");
+    let (ok, _, err) = gwn(&[
+        "remesh",
+        fixture("cube.off").to_str().unwrap(),
+        "--res",
+        "32",
+        "--samples",
+        "0",
+        "--out",
+        single.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert_eq!(
+        std::fs::read(&ply).unwrap(),
+        std::fs::read(&single).unwrap()
+    );
+    assert!(out.join("sub/triangle.obj.ply").is_file());
+    assert!(!out.join("broken_nan.off.ply").exists());
+    let manifest = std::fs::read_to_string(out.join("manifest.jsonl")).unwrap();
+    assert_eq!(manifest.lines().count(), 4);
+    assert!(manifest.lines().next().unwrap().contains("\"valid\":true"));
+
+    // Again: done, with the statistics of the run that made each file.
+    let again = run_dataset(&job, &meshes, &out, None, |_| {}).unwrap();
+    for (a, b) in rows.iter().zip(&again) {
+        if a.status == Status::Ok {
+            assert_eq!(b.status, Status::Done, "{b:?}");
+            assert_eq!(a.stats, b.stats);
+        } else {
+            assert_eq!(b.status, Status::Failed);
+        }
+    }
+    // Another resolution redoes them, and says so.
+    let coarser = RemeshJob {
+        samples: 2000,
+        ..RemeshJob::new(24)
+    };
+    let redone = run_dataset(&coarser, &meshes[..1], &out, None, |_| {}).unwrap();
+    assert_eq!(redone[0].status, Status::Ok);
+    assert_eq!(
+        redone[0].redone.as_deref(),
+        Some("options changed: res 32 -> 24")
+    );
+    assert_ne!(
+        std::fs::read(&ply).unwrap(),
+        std::fs::read(&single).unwrap()
+    );
+
+    // One file twice: refused before anything is written.
+    let twice = [meshes[0].clone(), meshes[0].clone()];
+    let fresh = dir.join("twice");
+    let err = run_dataset(&job, &twice, &fresh, None, |_| {}).unwrap_err();
+    assert!(matches!(err, DatasetError::Collision { .. }), "{err}");
+    assert!(!fresh.exists());
+    // Unusable options: refused up front.
+    let bad = RemeshJob {
+        thicken_cells: Some(0.5),
+        ..RemeshJob::new(32)
+    };
+    let err = run_dataset(&bad, &meshes, &fresh, None, |_| {}).unwrap_err();
+    assert!(
+        err.to_string().contains("at least one finest cell"),
+        "{err}"
+    );
+}
+
+#[test]
+fn remesh_dataset_cli() {
+    let scratch = Scratch::new("cli");
+    let dir = &scratch.0;
+    inputs(dir);
+    let out = dir.join("out");
+    let args = |extra: &[&str]| -> Vec<String> {
+        let mut a: Vec<String> = [
+            "remesh-dataset",
+            dir.join("in").to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--res",
+            "24",
+            "--samples",
+            "0",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        a.extend(extra.iter().map(|s| s.to_string()));
+        a
+    };
+    let run = |extra: &[&str]| {
+        let a = args(extra);
+        gwn(&a.iter().map(String::as_str).collect::<Vec<_>>())
+    };
+    // A failed mesh is a row and a stderr line; the job itself succeeds.
+    let (ok, stdout, stderr) = run(&["--format", "obj"]);
+    assert!(ok, "{stderr}");
+    assert!(
+        stdout.contains("remeshed 3 meshes (0 done before, 0 redone, 1 failed)"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("3 outputs valid"), "{stdout}");
+    assert!(
+        stderr.contains("gwn remesh-dataset: failed") && stderr.contains("broken_nan.off"),
+        "{stderr}"
+    );
+    let cube = gwn::io::load_mesh(out.join("cube.off.obj")).unwrap().mesh;
+    assert!(!cube.triangles().is_empty());
+    // The same run again: nothing to do; a knob changed: redone, and named.
+    let (ok, stdout, _) = run(&["--format", "obj"]);
+    assert!(
+        ok && stdout.contains("remeshed 0 meshes (3 done before"),
+        "{stdout}"
+    );
+    let (ok, _, stderr) = run(&["--format", "obj", "--no-relocate"]);
+    assert!(ok);
+    assert!(
+        stderr.contains("options changed: simplify_relocate true -> false"),
+        "{stderr}"
+    );
+    // Bad options: one line, non-zero.
+    let (ok, _, stderr) = run(&["--format", "step"]);
+    assert!(!ok);
+    assert_eq!(
+        stderr.trim(),
+        "gwn: --format step: expected obj, ply, stl or glb"
+    );
+    let (ok, _, stderr) = run(&["--thicken-cells", "0"]);
+    assert!(!ok);
+    assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
+    assert!(stderr.contains("at least one finest cell"), "{stderr}");
+}
