@@ -55,6 +55,7 @@ __all__ = [
     "load_polygon",
     "load_tets",
     "remesh",
+    "remesh_dataset",
     "sdf",
     "signed_distance",
     "slice",
@@ -66,21 +67,21 @@ __all__ = [
 class _ProgressBar:
     """A one-line text bar on stderr: ``label [=====     ] 3/10 path``, redrawn per mesh."""
 
-    def __init__(self, total, stream):
-        self.total, self.done, self.stream = total, 0, stream
+    def __init__(self, total, stream, name="label"):
+        self.total, self.done, self.stream, self.name = total, 0, stream, name
 
     def __call__(self, row):
         self.done += 1
         width = 30
         filled = width * self.done // max(self.total, 1)
-        self.stream.write("\rlabel [%s%s] %d/%d %s\x1b[K" % (
-            "=" * filled, " " * (width - filled), self.done, self.total, row["mesh"]))
+        self.stream.write("\r%s [%s%s] %d/%d %s\x1b[K" % (
+            self.name, "=" * filled, " " * (width - filled), self.done, self.total, row["mesh"]))
         if self.done == self.total:
             self.stream.write("\n")
         self.stream.flush()
 
 
-def _progress_callback(progress, total):
+def _progress_callback(progress, total, name="label"):
     """``progress`` as a function of one row (dict), or None: a callable is used as is,
     ``True`` draws a bar on stderr, ``None`` draws it only when stderr is a terminal, ``False``
     draws nothing."""
@@ -92,7 +93,7 @@ def _progress_callback(progress, total):
         stream = sys.stderr
         progress = stream is not None and hasattr(stream, "isatty") and stream.isatty()
     if progress is True:
-        return _ProgressBar(total, sys.stderr)
+        return _ProgressBar(total, sys.stderr, name)
     if progress is False:
         return None
     raise TypeError("progress must be None, True, False or a callable taking a row dict, got %r"
@@ -134,3 +135,50 @@ def label_dataset(paths, out_dir, *, root=None, uniform=50_000, near=50_000,
         threads=threads,
         progress=None if callback is None else (lambda line: callback(_json.loads(line))))
     return [_json.loads(r) for r in rows]
+
+
+def remesh_dataset(paths, out_dir, res=128, *, root=None, format="ply", samples=10_000,
+                   thicken_cells=None, weld=None, bisect=None, simplify=True, refine_plates=True,
+                   sub_cell_levels=None, planar_levels=None, threads=None, progress=None):
+    """Remeshes a dataset of meshes at w = 1/2, exactly as ``gwn remesh-dataset`` does.
+
+    Per mesh: the closed, edge- and vertex-manifold, oriented surface ``gwn.remesh`` makes at
+    ``res`` (exact w, the input triangles as the guide; the same bytes ``gwn remesh`` writes),
+    written to ``out_dir/<path below root>.<format>`` (``obj``, ``ply``, ``stl`` or ``glb``), and
+    ``out_dir/manifest.jsonl``. ``samples`` report samples per mesh measure the Hausdorff
+    distance and the occupancy agreement (0: neither); ``thicken_cells`` closes open sheets into
+    slabs of that half-thickness in finest cells. Meshes run one after the other, each on
+    ``threads`` threads (default: all cores), with the GIL released. Resumable (an existing
+    output is reused only when it was made with the same options from the same input, else
+    redone and ``redone`` says why); broken files and FIFOs are manifest rows; two inputs with
+    one output are a ``ValueError`` before anything is written. ``sub_cell_levels`` and
+    ``planar_levels`` and ``bisect``: ``None`` for ``gwn remesh``'s defaults.
+
+    ``progress`` as in ``gwn.label_dataset``. Returns the manifest rows (dicts with ``mesh``,
+    ``output``, ``status`` in ``ok``/``done``/``failed``, ``error``, ``faces``, ``vertices``,
+    ``output_faces``, ``output_vertices``, ``valid`` (closed, manifold, oriented, no exact
+    self-intersection), ``components``, ``self_intersections``, ``hausdorff_cells``,
+    ``occupancy_agreement``, ``seconds``, ``redone``), in input order. For a cluster, see
+    ``gwn.dask.remesh_dataset``.
+    """
+    from . import _gwn
+
+    paths = [_os.fspath(p) for p in paths]
+    callback = _progress_callback(progress, len(paths), "remesh")
+    rows = _gwn.remesh_dataset(
+        paths, _os.fspath(out_dir), res,
+        root=None if root is None else _os.fspath(root), **_remesh_job_options(
+            format=format, samples=samples, thicken_cells=thicken_cells, weld=weld,
+            bisect=bisect, simplify=simplify, refine_plates=refine_plates,
+            sub_cell_levels=sub_cell_levels, planar_levels=planar_levels),
+        threads=threads,
+        progress=None if callback is None else (lambda line: callback(_json.loads(line))))
+    return [_json.loads(r) for r in rows]
+
+
+def _remesh_job_options(**options):
+    """The keyword arguments of ``_gwn.remesh_dataset``/``remesh_file``: ``None`` bisection
+    steps and levels left out, so the library's defaults apply."""
+    return {k: v for k, v in options.items()
+            if v is not None or k not in ("bisect", "sub_cell_levels", "planar_levels")}
+

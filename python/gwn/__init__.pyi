@@ -353,3 +353,25 @@ def label_dataset(
     manifest.jsonl in out_dir, like `gwn label`; returns the manifest rows in input order.
     progress: None = a bar on stderr when it is a terminal, True/False = always/never, or a
     callable given each finished row."""
+
+def remesh_dataset(
+    paths: Sequence[_Path],
+    out_dir: _Path,
+    res: int = 128,
+    *,
+    root: Optional[_Path] = None,
+    format: str = "ply",
+    samples: int = 10_000,
+    thicken_cells: Optional[float] = None,
+    weld: Optional[bool] = None,
+    bisect: Optional[int] = None,
+    simplify: bool = True,
+    refine_plates: bool = True,
+    sub_cell_levels: Optional[int] = None,
+    planar_levels: Optional[int] = None,
+    threads: Optional[int] = None,
+    progress: Union[None, bool, Callable[[dict], Any]] = None,
+) -> list[dict]:
+    """Remeshes meshes at w = 1/2 (closed, manifold, oriented surfaces), one file per mesh and
+    manifest.jsonl in out_dir, like `gwn remesh-dataset`; returns the manifest rows in input
+    order. progress as in label_dataset."""

@@ -1,4 +1,5 @@
-"""Dataset labelling on a Dask cluster: one task per mesh, same files as the serial job.
+"""Dataset jobs on a Dask cluster (labelling, remeshing): one task per mesh, same files as the
+serial job.
 
 ``label_dataset(paths, out_dir, client=...)`` maps ``gwn._gwn.label_file`` over the meshes on a
 ``dask.distributed`` client, then writes ``out_dir/manifest.jsonl`` (input order) from the rows the
@@ -30,6 +31,15 @@ def label_dataset(paths, out_dir, client=None, *, root=None, uniform=50_000, nea
 
     Returns the manifest rows (dicts) in input order, after writing ``manifest.jsonl``.
     """
+    options = dict(uniform=uniform, near=near, sigmas=list(sigmas), padding=padding, seed=seed,
+                   time_limit=time_limit, weld=weld, threads=threads_per_task)
+    return _run(_label_one, paths, out_dir, client, root, "npz", progress, "label",
+                options=options)
+
+
+def _run(task, paths, out_dir, client, root, extension, progress, name, **task_args):
+    """Maps ``task(path, out_dir=..., root=..., **task_args)`` over ``paths`` on the client and
+    writes ``manifest.jsonl`` (input order) from the rows the tasks return."""
     from dask.distributed import as_completed, default_client
 
     from . import _progress_callback
@@ -39,14 +49,11 @@ def label_dataset(paths, out_dir, client=None, *, root=None, uniform=50_000, nea
     out_dir = os.path.abspath(os.fspath(out_dir))
     root = os.fspath(root) if root is not None else os.fspath(_gwn.common_root(paths))
     # Checked here, once, before any task runs: two meshes must not share an output.
-    _gwn.plan_outputs(paths, root)
-    options = dict(uniform=uniform, near=near, sigmas=list(sigmas), padding=padding, seed=seed,
-                   time_limit=time_limit, weld=weld, threads=threads_per_task)
+    _gwn.plan_outputs(paths, root, extension)
     os.makedirs(out_dir, exist_ok=True)
     _gwn.remove_partial_files(out_dir)
-    futures = client.map(_label_one, paths, out_dir=out_dir, root=root, options=options,
-                         pure=False)
-    callback = _progress_callback(progress, len(paths))
+    futures = client.map(task, paths, out_dir=out_dir, root=root, pure=False, **task_args)
+    callback = _progress_callback(progress, len(paths), name)
     if callback is not None:
         for future in as_completed(futures):
             callback(json.loads(future.result()))
@@ -59,3 +66,32 @@ def label_dataset(paths, out_dir, client=None, *, root=None, uniform=50_000, nea
             f.write(line + "\n")
     os.replace(tmp, manifest)
     return [json.loads(line) for line in lines]
+
+
+def _remesh_one(path, out_dir, root, res, options):
+    return _gwn.remesh_file(path, out_dir, root, res, **options)
+
+
+def remesh_dataset(paths, out_dir, client=None, res=128, *, root=None, format="ply",
+                   samples=10_000, thicken_cells=None, weld=None, bisect=None, simplify=True,
+                   refine_plates=True, sub_cell_levels=None, planar_levels=None,
+                   threads_per_task=1, progress=None):
+    """Remeshes ``paths`` into ``out_dir`` on a Dask cluster (``client``: a
+    ``dask.distributed.Client``; default: the current one), one task per mesh. Options and
+    ``progress`` as in ``gwn.remesh_dataset``; ``threads_per_task`` is the Rust thread count
+    inside each task. Each remesh sizes its memory limit by the memory its machine has free when
+    it starts: give a worker's tasks room (fewer worker threads, more ``threads_per_task``) on
+    large meshes or high ``res``. Outputs byte-identical to ``gwn.remesh_dataset``.
+
+    Returns the manifest rows (dicts) in input order, after writing ``manifest.jsonl``.
+    """
+    from . import _remesh_job_options
+
+    options = _remesh_job_options(
+        format=format, samples=samples, thicken_cells=thicken_cells, weld=weld, bisect=bisect,
+        simplify=simplify, refine_plates=refine_plates, sub_cell_levels=sub_cell_levels,
+        planar_levels=planar_levels)
+    options["threads"] = threads_per_task
+    return _run(_remesh_one, paths, out_dir, client, root, format.lower(), progress, "remesh",
+                res=res, options=options)
+

@@ -21,3 +21,25 @@ def label_dataset(
 ) -> list[dict]:
     """gwn.label_dataset with one Dask task per mesh on `client` (default: the current client);
     byte-identical outputs."""
+
+def remesh_dataset(
+    paths: Sequence[_Path],
+    out_dir: _Path,
+    client: Optional[Any] = None,
+    res: int = 128,
+    *,
+    root: Optional[_Path] = None,
+    format: str = "ply",
+    samples: int = 10_000,
+    thicken_cells: Optional[float] = None,
+    weld: Optional[bool] = None,
+    bisect: Optional[int] = None,
+    simplify: bool = True,
+    refine_plates: bool = True,
+    sub_cell_levels: Optional[int] = None,
+    planar_levels: Optional[int] = None,
+    threads_per_task: int = 1,
+    progress: Union[None, bool, Callable[[dict], Any]] = None,
+) -> list[dict]:
+    """gwn.remesh_dataset with one Dask task per mesh on `client` (default: the current client);
+    byte-identical outputs."""

@@ -7,9 +7,9 @@
 
 mod arrays;
 mod curve;
+mod dataset;
 mod errors;
 mod evaluator;
-mod label;
 mod loaders;
 mod oneshot;
 mod products;
@@ -33,11 +33,13 @@ fn _gwn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(products::filter_tets, m)?)?;
     m.add_function(wrap_pyfunction!(products::remesh, m)?)?;
     m.add_function(wrap_pyfunction!(curve::gauwn, m)?)?;
-    m.add_function(wrap_pyfunction!(label::label_dataset, m)?)?;
-    m.add_function(wrap_pyfunction!(label::label_file, m)?)?;
-    m.add_function(wrap_pyfunction!(label::common_root, m)?)?;
-    m.add_function(wrap_pyfunction!(label::plan_outputs, m)?)?;
-    m.add_function(wrap_pyfunction!(label::remove_partial_files, m)?)?;
+    m.add_function(wrap_pyfunction!(dataset::label_dataset, m)?)?;
+    m.add_function(wrap_pyfunction!(dataset::label_file, m)?)?;
+    m.add_function(wrap_pyfunction!(dataset::remesh_dataset, m)?)?;
+    m.add_function(wrap_pyfunction!(dataset::remesh_file, m)?)?;
+    m.add_function(wrap_pyfunction!(dataset::common_root, m)?)?;
+    m.add_function(wrap_pyfunction!(dataset::plan_outputs, m)?)?;
+    m.add_function(wrap_pyfunction!(dataset::remove_partial_files, m)?)?;
     m.add_function(wrap_pyfunction!(loaders::load, m)?)?;
     m.add_function(wrap_pyfunction!(loaders::load_point_cloud, m)?)?;
     m.add_function(wrap_pyfunction!(loaders::load_points, m)?)?;

@@ -1,14 +1,17 @@
-//! Dataset labelling: `label_dataset` (the whole job, rayon over meshes) and `label_file` (one
-//! mesh, the unit of a Dask task). Both call `gwn::products::label`, so the `.npz` files are the
-//! CLI's, byte for byte, and rows come back as the manifest's JSON lines.
+//! Dataset jobs: labelling (`label_dataset`, the whole job, and `label_file`, one mesh: the unit
+//! of a Dask task) and remeshing (`remesh_dataset`, `remesh_file`). All run the library's
+//! `gwn::products::dataset` jobs, so the files are the CLI's, byte for byte, and rows come back
+//! as the manifest's JSON lines.
 
 use std::path::PathBuf;
 use std::sync::mpsc;
 use std::time::Duration;
 
 use gwn::io::LoadOptions;
-use gwn::products::dataset;
-use gwn::products::label::{self, JobOptions, SamplingOptions};
+use gwn::products::dataset::{self, MeshJob};
+use gwn::products::label::{JobOptions, SamplingOptions};
+use gwn::products::remesh::dataset::RemeshJob;
+use gwn::products::remesh::write::SurfaceFormat;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
@@ -79,22 +82,36 @@ pub fn label_dataset(
     progress: Option<PyObject>,
 ) -> PyResult<Vec<String>> {
     let opts = job_options(uniform, near, sigmas, padding, seed, time_limit, weld)?;
+    run_job(py, opts, paths, out_dir, root, threads, progress)
+}
+
+/// Runs `job` over `paths` ([`dataset::run_dataset`]) on `threads`, the GIL released: the rows
+/// as JSON strings in input order. With `progress`, the job runs on its own thread and this one
+/// waits without the GIL, taking it only to hand each finished row to `progress`, so the
+/// callback runs on the caller's thread; an exception it raises is re-raised after the job.
+fn run_job<J: MeshJob + Send>(
+    py: Python<'_>,
+    job: J,
+    paths: Vec<PathBuf>,
+    out_dir: PathBuf,
+    root: Option<PathBuf>,
+    threads: Option<Threads>,
+    progress: Option<PyObject>,
+) -> PyResult<Vec<String>> {
     let Some(progress) = progress else {
         let rows = threads::run(py, threads, move || {
-            label::label_dataset(&paths, &out_dir, root.as_deref(), &opts, |_| {})
+            dataset::run_dataset(&job, &paths, &out_dir, root.as_deref(), |_| {})
         })?
         .map_err(value_error)?;
         return Ok(rows.iter().map(|r| r.to_json()).collect());
     };
-    // The job runs on its own thread; this thread waits without the GIL and takes it only to
-    // hand each finished row to `progress`, so the callback runs on the caller's thread.
     let pool = threads::pool_for(threads)?;
     let (tx, rx) = mpsc::channel::<String>();
     let (rows, callback_error) = py.allow_threads(move || {
         std::thread::scope(|scope| {
             let job = scope.spawn(move || {
                 let run = || {
-                    label::label_dataset(&paths, &out_dir, root.as_deref(), &opts, |row| {
+                    dataset::run_dataset(&job, &paths, &out_dir, root.as_deref(), |row| {
                         // The receiver outlives the job, so a send cannot fail.
                         let _ = tx.send(row.to_json());
                     })
@@ -117,7 +134,7 @@ pub fn label_dataset(
         Ok(r) => r.map_err(value_error)?,
         Err(_) => {
             return Err(pyo3::exceptions::PyRuntimeError::new_err(
-                "the labelling job panicked",
+                "the dataset job panicked",
             ));
         }
     };
@@ -152,7 +169,132 @@ pub fn label_file(
     let opts = job_options(uniform, near, sigmas, padding, seed, time_limit, weld)?;
     let root = std::path::absolute(&root).unwrap_or(root);
     threads::run(py, threads, move || {
-        label::label_file(&path, &root, &out_dir, &opts).to_json()
+        dataset::run_file(&opts, &path, &root, &out_dir).to_json()
+    })
+}
+
+#[allow(clippy::too_many_arguments)]
+fn remesh_job(
+    res: usize,
+    format: &str,
+    samples: usize,
+    thicken_cells: Option<f64>,
+    weld: Option<bool>,
+    bisect: u32,
+    simplify: bool,
+    refine_plates: bool,
+    sub_cell_levels: u32,
+    planar_levels: u32,
+) -> PyResult<RemeshJob> {
+    let format =
+        SurfaceFormat::of_path(std::path::Path::new(&format!("x.{format}"))).ok_or_else(|| {
+            PyValueError::new_err(format!("format={format:?}: expected obj, ply, stl or glb"))
+        })?;
+    let mut job = RemeshJob::new(res);
+    job.format = format;
+    job.samples = samples;
+    job.thicken_cells = thicken_cells;
+    job.load = LoadOptions { weld };
+    job.options.bisection_steps = bisect;
+    if !simplify {
+        job.options.simplify = None;
+    }
+    job.options.refine_plates = refine_plates;
+    job.options.sub_cell_levels = sub_cell_levels;
+    job.options.planar_levels = planar_levels;
+    job.validate().map_err(PyValueError::new_err)?;
+    Ok(job)
+}
+
+/// Remeshes every mesh of ``paths`` into ``out_dir`` (see ``gwn remesh-dataset --help``): per
+/// mesh, the closed, manifold, oriented surface ``gwn.remesh`` makes at ``res`` (the same bytes
+/// ``gwn remesh`` writes), at ``out_dir/<path below root>.<format>``, and
+/// ``out_dir/manifest.jsonl``. Meshes run one after the other, each on ``threads``. Resumable
+/// and failure-isolated as ``label_dataset``. Returns the manifest rows as JSON strings, in input
+/// order; ``progress`` as in ``label_dataset``.
+#[pyfunction]
+#[pyo3(signature = (paths, out_dir, res = 128, *, root = None, format = "ply", samples = 10_000,
+    thicken_cells = None, weld = None, bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS,
+    simplify = true, refine_plates = true,
+    sub_cell_levels = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS,
+    planar_levels = gwn::products::remesh::DEFAULT_PLANAR_LEVELS, threads = None,
+    progress = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn remesh_dataset(
+    py: Python<'_>,
+    paths: Vec<PathBuf>,
+    out_dir: PathBuf,
+    res: usize,
+    root: Option<PathBuf>,
+    format: &str,
+    samples: usize,
+    thicken_cells: Option<f64>,
+    weld: Option<bool>,
+    bisect: u32,
+    simplify: bool,
+    refine_plates: bool,
+    sub_cell_levels: u32,
+    planar_levels: u32,
+    threads: Option<Threads>,
+    progress: Option<PyObject>,
+) -> PyResult<Vec<String>> {
+    let job = remesh_job(
+        res,
+        format,
+        samples,
+        thicken_cells,
+        weld,
+        bisect,
+        simplify,
+        refine_plates,
+        sub_cell_levels,
+        planar_levels,
+    )?;
+    run_job(py, job, paths, out_dir, root, threads, progress)
+}
+
+/// Remeshes one mesh into ``out_dir`` (reused when its record shows the same options and
+/// input, else redone) and returns its manifest row as a JSON string: the unit of a Dask task.
+/// ``root`` must be the same for every mesh of a dataset (see ``common_root``).
+#[pyfunction]
+#[pyo3(signature = (path, out_dir, root, res = 128, *, format = "ply", samples = 10_000,
+    thicken_cells = None, weld = None, bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS,
+    simplify = true, refine_plates = true,
+    sub_cell_levels = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS,
+    planar_levels = gwn::products::remesh::DEFAULT_PLANAR_LEVELS, threads = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn remesh_file(
+    py: Python<'_>,
+    path: PathBuf,
+    out_dir: PathBuf,
+    root: PathBuf,
+    res: usize,
+    format: &str,
+    samples: usize,
+    thicken_cells: Option<f64>,
+    weld: Option<bool>,
+    bisect: u32,
+    simplify: bool,
+    refine_plates: bool,
+    sub_cell_levels: u32,
+    planar_levels: u32,
+    threads: Option<Threads>,
+) -> PyResult<String> {
+    let job = remesh_job(
+        res,
+        format,
+        samples,
+        thicken_cells,
+        weld,
+        bisect,
+        simplify,
+        refine_plates,
+        sub_cell_levels,
+        planar_levels,
+    )?;
+    let root = std::path::absolute(&root).unwrap_or(root);
+    threads::run(py, threads, move || {
+        dataset::run_file(&job, &path, &root, &out_dir).to_json()
     })
 }
 

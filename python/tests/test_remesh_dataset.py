@@ -1,0 +1,112 @@
+"""Dataset remeshing from Python: the Rust job's files bit for bit (gwn.remesh of the loaded
+mesh, the CLI's `gwn remesh-dataset`, gwn.dask.remesh_dataset on a real 2-worker LocalCluster),
+resuming, failures as rows."""
+
+import json
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+
+import gwn
+from conftest import FIXTURES
+
+OPTS = dict(samples=1000)
+
+
+def make_dataset(tmp_path):
+    files = {"a/cube.off": "cube.off", "b/scene.glb": "two_cubes.glb",
+             "b/broken.off": "broken_index.off"}
+    paths = []
+    for to, src in files.items():
+        p = tmp_path / "in" / to
+        p.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy(FIXTURES / src, p)
+        paths.append(p)
+    return paths
+
+
+def surfaces(d):
+    return {p.relative_to(d).as_posix(): p.read_bytes() for p in sorted(d.rglob("*.ply"))}
+
+
+def test_remesh_dataset_rows_outputs_and_resume(tmp_path, cli):
+    paths = make_dataset(tmp_path)
+    seen = []
+    rows = gwn.remesh_dataset(paths, tmp_path / "out", 24, **OPTS, threads=2,
+                              progress=seen.append)
+    assert [r["status"] for r in rows] == ["ok", "ok", "failed"]
+    assert sorted(r["mesh"] for r in seen) == sorted(r["mesh"] for r in rows)
+    cube, scene, broken = rows
+    assert cube["output"] == "a/cube.off.ply" and cube["faces"] == 12
+    assert cube["valid"] is True and cube["components"] == 1
+    assert cube["self_intersections"] == 0
+    assert cube["hausdorff_cells"] < 1 and cube["occupancy_agreement"] > 0.99
+    assert scene["components"] == 2
+    assert "broken.off" in broken["error"] and broken["output_faces"] is None
+    # The file is what gwn.remesh makes of the loaded mesh.
+    V, F = gwn.load(tmp_path / "out" / "a" / "cube.off.ply")
+    Vr, Fr = gwn.remesh(*gwn.load(paths[0]), res=24)
+    np.testing.assert_array_equal(F, Fr)
+    np.testing.assert_array_equal(V, Vr)  # the PLY holds float64
+    assert cube["output_faces"] == len(F) and cube["output_vertices"] == len(V)
+    # The CLI writes the same files and the same rows (but for seconds and paths' spelling).
+    subprocess.run([str(cli), "remesh-dataset", str(tmp_path / "in"), "--out",
+                    str(tmp_path / "cli"), "--res", "24", "--samples", "1000"], check=True,
+                   capture_output=True)
+    assert surfaces(tmp_path / "cli") == surfaces(tmp_path / "out")
+    manifest = [json.loads(l) for l in
+                (tmp_path / "cli" / "manifest.jsonl").read_text().splitlines()]
+    by_output = {r["output"]: r for r in manifest}
+    for r in rows:
+        c = by_output[r["output"]]
+        for key in ("status", "faces", "output_faces", "valid", "hausdorff_cells",
+                    "occupancy_agreement"):
+            assert c[key] == r[key], key
+    # Again: nothing to do; another option: redone, and named.
+    again = gwn.remesh_dataset(paths, tmp_path / "out", 24, **OPTS)
+    assert [r["status"] for r in again] == ["done", "done", "failed"]
+    assert again[0]["output_faces"] == cube["output_faces"]
+    redone = gwn.remesh_dataset(paths[:1], tmp_path / "out", 24, samples=0,
+                                root=tmp_path / "in")
+    assert redone[0]["status"] == "ok"
+    assert redone[0]["redone"] == "options changed: samples 1000 -> 0"
+    assert redone[0]["hausdorff_cells"] is None
+
+
+def test_remesh_dataset_bad_arguments_are_value_errors(tmp_path):
+    paths = make_dataset(tmp_path)
+    with pytest.raises(ValueError, match="expected obj, ply, stl or glb"):
+        gwn.remesh_dataset(paths, tmp_path / "o", format="step")
+    with pytest.raises(ValueError, match="at least one finest cell"):
+        gwn.remesh_dataset(paths, tmp_path / "o", thicken_cells=0.5)
+    with pytest.raises(ValueError, match="both be written"):
+        gwn.remesh_dataset([paths[0], paths[0]], tmp_path / "o")
+    assert not (tmp_path / "o").exists()
+
+
+def test_dask_remesh_matches_serial(tmp_path):
+    try:
+        from dask.distributed import Client, LocalCluster
+    except ImportError:
+        print("skipping: dask.distributed is not installed")
+        pytest.skip("dask.distributed is not installed")
+    import gwn.dask
+
+    paths = make_dataset(tmp_path)
+    serial = gwn.remesh_dataset(paths, tmp_path / "serial", 24, **OPTS, format="obj")
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                      dashboard_address=None) as cluster, Client(cluster) as client:
+        rows = gwn.dask.remesh_dataset(paths, tmp_path / "dask", client, 24, **OPTS,
+                                       format="obj")
+        with pytest.raises(ValueError, match="both be written"):
+            gwn.dask.remesh_dataset([paths[0], paths[0]], tmp_path / "twice", client)
+        assert not (tmp_path / "twice").exists()
+    assert [r["status"] for r in rows] == [r["status"] for r in serial]
+    assert [r["output"] for r in rows] == [r["output"] for r in serial]
+    objs = lambda d: {p.relative_to(d).as_posix(): p.read_bytes() for p in d.rglob("*.obj")}
+    assert objs(tmp_path / "dask") == objs(tmp_path / "serial")
+    assert len(objs(tmp_path / "dask")) == 2
+    manifest = (tmp_path / "dask" / "manifest.jsonl").read_text().splitlines()
+    assert [json.loads(l)["output"] for l in manifest] == [r["output"] for r in serial]
