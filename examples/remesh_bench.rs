@@ -73,8 +73,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 &lattice,
                 if guided { Some(&guide) } else { None },
                 usize::MAX,
+                None,
             )
-            .ok_or("too large")?;
+            .map_err(|_| "too large")?;
             let t1 = Instant::now();
             let band = extract::extract(&lattice, &classified);
             let t2 = Instant::now();

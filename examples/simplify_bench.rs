@@ -41,7 +41,7 @@ fn build(mesh_path: &PathBuf, res: usize) -> Result<Surface, Box<dyn std::error:
     let lattice = Lattice::new(bounds, res).ok_or("bad bounds")?;
     let guide = crossings::SegmentBvh::of_mesh(&mesh);
     let classified =
-        octree::classify(&wn, &lattice, Some(&guide), usize::MAX).ok_or("too large")?;
+        octree::classify(&wn, &lattice, Some(&guide), usize::MAX, None).map_err(|_| "too large")?;
     let band = extract::extract(&lattice, &classified);
     let placed = place::place_vertices(
         &wn,

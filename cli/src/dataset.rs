@@ -3,6 +3,7 @@
 
 use std::collections::{HashSet, VecDeque};
 use std::path::{Path, PathBuf};
+use std::time::Duration;
 
 use clap::Args as ClapArgs;
 use gwn::products::dataset::ManifestRow;
@@ -52,6 +53,17 @@ impl DatasetInputs {
             return Err(CliError::msg("no meshes given (INPUTS or --list)"));
         }
         Ok(meshes)
+    }
+}
+
+/// `--time-limit SECONDS` as a duration: positive and finite (below 10⁹ s).
+pub fn time_limit(seconds: Option<f64>) -> Result<Option<Duration>, CliError> {
+    match seconds {
+        Some(s) if s.is_finite() && s > 0.0 && s < 1e9 => Ok(Some(Duration::from_secs_f64(s))),
+        Some(s) => Err(CliError(format!(
+            "--time-limit {s}: expected a positive number of seconds"
+        ))),
+        None => Ok(None),
     }
 }
 

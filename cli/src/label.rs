@@ -2,14 +2,14 @@
 //! mesh, a manifest).
 
 use std::path::PathBuf;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use clap::Args as ClapArgs;
 use gwn::products::dataset::Status;
 use gwn::products::label::{JobOptions, SamplingOptions, label_dataset};
 
 use crate::common::{CliError, outln, progress};
-use crate::dataset::{DatasetInputs, print_problems};
+use crate::dataset::{DatasetInputs, print_problems, time_limit};
 
 /// Label a dataset of meshes for learning: per mesh, sample points uniform in the padded bounding
 /// box and near the surface (Gaussian offsets), label them with the exact winding number w,
@@ -60,15 +60,7 @@ pub struct Args {
 /// Runs `gwn label`.
 pub fn run(args: Args) -> Result<(), CliError> {
     let meshes = args.inputs.meshes()?;
-    let time_limit = match args.time_limit {
-        Some(s) if s.is_finite() && s > 0.0 && s < 1e9 => Some(Duration::from_secs_f64(s)),
-        Some(s) => {
-            return Err(CliError(format!(
-                "--time-limit {s}: expected a positive number of seconds"
-            )));
-        }
-        None => None,
-    };
+    let time_limit = time_limit(args.time_limit)?;
     let opts = JobOptions {
         sampling: SamplingOptions {
             uniform: args.uniform,

@@ -421,6 +421,7 @@ impl RemeshKnobs {
             planar_levels: self.planar_levels,
             probe_flatness: !self.no_flatness_probe,
             evaluator_crossings: guided,
+            deadline: None,
         }
     }
 }

@@ -10,13 +10,13 @@ use gwn::products::remesh::dataset::RemeshJob;
 use gwn::products::remesh::write::SurfaceFormat;
 
 use crate::common::{CliError, outln, progress};
-use crate::dataset::{DatasetInputs, print_problems};
+use crate::dataset::{DatasetInputs, print_problems, time_limit};
 use crate::remesh::RemeshKnobs;
 
 /// Remesh a dataset at w = 1/2: per mesh, the closed, edge- and vertex-manifold, oriented surface
 /// of `gwn remesh` (exact w, the input triangles as the guide), written to
 /// OUT/<path below the root>.FORMAT. OUT/manifest.jsonl gets one JSON line per mesh: status
-/// ok / done / failed, the error, the input's faces and vertices, the output's, whether it is
+/// ok / done / failed / timeout, the error, the input's faces and vertices, the output's, whether it is
 /// valid (closed, manifold, oriented, no exact self-intersection), its components, the
 /// self-intersecting face pairs, the Hausdorff distance in finest cells to where the input bounds
 /// the solid and the occupancy agreement (both sampled; null with --samples 0), seconds.
@@ -25,8 +25,9 @@ use crate::remesh::RemeshKnobs;
 /// existing output is reused only when its record (.meta.json beside it) shows the same options
 /// and input size and time; otherwise it is redone and the manifest says why. Broken files,
 /// FIFOs and devices are manifest rows; two inputs with one output are refused up front; the exit
-/// code is 0 unless the job itself cannot run. No time limit: a remesh cannot stop halfway (its
-/// memory is bounded: a mesh that needs more than the machine has is a failed row).
+/// code is 0 unless the job itself cannot run. --time-limit makes a mesh that runs past it a
+/// timeout row (the remesher checks it between phases and rounds); memory is bounded anyway (a
+/// mesh that needs more than the machine has is a failed row).
 ///
 /// Example: gwn remesh-dataset ../shared/meshes --out closed --res 128 --samples 0
 #[derive(ClapArgs, Debug)]
@@ -51,6 +52,9 @@ pub struct Args {
     /// cells, since a dataset's meshes come at any scale. Off by default.
     #[arg(long, value_name = "CELLS")]
     pub thicken_cells: Option<f64>,
+    /// Per-mesh time limit in seconds (checked between the remesher's phases and rounds).
+    #[arg(long)]
+    pub time_limit: Option<f64>,
     /// Do not weld STL and glTF vertices.
     #[arg(long)]
     pub no_weld: bool,
@@ -67,7 +71,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 args.format
             ))
         })?;
+    let time_limit = time_limit(args.time_limit)?;
     let job = RemeshJob {
+        time_limit,
         options: args.knobs.options(args.res, true),
         format,
         samples: args.samples,
@@ -94,15 +100,19 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let count = |s: Status| rows.iter().filter(|r| r.status == s).count();
     let valid = rows
         .iter()
-        .filter(|r| r.status != Status::Failed && r.stats.get("valid") == Some("true"))
+        .filter(|r| {
+            matches!(r.status, Status::Ok | Status::Done) && r.stats.get("valid") == Some("true")
+        })
         .count();
     let redone = rows.iter().filter(|r| r.redone.is_some()).count();
     outln!(
-        "remeshed {} meshes ({} done before, {redone} redone, {} failed) in {secs:.3} s; {valid} \
-         outputs valid (closed, manifold, oriented, no self-intersection); manifest: {}",
+        "remeshed {} meshes ({} done before, {redone} redone, {} failed, {} timed out) in \
+         {secs:.3} s; {valid} outputs valid (closed, manifold, oriented, no self-intersection); \
+         manifest: {}",
         count(Status::Ok),
         count(Status::Done),
         count(Status::Failed),
+        count(Status::Timeout),
         args.out.join("manifest.jsonl").display()
     )?;
     print_problems("remesh-dataset", &rows);

@@ -138,8 +138,9 @@ def label_dataset(paths, out_dir, *, root=None, uniform=50_000, near=50_000,
 
 
 def remesh_dataset(paths, out_dir, res=128, *, root=None, format="ply", samples=10_000,
-                   thicken_cells=None, weld=None, bisect=None, simplify=True, refine_plates=True,
-                   sub_cell_levels=None, planar_levels=None, threads=None, progress=None):
+                   thicken_cells=None, weld=None, time_limit=None, bisect=None, simplify=True,
+                   refine_plates=True, sub_cell_levels=None, planar_levels=None, threads=None,
+                   progress=None):
     """Remeshes a dataset of meshes at w = 1/2, exactly as ``gwn remesh-dataset`` does.
 
     Per mesh: the closed, edge- and vertex-manifold, oriented surface ``gwn.remesh`` makes at
@@ -147,7 +148,8 @@ def remesh_dataset(paths, out_dir, res=128, *, root=None, format="ply", samples=
     written to ``out_dir/<path below root>.<format>`` (``obj``, ``ply``, ``stl`` or ``glb``), and
     ``out_dir/manifest.jsonl``. ``samples`` report samples per mesh measure the Hausdorff
     distance and the occupancy agreement (0: neither); ``thicken_cells`` closes open sheets into
-    slabs of that half-thickness in finest cells. Meshes run one after the other, each on
+    slabs of that half-thickness in finest cells; a mesh past ``time_limit`` seconds is a
+    ``timeout`` row. Meshes run one after the other, each on
     ``threads`` threads (default: all cores), with the GIL released. Resumable (an existing
     output is reused only when it was made with the same options from the same input, else
     redone and ``redone`` says why); broken files and FIFOs are manifest rows; two inputs with
@@ -155,7 +157,8 @@ def remesh_dataset(paths, out_dir, res=128, *, root=None, format="ply", samples=
     ``planar_levels`` and ``bisect``: ``None`` for ``gwn remesh``'s defaults.
 
     ``progress`` as in ``gwn.label_dataset``. Returns the manifest rows (dicts with ``mesh``,
-    ``output``, ``status`` in ``ok``/``done``/``failed``, ``error``, ``faces``, ``vertices``,
+    ``output``, ``status`` in ``ok``/``done``/``failed``/``timeout``, ``error``, ``faces``,
+    ``vertices``,
     ``output_faces``, ``output_vertices``, ``valid`` (closed, manifold, oriented, no exact
     self-intersection), ``components``, ``self_intersections``, ``hausdorff_cells``,
     ``occupancy_agreement``, ``seconds``, ``redone``), in input order. For a cluster, see
@@ -169,6 +172,7 @@ def remesh_dataset(paths, out_dir, res=128, *, root=None, format="ply", samples=
         paths, _os.fspath(out_dir), res,
         root=None if root is None else _os.fspath(root), **_remesh_job_options(
             format=format, samples=samples, thicken_cells=thicken_cells, weld=weld,
+            time_limit=time_limit,
             bisect=bisect, simplify=simplify, refine_plates=refine_plates,
             sub_cell_levels=sub_cell_levels, planar_levels=planar_levels),
         threads=threads,

@@ -33,6 +33,7 @@ def remesh_dataset(
     samples: int = 10_000,
     thicken_cells: Optional[float] = None,
     weld: Optional[bool] = None,
+    time_limit: Optional[float] = None,
     bisect: Optional[int] = None,
     simplify: bool = True,
     refine_plates: bool = True,

@@ -18,6 +18,17 @@ use pyo3::prelude::*;
 use crate::errors::value_error;
 use crate::threads::{self, Threads};
 
+/// ``time_limit`` (seconds) as a duration: positive and finite (below 10⁹ s).
+fn time_limit_of(seconds: Option<f64>) -> PyResult<Option<Duration>> {
+    match seconds {
+        Some(s) if s.is_finite() && s > 0.0 && s < 1e9 => Ok(Some(Duration::from_secs_f64(s))),
+        Some(s) => Err(PyValueError::new_err(format!(
+            "time_limit must be a positive number of seconds, got {s}"
+        ))),
+        None => Ok(None),
+    }
+}
+
 #[allow(clippy::too_many_arguments)]
 fn job_options(
     uniform: usize,
@@ -28,15 +39,7 @@ fn job_options(
     time_limit: Option<f64>,
     weld: Option<bool>,
 ) -> PyResult<JobOptions> {
-    let time_limit = match time_limit {
-        Some(s) if s.is_finite() && s > 0.0 && s < 1e9 => Some(Duration::from_secs_f64(s)),
-        Some(s) => {
-            return Err(PyValueError::new_err(format!(
-                "time_limit must be a positive number of seconds, got {s}"
-            )));
-        }
-        None => None,
-    };
+    let time_limit = time_limit_of(time_limit)?;
     let sampling = SamplingOptions {
         uniform,
         near,
@@ -180,6 +183,7 @@ fn remesh_job(
     samples: usize,
     thicken_cells: Option<f64>,
     weld: Option<bool>,
+    time_limit: Option<f64>,
     bisect: u32,
     simplify: bool,
     refine_plates: bool,
@@ -195,6 +199,7 @@ fn remesh_job(
     job.samples = samples;
     job.thicken_cells = thicken_cells;
     job.load = LoadOptions { weld };
+    job.time_limit = time_limit_of(time_limit)?;
     job.options.bisection_steps = bisect;
     if !simplify {
         job.options.simplify = None;
@@ -210,11 +215,13 @@ fn remesh_job(
 /// mesh, the closed, manifold, oriented surface ``gwn.remesh`` makes at ``res`` (the same bytes
 /// ``gwn remesh`` writes), at ``out_dir/<path below root>.<format>``, and
 /// ``out_dir/manifest.jsonl``. Meshes run one after the other, each on ``threads``. Resumable
-/// and failure-isolated as ``label_dataset``. Returns the manifest rows as JSON strings, in input
+/// and failure-isolated as ``label_dataset``; a mesh past ``time_limit`` seconds is a
+/// ``timeout`` row. Returns the manifest rows as JSON strings, in input
 /// order; ``progress`` as in ``label_dataset``.
 #[pyfunction]
 #[pyo3(signature = (paths, out_dir, res = 128, *, root = None, format = "ply", samples = 10_000,
-    thicken_cells = None, weld = None, bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS,
+    thicken_cells = None, weld = None, time_limit = None,
+    bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS,
     simplify = true, refine_plates = true,
     sub_cell_levels = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS,
     planar_levels = gwn::products::remesh::DEFAULT_PLANAR_LEVELS, threads = None,
@@ -230,6 +237,7 @@ pub fn remesh_dataset(
     samples: usize,
     thicken_cells: Option<f64>,
     weld: Option<bool>,
+    time_limit: Option<f64>,
     bisect: u32,
     simplify: bool,
     refine_plates: bool,
@@ -244,6 +252,7 @@ pub fn remesh_dataset(
         samples,
         thicken_cells,
         weld,
+        time_limit,
         bisect,
         simplify,
         refine_plates,
@@ -258,7 +267,8 @@ pub fn remesh_dataset(
 /// ``root`` must be the same for every mesh of a dataset (see ``common_root``).
 #[pyfunction]
 #[pyo3(signature = (path, out_dir, root, res = 128, *, format = "ply", samples = 10_000,
-    thicken_cells = None, weld = None, bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS,
+    thicken_cells = None, weld = None, time_limit = None,
+    bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS,
     simplify = true, refine_plates = true,
     sub_cell_levels = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS,
     planar_levels = gwn::products::remesh::DEFAULT_PLANAR_LEVELS, threads = None))]
@@ -273,6 +283,7 @@ pub fn remesh_file(
     samples: usize,
     thicken_cells: Option<f64>,
     weld: Option<bool>,
+    time_limit: Option<f64>,
     bisect: u32,
     simplify: bool,
     refine_plates: bool,
@@ -286,6 +297,7 @@ pub fn remesh_file(
         samples,
         thicken_cells,
         weld,
+        time_limit,
         bisect,
         simplify,
         refine_plates,

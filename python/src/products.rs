@@ -478,6 +478,7 @@ pub fn remesh<'py>(
         planar_levels,
         probe_flatness: true,
         evaluator_crossings: true,
+        deadline: None,
     };
     let samples = if report { samples } else { 0 };
     RemeshReport::check_samples(samples)

@@ -83,7 +83,14 @@ def test_remesh_dataset_bad_arguments_are_value_errors(tmp_path):
         gwn.remesh_dataset(paths, tmp_path / "o", thicken_cells=0.5)
     with pytest.raises(ValueError, match="both be written"):
         gwn.remesh_dataset([paths[0], paths[0]], tmp_path / "o")
+    with pytest.raises(ValueError, match="time_limit must be a positive"):
+        gwn.remesh_dataset(paths, tmp_path / "o", time_limit=-1)
     assert not (tmp_path / "o").exists()
+    # A limit no mesh can meet: timeout rows (the broken file fails first), no outputs.
+    rows = gwn.remesh_dataset(paths, tmp_path / "t", 24, time_limit=1e-6)
+    assert [r["status"] for r in rows] == ["timeout", "timeout", "failed"]
+    assert rows[0]["error"].startswith("time limit of 0.000 s exceeded while ")
+    assert not list((tmp_path / "t").rglob("*.ply"))
 
 
 def test_dask_remesh_matches_serial(tmp_path):

@@ -187,7 +187,7 @@ fn remesh_dataset_cli() {
     let (ok, stdout, stderr) = run(&["--format", "obj"]);
     assert!(ok, "{stderr}");
     assert!(
-        stdout.contains("remeshed 3 meshes (0 done before, 0 redone, 1 failed)"),
+        stdout.contains("remeshed 3 meshes (0 done before, 0 redone, 1 failed, 0 timed out)"),
         "{stdout}"
     );
     assert!(stdout.contains("3 outputs valid"), "{stdout}");
@@ -216,8 +216,75 @@ fn remesh_dataset_cli() {
         stderr.trim(),
         "gwn: --format step: expected obj, ply, stl or glb"
     );
+    // A time limit no mesh can meet: timeout rows, the job still succeeds.
+    let (ok, stdout, _) = run(&["--time-limit", "0.000001", "--format", "stl"]);
+    assert!(ok);
+    assert!(stdout.contains("1 failed, 3 timed out"), "{stdout}");
     let (ok, _, stderr) = run(&["--thicken-cells", "0"]);
     assert!(!ok);
     assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
     assert!(stderr.contains("at least one finest cell"), "{stderr}");
+}
+
+#[test]
+fn remesh_stops_at_its_deadline_without_an_output() {
+    use gwn::products::remesh::{RemeshError, RemeshOptions, RemeshPhase, remesh_guided};
+    let mesh = gwn::io::load_mesh(crate::common::repo().join("data/lion-head.off"))
+        .unwrap()
+        .mesh;
+    let wn = gwn::eval::antipodal::WindingNumber::new(&mesh).unwrap();
+    let guide = gwn::products::remesh::crossings::SegmentBvh::of_field_mesh(&mesh);
+    let bounds = mesh.bounding_box().unwrap();
+    let options = RemeshOptions::with_resolution(64);
+    let run = |options: &RemeshOptions| remesh_guided(&wn, Some(&guide), bounds, options, &|_| {});
+    let start = std::time::Instant::now();
+    let full = run(&options).unwrap();
+    let took = start.elapsed();
+    // Past already: stopped before classifying.
+    let past = RemeshOptions {
+        deadline: Some(std::time::Instant::now()),
+        ..options
+    };
+    assert_eq!(
+        run(&past).unwrap_err(),
+        RemeshError::TimeLimit {
+            phase: RemeshPhase::Classify
+        }
+    );
+    // A third of the time a run takes: stopped in some later phase, with no surface.
+    let early = RemeshOptions {
+        deadline: Some(std::time::Instant::now() + took / 3),
+        ..options
+    };
+    assert!(
+        matches!(run(&early), Err(RemeshError::TimeLimit { .. })),
+        "a third of {took:?}"
+    );
+    // A deadline far ahead changes nothing.
+    let later = RemeshOptions {
+        deadline: Some(std::time::Instant::now() + std::time::Duration::from_secs(3600)),
+        ..options
+    };
+    let again = run(&later).unwrap();
+    assert_eq!(again.triangles, full.triangles);
+    assert_eq!(again.positions, full.positions);
+
+    // In a dataset: a `timeout` row that names the limit, and no output.
+    let scratch = Scratch::new("deadline");
+    let dir = &scratch.0;
+    let meshes = inputs(dir);
+    let job = RemeshJob {
+        time_limit: Some(std::time::Duration::from_micros(1)),
+        ..RemeshJob::new(32)
+    };
+    let rows = run_dataset(&job, &meshes[..2], &dir.join("out"), None, |_| {}).unwrap();
+    for row in &rows {
+        assert_eq!(row.status, Status::Timeout, "{row:?}");
+        let error = row.error.as_deref().unwrap();
+        assert!(
+            error.starts_with("time limit of 0.000 s exceeded while "),
+            "{error}"
+        );
+        assert!(!dir.join("out").join(&row.output).exists());
+    }
 }

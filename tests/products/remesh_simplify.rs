@@ -527,6 +527,7 @@ fn generous() -> SimplifyOptions {
         lattice_cube_cells: 1,
         // Slabs a cell thick: the hand-made surfaces are cut wherever they are thick enough.
         slab_cells: 1,
+        deadline: None,
     }
 }
 

@@ -53,6 +53,10 @@ pub struct RemeshJob {
     pub thicken_cells: Option<f64>,
     /// Loader options (welding).
     pub load: LoadOptions,
+    /// Per-mesh time limit (loading, remeshing, measuring; the remesher checks it between its
+    /// phases and rounds, [`RemeshOptions::deadline`], so a mesh overshoots by one round at
+    /// most). A mesh past it is a `timeout` row without an output.
+    pub time_limit: Option<Duration>,
 }
 
 impl RemeshJob {
@@ -65,12 +69,35 @@ impl RemeshJob {
             samples: 10_000,
             thicken_cells: None,
             load: LoadOptions::default(),
+            time_limit: None,
         }
     }
 }
 
 /// Why one mesh could not be remeshed (one line; the manifest row names the mesh).
 pub type RemeshJobError = Box<dyn std::error::Error + Send + Sync>;
+
+/// A mesh ran out of [`RemeshJob::time_limit`].
+#[derive(Debug)]
+pub struct TimeLimitExceeded {
+    /// What was running.
+    pub stage: &'static str,
+    /// The limit.
+    pub limit: Duration,
+}
+
+impl std::fmt::Display for TimeLimitExceeded {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "time limit of {:.3} s exceeded while {}",
+            self.limit.as_secs_f64(),
+            self.stage
+        )
+    }
+}
+
+impl std::error::Error for TimeLimitExceeded {}
 
 impl MeshJob for RemeshJob {
     type Error = RemeshJobError;
@@ -174,20 +201,32 @@ impl MeshJob for RemeshJob {
     }
 
     fn time_limit(&self) -> Option<Duration> {
-        // A remesh cannot stop halfway; its memory is bounded instead (`RemeshError::OutOfMemory`).
-        None
+        self.time_limit
+    }
+
+    fn status(error: &RemeshJobError) -> crate::products::dataset::Status {
+        if error.downcast_ref::<TimeLimitExceeded>().is_some() {
+            crate::products::dataset::Status::Timeout
+        } else {
+            crate::products::dataset::Status::Failed
+        }
     }
 
     fn run(
         &self,
         path: &Path,
         _key: &str,
-        _deadline: Option<(Instant, Duration)>,
+        deadline: Option<(Instant, Duration)>,
         stats: &mut Stats,
     ) -> Result<Vec<u8>, RemeshJobError> {
+        let in_time = |stage: &'static str| match deadline {
+            Some((at, limit)) if Instant::now() > at => Err(TimeLimitExceeded { stage, limit }),
+            _ => Ok(()),
+        };
         let mesh = load_mesh_with(path, &self.load)?.mesh;
         stats.set("faces", mesh.triangles().len());
         stats.set("vertices", mesh.positions().len());
+        in_time("loading")?;
         let bounds = mesh.bounding_box().ok_or("the mesh has no vertices")?;
         let wn = EvaluatorSpec::default().build_mesh(&mesh)?;
         let extent = (0..3)
@@ -219,7 +258,24 @@ impl MeshJob for RemeshJob {
                 DistanceReference::BoundingMesh(&mesh),
             ),
         };
-        let mut out = remesh_guided(field, Some(&guide), bounds, &self.options, &|_| {})?;
+        in_time("building the evaluator")?;
+        let options = RemeshOptions {
+            deadline: deadline.map(|(at, _)| at),
+            ..self.options
+        };
+        let mut out = remesh_guided(field, Some(&guide), bounds, &options, &|_| {}).map_err(
+            |e| -> RemeshJobError {
+                match (e, deadline) {
+                    (super::RemeshError::TimeLimit { phase }, Some((_, limit))) => {
+                        Box::new(TimeLimitExceeded {
+                            stage: phase.name(),
+                            limit,
+                        })
+                    }
+                    (e, _) => Box::new(e),
+                }
+            },
+        )?;
         let positions = std::mem::take(&mut out.positions);
         let triangles = std::mem::take(&mut out.triangles);
         let surface = Mesh::new(positions, triangles)?;
@@ -233,6 +289,7 @@ impl MeshJob for RemeshJob {
             self.samples,
             &|_| {},
         )?;
+        in_time("measuring the report")?;
         let mut bytes = Vec::new();
         write_surface(&mut bytes, self.format, &surface)?;
         let t = report.topology;

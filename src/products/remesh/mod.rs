@@ -178,6 +178,11 @@ pub struct RemeshOptions {
     /// like the triangles' crossings, instead of searching the field alone. Same guarantees,
     /// fewer evaluations; `false` for comparison.
     pub evaluator_crossings: bool,
+    /// Give up with [`RemeshError::TimeLimit`] once this instant has passed: checked between
+    /// the phases, between the octree's split rounds and between the simplifier's rounds, so
+    /// a run overshoots by one round at most. Never changes an output: a run either ends in
+    /// time with the surface it would have had, or returns no surface. `None`: no limit.
+    pub deadline: Option<std::time::Instant>,
 }
 
 impl RemeshOptions {
@@ -193,6 +198,7 @@ impl RemeshOptions {
             planar_levels: DEFAULT_PLANAR_LEVELS,
             probe_flatness: true,
             evaluator_crossings: true,
+            deadline: None,
         }
     }
 }
@@ -239,6 +245,11 @@ pub enum RemeshError {
         /// The budget, in classified lattice points.
         max_points: usize,
     },
+    /// [`RemeshOptions::deadline`] passed during this phase.
+    TimeLimit {
+        /// The phase that was running.
+        phase: RemeshPhase,
+    },
 }
 
 impl std::fmt::Display for RemeshError {
@@ -276,6 +287,9 @@ impl std::fmt::Display for RemeshError {
                  {BYTES_PER_CLASSIFIED_POINT} bytes each), more than the memory available: \
                  lower the resolution"
             ),
+            RemeshError::TimeLimit { phase } => {
+                write!(f, "the time limit ran out while {}", phase.name())
+            }
         }
     }
 }
@@ -497,14 +511,26 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
             usize::try_from(bytes / BYTES_PER_CLASSIFIED_POINT).unwrap_or(usize::MAX)
         })
     });
+    // Each phase checks the deadline as it ends (and the long ones between their rounds).
+    let in_time = |phase: RemeshPhase| match options.deadline {
+        Some(at) if std::time::Instant::now() > at => Err(RemeshError::TimeLimit { phase }),
+        _ => Ok(()),
+    };
+    in_time(RemeshPhase::Classify)?;
     progress(RemeshPhase::Classify);
-    let classified = octree::classify(evaluator, &lattice, guide, max_points)
-        .ok_or(RemeshError::OutOfMemory { max_points })?;
+    let classified = octree::classify(evaluator, &lattice, guide, max_points, options.deadline)
+        .map_err(|stop| match stop {
+            octree::Stop::TooManyPoints => RemeshError::OutOfMemory { max_points },
+            octree::Stop::TimeLimit => RemeshError::TimeLimit {
+                phase: RemeshPhase::Classify,
+            },
+        })?;
     progress(RemeshPhase::Extract);
     let band = extract::extract(&lattice, &classified);
     if band.edges.len() > u32::MAX as usize {
         return Err(RemeshError::TooManyVertices);
     }
+    in_time(RemeshPhase::Extract)?;
     progress(RemeshPhase::Place);
     let mut placed = place::place_vertices(
         evaluator,
@@ -539,6 +565,7 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
         plates,
     };
     drop(classified);
+    in_time(RemeshPhase::Place)?;
     let (positions, fixed, triangles) = match &options.simplify {
         None => (placed.positions, placed.fixed, band.triangles),
         Some(simplify_options) => {
@@ -555,6 +582,7 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
             drop(band.edges);
             let simplify_options = &simplify::SimplifyOptions {
                 lattice_cube_cells: 1 << planar,
+                deadline: options.deadline,
                 ..*simplify_options
             };
             let s = simplify::simplify_with_planes(
@@ -566,6 +594,9 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
                     * band.marching_cubes_triangles as f64) as usize,
                 planes,
             );
+            // Past the deadline the simplifier stops between rounds: that surface is valid but
+            // not the one the options ask for, so it is not returned.
+            in_time(RemeshPhase::Simplify)?;
             stats.simplify = s.stats;
             // From the fixed point, as `place` does (exact dyadic steps: the same `f64` for a
             // vertex that was not relocated).

@@ -271,8 +271,18 @@ fn touched(guide: Option<&SegmentBvh>, lattice: &Lattice, level: u32, m: Corner)
     guide.meets_box(lo, hi, pad)
 }
 
-/// Classifies the lattice (see the [module documentation](self)); `None` as soon as more than
-/// `max_points` lattice points would be classified. `guide`: the input triangles, whose cells
+/// Why [`classify`] stopped before the end.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stop {
+    /// More than `max_points` lattice points would be classified.
+    TooManyPoints,
+    /// The deadline passed (checked between split rounds).
+    TimeLimit,
+}
+
+/// Classifies the lattice (see the [module documentation](self)); [`Stop::TooManyPoints`] as
+/// soon as more than `max_points` lattice points would be classified, [`Stop::TimeLimit`] at
+/// the first split round that starts after `deadline`. `guide`: the input triangles, whose cells
 /// are refined to the regular level too (and below it where a part is thinner than a cell,
 /// when the lattice has [`Lattice::sub_levels`]).
 pub fn classify<E: Evaluator + ?Sized>(
@@ -280,7 +290,8 @@ pub fn classify<E: Evaluator + ?Sized>(
     lattice: &Lattice,
     guide: Option<&SegmentBvh>,
     max_points: usize,
-) -> Option<Classified> {
+    deadline: Option<std::time::Instant>,
+) -> Result<Classified, Stop> {
     assert!(
         lattice.resolution_level() <= MAX_SUB_LEVELS && lattice.planar_levels <= MAX_PLANAR_LEVELS,
         "sub-levels beyond MAX_SUB_LEVELS or planar levels beyond MAX_PLANAR_LEVELS"
@@ -303,7 +314,7 @@ pub fn classify<E: Evaluator + ?Sized>(
     // cells: always a valid, small grid.
     let spec = GridSpec { bounds, dims };
     if spec.len() > max_points {
-        return None;
+        return Err(Stop::TooManyPoints);
     }
     let values = super::levels::decisive_grid_values(evaluator, &spec);
     for k in 0..dims[2] {
@@ -338,7 +349,7 @@ pub fn classify<E: Evaluator + ?Sized>(
                     .map(|&m| (levels, m)),
             );
         }
-        out.split_rounds(evaluator, lattice, guide, queue, max_points)?;
+        out.split_rounds(evaluator, lattice, guide, queue, max_points, deadline)?;
     }
     // The cells of the tree at `level` (split or leaves): the children of split cells one level
     // up, or the coarse cells.
@@ -381,7 +392,14 @@ pub fn classify<E: Evaluator + ?Sized>(
                     })
                     .map(|m| (level, m))
                     .collect();
-                out.split_rounds(evaluator, lattice, Some(guide), curved.clone(), max_points)?;
+                out.split_rounds(
+                    evaluator,
+                    lattice,
+                    Some(guide),
+                    curved.clone(),
+                    max_points,
+                    deadline,
+                )?;
             }
             let crossed: Vec<Corner> = cells_at(&out, level)
                 .into_par_iter()
@@ -397,7 +415,7 @@ pub fn classify<E: Evaluator + ?Sized>(
                 .map(|m| (level, m))
                 .collect();
             let mut split_now: Vec<Corner> = thin.iter().chain(&curved).map(|&(_, m)| m).collect();
-            out.split_rounds(evaluator, lattice, Some(guide), thin, max_points)?;
+            out.split_rounds(evaluator, lattice, Some(guide), thin, max_points, deadline)?;
             // A thin part goes on into cells whose corners do not agree (a plate through a
             // corner of them): a leaf of this level next to a cell just split, where one of
             // the split's new points on their common face or edge has a class that the corners
@@ -423,7 +441,7 @@ pub fn classify<E: Evaluator + ?Sized>(
                 next.sort_unstable_by_key(|&(l, c)| (l, pack(c)));
                 next.dedup();
                 split_now = next.iter().map(|&(_, m)| m).collect();
-                out.split_rounds(evaluator, lattice, Some(guide), next, max_points)?;
+                out.split_rounds(evaluator, lattice, Some(guide), next, max_points, deadline)?;
             }
         }
         // Balance: the cells around a split cell of a level at most the regular one are
@@ -445,7 +463,14 @@ pub fn classify<E: Evaluator + ?Sized>(
             if coarser.is_empty() {
                 break;
             }
-            out.split_rounds(evaluator, lattice, Some(guide), coarser, max_points)?;
+            out.split_rounds(
+                evaluator,
+                lattice,
+                Some(guide),
+                coarser,
+                max_points,
+                deadline,
+            )?;
         }
     }
     // Leaves next to a split cell of their level across a face or an edge get the transition
@@ -495,7 +520,7 @@ pub fn classify<E: Evaluator + ?Sized>(
         fresh.sort_unstable();
         fresh.dedup();
         if out.labels.len() + fresh.len() > max_points {
-            return None;
+            return Err(Stop::TooManyPoints);
         }
         // Cell and face centres: inside leaves at most regular and on faces between two of
         // them, on no larger leaf's closed box, so the octree's invariant is not concerned. A
@@ -537,7 +562,7 @@ pub fn classify<E: Evaluator + ?Sized>(
     out.band = band;
     out.fine_band = fine_band;
     out.transition = transition;
-    Some(out)
+    Ok(out)
 }
 
 /// Most sub-levels [`classify`] refines below the regular cells (each level costs up to 19
@@ -873,7 +898,8 @@ impl Classified {
 
     /// Splits the cells of `queue` and whatever keeps the invariant of the [module
     /// documentation](self): mixed or touched children above the regular level, and leaves
-    /// above it that a new point contradicts. `None` past `max_points`.
+    /// above it that a new point contradicts. [`Stop::TooManyPoints`] past `max_points`,
+    /// [`Stop::TimeLimit`] at a round that starts after `deadline`.
     fn split_rounds<E: Evaluator + ?Sized>(
         &mut self,
         evaluator: &E,
@@ -881,10 +907,14 @@ impl Classified {
         guide: Option<&SegmentBvh>,
         mut queue: Vec<(u32, Corner)>,
         max_points: usize,
-    ) -> Option<()> {
+        deadline: Option<std::time::Instant>,
+    ) -> Result<(), Stop> {
         let regular = lattice.sub_levels;
         let out = self;
         while !queue.is_empty() {
+            if deadline.is_some_and(|at| std::time::Instant::now() > at) {
+                return Err(Stop::TimeLimit);
+            }
             queue.sort_unstable_by_key(|&(l, m)| (l, pack(m)));
             queue.dedup();
             queue.retain(|&(level, m)| level > 0 && !out.split.contains(&(level, pack(m))));
@@ -907,7 +937,7 @@ impl Classified {
                 out.split.insert((level, pack(m)));
             }
             if out.labels.len() + new_points.len() > max_points {
-                return None;
+                return Err(Stop::TooManyPoints);
             }
             let interior: Vec<Corner> = new_points
                 .iter()
@@ -961,7 +991,7 @@ impl Classified {
                 })
             }));
         }
-        Some(())
+        Ok(())
     }
 }
 

@@ -193,6 +193,10 @@ pub struct SimplifyOptions {
     /// of the slabs in parallel and each in a smaller memory. The result depends on this, not
     /// on the thread count. 0: no slabs.
     pub slab_cells: u32,
+    /// Stop collapsing and relocating once this instant has passed (checked between rounds):
+    /// the surface is then valid but less simplified than the options ask, which is why the
+    /// remesher returns none at all past its deadline ([`super::RemeshOptions::deadline`]).
+    pub deadline: Option<std::time::Instant>,
 }
 
 impl Default for SimplifyOptions {
@@ -209,6 +213,7 @@ impl Default for SimplifyOptions {
             lattice_diagonal_error: DEFAULT_DIAGONAL_ERROR,
             lattice_cube_cells: 1,
             slab_cells: DEFAULT_SLAB_CELLS,
+            deadline: None,
         }
     }
 }
@@ -431,6 +436,8 @@ pub struct Simplifier {
     flat_limit: Option<f64>,
     /// In a slab's simplifier ([`slabs`]): the open slab its collapses must stay inside.
     slab: Option<slabs::Slab>,
+    /// [`SimplifyOptions::deadline`].
+    deadline: Option<std::time::Instant>,
     stats: SimplifyStats,
 }
 
@@ -605,11 +612,18 @@ impl Simplifier {
             max_distance2: (options.max_distance * options.max_distance),
             flat_limit: None,
             slab: None,
+            deadline: options.deadline,
             stats: SimplifyStats {
                 faces_before: faces,
                 ..SimplifyStats::default()
             },
         })
+    }
+
+    /// Whether [`SimplifyOptions::deadline`] has passed.
+    fn past_deadline(&self) -> bool {
+        self.deadline
+            .is_some_and(|at| std::time::Instant::now() > at)
     }
 
     /// Indexes every live face, once.
@@ -697,6 +711,9 @@ impl Simplifier {
         let mut deferred = Vec::new();
         let mut touched: Vec<u32> = Vec::new();
         loop {
+            if self.past_deadline() {
+                break;
+            }
             let faces_now = self.stats.faces_before - 2 * self.stats.collapses;
             taken.clear();
             selected.clear();
@@ -856,7 +873,7 @@ impl Simplifier {
         let mut selected: Vec<(u32, P)> = Vec::with_capacity(ROUND);
         let mut deferred: Vec<(u32, P)> = Vec::new();
         let bucket = 2 * self.ticks;
-        while !pending.is_empty() {
+        while !pending.is_empty() && !self.past_deadline() {
             taken.clear();
             selected.clear();
             deferred.clear();

@@ -321,6 +321,7 @@ impl Simplifier {
             max_distance2: self.max_distance2,
             flat_limit: None,
             slab: Some(slab),
+            deadline: self.deadline,
             stats: SimplifyStats {
                 faces_before: faces.len(),
                 ..SimplifyStats::default()
@@ -431,7 +432,7 @@ mod tests {
         let wn = WindingNumber::new(&mesh).unwrap();
         let guide = SegmentBvh::of_mesh(&mesh);
         let lattice = lattice::Lattice::new(mesh.bounding_box().unwrap(), 40).unwrap();
-        let classified = octree::classify(&wn, &lattice, Some(&guide), usize::MAX).unwrap();
+        let classified = octree::classify(&wn, &lattice, Some(&guide), usize::MAX, None).unwrap();
         let band = extract::extract(&lattice, &classified);
         let placed = place::place_vertices(
             &wn,
