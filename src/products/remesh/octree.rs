@@ -367,6 +367,9 @@ pub fn classify<E: Evaluator + ?Sized>(
         // is shrunk) while its corners agree holds a piece of surface that no corner sees.
         // Split it, level by level down to the finest.
         for level in (1..=regular).rev() {
+            if deadline.is_some_and(|at| std::time::Instant::now() > at) {
+                return Err(Stop::TimeLimit);
+            }
             // Above the resolution's cell: a leaf whose corners differ stays whole only where
             // the input in it is flat (`Classified::flat`), cut to the resolution's cell
             // elsewhere.
@@ -502,6 +505,9 @@ pub fn classify<E: Evaluator + ?Sized>(
     }
     transition.sort_unstable_by_key(|&(l, c)| (l, c[2], c[1], c[0]));
     transition.dedup();
+    if deadline.is_some_and(|at| std::time::Instant::now() > at) {
+        return Err(Stop::TimeLimit);
+    }
     if let Some(guide) = guide {
         out.lend_untouched_transitions(evaluator, lattice, guide, &mut transition);
     }
@@ -948,7 +954,7 @@ impl Classified {
                 .par_iter()
                 .map(|&p| lattice.corner_position(p))
                 .collect();
-            let values = super::levels::decisive_corner_values(evaluator, &positions);
+            let values = values_by_chunks(evaluator, &positions, deadline)?;
             out.labels.reserve(new_points.len());
             for &p in &new_points {
                 out.labels.insert(pack(p), CornerValue::BORDER);
@@ -993,6 +999,29 @@ impl Classified {
         }
         Ok(())
     }
+}
+
+/// Points per batch of [`values_by_chunks`]: a round of a fine lattice classifies millions of
+/// points (seconds of work on an inconsistently oriented input), and the deadline is checked
+/// between batches; this many keep both threads busy and cut few columns of the ray reuse.
+const DEADLINE_CHUNK: usize = 1 << 17;
+
+/// [`super::levels::decisive_corner_values`] of `positions`, [`DEADLINE_CHUNK`] at a time with
+/// `deadline` checked before each. The values are per point (the evaluator's batches give the
+/// bits of point-by-point evaluation), so the chunks change nothing but where the run can stop.
+fn values_by_chunks<E: Evaluator + ?Sized>(
+    evaluator: &E,
+    positions: &[[f64; 3]],
+    deadline: Option<std::time::Instant>,
+) -> Result<Vec<(f64, bool)>, Stop> {
+    let mut values = Vec::with_capacity(positions.len());
+    for chunk in positions.chunks(DEADLINE_CHUNK) {
+        if deadline.is_some_and(|at| std::time::Instant::now() > at) {
+            return Err(Stop::TimeLimit);
+        }
+        values.extend(super::levels::decisive_corner_values(evaluator, chunk));
+    }
+    Ok(values)
 }
 
 /// Whether `w` is at least `margin` from ½ (NaN, at border points: no).

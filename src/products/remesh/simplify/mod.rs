@@ -337,21 +337,32 @@ pub fn simplify_with_planes(
             // neighbours and wait for each other): on cgal-fandisk_large at res 256, 38.8k flat
             // collapses in 1,789 rounds took a third of the simplification's time.
             let slabs = s.slabs(options.slab_cells);
+            // Past the deadline every later stage is skipped (each round loop also stops):
+            // the surface stays valid, and the remesher returns none.
             s.in_slabs(&slabs, |slab, share, foreign| {
+                if slab.past_deadline() {
+                    return;
+                }
                 if let Some(max_error) = diagonals {
                     slab.collapse_lattice_diagonals(max_error);
                 }
                 slab.run(Simplifier::slab_target(target_faces, share, foreign));
-                if flat {
+                if flat && !slab.past_deadline() {
                     slab.flat_stage(options.flat_tolerance, false);
                 }
             });
+            if s.past_deadline() {
+                return s.finish();
+            }
             if slabs.is_empty()
                 && let Some(max_error) = diagonals
             {
                 s.collapse_lattice_diagonals(max_error);
             }
             s.run(target_faces);
+            if s.past_deadline() {
+                return s.finish();
+            }
             if flat {
                 // Large flat faces only here, after the slabs: a slab cannot make a face across
                 // its planes, and the strips of large faces it leaves along them are hard to
@@ -364,7 +375,7 @@ pub fn simplify_with_planes(
                 }
                 s.flat_stage(options.flat_tolerance, large);
             }
-            if options.relocate {
+            if options.relocate && !s.past_deadline() {
                 s.relocate();
             }
             s.finish()
