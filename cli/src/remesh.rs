@@ -54,6 +54,10 @@ pub struct Args {
     /// surface is open; solids are left as they are. Meshes and soups only. Off by default.
     #[arg(long, value_name = "EPS")]
     pub thicken: Option<f64>,
+    /// Give up (exit 1) once the remesh has run this many seconds (checked between its phases
+    /// and rounds; the report after it is not limited).
+    #[arg(long)]
+    pub time_limit: Option<f64>,
     #[command(flatten)]
     pub knobs: RemeshKnobs,
     #[command(flatten)]
@@ -74,6 +78,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     })?;
     RemeshReport::check_samples(args.samples)
         .map_err(|e| CliError::msg(format!("--samples: {e}")))?;
+    let time_limit = crate::dataset::time_limit(args.time_limit)?;
     let method = args.method.spec(args.tolerance, args.weld);
     method.validate()?;
     let input = crate::method::load_input(&args.mesh, args.weld)?;
@@ -119,11 +124,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
         Some(t) => t,
         None => &*built,
     };
-    let options = args.knobs.options(args.res, !args.no_guide);
+    let mut options = args.knobs.options(args.res, !args.no_guide);
     // Phases: classify, extract, place, [simplify,] write, self-intersections, Hausdorff,
     // agreement.
     let bar = crate::common::progress(if args.knobs.no_simplify { 7 } else { 8 }, "remesh");
     let start = std::time::Instant::now();
+    options.deadline = time_limit.map(|limit| start + limit);
     let guide = match input.mesh() {
         // The input's own `w` is the field unless it was thickened.
         Some(m) if !args.no_guide && thickened.is_none() => Some(SegmentBvh::of_field_mesh(m)),

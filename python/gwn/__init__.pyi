@@ -197,6 +197,7 @@ def remesh(
     planar_levels: int = 3,
     report: Literal[False] = False,
     samples: int = 10000,
+    time_limit: Optional[float] = None,
 ) -> Tuple[_F64, _I64]:
     """A closed, manifold, oriented surface of the solid w > 1/2 as (V float64 (n, 3), F int64 (m, 3)); simplify=False: the raw marching-tetrahedra surface; refine_plates=False keeps the lattice of res alone. remesh(model, res=...) of a StepModel takes no F."""
 
@@ -219,6 +220,7 @@ def remesh(
     planar_levels: int = 3,
     report: Literal[True],
     samples: int = 10000,
+    time_limit: Optional[float] = None,
 ) -> Tuple[_F64, _I64, dict]:
     """(V, F, report): the report a dict of what ``gwn remesh --report`` writes (closed, edge_manifold, vertex_manifold, oriented, euler_characteristic, components, self_intersections, hausdorff_boundary_cells, occupancy_agreement, seconds, ...); samples per surface and in the box for the distance and the agreement (0: neither)."""
 

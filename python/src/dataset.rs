@@ -19,7 +19,7 @@ use crate::errors::value_error;
 use crate::threads::{self, Threads};
 
 /// ``time_limit`` (seconds) as a duration: positive and finite (below 10⁹ s).
-fn time_limit_of(seconds: Option<f64>) -> PyResult<Option<Duration>> {
+pub(crate) fn time_limit_of(seconds: Option<f64>) -> PyResult<Option<Duration>> {
     match seconds {
         Some(s) if s.is_finite() && s > 0.0 && s < 1e9 => Ok(Some(Duration::from_secs_f64(s))),
         Some(s) => Err(PyValueError::new_err(format!(

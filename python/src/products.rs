@@ -439,9 +439,10 @@ pub fn filter_tets<'py>(
 /// count, sampled Hausdorff distance to the input and to where it bounds the solid, in world
 /// units and cells, occupancy agreement, the run's counters and ``seconds``), with ``samples``
 /// points per surface and in the box (default 10,000, at most 10,000,000; 0 measures neither
-/// the distance nor the agreement).
+/// the distance nor the agreement). ``time_limit`` (seconds) raises ``TimeoutError`` once the
+/// remesh runs past it (checked between its phases and rounds; the report is not limited).
 #[pyfunction]
-#[pyo3(signature = (V, F = None, res = 128, *, bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS, simplify = true, method = "exact", beta = None, order = None, tolerance = None, threads = None, thicken = None, refine_plates = true, sub_cell_levels = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS, planar_levels = gwn::products::remesh::DEFAULT_PLANAR_LEVELS, report = false, samples = 10_000))]
+#[pyo3(signature = (V, F = None, res = 128, *, bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS, simplify = true, method = "exact", beta = None, order = None, tolerance = None, threads = None, thicken = None, refine_plates = true, sub_cell_levels = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS, planar_levels = gwn::products::remesh::DEFAULT_PLANAR_LEVELS, report = false, samples = 10_000, time_limit = None))]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub fn remesh<'py>(
     py: Python<'py>,
@@ -461,6 +462,7 @@ pub fn remesh<'py>(
     planar_levels: u32,
     report: bool,
     samples: usize,
+    time_limit: Option<f64>,
 ) -> PyResult<Bound<'py, PyTuple>> {
     use gwn::products::remesh::report::{DistanceReference, RemeshReport};
 
@@ -478,7 +480,9 @@ pub fn remesh<'py>(
         planar_levels,
         probe_flatness: true,
         evaluator_crossings: true,
-        deadline: None,
+        // From the call: the arguments are checked and the mesh copied by now.
+        deadline: crate::dataset::time_limit_of(time_limit)?
+            .map(|limit| std::time::Instant::now() + limit),
     };
     let samples = if report { samples } else { 0 };
     RemeshReport::check_samples(samples)
@@ -522,7 +526,7 @@ pub fn remesh<'py>(
             });
             measured(out, &wn, request)
         })?
-        .map_err(value_error)?;
+        .map_err(remesh_error)?;
         return surface_tuple(py, out);
     }
     let Some(F) = F else {
@@ -586,8 +590,19 @@ pub fn remesh<'py>(
         });
         measured(out, field, request)
     })?
-    .map_err(value_error)?;
+    .map_err(remesh_error)?;
     surface_tuple(py, out)
+}
+
+/// A remesh's error as a Python exception: `TimeoutError` past ``time_limit``, else
+/// `ValueError`, with the library's message.
+fn remesh_error(e: Box<dyn std::error::Error + Send + Sync>) -> PyErr {
+    match e.downcast_ref::<gwn::products::remesh::RemeshError>() {
+        Some(gwn::products::remesh::RemeshError::TimeLimit { .. }) => {
+            pyo3::exceptions::PyTimeoutError::new_err(e.to_string())
+        }
+        _ => value_error(e),
+    }
 }
 
 /// What [`measured`] measures a remesh against, and the run's facts the report carries.

@@ -93,6 +93,17 @@ def test_remesh_dataset_bad_arguments_are_value_errors(tmp_path):
     assert not list((tmp_path / "t").rglob("*.ply"))
 
 
+def test_remesh_time_limit_is_a_timeout_error():
+    V, F = gwn.load(FIXTURES / "cube.off")
+    with pytest.raises(TimeoutError, match="the time limit ran out while "):
+        gwn.remesh(V, F, res=64, time_limit=1e-6)
+    with pytest.raises(ValueError, match="time_limit must be a positive"):
+        gwn.remesh(V, F, res=64, time_limit=0)
+    # A limit the run meets changes nothing.
+    np.testing.assert_array_equal(gwn.remesh(V, F, res=16, time_limit=3600)[1],
+                                  gwn.remesh(V, F, res=16)[1])
+
+
 def test_dask_remesh_matches_serial(tmp_path):
     try:
         from dask.distributed import Client, LocalCluster

@@ -220,6 +220,26 @@ fn remesh_dataset_cli() {
     let (ok, stdout, _) = run(&["--time-limit", "0.000001", "--format", "stl"]);
     assert!(ok);
     assert!(stdout.contains("1 failed, 3 timed out"), "{stdout}");
+    // `gwn remesh --time-limit`: one line naming the mesh and the phase, exit 1, no output.
+    let single = dir.join("single.ply");
+    let cube = fixture("cube.off");
+    let (ok, _, stderr) = gwn(&[
+        "remesh",
+        cube.to_str().unwrap(),
+        "--res",
+        "64",
+        "--time-limit",
+        "0.000001",
+        "--out",
+        single.to_str().unwrap(),
+    ]);
+    assert!(!ok);
+    assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.contains("cube.off: the time limit ran out while "),
+        "{stderr}"
+    );
+    assert!(!single.exists());
     let (ok, _, stderr) = run(&["--thicken-cells", "0"]);
     assert!(!ok);
     assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
