@@ -467,7 +467,8 @@ pub fn remesh<'py>(
     use gwn::products::remesh::report::{DistanceReference, RemeshReport};
 
     use gwn::products::remesh::{
-        RemeshOptions, crossings::SegmentBvh, remesh_guided, thicken::ThickenedSheets,
+        RemeshOptions, remesh_guided,
+        thicken::{self, ThickenedSheets},
     };
     let method = spec_of(method, beta, order, tolerance)?;
     let options = RemeshOptions {
@@ -555,29 +556,16 @@ pub fn remesh<'py>(
     let out = threads::run(py, threads, || {
         let wn = evaluator_for(&mesh, &method)?;
         let thick = thicken
-            .map(|eps| ThickenedSheets::new(&mesh, &wn, eps))
+            .map(|eps| ThickenedSheets::new(&mesh, &*wn, eps))
             .transpose()?;
         let start = std::time::Instant::now();
-        let (field, guide, bounds, reference): (&dyn gwn::eval::Evaluator, _, _, _) = match &thick {
-            // The slabs reach `eps` past the input's box (as in `gwn remesh`), and the input
-            // bounds nothing of their solid: every sample of the distance counts.
-            Some(t) => (
-                t,
-                SegmentBvh::of_mesh(&mesh),
-                gwn::BoundingBox {
-                    min: bounds.min.map(|x| x - t.eps()),
-                    max: bounds.max.map(|x| x + t.eps()),
-                },
-                DistanceReference::Mesh(&mesh),
-            ),
-            // The input's own `w` is the field: probes may be screened by an approximation.
-            None => (
-                &wn,
-                SegmentBvh::of_field_mesh(&mesh),
-                bounds,
-                DistanceReference::BoundingMesh(&mesh),
-            ),
-        };
+        // As `gwn remesh` sets it up (the box grown by the slabs, the distance's reference).
+        let thicken::MeshField {
+            field,
+            guide,
+            bounds,
+            reference,
+        } = thicken::of_mesh(&mesh, &*wn, thick.as_ref(), bounds);
         let out = remesh_guided(field, Some(&guide), bounds, &options, &|_| {})?;
         let seconds = start.elapsed().as_secs_f64();
         let request = report.then_some(ReportRequest {

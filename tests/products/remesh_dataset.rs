@@ -144,6 +144,17 @@ fn remesh_dataset_writes_what_gwn_remesh_writes_and_resumes() {
     let err = run_dataset(&job, &twice, &fresh, None, |_| {}).unwrap_err();
     assert!(matches!(err, DatasetError::Collision { .. }), "{err}");
     assert!(!fresh.exists());
+    // Thickened: the lone triangle becomes a closed slab (it bounded nothing before).
+    let thick = RemeshJob {
+        samples: 2000,
+        thicken_cells: Some(2.0),
+        ..RemeshJob::new(32)
+    };
+    let slab = run_dataset(&thick, &meshes[2..3], &dir.join("thick"), None, |_| {}).unwrap();
+    assert_eq!(slab[0].status, Status::Ok, "{slab:?}");
+    assert_eq!(slab[0].stats.get("valid"), Some("true"));
+    assert_eq!(slab[0].stats.get("components"), Some("1"));
+    assert!(slab[0].stats.count("output_faces").unwrap() > 0);
     // Unusable options: refused up front.
     let bad = RemeshJob {
         thicken_cells: Some(0.5),

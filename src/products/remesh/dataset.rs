@@ -27,9 +27,8 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use super::crossings::SegmentBvh;
-use super::report::{DistanceReference, RemeshReport};
-use super::thicken::ThickenedSheets;
+use super::report::RemeshReport;
+use super::thicken::{self, MeshField, ThickenedSheets};
 use super::write::{SurfaceFormat, write_surface};
 use super::{RemeshOptions, remesh_guided};
 use crate::io::{LoadOptions, load_mesh_with};
@@ -237,27 +236,12 @@ impl MeshJob for RemeshJob {
             .thicken_cells
             .map(|k| ThickenedSheets::new(&mesh, &*wn, k * cell))
             .transpose()?;
-        // As `gwn remesh` does: the input's own `w` is the field (the guide may screen probes
-        // by an approximation) unless it was thickened; slabs reach `eps` past the box, and the
-        // input bounds nothing of their solid.
-        let (field, guide, bounds, reference): (&dyn crate::eval::Evaluator, _, _, _) = match &thick
-        {
-            Some(t) => (
-                t,
-                SegmentBvh::of_mesh(&mesh),
-                crate::BoundingBox {
-                    min: bounds.min.map(|x| x - t.eps()),
-                    max: bounds.max.map(|x| x + t.eps()),
-                },
-                DistanceReference::Mesh(&mesh),
-            ),
-            None => (
-                &*wn,
-                SegmentBvh::of_field_mesh(&mesh),
-                bounds,
-                DistanceReference::BoundingMesh(&mesh),
-            ),
-        };
+        let MeshField {
+            field,
+            guide,
+            bounds,
+            reference,
+        } = thicken::of_mesh(&mesh, &*wn, thick.as_ref(), bounds);
         in_time("building the evaluator")?;
         let options = RemeshOptions {
             deadline: deadline.map(|(at, _)| at),

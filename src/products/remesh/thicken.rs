@@ -165,3 +165,49 @@ impl<E: Evaluator + ?Sized> Evaluator for ThickenedSheets<'_, E> {
         self.thicken_all(&points, w)
     }
 }
+
+/// What a remesh of a triangle mesh runs on, thickened or not: the field, the guide, the box
+/// and the reference of the report's distance ([`of_mesh`]).
+pub struct MeshField<'a> {
+    /// The mesh's own `w`, or the thickened sheets'.
+    pub field: &'a dyn Evaluator,
+    /// The input triangles, as the guide of [`super::remesh_guided`].
+    pub guide: super::crossings::SegmentBvh,
+    /// The box to remesh.
+    pub bounds: crate::BoundingBox,
+    /// What the report's Hausdorff distance measures against.
+    pub reference: super::report::DistanceReference<'a>,
+}
+
+/// The [`MeshField`] of `mesh` (bounding box `bounds`, own field `own`) as `gwn remesh` sets it
+/// up: without `sheets`, the mesh's own `w` is the field, so the guide may screen the thin-part
+/// probes by an approximation of it ([`super::crossings::SegmentBvh::of_field_mesh`]), and the
+/// distance is to where the mesh bounds the solid; with them, the slabs reach `eps` past the
+/// mesh's box (the box grows, or they would be capped by it) and the mesh bounds nothing of
+/// their solid, so every sample of the distance counts.
+pub fn of_mesh<'a>(
+    mesh: &'a crate::Mesh,
+    own: &'a (dyn Evaluator + 'a),
+    sheets: Option<&'a ThickenedSheets<'a, dyn Evaluator + 'a>>,
+    bounds: crate::BoundingBox,
+) -> MeshField<'a> {
+    use super::crossings::SegmentBvh;
+    use super::report::DistanceReference;
+    match sheets {
+        Some(t) => MeshField {
+            field: t,
+            guide: SegmentBvh::of_mesh(mesh),
+            bounds: crate::BoundingBox {
+                min: bounds.min.map(|x| x - t.eps()),
+                max: bounds.max.map(|x| x + t.eps()),
+            },
+            reference: DistanceReference::Mesh(mesh),
+        },
+        None => MeshField {
+            field: own,
+            guide: SegmentBvh::of_field_mesh(mesh),
+            bounds,
+            reference: DistanceReference::BoundingMesh(mesh),
+        },
+    }
+}
