@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use clap::Args as ClapArgs;
-use gwn::products::dataset::ManifestRow;
+use gwn::products::dataset::{ManifestRow, MeshJob, run_dataset};
 
 use crate::common::CliError;
 
@@ -53,6 +53,27 @@ impl DatasetInputs {
             return Err(CliError::msg("no meshes given (INPUTS or --list)"));
         }
         Ok(meshes)
+    }
+}
+
+impl DatasetInputs {
+    /// Runs `job` over the inputs into `out` with a progress bar named `name`: the rows and the
+    /// wall time in seconds.
+    pub fn run<J: MeshJob>(
+        &self,
+        job: &J,
+        out: &Path,
+        name: &str,
+    ) -> Result<(Vec<ManifestRow>, f64), CliError> {
+        let meshes = self.meshes()?;
+        let pb = crate::common::progress(meshes.len() as u64, name);
+        let start = std::time::Instant::now();
+        let rows = run_dataset(job, &meshes, out, self.root.as_deref(), |row| {
+            pb.set_message(row.mesh.display().to_string());
+            pb.inc(1);
+        })?;
+        pb.finish_and_clear();
+        Ok((rows, start.elapsed().as_secs_f64()))
     }
 }
 

@@ -2,13 +2,12 @@
 //! mesh, a manifest).
 
 use std::path::PathBuf;
-use std::time::Instant;
 
 use clap::Args as ClapArgs;
 use gwn::products::dataset::Status;
-use gwn::products::label::{JobOptions, SamplingOptions, label_dataset};
+use gwn::products::label::{JobOptions, SamplingOptions};
 
-use crate::common::{CliError, outln, progress};
+use crate::common::{CliError, outln};
 use crate::dataset::{DatasetInputs, print_problems, time_limit};
 
 /// Label a dataset of meshes for learning: per mesh, sample points uniform in the padded bounding
@@ -59,7 +58,6 @@ pub struct Args {
 
 /// Runs `gwn label`.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let meshes = args.inputs.meshes()?;
     let time_limit = time_limit(args.time_limit)?;
     let opts = JobOptions {
         sampling: SamplingOptions {
@@ -74,20 +72,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             weld: if args.no_weld { Some(false) } else { None },
         },
     };
-    let pb = progress(meshes.len() as u64, "label");
-    let start = Instant::now();
-    let rows = label_dataset(
-        &meshes,
-        &args.out,
-        args.inputs.root.as_deref(),
-        &opts,
-        |row| {
-            pb.set_message(row.mesh.display().to_string());
-            pb.inc(1);
-        },
-    )?;
-    pb.finish_and_clear();
-    let secs = start.elapsed().as_secs_f64();
+    let (rows, secs) = args.inputs.run(&opts, &args.out, "label")?;
     let count = |s: Status| rows.iter().filter(|r| r.status == s).count();
     let points: usize = rows.iter().filter_map(|r| r.stats.count("points")).sum();
     let ok = count(Status::Ok);

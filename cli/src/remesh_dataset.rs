@@ -2,14 +2,13 @@
 //! `gwn::products::remesh::dataset`).
 
 use std::path::PathBuf;
-use std::time::Instant;
 
 use clap::Args as ClapArgs;
-use gwn::products::dataset::{Status, run_dataset};
+use gwn::products::dataset::Status;
 use gwn::products::remesh::dataset::RemeshJob;
 use gwn::products::remesh::write::SurfaceFormat;
 
-use crate::common::{CliError, outln, progress};
+use crate::common::{CliError, outln};
 use crate::dataset::{DatasetInputs, print_problems, time_limit};
 use crate::remesh::RemeshKnobs;
 
@@ -82,21 +81,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             weld: if args.no_weld { Some(false) } else { None },
         },
     };
-    let meshes = args.inputs.meshes()?;
-    let pb = progress(meshes.len() as u64, "remesh");
-    let start = Instant::now();
-    let rows = run_dataset(
-        &job,
-        &meshes,
-        &args.out,
-        args.inputs.root.as_deref(),
-        |row| {
-            pb.set_message(row.mesh.display().to_string());
-            pb.inc(1);
-        },
-    )?;
-    pb.finish_and_clear();
-    let secs = start.elapsed().as_secs_f64();
+    let (rows, secs) = args.inputs.run(&job, &args.out, "remesh")?;
     let count = |s: Status| rows.iter().filter(|r| r.status == s).count();
     let valid = rows
         .iter()
