@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use clap::Args as ClapArgs;
 use gwn::products::remesh::crossings::SegmentBvh;
 use gwn::products::remesh::report::{
-    DistanceReference, RemeshReport, ReportPhase, patch_surface_for_distance,
+    DistanceReference, PhaseClock, RemeshReport, ReportPhase, patch_surface_for_distance,
     step_surface_for_distance,
 };
 use gwn::products::remesh::simplify::SimplifyOptions;
@@ -136,7 +136,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
         Some(m) if !args.no_guide => Some(SegmentBvh::of_mesh(m)),
         _ => None,
     };
+    let clock = PhaseClock::start();
     let announce = |phase: gwn::products::remesh::RemeshPhase| {
+        clock.mark(phase);
         bar.set_message(phase.name());
         if phase != gwn::products::remesh::RemeshPhase::Classify {
             bar.inc(1);
@@ -145,6 +147,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let mut out = remesh_guided(wn, guide.as_ref(), bounds, &options, &announce)
         .map_err(|e| CliError(format!("{}: {e}", args.mesh.display())))?;
     let secs = start.elapsed().as_secs_f64();
+    let phase_seconds = clock.seconds();
     bar.inc(1);
     bar.set_message("writing");
     let file = std::fs::File::create(&args.out)
@@ -185,6 +188,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     )
     .map_err(|e| CliError::msg(format!("--samples: {e}")))?;
     report.seconds = secs;
+    report.phase_seconds = Some(phase_seconds);
     report.thicken = thickened.as_ref().map(|t| t.eps());
     drop(curved_surface);
     let topology = report.topology;
@@ -209,6 +213,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
         s.classified_points,
         s.band_cells
     )?;
+    let phases: Vec<String> = phase_seconds
+        .named()
+        .iter()
+        .map(|(name, s)| format!("{name} {s:.2}"))
+        .collect();
+    outln!("seconds by phase: {}", phases.join(", "))?;
     if options.sub_cell_levels > 0 {
         outln!(
             "sub-cell levels: {} ({} cells crossed by the input with agreeing corners refined)",

@@ -464,7 +464,7 @@ pub fn remesh<'py>(
     samples: usize,
     time_limit: Option<f64>,
 ) -> PyResult<Bound<'py, PyTuple>> {
-    use gwn::products::remesh::report::{DistanceReference, RemeshReport};
+    use gwn::products::remesh::report::{DistanceReference, PhaseClock, RemeshReport};
 
     use gwn::products::remesh::{
         RemeshOptions, remesh_guided,
@@ -507,8 +507,10 @@ pub fn remesh<'py>(
         let out = threads::run(py, threads, || {
             let wn = crate::evaluator::step_evaluator(model, &method)?;
             let start = std::time::Instant::now();
-            let out = remesh_guided(&wn, None, bounds, &options, &|_| {})?;
+            let clock = PhaseClock::start();
+            let out = remesh_guided(&wn, None, bounds, &options, &|phase| clock.mark(phase))?;
             let seconds = start.elapsed().as_secs_f64();
+            let phase_seconds = clock.seconds();
             let curved = (report && samples > 0)
                 .then(|| {
                     gwn::products::remesh::report::step_surface_for_distance(model, out.cell_size)
@@ -523,6 +525,7 @@ pub fn remesh<'py>(
                 bounds,
                 samples,
                 seconds,
+                phase_seconds,
                 thicken: None,
             });
             measured(out, &wn, request)
@@ -566,14 +569,19 @@ pub fn remesh<'py>(
             bounds,
             reference,
         } = thicken::of_mesh(&mesh, &*wn, thick.as_ref(), bounds);
-        let out = remesh_guided(field, Some(&guide), bounds, &options, &|_| {})?;
+        let clock = PhaseClock::start();
+        let out = remesh_guided(field, Some(&guide), bounds, &options, &|phase| {
+            clock.mark(phase)
+        })?;
         let seconds = start.elapsed().as_secs_f64();
+        let phase_seconds = clock.seconds();
         let request = report.then_some(ReportRequest {
             options: &options,
             reference,
             bounds,
             samples,
             seconds,
+            phase_seconds,
             thicken,
         });
         measured(out, field, request)
@@ -600,6 +608,7 @@ struct ReportRequest<'a> {
     bounds: gwn::BoundingBox,
     samples: usize,
     seconds: f64,
+    phase_seconds: gwn::products::remesh::report::PhaseSeconds,
     thicken: Option<f64>,
 }
 
@@ -634,6 +643,7 @@ fn measured<E: gwn::eval::Evaluator + ?Sized>(
         &|_| {},
     )?;
     report.seconds = r.seconds;
+    report.phase_seconds = Some(r.phase_seconds);
     report.thicken = r.thicken;
     Ok((
         surface.positions().to_vec(),

@@ -124,6 +124,8 @@ pub struct RemeshReport {
     pub method: String,
     /// Seconds of the remesh itself (set by the caller that timed it; 0 otherwise).
     pub seconds: f64,
+    /// The same by phase (set by a caller that timed them with a [`super::PhaseClock`]).
+    pub phase_seconds: Option<super::PhaseSeconds>,
     /// Half-thickness of thickened sheets, if the field was a thickened one.
     pub thicken: Option<f64>,
 }
@@ -246,6 +248,7 @@ impl RemeshReport {
             stats: out.stats,
             method: field.name().to_string(),
             seconds: 0.0,
+            phase_seconds: None,
             thicken: None,
         })
     }
@@ -273,6 +276,11 @@ impl RemeshReport {
             ),
             ("plate_thin_fraction", triple(s.plates.thin_fraction)),
             ("seconds", format!("{:.3}", self.seconds)),
+        ];
+        if let Some(phases) = &self.phase_seconds {
+            members.push(("phase_seconds", phases.to_json()));
+        }
+        members.extend([
             ("classified_points", s.classified_points.to_string()),
             ("band_cells", s.band_cells.to_string()),
             ("sub_cell_levels", self.sub_cell_levels.to_string()),
@@ -299,7 +307,7 @@ impl RemeshReport {
             ),
             ("diagonals_kept", s.simplify.diagonals_left.to_string()),
             ("relocated_vertices", s.simplify.relocated.to_string()),
-        ];
+        ]);
         match &self.self_intersections {
             Ok(r) => {
                 members.push(("self_intersections", r.pairs.to_string()));

@@ -8,10 +8,12 @@
 use rayon::prelude::*;
 
 mod measure;
+mod timing;
 pub use measure::{
     AGREEMENT_SEED, DistanceReference, HAUSDORFF_SEED, MAX_SAMPLES, RemeshReport, ReportPhase,
     SIDE_TEST_OFFSET_CELLS, TooManySamples,
 };
+pub use timing::{PhaseClock, PhaseSeconds};
 
 /// The topology of a triangle surface.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
