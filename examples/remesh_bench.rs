@@ -90,6 +90,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 } else {
                     place::CrossingSource::None
                 },
+                None,
             );
             let t3 = Instant::now();
             let (positions, triangles) = if simplified {

@@ -50,6 +50,7 @@ fn build(mesh_path: &PathBuf, res: usize) -> Result<Surface, Box<dyn std::error:
         &classified.edge_values(&band.edges),
         DEFAULT_BISECTION_STEPS,
         place::CrossingSource::Triangles(&guide),
+        None,
     );
     let planes = placed
         .planes_in_lattice_units(&lattice)

@@ -319,3 +319,62 @@ fn remesh_stops_at_its_deadline_without_an_output() {
         assert!(!dir.join("out").join(&row.output).exists());
     }
 }
+
+/// A field whose evaluations are slow (as next to a long signed boundary), and that counts
+/// those that begin after a deadline.
+struct SlowField {
+    deadline: std::time::Instant,
+    after: std::sync::atomic::AtomicUsize,
+    before: std::sync::atomic::AtomicUsize,
+}
+
+impl gwn::eval::Evaluator for SlowField {
+    fn eval(&self, q: [f64; 3]) -> f64 {
+        use std::sync::atomic::Ordering::Relaxed;
+        if std::time::Instant::now() > self.deadline {
+            self.after.fetch_add(1, Relaxed);
+        } else {
+            self.before.fetch_add(1, Relaxed);
+        }
+        std::thread::sleep(std::time::Duration::from_micros(20));
+        // A ball of radius 0.3.
+        let r2: f64 = q.iter().map(|c| (c - 0.5) * (c - 0.5)).sum();
+        if r2 < 0.09 { 1.0 } else { 0.0 }
+    }
+}
+
+#[test]
+fn remesh_evaluates_little_past_its_deadline() {
+    use gwn::products::remesh::{RemeshError, RemeshOptions, remesh_guided};
+    // The coarse grid alone is 33³ points, ~0.4 s of this field on two threads: one batch that
+    // used to run to its end whatever the deadline.
+    let deadline = std::time::Instant::now() + std::time::Duration::from_millis(50);
+    let field = SlowField {
+        deadline,
+        after: Default::default(),
+        before: Default::default(),
+    };
+    let bounds = gwn::BoundingBox {
+        min: [0.0; 3],
+        max: [1.0; 3],
+    };
+    let options = RemeshOptions {
+        deadline: Some(deadline),
+        ..RemeshOptions::with_resolution(128)
+    };
+    let out = remesh_guided(&field, None, bounds, &options, &|_| {});
+    assert!(
+        matches!(out, Err(RemeshError::TimeLimit { .. })),
+        "{:?}",
+        out.map(|r| r.triangles.len())
+    );
+    let (before, after) = (
+        field.before.load(std::sync::atomic::Ordering::Relaxed),
+        field.after.load(std::sync::atomic::Ordering::Relaxed),
+    );
+    // At most the chunk under way when the deadline passed (4096 points) went on.
+    assert!(
+        after <= 4096,
+        "{before} evaluations before the deadline, {after} after"
+    );
+}

@@ -263,11 +263,13 @@ impl MeshJob for RemeshJob {
         let positions = std::mem::take(&mut out.positions);
         let triangles = std::mem::take(&mut out.triangles);
         let surface = Mesh::new(positions, triangles)?;
+        // The agreement's and the distance's side tests evaluate `w` too: stopped at the
+        // deadline like the remesh, the report then discarded by the check below.
         let report = RemeshReport::measure(
             &out,
             &surface,
             &self.options,
-            field,
+            &super::deadline::Deadlined::new(field, deadline.map(|(at, _)| at)),
             reference,
             bounds,
             self.samples,

@@ -51,6 +51,7 @@
 
 pub mod crossings;
 pub mod dataset;
+mod deadline;
 pub mod extract;
 pub mod flatness;
 pub mod intersect;
@@ -460,6 +461,9 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
             }
         }
     }
+    // Every evaluation below stops at the deadline (NaN after it). All of them are made before
+    // placement ends, which checks the clock, so those values never reach a surface.
+    let evaluator = &deadline::Deadlined::new(evaluator, options.deadline);
     let mut lattice =
         lattice::Lattice::new(bounds, options.resolution).ok_or(RemeshError::BadBounds)?;
     // The unit of distances in cells stays the resolution's cell whatever the plates refine.
@@ -545,6 +549,7 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
             None if options.evaluator_crossings => place::CrossingSource::Evaluator,
             None => place::CrossingSource::None,
         },
+        options.deadline,
     );
     let mut stats = RemeshStats {
         lattice_cells: lattice.cells,

@@ -281,8 +281,9 @@ pub enum Stop {
 }
 
 /// Classifies the lattice (see the [module documentation](self)); [`Stop::TooManyPoints`] as
-/// soon as more than `max_points` lattice points would be classified, [`Stop::TimeLimit`] at
-/// the first split round that starts after `deadline`. `guide`: the input triangles, whose cells
+/// soon as more than `max_points` lattice points would be classified, [`Stop::TimeLimit`]
+/// within one chunk of evaluations (4096 points) or one split round's
+/// bookkeeping after `deadline`. `guide`: the input triangles, whose cells
 /// are refined to the regular level too (and below it where a part is thinner than a cell,
 /// when the lattice has [`Lattice::sub_levels`]).
 pub fn classify<E: Evaluator + ?Sized>(
@@ -296,6 +297,10 @@ pub fn classify<E: Evaluator + ?Sized>(
         lattice.resolution_level() <= MAX_SUB_LEVELS && lattice.planar_levels <= MAX_PLANAR_LEVELS,
         "sub-levels beyond MAX_SUB_LEVELS or planar levels beyond MAX_PLANAR_LEVELS"
     );
+    // Each batch stops at the deadline too (a round of a fine lattice is millions of points,
+    // seconds of work on an inconsistently oriented input); its NaN answers are discarded by
+    // the round's check that follows.
+    let evaluator = &super::deadline::Deadlined::new(evaluator, deadline);
     let mut out = Classified::default();
     let levels = lattice.levels;
     let regular = lattice.sub_levels;
@@ -568,6 +573,10 @@ pub fn classify<E: Evaluator + ?Sized>(
     out.band = band;
     out.fine_band = fine_band;
     out.transition = transition;
+    // Past the deadline some values above may be the deadlined evaluator's NaN.
+    if deadline.is_some_and(|at| std::time::Instant::now() > at) {
+        return Err(Stop::TimeLimit);
+    }
     Ok(out)
 }
 
@@ -954,7 +963,7 @@ impl Classified {
                 .par_iter()
                 .map(|&p| lattice.corner_position(p))
                 .collect();
-            let values = values_by_chunks(evaluator, &positions, deadline)?;
+            let values = super::levels::decisive_corner_values(evaluator, &positions);
             out.labels.reserve(new_points.len());
             for &p in &new_points {
                 out.labels.insert(pack(p), CornerValue::BORDER);
@@ -999,29 +1008,6 @@ impl Classified {
         }
         Ok(())
     }
-}
-
-/// Points per batch of [`values_by_chunks`]: a round of a fine lattice classifies millions of
-/// points (seconds of work on an inconsistently oriented input), and the deadline is checked
-/// between batches; this many keep both threads busy and cut few columns of the ray reuse.
-const DEADLINE_CHUNK: usize = 1 << 17;
-
-/// [`super::levels::decisive_corner_values`] of `positions`, [`DEADLINE_CHUNK`] at a time with
-/// `deadline` checked before each. The values are per point (the evaluator's batches give the
-/// bits of point-by-point evaluation), so the chunks change nothing but where the run can stop.
-fn values_by_chunks<E: Evaluator + ?Sized>(
-    evaluator: &E,
-    positions: &[[f64; 3]],
-    deadline: Option<std::time::Instant>,
-) -> Result<Vec<(f64, bool)>, Stop> {
-    let mut values = Vec::with_capacity(positions.len());
-    for chunk in positions.chunks(DEADLINE_CHUNK) {
-        if deadline.is_some_and(|at| std::time::Instant::now() > at) {
-            return Err(Stop::TimeLimit);
-        }
-        values.extend(super::levels::decisive_corner_values(evaluator, chunk));
-    }
-    Ok(values)
 }
 
 /// Whether `w` is at least `margin` from ½ (NaN, at border points: no).

@@ -248,6 +248,7 @@ pub fn place_vertices<E: Evaluator + ?Sized>(
     corner_w: &[[f64; 2]],
     steps: u32,
     guide: CrossingSource,
+    deadline: Option<std::time::Instant>,
 ) -> Placement {
     assert_eq!(edges.len(), corner_w.len());
     let ticks: i64 = 1 << (steps + 1);
@@ -347,7 +348,10 @@ pub fn place_vertices<E: Evaluator + ?Sized>(
         .collect();
     let mut evaluations = 0;
     let mut probes: Vec<(u32, i64)> = Vec::new();
-    loop {
+    // Past the deadline the caller discards the placement (`RemeshError::TimeLimit`): the
+    // rounds stop, since a deadlined evaluator's NaN would only walk each bracket down a tick
+    // per round.
+    while deadline.is_none_or(|at| std::time::Instant::now() <= at) {
         probes.clear();
         for (j, s) in searches.iter_mut().enumerate() {
             if !s.is_open() {
@@ -540,7 +544,7 @@ mod tests {
         edges
             .iter()
             .map(|&(e, w)| {
-                let p = place_vertices(field, lattice, &[e], &[w], STEPS, guide);
+                let p = place_vertices(field, lattice, &[e], &[w], STEPS, guide, None);
                 assert_within_a_tick_of_a_change(field, lattice, e, p.fixed[0]);
                 p.evaluations
             })
@@ -587,7 +591,7 @@ mod tests {
         );
         // All at once gives the same vertices as one by one (each edge's search is its own).
         let (e, w): (Vec<_>, Vec<_>) = edges.iter().copied().unzip();
-        let together = place_vertices(&field, &lattice, &e, &w, STEPS, CrossingSource::None);
+        let together = place_vertices(&field, &lattice, &e, &w, STEPS, CrossingSource::None, None);
         assert_eq!(together.evaluations, total);
         for (&edge, &fixed) in e.iter().zip(&together.fixed) {
             assert_within_a_tick_of_a_change(&field, &lattice, edge, fixed);
@@ -652,7 +656,15 @@ mod tests {
         // Right proposals: two evaluations per vertex (one next to an end of the edge), every
         // vertex verified, with the sphere's tangent plane (the normal at the crossing, and
         // the plane through it).
-        let p = place_vertices(&exact, &lattice, &e, &w, STEPS, CrossingSource::Evaluator);
+        let p = place_vertices(
+            &exact,
+            &lattice,
+            &e,
+            &w,
+            STEPS,
+            CrossingSource::Evaluator,
+            None,
+        );
         assert_eq!(p.guided, e.len());
         assert!(p.evaluations <= 2 * e.len(), "{}", p.evaluations);
         for ((&edge, &fixed), plane) in e.iter().zip(&p.fixed).zip(&p.planes) {
@@ -663,7 +675,7 @@ mod tests {
             assert!((((a + b + c) * 0.5 + d).abs() - 0.31).abs() < 1e-9);
         }
         // Without them, the field's search: bisection across a closed sheet, 8 per vertex.
-        let none = place_vertices(&exact, &lattice, &e, &w, STEPS, CrossingSource::None);
+        let none = place_vertices(&exact, &lattice, &e, &w, STEPS, CrossingSource::None, None);
         assert_eq!(
             (none.guided, none.evaluations),
             (0, STEPS as usize * e.len())
@@ -674,7 +686,15 @@ mod tests {
         let tick = lattice.h[0] / TICKS as f64;
         for error in [3.0 * tick, -3.0 * tick] {
             let off = BallWithCrossings { r: 0.31, error };
-            let p = place_vertices(&off, &lattice, &e, &w, STEPS, CrossingSource::Evaluator);
+            let p = place_vertices(
+                &off,
+                &lattice,
+                &e,
+                &w,
+                STEPS,
+                CrossingSource::Evaluator,
+                None,
+            );
             assert!(p.guided < e.len() / 10, "{} of {}", p.guided, e.len());
             assert!(p.evaluations <= (STEPS as usize + 2) * e.len());
             for (&edge, &fixed) in e.iter().zip(&p.fixed) {
@@ -741,7 +761,15 @@ mod tests {
             edge: (Corner, Corner),
         ) -> Placement {
             let w = [[0.7, f64::NAN]];
-            place_vertices(field, lattice, &[edge], &w, STEPS, CrossingSource::None)
+            place_vertices(
+                field,
+                lattice,
+                &[edge],
+                &w,
+                STEPS,
+                CrossingSource::None,
+                None,
+            )
         }
         let p = place_from_border(&field, &lattice, edge);
         assert_eq!(p.evaluations, 1);
@@ -778,8 +806,17 @@ mod tests {
                 0.0
             }
         });
-        let place =
-            |source| place_vertices(&field, &lattice, &[edge], &[[1.0, 0.0]], STEPS, source);
+        let place = |source| {
+            place_vertices(
+                &field,
+                &lattice,
+                &[edge],
+                &[[1.0, 0.0]],
+                STEPS,
+                source,
+                None,
+            )
+        };
         let p = place(CrossingSource::Triangles(&guide));
         assert_eq!((p.evaluations, p.guided), (3, 1));
         assert_within_a_tick_of_a_change(&field, &lattice, edge, p.fixed[0]);

@@ -441,6 +441,7 @@ mod tests {
             &classified.edge_values(&band.edges),
             8,
             place::CrossingSource::Triangles(&guide),
+            None,
         );
         let planes = placed.planes_in_lattice_units(&lattice);
         assert!(planes.iter().filter(|p| p.is_some()).count() * 2 > planes.len());
