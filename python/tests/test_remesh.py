@@ -179,7 +179,8 @@ def test_a_step_model_remeshes_like_the_cli(cli, tmp_path):
     _, Fr, report = gwn.remesh(model, res=12, report=True, samples=2000)
     np.testing.assert_array_equal(Fr, F)
     want = json.loads(json_path.read_text())
-    report.pop("seconds"), want.pop("seconds")
+    for timing in ["seconds", "phase_seconds"]:
+        report.pop(timing), want.pop(timing)
     assert report == want
     assert report["hausdorff_reference_segment_cells"] <= 0.5
     assert report["hausdorff_boundary_cells"] < 1 and report["closed"]
@@ -200,6 +201,9 @@ def test_report_measures_the_surface_it_returns():
     assert report["closed"] and report["edge_manifold"] and report["vertex_manifold"]
     assert report["oriented"] and report["euler_characteristic"] == 2
     assert report["components"] == 1 and report["self_intersections"] == 0
+    phases = report["phase_seconds"]
+    assert list(phases) == ["probes", "classify", "extract", "place", "simplify"]
+    assert all(s >= 0 for s in phases.values()) and sum(phases.values()) <= report["seconds"] + 0.01
     cell = report["cell_size"]
     assert abs(cell - 1 / 16) < 1e-12 and report["resolution"] == 16
     # Every cube face bounds the solid; the output's chords stay within a cell of it.

@@ -46,9 +46,11 @@ fn remesh_writes_every_format_and_a_report() {
             "\"marching_tetrahedra_faces\": ",
             "\"marching_cubes_faces\": ",
             "\"collapses\": ",
+            "\"phase_seconds\": {\"probes\": ",
         ] {
             assert!(json.contains(member), "{member} not in {json}");
         }
+        assert!(stdout.contains("seconds by phase: probes "), "{stdout}");
         // STL has no shared vertices: weld when reading back (the loader does for STL).
         let back = gwn::io::load_mesh(&out).unwrap().mesh;
         let r =
