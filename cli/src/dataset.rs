@@ -13,7 +13,9 @@ use crate::common::CliError;
 /// The meshes of a dataset job.
 #[derive(ClapArgs, Debug)]
 pub struct DatasetInputs {
-    /// Mesh files or folders (every .obj/.stl/.off/.ply/.gltf/.glb below, recursively, sorted).
+    /// Input files or folders: every file below that the command reads, recursively, sorted
+    /// (meshes: .obj/.stl/.off/.ply/.gltf/.glb; gwn remesh-dataset also takes STEP models
+    /// .step/.stp and patch sets .bpt/.rbpt, and point clouds named one by one or in --list).
     pub inputs: Vec<PathBuf>,
     /// A text file with one mesh path per line (added to INPUTS; blank lines and # comments skipped).
     #[arg(long)]
@@ -25,15 +27,16 @@ pub struct DatasetInputs {
 }
 
 impl DatasetInputs {
-    /// The mesh files, folders walked in sorted order, then the list's; an error when none.
-    pub fn meshes(&self) -> Result<Vec<PathBuf>, CliError> {
+    /// The input files, folders walked in sorted order (the files `walks` takes), then the
+    /// list's; an error when none.
+    pub fn meshes(&self, walks: &dyn Fn(&Path) -> bool) -> Result<Vec<PathBuf>, CliError> {
         let mut meshes = Vec::new();
         let mut walked = HashSet::new();
         for p in &self.inputs {
             if p.is_dir() {
                 let mut linked = VecDeque::from([p.clone()]);
                 while let Some(dir) = linked.pop_front() {
-                    collect_meshes(&dir, &mut meshes, &mut walked, &mut linked)?;
+                    collect_meshes(&dir, walks, &mut meshes, &mut walked, &mut linked)?;
                 }
             } else {
                 meshes.push(p.clone());
@@ -65,7 +68,7 @@ impl DatasetInputs {
         out: &Path,
         name: &str,
     ) -> Result<(Vec<ManifestRow>, f64), CliError> {
-        let meshes = self.meshes()?;
+        let meshes = self.meshes(&|p| job.walks(p))?;
         let pb = crate::common::progress(meshes.len() as u64, name);
         let start = std::time::Instant::now();
         let rows = run_dataset(job, &meshes, out, self.root.as_deref(), |row| {
@@ -107,7 +110,7 @@ pub fn print_problems(command: &str, rows: &[ManifestRow]) {
     }
 }
 
-/// Every mesh file below `dir` (known extensions), recursively, sorted; folders reached through a
+/// Every file below `dir` that `walks` takes (by extension), recursively, sorted; folders reached through a
 /// symlink are put on `linked` for later, so a file is named by its real path when the walk
 /// reaches it both ways. Each real folder is walked once (`walked` holds canonical paths): a link
 /// to an ancestor cannot loop, and two links to one folder do not list its files twice. Files
@@ -115,6 +118,7 @@ pub fn print_problems(command: &str, rows: &[ManifestRow]) {
 /// opening it.
 fn collect_meshes(
     dir: &Path,
+    walks: &dyn Fn(&Path) -> bool,
     out: &mut Vec<PathBuf>,
     walked: &mut HashSet<PathBuf>,
     linked: &mut VecDeque<PathBuf>,
@@ -136,9 +140,9 @@ fn collect_meshes(
             {
                 linked.push_back(p);
             } else {
-                collect_meshes(&p, out, walked, linked)?;
+                collect_meshes(&p, walks, out, walked, linked)?;
             }
-        } else if gwn::io::format_from_extension(&p).is_some() {
+        } else if walks(&p) {
             out.push(p);
         }
     }

@@ -5,8 +5,7 @@ use std::path::PathBuf;
 use clap::Args as ClapArgs;
 use gwn::products::remesh::crossings::SegmentBvh;
 use gwn::products::remesh::report::{
-    DistanceReference, PhaseClock, RemeshReport, ReportPhase, patch_surface_for_distance,
-    step_surface_for_distance,
+    DistanceReference, PhaseClock, RemeshReport, ReportPhase, curved_surface_for_distance,
 };
 use gwn::products::remesh::simplify::SimplifyOptions;
 use gwn::products::remesh::thicken::ThickenedSheets;
@@ -159,12 +158,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .map_err(|e| CliError(format!("{}: {e}", args.out.display())))?;
     // Curved inputs are measured against a tessellation within a small fraction of a cell
     // (`patch_surface_for_distance`, `step_surface_for_distance`).
-    let curved_surface = match &input {
-        _ if args.samples == 0 => None,
-        gwn::input::Input::Patches(set) => patch_surface_for_distance(set, out.cell_size),
-        gwn::input::Input::Step(model) => step_surface_for_distance(model, out.cell_size),
-        _ => None,
-    };
+    let curved_surface = (args.samples > 0)
+        .then(|| curved_surface_for_distance(&input, out.cell_size))
+        .flatten();
     // Thickened sheets bound nothing of the slabs' solid: their distance counts every sample.
     let reference = match (input.mesh(), &curved_surface) {
         (Some(m), _) if thickened.is_none() => DistanceReference::BoundingMesh(m),

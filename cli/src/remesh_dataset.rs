@@ -12,21 +12,26 @@ use crate::common::{CliError, outln};
 use crate::dataset::{DatasetInputs, print_problems, time_limit};
 use crate::remesh::RemeshKnobs;
 
-/// Remesh a dataset at w = 1/2: per mesh, the closed, edge- and vertex-manifold, oriented surface
-/// of `gwn remesh` (exact w, the input triangles as the guide), written to
-/// OUT/<path below the root>.FORMAT. OUT/manifest.jsonl gets one JSON line per mesh: status
-/// ok / done / failed / timeout, the error, the input's faces and vertices, the output's, whether it is
-/// valid (closed, manifold, oriented, no exact self-intersection), its components, the
-/// self-intersecting face pairs, the Hausdorff distance in finest cells to where the input bounds
-/// the solid and the occupancy agreement (both sampled; null with --samples 0), seconds.
+/// Remesh a dataset at w = 1/2: per input, the closed, edge- and vertex-manifold, oriented surface
+/// of `gwn remesh` (meshes and soups: exact w, the input triangles as the guide; STEP models and
+/// patch sets: their own evaluator, vertices at their surface hits; oriented point clouds: the
+/// fast evaluator), written to OUT/<path below the root>.FORMAT. OUT/manifest.jsonl gets one
+/// JSON line per input: status ok / done / failed / timeout, the error, the input's kind, faces
+/// (triangles, patches or B-rep faces) and vertices (mesh vertices or points), the output's
+/// faces and vertices, whether it is valid (closed, manifold, oriented, no exact
+/// self-intersection), its components, the self-intersecting face pairs, the Hausdorff distance
+/// in finest cells to where the input bounds the solid (to a fine tessellation of a curved one;
+/// none for point clouds) and the occupancy agreement (both sampled; null with --samples 0),
+/// seconds.
 ///
-/// Meshes run one after the other, each on every thread. Resumable as `gwn label` is: an
+/// Inputs run one after the other, each on every thread. Resumable as `gwn label` is: an
 /// existing output is reused only when its record (.meta.json beside it) shows the same options
 /// and input size and time; otherwise it is redone and the manifest says why. Broken files,
 /// FIFOs and devices are manifest rows; two inputs with one output are refused up front; the exit
-/// code is 0 unless the job itself cannot run. --time-limit makes a mesh that runs past it a
-/// timeout row (the remesher checks it between phases and rounds); memory is bounded anyway (a
-/// mesh that needs more than the machine has is a failed row).
+/// code is 0 unless the job itself cannot run. --time-limit makes an input that runs past it a
+/// timeout row (checked between the remesher's phases and rounds and between chunks of 4096
+/// evaluations); memory is bounded anyway (an input that needs more than the machine has is a
+/// failed row).
 ///
 /// Example: gwn remesh-dataset ../shared/meshes --out closed --res 128 --samples 0
 #[derive(ClapArgs, Debug)]
@@ -48,10 +53,12 @@ pub struct Args {
     #[arg(long, default_value_t = 10_000)]
     pub samples: usize,
     /// Close open sheets into slabs of this half-thickness, in finest cells (at least 1): in
-    /// cells, since a dataset's meshes come at any scale. Off by default.
+    /// cells, since a dataset's meshes come at any scale. Off by default; meshes only (other
+    /// inputs are then failed rows).
     #[arg(long, value_name = "CELLS")]
     pub thicken_cells: Option<f64>,
-    /// Per-mesh time limit in seconds (checked between the remesher's phases and rounds).
+    /// Per-input time limit in seconds (checked between the remesher's phases and rounds, and
+    /// between chunks of 4096 evaluations).
     #[arg(long)]
     pub time_limit: Option<f64>,
     /// Do not weld STL and glTF vertices.
@@ -91,7 +98,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .count();
     let redone = rows.iter().filter(|r| r.redone.is_some()).count();
     outln!(
-        "remeshed {} meshes ({} done before, {redone} redone, {} failed, {} timed out) in \
+        "remeshed {} inputs ({} done before, {redone} redone, {} failed, {} timed out) in \
          {secs:.3} s; {valid} outputs valid (closed, manifold, oriented, no self-intersection); \
          manifest: {}",
         count(Status::Ok),

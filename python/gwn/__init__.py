@@ -141,15 +141,16 @@ def remesh_dataset(paths, out_dir, res=128, *, root=None, format="ply", samples=
                    thicken_cells=None, weld=None, time_limit=None, bisect=None, simplify=True,
                    refine_plates=True, sub_cell_levels=None, planar_levels=None, threads=None,
                    progress=None):
-    """Remeshes a dataset of meshes at w = 1/2, exactly as ``gwn remesh-dataset`` does.
+    """Remeshes a dataset at w = 1/2, exactly as ``gwn remesh-dataset`` does.
 
-    Per mesh: the closed, edge- and vertex-manifold, oriented surface ``gwn.remesh`` makes at
-    ``res`` (exact w, the input triangles as the guide; the same bytes ``gwn remesh`` writes),
-    written to ``out_dir/<path below root>.<format>`` (``obj``, ``ply``, ``stl`` or ``glb``), and
-    ``out_dir/manifest.jsonl``. ``samples`` report samples per mesh measure the Hausdorff
-    distance and the occupancy agreement (0: neither); ``thicken_cells`` closes open sheets into
-    slabs of that half-thickness in finest cells; a mesh past ``time_limit`` seconds is a
-    ``timeout`` row. Meshes run one after the other, each on
+    Per input: the closed, edge- and vertex-manifold, oriented surface ``gwn remesh`` makes at
+    ``res`` (meshes and soups: exact w, the input triangles as the guide; STEP models and patch
+    sets: their own evaluator; oriented point clouds: the fast evaluator; the same bytes
+    ``gwn remesh`` writes), written to ``out_dir/<path below root>.<format>`` (``obj``, ``ply``,
+    ``stl`` or ``glb``), and ``out_dir/manifest.jsonl``. ``samples`` report samples per input
+    measure the Hausdorff distance and the occupancy agreement (0: neither); ``thicken_cells``
+    closes open sheets of meshes into slabs of that half-thickness in finest cells; an input
+    past ``time_limit`` seconds is a ``timeout`` row. Inputs run one after the other, each on
     ``threads`` threads (default: all cores), with the GIL released. Resumable (an existing
     output is reused only when it was made with the same options from the same input, else
     redone and ``redone`` says why); broken files and FIFOs are manifest rows; two inputs with
@@ -157,12 +158,12 @@ def remesh_dataset(paths, out_dir, res=128, *, root=None, format="ply", samples=
     ``planar_levels`` and ``bisect``: ``None`` for ``gwn remesh``'s defaults.
 
     ``progress`` as in ``gwn.label_dataset``. Returns the manifest rows (dicts with ``mesh``,
-    ``output``, ``status`` in ``ok``/``done``/``failed``/``timeout``, ``error``, ``faces``,
-    ``vertices``,
-    ``output_faces``, ``output_vertices``, ``valid`` (closed, manifold, oriented, no exact
-    self-intersection), ``components``, ``self_intersections``, ``hausdorff_cells``,
-    ``occupancy_agreement``, ``seconds``, ``redone``), in input order. For a cluster, see
-    ``gwn.dask.remesh_dataset``.
+    ``output``, ``status`` in ``ok``/``done``/``failed``/``timeout``, ``error``, ``input`` (the
+    kind: ``mesh``, ``point cloud``, ``patch set``, ``STEP model``), ``faces`` (triangles,
+    patches or B-rep faces), ``vertices`` (mesh vertices or points), ``output_faces``,
+    ``output_vertices``, ``valid`` (closed, manifold, oriented, no exact self-intersection),
+    ``components``, ``self_intersections``, ``hausdorff_cells``, ``occupancy_agreement``,
+    ``seconds``, ``redone``), in input order. For a cluster, see ``gwn.dask.remesh_dataset``.
     """
     from . import _gwn
 

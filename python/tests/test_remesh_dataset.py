@@ -128,3 +128,18 @@ def test_dask_remesh_matches_serial(tmp_path):
     assert len(objs(tmp_path / "dask")) == 2
     manifest = (tmp_path / "dask" / "manifest.jsonl").read_text().splitlines()
     assert [json.loads(l)["output"] for l in manifest] == [r["output"] for r in serial]
+
+
+def test_remesh_dataset_takes_a_step_model(tmp_path):
+    """A STEP model is an input like a mesh: its row names the kind and its B-rep faces, and the
+    file is what gwn.remesh makes of the model."""
+    step = tmp_path / "in" / "capped_cylinder.step"
+    step.parent.mkdir(parents=True)
+    shutil.copy(FIXTURES / "step" / "capped_cylinder.step", step)
+    (row,) = gwn.remesh_dataset([step], tmp_path / "out", 16, samples=0, threads=2)
+    assert row["status"] == "ok" and row["input"] == "STEP model" and row["faces"] == 3
+    assert row["valid"] is True and row["components"] == 1 and row["vertices"] is None
+    V, F = gwn.load(tmp_path / "out" / "capped_cylinder.step.ply")
+    Vr, Fr = gwn.remesh(gwn.load(step), res=16)
+    np.testing.assert_array_equal(F, Fr)
+    np.testing.assert_array_equal(V, Vr)

@@ -70,6 +70,11 @@ pub trait MeshJob: Sync {
     fn validate(&self) -> Result<(), String>;
     /// The time limit per mesh, if any.
     fn time_limit(&self) -> Option<Duration>;
+    /// Whether a folder walk takes the file `path` as an input (by its extension; files named
+    /// one by one are always taken). Default: the mesh formats of [`crate::io`].
+    fn walks(&self, path: &Path) -> bool {
+        crate::io::format_from_extension(path).is_some()
+    }
     /// The manifest status of a failure (default: failed).
     fn status(_error: &Self::Error) -> Status {
         Status::Failed

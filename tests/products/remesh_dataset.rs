@@ -198,7 +198,7 @@ fn remesh_dataset_cli() {
     let (ok, stdout, stderr) = run(&["--format", "obj"]);
     assert!(ok, "{stderr}");
     assert!(
-        stdout.contains("remeshed 3 meshes (0 done before, 0 redone, 1 failed, 0 timed out)"),
+        stdout.contains("remeshed 3 inputs (0 done before, 0 redone, 1 failed, 0 timed out)"),
         "{stdout}"
     );
     assert!(stdout.contains("3 outputs valid"), "{stdout}");
@@ -211,7 +211,7 @@ fn remesh_dataset_cli() {
     // The same run again: nothing to do; a knob changed: redone, and named.
     let (ok, stdout, _) = run(&["--format", "obj"]);
     assert!(
-        ok && stdout.contains("remeshed 0 meshes (3 done before"),
+        ok && stdout.contains("remeshed 0 inputs (3 done before"),
         "{stdout}"
     );
     let (ok, _, stderr) = run(&["--format", "obj", "--no-relocate"]);
@@ -377,4 +377,149 @@ fn remesh_evaluates_little_past_its_deadline() {
         after <= 4096,
         "{before} evaluations before the deadline, {after} after"
     );
+}
+
+/// An oriented point cloud of the unit sphere (Fibonacci points, outward normals) as ASCII PLY
+/// without faces: a point cloud to `gwn::input`.
+fn sphere_cloud(path: &Path, n: usize) {
+    let mut ply = format!(
+        "ply\nformat ascii 1.0\nelement vertex {n}\nproperty float x\nproperty float y\n\
+         property float z\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n"
+    );
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    for i in 0..n {
+        let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+        let r = (1.0 - z * z).sqrt();
+        let (x, y) = (r * (golden * i as f64).cos(), r * (golden * i as f64).sin());
+        ply.push_str(&format!("{x} {y} {z} {x} {y} {z}\n"));
+    }
+    std::fs::write(path, ply).unwrap();
+}
+
+/// STEP models, patch sets and oriented point clouds are inputs of the dataset job as of
+/// `gwn remesh`: walked from folders by their extensions (`.step`, `.stp`, `.bpt`), set up with
+/// their own evaluators, written as the same bytes, the manifest naming each input's kind.
+#[test]
+fn remesh_dataset_takes_step_models_patch_sets_and_point_clouds() {
+    let scratch = Scratch::new("inputs");
+    let dir = &scratch.0;
+    let input = dir.join("in");
+    std::fs::create_dir_all(&input).unwrap();
+    for name in [
+        "torus_full.step",
+        "capped_cylinder.step",
+        "plate_with_hole.stp",
+    ] {
+        std::fs::copy(fixture(&format!("step/{name}")), input.join(name)).unwrap();
+    }
+    std::fs::copy(fixture("cube.off"), input.join("cube.off")).unwrap();
+    sphere_cloud(&input.join("sphere.ply"), 3000);
+    // Not an input: a folder walk skips it.
+    std::fs::write(input.join("notes.txt"), "not a mesh\n").unwrap();
+    let teapot = crate::common::shared_file("parametric/teapot.bpt");
+    if let Some(teapot) = &teapot {
+        std::fs::copy(teapot, input.join("teapot.bpt")).unwrap();
+    }
+    let out = dir.join("out");
+    let (ok, stdout, err) = gwn(&[
+        "remesh-dataset",
+        input.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--res",
+        "24",
+        "--samples",
+        "2000",
+    ]);
+    assert!(ok, "{err}");
+    let inputs = 5 + usize::from(teapot.is_some());
+    assert!(
+        stdout.contains(&format!(
+            "remeshed {inputs} inputs (0 done before, 0 redone, 0 failed"
+        )),
+        "{stdout}"
+    );
+    let manifest = std::fs::read_to_string(out.join("manifest.jsonl")).unwrap();
+    let row = |name: &str| -> String {
+        manifest
+            .lines()
+            .find(|l| l.contains(&format!("\"mesh\":\"{}", input.join(name).display())))
+            .unwrap_or_else(|| panic!("no row for {name} in {manifest}"))
+            .to_string()
+    };
+    for (name, kind, faces) in [
+        ("cube.off", "mesh", "12"),
+        ("torus_full.step", "STEP model", "1"),
+        ("capped_cylinder.step", "STEP model", "3"),
+        ("sphere.ply", "point cloud", "null"),
+    ] {
+        let r = row(name);
+        assert!(r.contains(&format!("\"input\":\"{kind}\"")), "{r}");
+        assert!(r.contains(&format!("\"faces\":{faces},")), "{r}");
+        assert!(
+            r.contains("\"valid\":true") && r.contains("\"components\":1"),
+            "{r}"
+        );
+        assert!(r.contains("\"status\":\"ok\""), "{r}");
+    }
+    // The cloud's points are its vertices; it has no distance (nothing to measure it to), a
+    // curved input's is to its tessellation.
+    assert!(row("sphere.ply").contains("\"vertices\":3000,"));
+    assert!(row("sphere.ply").contains("\"hausdorff_cells\":null"));
+    assert!(!row("torus_full.step").contains("\"hausdorff_cells\":null"));
+    assert!(!manifest.contains("notes.txt"));
+    // An open plate (`.stp`) bounds nothing: an empty, valid surface.
+    let plate = row("plate_with_hole.stp");
+    assert!(
+        plate.contains("\"input\":\"STEP model\",\"faces\":1,"),
+        "{plate}"
+    );
+    assert!(plate.contains("\"output_faces\":0,") && plate.contains("\"valid\":true"));
+    if teapot.is_some() {
+        assert!(row("teapot.bpt").contains("\"input\":\"patch set\",\"faces\":32,"));
+    } else {
+        crate::common::report_skip("../shared/parametric/teapot.bpt (the patch-set row)");
+    }
+    // The bytes `gwn remesh` writes for each.
+    for name in ["torus_full.step", "sphere.ply"] {
+        let single = dir.join("single.ply");
+        let (ok, _, err) = gwn(&[
+            "remesh",
+            input.join(name).to_str().unwrap(),
+            "--res",
+            "24",
+            "--samples",
+            "0",
+            "--out",
+            single.to_str().unwrap(),
+        ]);
+        assert!(ok, "{err}");
+        assert_eq!(
+            std::fs::read(out.join(format!("{name}.ply"))).unwrap(),
+            std::fs::read(&single).unwrap(),
+            "{name}"
+        );
+    }
+    // Thickening needs triangles: a failed row that says so, the mesh remeshed.
+    let job = RemeshJob {
+        thicken_cells: Some(1.0),
+        samples: 0,
+        ..RemeshJob::new(16)
+    };
+    let rows = run_dataset(
+        &job,
+        &[input.join("torus_full.step"), input.join("cube.off")],
+        &dir.join("thick"),
+        None,
+        |_| {},
+    )
+    .unwrap();
+    assert_eq!(rows[0].status, Status::Failed);
+    let error = rows[0].error.as_deref().unwrap();
+    assert!(
+        error.contains("thicken: needs triangles (a mesh or soup), not a STEP model"),
+        "{error}"
+    );
+    assert_eq!(rows[0].stats.get("input"), Some("\"STEP model\""));
+    assert_eq!(rows[1].status, Status::Ok);
 }

@@ -1,9 +1,14 @@
 //! Remeshing a dataset: [`RemeshJob`], the [`MeshJob`] that writes one closed, manifold,
-//! oriented surface per input mesh (what [`super::remesh_guided`] makes of its exact `w`, with
-//! the input triangles as the guide) and a manifest row with its report's main numbers — the
-//! job ML pipelines run over ShapeNet or Objaverse before computing occupancy or SDF labels.
+//! oriented surface per input and a manifest row with its report's main numbers — the job ML
+//! pipelines run over ShapeNet or Objaverse before computing occupancy or SDF labels, and over
+//! CAD collections (ABC's STEP files) to get watertight meshes of them. Each input is set up as
+//! `gwn remesh` sets it up: a mesh or soup remeshes its exact `w` with its triangles as the guide
+//! ([`super::thicken::of_mesh`]); a STEP model or a patch set its own evaluator, vertices placed
+//! at its surface hits, the distance measured to a fine tessellation
+//! ([`super::report::curved_surface_for_distance`]); an oriented point cloud the fast
+//! evaluator, with no distance.
 //!
-//! Meshes run one after the other, each on every thread (a remesh is parallel inside and takes
+//! Inputs run one after the other, each on every thread (a remesh is parallel inside and takes
 //! the memory it finds: two side by side could each count on all of it). Everything else —
 //! outputs mirroring the inputs' layout, atomic writes, resuming, broken files as rows — is
 //! [`crate::products::dataset`]'s.
@@ -27,14 +32,17 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use super::report::RemeshReport;
+use super::crossings::SegmentBvh;
+use super::report::{DistanceReference, RemeshReport};
 use super::thicken::{self, MeshField, ThickenedSheets};
 use super::write::{SurfaceFormat, write_surface};
-use super::{RemeshOptions, remesh_guided};
-use crate::io::{LoadOptions, load_mesh_with};
+use super::{RemeshOptions, Remeshed, remesh_guided};
+use crate::eval::Evaluator;
+use crate::input::{Input, InputKind, load_input_with};
+use crate::io::LoadOptions;
 use crate::mesh::Mesh;
 use crate::products::dataset::{MeshJob, Stats};
-use crate::products::json::json_number;
+use crate::products::json::{json_number, json_string};
 use crate::spec::EvaluatorSpec;
 
 /// Options of the remeshing job.
@@ -48,13 +56,14 @@ pub struct RemeshJob {
     /// Hausdorff distance; 0 measures neither). At most [`super::report::MAX_SAMPLES`].
     pub samples: usize,
     /// Close open sheets into slabs of this half-thickness in finest cells (at least 1): in
-    /// cells, not world units, since a dataset's meshes come at any scale.
+    /// cells, not world units, since a dataset's meshes come at any scale. Meshes only: other
+    /// inputs fail.
     pub thicken_cells: Option<f64>,
     /// Loader options (welding).
     pub load: LoadOptions,
-    /// Per-mesh time limit (loading, remeshing, measuring; the remesher checks it between its
-    /// phases and rounds, [`RemeshOptions::deadline`], so a mesh overshoots by one round at
-    /// most). A mesh past it is a `timeout` row without an output.
+    /// Per-input time limit (loading, remeshing, measuring; the remesher checks it between its
+    /// phases and rounds and every 4096 evaluations, [`RemeshOptions::deadline`]). An input
+    /// past it is a `timeout` row without an output.
     pub time_limit: Option<Duration>,
 }
 
@@ -102,6 +111,7 @@ impl MeshJob for RemeshJob {
     type Error = RemeshJobError;
     const RECORD: &'static str = "gwn_remesh";
     const STATS: &'static [(&'static str, &'static str)] = &[
+        ("input", "null"),
         ("faces", "null"),
         ("vertices", "null"),
         ("output_faces", "null"),
@@ -112,7 +122,7 @@ impl MeshJob for RemeshJob {
         ("hausdorff_cells", "null"),
         ("occupancy_agreement", "null"),
     ];
-    const INPUT_STATS: &'static [&'static str] = &["faces", "vertices"];
+    const INPUT_STATS: &'static [&'static str] = &["input", "faces", "vertices"];
     const MESHES_IN_PARALLEL: bool = false;
 
     fn extension(&self) -> &'static str {
@@ -211,6 +221,11 @@ impl MeshJob for RemeshJob {
         }
     }
 
+    fn walks(&self, path: &Path) -> bool {
+        let curved = cfg!(feature = "patch") && is_curved_path(path);
+        curved || crate::io::format_from_extension(path).is_some()
+    }
+
     fn run(
         &self,
         path: &Path,
@@ -222,44 +237,131 @@ impl MeshJob for RemeshJob {
             Some((at, limit)) if Instant::now() > at => Err(TimeLimitExceeded { stage, limit }),
             _ => Ok(()),
         };
-        let mesh = load_mesh_with(path, &self.load)?.mesh;
-        stats.set("faces", mesh.triangles().len());
-        stats.set("vertices", mesh.positions().len());
+        let input = load_input_with(path, &self.load)?.input;
+        stats.set("input", json_string(input_name(input.kind())));
+        match &input {
+            Input::Mesh(mesh) => {
+                stats.set("faces", mesh.triangles().len());
+                stats.set("vertices", mesh.positions().len());
+            }
+            Input::Cloud(cloud) => stats.set("vertices", cloud.len()),
+            #[cfg(feature = "patch")]
+            Input::Patches(set) => stats.set("faces", set.patches().len()),
+            #[cfg(feature = "patch")]
+            Input::Step(model) => stats.set("faces", model.faces().len()),
+        }
         in_time("loading")?;
-        let bounds = mesh.bounding_box().ok_or("the mesh has no vertices")?;
-        let wn = EvaluatorSpec::default().build_mesh(&mesh)?;
+        let bounds = input.bounding_box().ok_or("the input has no geometry")?;
+        let wn = EvaluatorSpec::default().build(&input)?;
+        let Some(mesh) = input.mesh() else {
+            // A point cloud (the fast evaluator) or a curved input (its own surface hits place
+            // the vertices): no triangles to guide the remesh or to thicken, as `gwn remesh`.
+            if self.thicken_cells.is_some() {
+                return Err(format!(
+                    "thicken: needs triangles (a mesh or soup), not {}",
+                    input.kind()
+                )
+                .into());
+            }
+            in_time("building the evaluator")?;
+            let out = self.remesh(&*wn, None, bounds, deadline)?;
+            #[cfg(feature = "patch")]
+            let curved = (self.samples > 0)
+                .then(|| super::report::curved_surface_for_distance(&input, out.cell_size))
+                .flatten();
+            #[cfg(feature = "patch")]
+            let reference = curved
+                .as_ref()
+                .map_or(DistanceReference::None, DistanceReference::Curved);
+            #[cfg(not(feature = "patch"))]
+            let reference = DistanceReference::None;
+            return self.finish(out, &*wn, reference, bounds, deadline, stats);
+        };
         let extent = (0..3)
             .map(|k| bounds.max[k] - bounds.min[k])
             .fold(0.0, f64::max);
         let cell = extent / self.options.resolution as f64;
         let thick = self
             .thicken_cells
-            .map(|k| ThickenedSheets::new(&mesh, &*wn, k * cell))
+            .map(|k| ThickenedSheets::new(mesh, &*wn, k * cell))
             .transpose()?;
         let MeshField {
             field,
             guide,
             bounds,
             reference,
-        } = thicken::of_mesh(&mesh, &*wn, thick.as_ref(), bounds);
+        } = thicken::of_mesh(mesh, &*wn, thick.as_ref(), bounds);
         in_time("building the evaluator")?;
+        let out = self.remesh(field, Some(&guide), bounds, deadline)?;
+        self.finish(out, field, reference, bounds, deadline, stats)
+    }
+}
+
+/// Whether `path` names a patch set or a STEP model (by its extension).
+fn is_curved_path(path: &Path) -> bool {
+    #[cfg(feature = "patch")]
+    {
+        crate::patch::is_patch_path(path) || crate::patch::step::is_step_path(path)
+    }
+    #[cfg(not(feature = "patch"))]
+    {
+        let _ = path;
+        false
+    }
+}
+
+/// The manifest's name of an input kind.
+fn input_name(kind: InputKind) -> &'static str {
+    match kind {
+        InputKind::Mesh => "mesh",
+        InputKind::Cloud => "point cloud",
+        InputKind::Patches => "patch set",
+        InputKind::Step => "STEP model",
+    }
+}
+
+impl RemeshJob {
+    /// [`remesh_guided`] under the job's options and `deadline`, its time limit named as the
+    /// job's.
+    fn remesh(
+        &self,
+        field: &dyn Evaluator,
+        guide: Option<&SegmentBvh>,
+        bounds: crate::BoundingBox,
+        deadline: Option<(Instant, Duration)>,
+    ) -> Result<Remeshed, RemeshJobError> {
         let options = RemeshOptions {
             deadline: deadline.map(|(at, _)| at),
             ..self.options
         };
-        let mut out = remesh_guided(field, Some(&guide), bounds, &options, &|_| {}).map_err(
-            |e| -> RemeshJobError {
-                match (e, deadline) {
-                    (super::RemeshError::TimeLimit { phase }, Some((_, limit))) => {
-                        Box::new(TimeLimitExceeded {
-                            stage: phase.name(),
-                            limit,
-                        })
-                    }
-                    (e, _) => Box::new(e),
+        remesh_guided(field, guide, bounds, &options, &|_| {}).map_err(|e| -> RemeshJobError {
+            match (e, deadline) {
+                (super::RemeshError::TimeLimit { phase }, Some((_, limit))) => {
+                    Box::new(TimeLimitExceeded {
+                        stage: phase.name(),
+                        limit,
+                    })
                 }
-            },
-        )?;
+                (e, _) => Box::new(e),
+            }
+        })
+    }
+
+    /// Measures `out` against `reference`, fills the row's statistics and gives the output's
+    /// bytes.
+    fn finish(
+        &self,
+        mut out: Remeshed,
+        field: &dyn Evaluator,
+        reference: DistanceReference<'_>,
+        bounds: crate::BoundingBox,
+        deadline: Option<(Instant, Duration)>,
+        stats: &mut Stats,
+    ) -> Result<Vec<u8>, RemeshJobError> {
+        let in_time = |stage: &'static str| match deadline {
+            Some((at, limit)) if Instant::now() > at => Err(TimeLimitExceeded { stage, limit }),
+            _ => Ok(()),
+        };
         let positions = std::mem::take(&mut out.positions);
         let triangles = std::mem::take(&mut out.triangles);
         let surface = Mesh::new(positions, triangles)?;

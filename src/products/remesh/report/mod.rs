@@ -460,6 +460,22 @@ fn box_diagonal(points: &[[f64; 3]]) -> f64 {
     (0..3).map(|a| (hi[a] - lo[a]).powi(2)).sum::<f64>().sqrt()
 }
 
+/// The [`CurvedSurface`] that stands for a curved input in the report's distance
+/// ([`patch_surface_for_distance`], [`step_surface_for_distance`]); `None` for meshes and point
+/// clouds.
+#[cfg(feature = "patch")]
+pub fn curved_surface_for_distance(
+    input: &crate::input::Input,
+    cell_size: f64,
+) -> Option<CurvedSurface> {
+    match input {
+        crate::input::Input::Patches(set) => patch_surface_for_distance(set, cell_size),
+        #[cfg(feature = "io")]
+        crate::input::Input::Step(model) => step_surface_for_distance(model, cell_size),
+        _ => None,
+    }
+}
+
 /// A Bézier patch set's [`CurvedSurface`]: `k × k` quads per patch
 /// ([`crate::patch::tessellate::tessellate`], welded) with `k` such that the largest patch's
 /// segments are at most half a cell, fewer where the budget says so. `None` for a cell size
