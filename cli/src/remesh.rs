@@ -8,7 +8,7 @@ use gwn::products::remesh::report::{
     DistanceReference, PhaseClock, RemeshReport, ReportPhase, curved_surface_for_distance,
 };
 use gwn::products::remesh::simplify::SimplifyOptions;
-use gwn::products::remesh::thicken::ThickenedSheets;
+use gwn::products::remesh::thicken::{self, ThickenedSheets};
 use gwn::products::remesh::write::{SurfaceFormat, write_surface};
 use gwn::products::remesh::{DEFAULT_BISECTION_STEPS, RemeshOptions, remesh_guided};
 
@@ -113,28 +113,23 @@ pub fn run(args: Args) -> Result<(), CliError> {
             )
         }
     };
-    // The slabs reach EPS past the input's box: the lattice must hold them, or they are capped
-    // by the box (and squashed flat where the box is thin on one axis).
-    let bounds = match &thickened {
-        Some(t) => grown(bounds, t.eps()),
-        None => bounds,
-    };
-    let wn: &dyn gwn::eval::Evaluator = match &thickened {
-        Some(t) => t,
-        None => &*built,
-    };
     let mut options = args.knobs.options(args.res, !args.no_guide);
     // Phases: classify, extract, place, [simplify,] write, self-intersections, Hausdorff,
     // agreement.
     let bar = crate::common::progress(if args.knobs.no_simplify { 7 } else { 8 }, "remesh");
     let start = std::time::Instant::now();
     options.deadline = time_limit.map(|limit| start + limit);
-    let guide = match input.mesh() {
-        // The input's own `w` is the field unless it was thickened.
-        Some(m) if !args.no_guide && thickened.is_none() => Some(SegmentBvh::of_field_mesh(m)),
-        Some(m) if !args.no_guide => Some(SegmentBvh::of_mesh(m)),
-        _ => None,
-    };
+    // A mesh's field, guide, box and distance reference as every remesh of a mesh sets them up
+    // (thickened or not: the slabs reach EPS past the box, which grows to hold them); the other
+    // inputs have their own evaluator and no triangles.
+    let mesh_field = input
+        .mesh()
+        .map(|m| thicken::of_mesh(m, &*built, thickened.as_ref(), bounds));
+    let (wn, guide, bounds): (&dyn gwn::eval::Evaluator, Option<&SegmentBvh>, _) =
+        match &mesh_field {
+            Some(f) => (f.field, (!args.no_guide).then_some(&f.guide), f.bounds),
+            None => (&*built, None, bounds),
+        };
     let clock = PhaseClock::start();
     let announce = |phase: gwn::products::remesh::RemeshPhase| {
         clock.mark(phase);
@@ -143,7 +138,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             bar.inc(1);
         }
     };
-    let mut out = remesh_guided(wn, guide.as_ref(), bounds, &options, &announce)
+    let mut out = remesh_guided(wn, guide, bounds, &options, &announce)
         .map_err(|e| CliError(format!("{}: {e}", args.mesh.display())))?;
     let secs = start.elapsed().as_secs_f64();
     let phase_seconds = clock.seconds();
@@ -162,9 +157,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .then(|| curved_surface_for_distance(&input, out.cell_size))
         .flatten();
     // Thickened sheets bound nothing of the slabs' solid: their distance counts every sample.
-    let reference = match (input.mesh(), &curved_surface) {
-        (Some(m), _) if thickened.is_none() => DistanceReference::BoundingMesh(m),
-        (Some(m), _) => DistanceReference::Mesh(m),
+    let reference = match (&mesh_field, &curved_surface) {
+        (Some(f), _) => f.reference,
         (None, Some(curved)) => DistanceReference::Curved(curved),
         (None, None) => DistanceReference::None,
     };
@@ -435,13 +429,5 @@ impl RemeshKnobs {
             evaluator_crossings: guided,
             deadline: None,
         }
-    }
-}
-
-/// `bounds` grown by `d` on every side.
-fn grown(bounds: gwn::BoundingBox, d: f64) -> gwn::BoundingBox {
-    gwn::BoundingBox {
-        min: bounds.min.map(|x| x - d),
-        max: bounds.max.map(|x| x + d),
     }
 }
