@@ -125,11 +125,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let mesh_field = input
         .mesh()
         .map(|m| thicken::of_mesh(m, &*built, thickened.as_ref(), bounds));
-    let (wn, guide, bounds): (&dyn gwn::eval::Evaluator, Option<&SegmentBvh>, _) =
-        match &mesh_field {
-            Some(f) => (f.field, (!args.no_guide).then_some(&f.guide), f.bounds),
-            None => (&*built, None, bounds),
-        };
+    let (wn, guide, bounds): (&dyn gwn::eval::Evaluator, Option<&SegmentBvh>, _) = match &mesh_field
+    {
+        Some(f) => (f.field, (!args.no_guide).then_some(&f.guide), f.bounds),
+        None => (&*built, None, bounds),
+    };
     let clock = PhaseClock::start();
     let announce = |phase: gwn::products::remesh::RemeshPhase| {
         clock.mark(phase);

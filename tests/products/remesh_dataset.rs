@@ -52,6 +52,23 @@ fn inputs(dir: &Path) -> Vec<PathBuf> {
     .collect()
 }
 
+/// The PLY bytes `gwn remesh INPUT --res RES --samples 0` writes (to a file in `scratch`).
+fn remeshed_by_the_cli(input: &Path, res: usize, scratch: &Path) -> Vec<u8> {
+    let single = scratch.join("single.ply");
+    let (ok, _, err) = gwn(&[
+        "remesh",
+        input.to_str().unwrap(),
+        "--res",
+        &res.to_string(),
+        "--samples",
+        "0",
+        "--out",
+        single.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    std::fs::read(&single).unwrap()
+}
+
 #[test]
 fn remesh_dataset_writes_what_gwn_remesh_writes_and_resumes() {
     let scratch = Scratch::new("library");
@@ -89,22 +106,9 @@ fn remesh_dataset_writes_what_gwn_remesh_writes_and_resumes() {
     );
     // The outputs mirror the inputs, and are the bytes `gwn remesh` writes at the same options
     // (the job's defaults are the CLI's).
-    let ply = out.join("cube.off.ply");
-    let single = dir.join("single.ply");
-    let (ok, _, err) = gwn(&[
-        "remesh",
-        fixture("cube.off").to_str().unwrap(),
-        "--res",
-        "32",
-        "--samples",
-        "0",
-        "--out",
-        single.to_str().unwrap(),
-    ]);
-    assert!(ok, "{err}");
     assert_eq!(
-        std::fs::read(&ply).unwrap(),
-        std::fs::read(&single).unwrap()
+        std::fs::read(out.join("cube.off.ply")).unwrap(),
+        remeshed_by_the_cli(&fixture("cube.off"), 32, dir)
     );
     assert!(out.join("sub/triangle.obj.ply").is_file());
     assert!(!out.join("broken_nan.off.ply").exists());
@@ -134,8 +138,8 @@ fn remesh_dataset_writes_what_gwn_remesh_writes_and_resumes() {
         Some("options changed: res 32 -> 24")
     );
     assert_ne!(
-        std::fs::read(&ply).unwrap(),
-        std::fs::read(&single).unwrap()
+        std::fs::read(out.join("cube.off.ply")).unwrap(),
+        remeshed_by_the_cli(&fixture("cube.off"), 32, dir)
     );
 
     // One file twice: refused before anything is written.
@@ -482,21 +486,9 @@ fn remesh_dataset_takes_step_models_patch_sets_and_point_clouds() {
     }
     // The bytes `gwn remesh` writes for each.
     for name in ["torus_full.step", "sphere.ply"] {
-        let single = dir.join("single.ply");
-        let (ok, _, err) = gwn(&[
-            "remesh",
-            input.join(name).to_str().unwrap(),
-            "--res",
-            "24",
-            "--samples",
-            "0",
-            "--out",
-            single.to_str().unwrap(),
-        ]);
-        assert!(ok, "{err}");
         assert_eq!(
             std::fs::read(out.join(format!("{name}.ply"))).unwrap(),
-            std::fs::read(&single).unwrap(),
+            remeshed_by_the_cli(&input.join(name), 24, dir),
             "{name}"
         );
     }

@@ -233,10 +233,7 @@ impl MeshJob for RemeshJob {
         deadline: Option<(Instant, Duration)>,
         stats: &mut Stats,
     ) -> Result<Vec<u8>, RemeshJobError> {
-        let in_time = |stage: &'static str| match deadline {
-            Some((at, limit)) if Instant::now() > at => Err(TimeLimitExceeded { stage, limit }),
-            _ => Ok(()),
-        };
+        let in_time = |stage| in_time(deadline, stage);
         let input = load_input_with(path, &self.load)?.input;
         stats.set("input", json_string(input_name(input.kind())));
         match &input {
@@ -294,6 +291,17 @@ impl MeshJob for RemeshJob {
         in_time("building the evaluator")?;
         let out = self.remesh(field, Some(&guide), bounds, deadline)?;
         self.finish(out, field, reference, bounds, deadline, stats)
+    }
+}
+
+/// [`TimeLimitExceeded`] while `stage` runs once `deadline` has passed.
+fn in_time(
+    deadline: Option<(Instant, Duration)>,
+    stage: &'static str,
+) -> Result<(), TimeLimitExceeded> {
+    match deadline {
+        Some((at, limit)) if Instant::now() > at => Err(TimeLimitExceeded { stage, limit }),
+        _ => Ok(()),
     }
 }
 
@@ -358,10 +366,7 @@ impl RemeshJob {
         deadline: Option<(Instant, Duration)>,
         stats: &mut Stats,
     ) -> Result<Vec<u8>, RemeshJobError> {
-        let in_time = |stage: &'static str| match deadline {
-            Some((at, limit)) if Instant::now() > at => Err(TimeLimitExceeded { stage, limit }),
-            _ => Ok(()),
-        };
+        let in_time = |stage| in_time(deadline, stage);
         let positions = std::mem::take(&mut out.positions);
         let triangles = std::mem::take(&mut out.triangles);
         let surface = Mesh::new(positions, triangles)?;
