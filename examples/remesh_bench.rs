@@ -77,7 +77,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             )
             .map_err(|_| "too large")?;
             let t1 = Instant::now();
-            let band = extract::extract(&lattice, &classified);
+            let band = extract::extract(&lattice, &classified, None).expect("no deadline");
             let t2 = Instant::now();
             let placed = place::place_vertices(
                 &wn,
@@ -91,7 +91,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     place::CrossingSource::None
                 },
                 None,
-            );
+            )
+            .expect("no deadline");
             let t3 = Instant::now();
             let (positions, triangles) = if simplified {
                 let planes = placed.planes_in_lattice_units(&lattice);

@@ -42,7 +42,7 @@ fn build(mesh_path: &PathBuf, res: usize) -> Result<Surface, Box<dyn std::error:
     let guide = crossings::SegmentBvh::of_mesh(&mesh);
     let classified =
         octree::classify(&wn, &lattice, Some(&guide), usize::MAX, None).map_err(|_| "too large")?;
-    let band = extract::extract(&lattice, &classified);
+    let band = extract::extract(&lattice, &classified, None).ok_or("no deadline")?;
     let placed = place::place_vertices(
         &wn,
         &lattice,
@@ -51,7 +51,8 @@ fn build(mesh_path: &PathBuf, res: usize) -> Result<Surface, Box<dyn std::error:
         DEFAULT_BISECTION_STEPS,
         place::CrossingSource::Triangles(&guide),
         None,
-    );
+    )
+    .ok_or("no deadline")?;
     let planes = placed
         .planes_in_lattice_units(&lattice)
         .into_iter()

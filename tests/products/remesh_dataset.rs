@@ -303,6 +303,23 @@ fn remesh_stops_at_its_deadline_without_an_output() {
     let again = run(&later).unwrap();
     assert_eq!(again.triangles, full.triangles);
     assert_eq!(again.positions, full.positions);
+    // Extraction looks at the clock between its batches of cubes (seconds of serial work on a
+    // large band), and a deadline it does not reach changes nothing.
+    {
+        use gwn::products::remesh::{extract::extract, lattice::Lattice, octree::classify};
+        let lattice = Lattice::new(bounds, 64).unwrap();
+        let before = std::time::Instant::now();
+        let classified = classify(&wn, &lattice, Some(&guide), usize::MAX, None).unwrap();
+        assert!(extract(&lattice, &classified, Some(before)).is_none());
+        let now = std::time::Instant::now();
+        let far = now + std::time::Duration::from_secs(3600);
+        let (a, b) = (
+            extract(&lattice, &classified, Some(far)).unwrap(),
+            extract(&lattice, &classified, None).unwrap(),
+        );
+        assert!(!a.triangles.is_empty());
+        assert_eq!((a.triangles, a.edges), (b.triangles, b.edges));
+    }
 
     // In a dataset: a `timeout` row that names the limit, and no output.
     let scratch = Scratch::new("deadline");

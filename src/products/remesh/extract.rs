@@ -44,8 +44,14 @@ pub struct Band {
 
 /// Extracts the separating surface of the band of `classified`: the regular cells'
 /// Freudenthal split, and with sub-levels the refined cells' finer one and the transition
-/// split between them ([`super::transition`]).
-pub fn extract(lattice: &Lattice, classified: &Classified) -> Band {
+/// split between them ([`super::transition`]). `None` once `deadline` has passed (checked
+/// between batches of cubes: the extraction of a large band is seconds of serial numbering).
+pub fn extract(
+    lattice: &Lattice,
+    classified: &Classified,
+    deadline: Option<std::time::Instant>,
+) -> Option<Band> {
+    let past = || deadline.is_some_and(|at| std::time::Instant::now() > at);
     let mut band = Band {
         band_cells: classified.band.len()
             + classified.fine_band.len()
@@ -92,6 +98,9 @@ pub fn extract(lattice: &Lattice, classified: &Classified) -> Band {
     // numbered stay a small part of the surface.
     let cubes = |cells: &[(u32, Corner)], band: &mut Band, number: &mut dyn FnMut(_, &mut Band)| {
         for batch in cells.chunks(CUBES_PER_CHUNK * CHUNKS_PER_BATCH) {
+            if past() {
+                return None;
+            }
             let parts: Vec<(Part, usize)> = batch
                 .par_chunks(CUBES_PER_CHUNK)
                 .map(|chunk| {
@@ -114,11 +123,15 @@ pub fn extract(lattice: &Lattice, classified: &Classified) -> Band {
                 number(part, band);
             }
         }
+        Some(())
     };
     // The regular cells' edge is `1 << sub_levels` finest cells (`Lattice::regular_cell`).
     let regular = lattice.sub_levels;
     let regular_cells: Vec<(u32, Corner)> = classified.band.iter().map(|&m| (regular, m)).collect();
-    cubes(&regular_cells, &mut band, &mut number);
+    cubes(&regular_cells, &mut band, &mut number)?;
+    if past() {
+        return None;
+    }
     for &(level, m) in &classified.transition {
         let corners: [Corner; 8] = std::array::from_fn(|b| offset(m, b, 1 << level));
         band.marching_cubes_triangles +=
@@ -138,8 +151,8 @@ pub fn extract(lattice: &Lattice, classified: &Classified) -> Band {
                 marching_cubes(resolution, corners.map(|c| classified.label(c)));
         }
     }
-    cubes(&classified.fine_band, &mut band, &mut number);
-    band
+    cubes(&classified.fine_band, &mut band, &mut number)?;
+    Some(band)
 }
 
 /// A triangle of the extracted surface as its three lattice edges (inside corner, outside

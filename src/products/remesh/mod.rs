@@ -530,7 +530,11 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
             },
         })?;
     progress(RemeshPhase::Extract);
-    let band = extract::extract(&lattice, &classified);
+    let band = extract::extract(&lattice, &classified, options.deadline).ok_or(
+        RemeshError::TimeLimit {
+            phase: RemeshPhase::Extract,
+        },
+    )?;
     if band.edges.len() > u32::MAX as usize {
         return Err(RemeshError::TooManyVertices);
     }
@@ -550,7 +554,10 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
             None => place::CrossingSource::None,
         },
         options.deadline,
-    );
+    )
+    .ok_or(RemeshError::TimeLimit {
+        phase: RemeshPhase::Place,
+    })?;
     let mut stats = RemeshStats {
         lattice_cells: lattice.cells,
         coarse_cells: lattice.coarse_cells(),

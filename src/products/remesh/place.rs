@@ -240,7 +240,8 @@ fn stride(l: i64, regular: u32) -> i64 {
 /// see [`stride`]) of a class change; `corner_w` is `w` at each edge's two corners
 /// (the first above ½, the second not or NaN for a corner declared outside without an
 /// evaluation; only the number of evaluations depends on them), and `guide` proposes crossings
-/// (see the module documentation).
+/// (see the module documentation). `None` once `deadline` has passed (checked between the
+/// crossings' chunks and the search's rounds).
 pub fn place_vertices<E: Evaluator + ?Sized>(
     evaluator: &E,
     lattice: &Lattice,
@@ -249,7 +250,8 @@ pub fn place_vertices<E: Evaluator + ?Sized>(
     steps: u32,
     guide: CrossingSource,
     deadline: Option<std::time::Instant>,
-) -> Placement {
+) -> Option<Placement> {
+    let past = || deadline.is_some_and(|at| std::time::Instant::now() > at);
     assert_eq!(edges.len(), corner_w.len());
     let ticks: i64 = 1 << (steps + 1);
     // Each edge's search runs on its own units of `stride` ticks, `units(e)` of them.
@@ -296,6 +298,11 @@ pub fn place_vertices<E: Evaluator + ?Sized>(
                 .par_chunks(4096)
                 .map(|chunk| {
                     let (mut ks, mut planes, mut counts) = (Vec::new(), Vec::new(), Vec::new());
+                    // Past the deadline the placement is discarded: no crossings are looked
+                    // for (millions of edges are seconds of hierarchy walks).
+                    if past() {
+                        return (ks, planes, vec![0; chunk.len()]);
+                    }
                     let mut hits: Vec<(i64, Plane)> = Vec::new();
                     for &e in chunk {
                         hits.clear();
@@ -332,6 +339,9 @@ pub fn place_vertices<E: Evaluator + ?Sized>(
             }
             (all, planes, ranges)
         };
+    if past() {
+        return None;
+    }
     let mut searches: Vec<Search> = edges
         .iter()
         .zip(corner_w)
@@ -348,10 +358,13 @@ pub fn place_vertices<E: Evaluator + ?Sized>(
         .collect();
     let mut evaluations = 0;
     let mut probes: Vec<(u32, i64)> = Vec::new();
-    // Past the deadline the caller discards the placement (`RemeshError::TimeLimit`): the
-    // rounds stop, since a deadlined evaluator's NaN would only walk each bracket down a tick
-    // per round.
-    while deadline.is_none_or(|at| std::time::Instant::now() <= at) {
+    // Past the deadline there is no placement (the remesh ends with `RemeshError::TimeLimit`):
+    // the rounds stop, since a deadlined evaluator's NaN would only walk each bracket down a
+    // tick per round.
+    loop {
+        if past() {
+            return None;
+        }
         probes.clear();
         for (j, s) in searches.iter_mut().enumerate() {
             if !s.is_open() {
@@ -436,14 +449,14 @@ pub fn place_vertices<E: Evaluator + ?Sized>(
                 .map(|i| crossing_planes[first as usize + i])
         })
         .collect();
-    Placement {
+    Some(Placement {
         positions,
         fixed,
         ticks_per_cell: ticks,
         evaluations,
         guided: searches.iter().filter(|s| s.verified).count(),
         planes,
-    }
+    })
 }
 
 #[cfg(test)]
@@ -544,7 +557,7 @@ mod tests {
         edges
             .iter()
             .map(|&(e, w)| {
-                let p = place_vertices(field, lattice, &[e], &[w], STEPS, guide, None);
+                let p = place_vertices(field, lattice, &[e], &[w], STEPS, guide, None).unwrap();
                 assert_within_a_tick_of_a_change(field, lattice, e, p.fixed[0]);
                 p.evaluations
             })
@@ -591,7 +604,8 @@ mod tests {
         );
         // All at once gives the same vertices as one by one (each edge's search is its own).
         let (e, w): (Vec<_>, Vec<_>) = edges.iter().copied().unzip();
-        let together = place_vertices(&field, &lattice, &e, &w, STEPS, CrossingSource::None, None);
+        let together =
+            place_vertices(&field, &lattice, &e, &w, STEPS, CrossingSource::None, None).unwrap();
         assert_eq!(together.evaluations, total);
         for (&edge, &fixed) in e.iter().zip(&together.fixed) {
             assert_within_a_tick_of_a_change(&field, &lattice, edge, fixed);
@@ -664,7 +678,8 @@ mod tests {
             STEPS,
             CrossingSource::Evaluator,
             None,
-        );
+        )
+        .unwrap();
         assert_eq!(p.guided, e.len());
         assert!(p.evaluations <= 2 * e.len(), "{}", p.evaluations);
         for ((&edge, &fixed), plane) in e.iter().zip(&p.fixed).zip(&p.planes) {
@@ -675,7 +690,8 @@ mod tests {
             assert!((((a + b + c) * 0.5 + d).abs() - 0.31).abs() < 1e-9);
         }
         // Without them, the field's search: bisection across a closed sheet, 8 per vertex.
-        let none = place_vertices(&exact, &lattice, &e, &w, STEPS, CrossingSource::None, None);
+        let none =
+            place_vertices(&exact, &lattice, &e, &w, STEPS, CrossingSource::None, None).unwrap();
         assert_eq!(
             (none.guided, none.evaluations),
             (0, STEPS as usize * e.len())
@@ -694,7 +710,8 @@ mod tests {
                 STEPS,
                 CrossingSource::Evaluator,
                 None,
-            );
+            )
+            .unwrap();
             assert!(p.guided < e.len() / 10, "{} of {}", p.guided, e.len());
             assert!(p.evaluations <= (STEPS as usize + 2) * e.len());
             for (&edge, &fixed) in e.iter().zip(&p.fixed) {
@@ -770,6 +787,7 @@ mod tests {
                 CrossingSource::None,
                 None,
             )
+            .unwrap()
         }
         let p = place_from_border(&field, &lattice, edge);
         assert_eq!(p.evaluations, 1);
@@ -816,6 +834,7 @@ mod tests {
                 source,
                 None,
             )
+            .unwrap()
         };
         let p = place(CrossingSource::Triangles(&guide));
         assert_eq!((p.evaluations, p.guided), (3, 1));

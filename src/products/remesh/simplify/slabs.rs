@@ -433,7 +433,7 @@ mod tests {
         let guide = SegmentBvh::of_mesh(&mesh);
         let lattice = lattice::Lattice::new(mesh.bounding_box().unwrap(), 40).unwrap();
         let classified = octree::classify(&wn, &lattice, Some(&guide), usize::MAX, None).unwrap();
-        let band = extract::extract(&lattice, &classified);
+        let band = extract::extract(&lattice, &classified, None).unwrap();
         let placed = place::place_vertices(
             &wn,
             &lattice,
@@ -442,7 +442,8 @@ mod tests {
             8,
             place::CrossingSource::Triangles(&guide),
             None,
-        );
+        )
+        .unwrap();
         let planes = placed.planes_in_lattice_units(&lattice);
         assert!(planes.iter().filter(|p| p.is_some()).count() * 2 > planes.len());
         let options = super::super::SimplifyOptions::default();
