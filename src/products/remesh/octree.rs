@@ -964,12 +964,22 @@ impl Classified {
                 .map(|&p| lattice.corner_position(p))
                 .collect();
             let values = super::levels::decisive_corner_values(evaluator, &positions);
+            // Past the deadline (the evaluations stopped, answering NaN) the rest of the round
+            // is not worth doing.
+            if deadline.is_some_and(|at| std::time::Instant::now() > at) {
+                return Err(Stop::TimeLimit);
+            }
             out.labels.reserve(new_points.len());
             for &p in &new_points {
                 out.labels.insert(pack(p), CornerValue::BORDER);
             }
             for (p, w) in interior.iter().zip(values) {
                 out.labels.insert(pack(*p), CornerValue::of(w));
+            }
+            // The insertions, and each of the two searches below, are up to a second of a
+            // large round: the clock is read between them.
+            if deadline.is_some_and(|at| std::time::Instant::now() > at) {
+                return Err(Stop::TimeLimit);
             }
             // (2) new children above the regular level whose closed box is mixed or that a
             // triangle meets.
@@ -987,6 +997,9 @@ impl Classified {
                     })
                 })
                 .collect();
+            if deadline.is_some_and(|at| std::time::Instant::now() > at) {
+                return Err(Stop::TimeLimit);
+            }
             // (3) leaves above the regular level around each new point that it contradicts.
             // (In parallel: the lookups of eight leaves per point were the serial half of a
             // round; the queue is sorted before use.)
