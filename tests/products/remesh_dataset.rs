@@ -318,6 +318,15 @@ fn remesh_stops_at_its_deadline_without_an_output() {
             extract(&lattice, &classified, None).unwrap(),
         );
         assert!(!a.triangles.is_empty());
+        // Placement too: nothing past the deadline, the same vertices before it.
+        use gwn::products::remesh::place::{CrossingSource, place_vertices};
+        let corner_w = classified.edge_values(&a.edges);
+        let place = |deadline| {
+            let source = CrossingSource::Triangles(&guide);
+            place_vertices(&wn, &lattice, &a.edges, &corner_w, 8, source, deadline)
+        };
+        assert!(place(Some(before)).is_none());
+        assert_eq!(place(Some(far)).unwrap().fixed, place(None).unwrap().fixed);
         assert_eq!((a.triangles, a.edges), (b.triangles, b.edges));
     }
 
