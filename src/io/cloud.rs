@@ -200,8 +200,10 @@ pub(super) fn cloud_from_ply(
         return Err(LoadError::new(
             name,
             Location::File,
+            // Said whole: a PLY meant as a mesh but without faces lands here too.
             LoadErrorKind::Syntax(format!(
-                "PLY `vertex` element has no scalar property `{}`",
+                "no faces (not a mesh), and as a point cloud: PLY `vertex` element has no \
+                 scalar property `{}`",
                 NAMES[k]
             )),
         ));
