@@ -30,6 +30,23 @@ TET_V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=np.float64)
 TET_F = np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]], dtype=np.int64)
 
 
+def copy_fixtures(tmp_path, files):
+    """Copies fixtures into ``tmp_path/in``: ``files`` maps a path below it to a fixture name.
+    Returns the copies' paths, in ``files``' order."""
+    paths = []
+    for to, src in files.items():
+        p = tmp_path / "in" / to
+        p.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy(FIXTURES / src, p)
+        paths.append(p)
+    return paths
+
+
+def files_by_suffix(d, suffix):
+    """Every file below ``d`` ending in ``suffix``, as {relative posix path: bytes}."""
+    return {p.relative_to(d).as_posix(): p.read_bytes() for p in sorted(d.rglob("*" + suffix))}
+
+
 def random_points(n, lo=-0.5, hi=1.5, seed=0):
     return np.random.default_rng(seed).uniform(lo, hi, size=(n, 3))
 

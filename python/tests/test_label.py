@@ -2,13 +2,12 @@
 gwn.dask.label_dataset on a real 2-worker LocalCluster), closed forms, failures as rows."""
 
 import json
-import shutil
 
 import numpy as np
 import pytest
 
 import gwn
-from conftest import FIXTURES
+from conftest import FIXTURES, copy_fixtures, files_by_suffix
 
 OPTS = dict(uniform=200, near=200, sigmas=(0.01, 0.1), seed=3)
 
@@ -16,17 +15,11 @@ OPTS = dict(uniform=200, near=200, sigmas=(0.01, 0.1), seed=3)
 def make_dataset(tmp_path):
     files = {"a/cube.off": "cube.off", "a/cube.obj": "cube.obj", "b/scene.glb": "two_cubes.glb",
              "b/broken.off": "broken_index.off", "b/c/cube.ply": "cube_binary_le.ply"}
-    paths = []
-    for to, src in files.items():
-        p = tmp_path / "in" / to
-        p.parent.mkdir(parents=True, exist_ok=True)
-        shutil.copy(FIXTURES / src, p)
-        paths.append(p)
-    return paths
+    return copy_fixtures(tmp_path, files)
 
 
 def npz_files(d):
-    return {p.relative_to(d).as_posix(): p.read_bytes() for p in sorted(d.rglob("*.npz"))}
+    return files_by_suffix(d, ".npz")
 
 
 def test_label_dataset_rows_and_closed_form(tmp_path):

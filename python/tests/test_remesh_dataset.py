@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import gwn
-from conftest import FIXTURES
+from conftest import FIXTURES, copy_fixtures, files_by_suffix
 
 OPTS = dict(samples=1000)
 
@@ -18,17 +18,11 @@ OPTS = dict(samples=1000)
 def make_dataset(tmp_path):
     files = {"a/cube.off": "cube.off", "b/scene.glb": "two_cubes.glb",
              "b/broken.off": "broken_index.off"}
-    paths = []
-    for to, src in files.items():
-        p = tmp_path / "in" / to
-        p.parent.mkdir(parents=True, exist_ok=True)
-        shutil.copy(FIXTURES / src, p)
-        paths.append(p)
-    return paths
+    return copy_fixtures(tmp_path, files)
 
 
 def surfaces(d):
-    return {p.relative_to(d).as_posix(): p.read_bytes() for p in sorted(d.rglob("*.ply"))}
+    return files_by_suffix(d, ".ply")
 
 
 def test_remesh_dataset_rows_outputs_and_resume(tmp_path, cli):
