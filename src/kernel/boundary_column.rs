@@ -18,9 +18,11 @@ use super::angle_sum::AngleSum;
 use super::angle_sum::AngleSumAvx2;
 use super::boundary_sum::BoundaryEdges;
 #[cfg(target_arch = "x86_64")]
+use super::boundary_sum::LoopQuery;
+#[cfg(target_arch = "x86_64")]
 use super::boundary_sum::shift_one_avx2;
 #[cfg(target_arch = "x86_64")]
-use super::lanes::{Avx2, edge_term, horizontal_sq, projected_dot, vertex_factors};
+use super::lanes::{Avx2, edge_term, horizontal_sq, projected_dot, split_offset, vertex_factors};
 use super::predicates::Width;
 #[cfg(target_arch = "x86_64")]
 use super::predicates::orient2d_filter_lanes;
@@ -36,20 +38,10 @@ pub struct ColumnQuery {
     pub z_exact: bool,
     /// The query's `z` in grid units when `z_exact` is false.
     pub qz_units: f64,
-    /// The query's exact residual in cells (`r[2] = 0` when `z_exact` is false): signs of edges
-    /// off the lattice are taken at `(x, y, z) + r` (see [`BoundaryEdges::area_sum`]).
+    /// The query's exact residual in cells (`r[2] = 0` when `z_exact` is false; `r[0]`, `r[1]`
+    /// the same for the whole column): the magnitudes, and the signs of edges off the lattice,
+    /// are taken at `(x, y, z) + r` (see [`BoundaryEdges::area_sum`]).
     pub r: [f64; 3],
-}
-
-impl ColumnQuery {
-    /// The `z` the magnitudes use.
-    fn z_units(&self) -> f64 {
-        if self.z_exact {
-            self.z as f64
-        } else {
-            self.qz_units
-        }
-    }
 }
 
 /// Queries per pass: the shared work is split four ways, and four angle products in flight hide
@@ -77,14 +69,23 @@ impl BoundaryEdges {
             for (batch, out) in queries.chunks(QUERIES).zip(out.chunks_mut(QUERIES)) {
                 // A short last batch repeats its last query (the extra results are dropped).
                 let pick = |k: usize| batch[k.min(batch.len() - 1)];
-                let zs: [f64; QUERIES] = std::array::from_fn(|k| pick(k).z_units());
+                // The column shares `x, y` and their residuals; each query has its own `z`.
+                let loop_query = |c: ColumnQuery| {
+                    LoopQuery::new([qxy[0], qxy[1], c.z], c.r, c.z_exact, c.qz_units)
+                };
+                let zs: [(f64, f64); QUERIES] = std::array::from_fn(|k| {
+                    let q = loop_query(pick(k));
+                    (q.hi[2], q.lo[2])
+                });
+                let first = loop_query(batch[0]);
+                debug_assert!(batch.iter().all(|c| c.r[..2] == batch[0].r[..2]));
                 let mut undecided = Vec::new();
                 // SAFETY: `column_angles_avx2` only needs the AVX2 instructions it is compiled
                 // with, and the CPU was just checked to have them.
                 #[allow(unsafe_code)]
                 let angles = unsafe {
                     self.column_angles_avx2(
-                        [qxy[0] as f64, qxy[1] as f64],
+                        ([first.hi[0], first.hi[1]], [first.lo[0], first.lo[1]]),
                         zs,
                         0..self.slots(),
                         &mut |e| undecided.push(e),
@@ -118,13 +119,13 @@ impl BoundaryEdges {
     #[target_feature(enable = "avx2")]
     fn column_angles_avx2(
         &self,
-        xy: [f64; 2],
-        zs: [f64; QUERIES],
+        (xy, xy_lo): ([f64; 2], [f64; 2]),
+        zs: [(f64, f64); QUERIES],
         slots: std::ops::Range<usize>,
         undecided: &mut impl FnMut(u32),
     ) -> [AngleSum; QUERIES] {
         use std::arch::x86_64::*;
-        let (xs, ys, vz, link) = self.vertex_arrays();
+        let ([xs, ys, vz], [xs_lo, ys_lo, vz_lo], link) = self.vertex_arrays();
         let load = |v: &[f64], j: usize| -> __m256d {
             bytemuck::cast(<[f64; 4]>::try_from(&v[j..j + 4]).unwrap())
         };
@@ -134,6 +135,7 @@ impl BoundaryEdges {
         };
         let o = Avx2;
         let (qx, qy) = (o.splat(xy[0]), o.splat(xy[1]));
+        let (qx_lo, qy_lo) = (o.splat(xy_lo[0]), o.splat(xy_lo[1]));
         let (conv, rel) = self.filter_constants();
         let (conv, rel) = (o.splat(conv), o.splat(rel));
         let zero = o.splat(0.0);
@@ -150,16 +152,22 @@ impl BoundaryEdges {
             // Vertices j0 .. j0 + 4·blocks + 4: every block's edges end one vertex further.
             for b in 0..=blocks {
                 let (i, j) = (4 * b, j0 + 4 * b);
-                let x = o.sub(load(xs, j), qx);
-                let y = o.sub(load(ys, j), qy);
+                let x = split_offset!(o, (load(xs, j), load(xs_lo, j)), (qx, qx_lo));
+                let y = split_offset!(o, (load(ys, j), load(ys_lo, j)), (qy, qy_lo));
                 store(&mut h, i, horizontal_sq!(o, x, y));
             }
             for b in 0..blocks {
                 let (i, j) = (4 * b, j0 + 4 * b);
                 // The edge ends' offsets straight from the vertex arrays (unaligned loads of
                 // data not written here: no store forwarding, no shuffles).
-                let (ax, ay) = (o.sub(load(xs, j), qx), o.sub(load(ys, j), qy));
-                let (bx, by) = (o.sub(load(xs, j + 1), qx), o.sub(load(ys, j + 1), qy));
+                let (ax, ay) = (
+                    split_offset!(o, (load(xs, j), load(xs_lo, j)), (qx, qx_lo)),
+                    split_offset!(o, (load(ys, j), load(ys_lo, j)), (qy, qy_lo)),
+                );
+                let (bx, by) = (
+                    split_offset!(o, (load(xs, j + 1), load(xs_lo, j + 1)), (qx, qx_lo)),
+                    split_offset!(o, (load(ys, j + 1), load(ys_lo, j + 1)), (qy, qy_lo)),
+                );
                 let real = o.gt(load(link, j), zero);
                 let (d, lane_ok) = orient2d_filter_lanes!(o, [ax, ay, bx, by], real, conv, rel);
                 store(&mut ok, i, lane_ok);
@@ -169,7 +177,7 @@ impl BoundaryEdges {
                 self.report_undecided(j, mask, undecided);
             }
             for (k, acc) in acc.iter_mut().enumerate() {
-                let qz = o.splat(zs[k]);
+                let (qz, qz_lo) = (o.splat(zs[k].0), o.splat(zs[k].1));
                 // s and p of vertex block `b` (one `sqrt` per vertex), kept in registers: the
                 // next block's are computed before this block's products, so that the square
                 // roots overlap with them, and the edge ends come by lane shifts (a load
@@ -177,7 +185,8 @@ impl BoundaryEdges {
                 macro_rules! vertices {
                     ($b:expr) => {{
                         let (i, j) = (4 * $b, j0 + 4 * $b);
-                        vertex_factors!(o, load(&h, i), o.sub(load(vz, j), qz))
+                        let z = split_offset!(o, (load(vz, j), load(vz_lo, j)), (qz, qz_lo));
+                        vertex_factors!(o, load(&h, i), z)
                     }};
                 }
                 let mut cur = vertices!(0);
@@ -250,6 +259,16 @@ mod tests {
                 } else {
                     [coord(&mut next), coord(&mut next)]
                 };
+                // Residuals (cells): shared across the column in x, y, each query's own in z.
+                let residual = |next: &mut dyn FnMut(u64) -> u64| {
+                    (next(1 << 20) as f64 - 524288.0) / 1048576.0
+                };
+                let off_lattice = next(2) == 0;
+                let rxy = if off_lattice {
+                    [residual(&mut next), residual(&mut next)]
+                } else {
+                    [0.0; 2]
+                };
                 let queries: Vec<ColumnQuery> = (0..1 + next(11))
                     .map(|_| {
                         let z_exact = next(5) != 0;
@@ -262,7 +281,15 @@ mod tests {
                             z,
                             z_exact,
                             qz_units: if z_exact { 0.0 } else { z as f64 * 3.0 + 0.5 },
-                            r: [0.0; 3],
+                            r: [
+                                rxy[0],
+                                rxy[1],
+                                if off_lattice && z_exact {
+                                    residual(&mut next)
+                                } else {
+                                    0.0
+                                },
+                            ],
                         }
                     })
                     .collect();

@@ -368,11 +368,11 @@ impl Expansion {
         }
     }
 
-    /// `(Ω_K(q), rounding allowance)` about `centre` (Eq. 5b). The allowance is
+    /// `(Ω_K(q), rounding allowance)` about the expansion's centre (Eq. 5b), from `s = centre −
+    /// q` (the caller computes it without cancellation). The allowance is
     /// [`EVALUATION_ROUNDING`] times the sum's magnitude bound `(1/r)·Σ_n M_n·r^−n` (`|σ^β| ≤ r^−n`).
     #[inline]
-    pub fn evaluate(&self, centre: [f64; 3], q: [f64; 3], order: usize) -> (f64, f64) {
-        let s = [centre[0] - q[0], centre[1] - q[1], centre[2] - q[2]];
+    pub fn evaluate(&self, s: [f64; 3], order: usize) -> (f64, f64) {
         let r2 = s[0] * s[0] + s[1] * s[1] + s[2] * s[2];
         let inv_r2 = 1.0 / r2;
         let inv_r = inv_r2.sqrt();
@@ -555,7 +555,7 @@ mod tests {
                     .map(|w| triangle_solid_angle(rel(p), rel(w[0]), rel(w[1])))
                     .sum();
                 for order in 1..=MAX_ORDER {
-                    let (value, rounding) = expansion.evaluate([0.0; 3], q, order);
+                    let (value, rounding) = expansion.evaluate(q.map(|c| -c), order);
                     let (reference, _) = evaluate(&m, [0.0; 3], q, order);
                     assert!(
                         (value - reference).abs() <= 1e-13 * (1.0 + reference.abs()),

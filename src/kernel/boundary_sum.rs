@@ -23,10 +23,12 @@ use super::double_double::DoubleDouble;
 use super::input_predicates::{InputPoint, LatticeFrame, input_inside_segment, input_orient2d};
 #[cfg(target_arch = "x86_64")]
 use super::lanes::Avx2;
-use super::lanes::{Portable, edge_term, horizontal_sq, projected_dot, vertex_factors};
+use super::lanes::{
+    Portable, edge_term, horizontal_sq, projected_dot, split_offset, vertex_factors,
+};
 use super::predicates::{
     ORIENT2D_FILTER_CONVERSION, ORIENT2D_FILTER_RELATIVE, Width, orient2d_filter_lanes,
-    perturbed_orient2d, perturbed_orient2d_at, query_inside_segment, query_inside_segment_at,
+    perturbed_orient2d_at, query_inside_segment_at,
 };
 use super::spherical::{EdgeSigns, antipodal_edge_area, antipodal_edge_area_accurate};
 use crate::base::compensated::NeumaierSum;
@@ -58,6 +60,52 @@ pub(super) fn shift_one_avx2(
     _mm256_shuffle_pd::<0b0101>(a, mid)
 }
 
+/// Splits the exact coordinate `n + r` (lattice point, residual; cells) of a chain vertex into
+/// `n` rounded to `f64` (returned) and the rest (pushed onto `lo`): `n − fl(n)` is an integer of
+/// at most `2^5` (exact), and adding `|r| ≤ 1/2` rounds by at most `2^-48` cells.
+fn split_coordinates(n: [i64; 3], r: [f64; 3], lo: &mut [Vec<f64>; 3]) -> [f64; 3] {
+    std::array::from_fn(|k| {
+        let hi = n[k] as f64;
+        lo[k].push((n[k] - hi as i64) as f64 + r[k]);
+        hi
+    })
+}
+
+/// A query as the loops see it: each coordinate split like the chain vertices'
+/// ([`split_coordinates`]), so that an offset is `(x_hi − q_hi) + (x_lo − q_lo)`
+/// ([`split_offset!`]) — the difference of the *input* points, vertex residual and query
+/// residual included, rounded three times: within `2u·|offset| + 2^-46` cells (`u = 2^-53`).
+///
+/// Why: the offsets were `fl(x) − fl(q)` of the lattice points, off by up to `2^6` cells from
+/// rounding 59-bit integers and by half a cell per point from snapping, whatever the offset's
+/// size. The near-edge tube ([`near_edge_pad`]) assumed relative error, so a query a few cells
+/// beyond it from a short edge (a mesh of extent `1e15` with edges of length 10) got magnitudes
+/// wrong in the fourth digit while every sign stayed exact (issue 11's promise: exact to the
+/// input bits, for the magnitudes as for the signs).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct LoopQuery {
+    pub hi: [f64; 3],
+    pub lo: [f64; 3],
+}
+
+impl LoopQuery {
+    /// The query `qi + r` (lattice point, residual in cells; frame). When `z_exact` is false
+    /// the query lies beyond the grid along the ray and `qz_units` is its `z` (then `r[2]` is 0
+    /// and the `f64` value is all there is: it is farther than the extent from every vertex).
+    pub fn new(qi: [i64; 3], r: [f64; 3], z_exact: bool, qz_units: f64) -> LoopQuery {
+        let split = |k: usize| {
+            let hi = qi[k] as f64;
+            (hi, (qi[k] - hi as i64) as f64 + r[k])
+        };
+        let (x, y, z) = (split(0), split(1), split(2));
+        let z = if z_exact { z } else { (qz_units, 0.0) };
+        LoopQuery {
+            hi: [x.0, y.0, z.0],
+            lo: [x.1, y.1, z.1],
+        }
+    }
+}
+
 /// Boundary edges of one mesh in the ray frame, in grid units.
 ///
 /// The SIMD loop walks the edges as *chains* of vertices (`v0 → v1 → v2 …`, closed loops repeat
@@ -70,11 +118,19 @@ pub struct BoundaryEdges {
     a: Vec<[i64; 3]>,
     b: Vec<[i64; 3]>,
     weight: Vec<f64>,
-    /// Chain vertices (structure of arrays, `f64` grid coordinates), padded with copies of the
-    /// last vertex so that every block reads in bounds.
+    /// Chain vertices (structure of arrays, `f64` grid coordinates rounded to nearest), padded
+    /// with copies of the last vertex so that every block reads in bounds.
     xs: Vec<f64>,
     ys: Vec<f64>,
     zs: Vec<f64>,
+    /// What `xs`, `ys`, `zs` leave out of the exact input coordinate (cells): the lattice
+    /// coordinate's rounding to `f64` (an integer, up to `2^5` cells at 59 bits) plus the
+    /// vertex's residual off the lattice. The loops' offsets are the split differences
+    /// ([`split_offset!`]), so the magnitudes are those of the input points (see
+    /// [`LoopQuery`]).
+    xs_lo: Vec<f64>,
+    ys_lo: Vec<f64>,
+    zs_lo: Vec<f64>,
     /// `link[j] = 1` when slot `j` → `j + 1` is an edge, `0` for a break or padding.
     link: Vec<f64>,
     /// The edge (index into `a`, `b`) of each linked slot, for the exact fallback.
@@ -112,8 +168,9 @@ struct EdgeInputs {
 /// edge's largest extent, at least 16 cells (which also covers the one-cell reach of a residual,
 /// see [`BoundaryEdges::needs_accurate_sum`]).
 ///
-/// Error model of the `f64` term at distance `d` from the edge: the offsets are exact integers
-/// rounded once (relative `u = 2^-53`); near the segment both `atan2` arguments are
+/// Error model of the `f64` term at distance `d` from the edge: the offsets are the exact
+/// inputs' differences rounded (relative `2u`, `u = 2^-53`, plus `2^-45` cells: [`LoopQuery`];
+/// before it they were off by up to `2^6` cells whatever `d`, see there); near the segment both `atan2` arguments are
 /// `≈ |a−q||b−q|·θ`, `θ ≈ d·len/(|a−q||b−q|)`, while their rounding errors are `≈ 2u·|a−q||b−q|`,
 /// so the term errs by `≲ 2u/θ ≤ u·len/(2d)` (`|a−q||b−q| ≤ len²/4` on the segment, less
 /// elsewhere; we allow `4u·len/d`). At `d ≥ 2^-7·len/√3` that is `≤ 900u = 1e-13`. Only a thin
@@ -192,10 +249,11 @@ fn ill_conditioned(
 /// Why: a vertex `v` seen almost along the ray (transverse offset `h ≪ |v − q|`) enters its
 /// terms through the azimuth of `v − q` around the ray (the on-ray limit of
 /// docs/robustness.md §3), so an absolute error `δ` in the transverse offset moves the term by
-/// `≈ 2δ/h` whatever the distance along the ray. The loop's offsets carry `δ ≤ 2^7` cells (two
-/// conversions of 59-bit integers to `f64`, half a cell of snapping); outside the column the
-/// term errs by `≤ 2·2^7/2^45 = 2^-37` in area, `≤ 6e-13` on `w`. Queries in the column are
-/// rare (`π(1e-5)²` of the box per boundary vertex), so the slow path stays rare.
+/// `≈ 2δ/h` whatever the distance along the ray. The loop's offsets carry `δ ≤ 2u·|v − q| +
+/// 2^-45` cells ([`LoopQuery`]; the column was sized when they carried `2^7` cells, two
+/// conversions of 59-bit integers and half a cell of snapping); outside the column the term
+/// errs by `≤ 2·2^7/2^45 = 2^-37` in area, `≤ 6e-13` on `w`, now far less. Queries in the
+/// column are rare (`π(1e-5)²` of the box per boundary vertex), so the slow path stays rare.
 #[inline]
 fn ray_tube(limit: f64) -> i64 {
     (limit as i64) >> 14
@@ -277,23 +335,28 @@ impl BoundaryEdges {
         let mut xs = Vec::new();
         let mut ys = Vec::new();
         let mut zs = Vec::new();
+        let mut lo: [Vec<f64>; 3] = Default::default();
         let mut link = Vec::new();
         let mut edge_of = Vec::new();
+        let exact_a = |e: u32| inputs.as_ref().map_or([0.0; 3], |x| x.a[e as usize].r);
+        let exact_b = |e: u32| inputs.as_ref().map_or([0.0; 3], |x| x.b[e as usize].r);
         for chain in &chains {
             let v0 = chain[0];
-            let mut push = |v: [i64; 3], l: f64, e: u32| {
-                xs.push(v[0] as f64);
-                ys.push(v[1] as f64);
-                zs.push(v[2] as f64);
+            let mut push = |v: [i64; 3], r: [f64; 3], l: f64, e: u32| {
+                let hi = split_coordinates(v, r, &mut lo);
+                xs.push(hi[0]);
+                ys.push(hi[1]);
+                zs.push(hi[2]);
                 link.push(l);
                 edge_of.push(e);
             };
-            push(a[v0 as usize], 1.0, v0);
+            push(a[v0 as usize], exact_a(v0), 1.0, v0);
             for (k, &e) in chain.iter().enumerate() {
                 let last = k + 1 == chain.len();
                 let next = if last { 0 } else { chain[k + 1] };
                 push(
                     b[e as usize],
+                    exact_b(e),
                     if last { 0.0 } else { 1.0 },
                     if last { u32::MAX } else { next },
                 );
@@ -325,10 +388,14 @@ impl BoundaryEdges {
             ys.last().copied().unwrap_or(0.0),
             zs.last().copied().unwrap_or(0.0),
         );
+        let last_lo = lo.each_ref().map(|v| v.last().copied().unwrap_or(0.0));
         for _ in 0..pad {
             xs.push(lx);
             ys.push(ly);
             zs.push(lz);
+            for k in 0..3 {
+                lo[k].push(last_lo[k]);
+            }
             link.push(0.0);
             edge_of.push(u32::MAX);
         }
@@ -352,6 +419,7 @@ impl BoundaryEdges {
             })
             .collect();
         let near = RayBvh::build(&near_boxes);
+        let [xs_lo, ys_lo, zs_lo] = lo;
         BoundaryEdges {
             a,
             b,
@@ -359,6 +427,9 @@ impl BoundaryEdges {
             xs,
             ys,
             zs,
+            xs_lo,
+            ys_lo,
+            zs_lo,
             link,
             edge_of,
             edge_slots_start,
@@ -391,8 +462,8 @@ impl BoundaryEdges {
     /// query's z lies outside the grid: `qz_units` (its z in grid units, `f64`) is used for the
     /// magnitudes and `qi[2]` (clamped) for nothing but the predicates, which do not involve z.
     /// `r` is the query's exact residual (cells; `r[2] = 0` when `z_exact` is false): the
-    /// magnitudes use the lattice point, every sign the exact query (see
-    /// [`BoundaryEdges::exact_edge_area`]; the caller has checked with
+    /// magnitudes are the exact query's and the exact vertices' ([`LoopQuery`]), every sign the
+    /// exact query's (see [`BoundaryEdges::exact_edge_area`]; the caller has checked with
     /// [`BoundaryEdges::needs_accurate_sum`] that `r` changes no lattice edge's sign).
     pub fn area_sum<W: Width>(
         &self,
@@ -420,11 +491,7 @@ impl BoundaryEdges {
         range: std::ops::Range<usize>,
     ) -> (AngleSum, f64) {
         debug_assert!(range.start.is_multiple_of(4) && range.end <= self.padded_slots());
-        let q = [
-            qi[0] as f64,
-            qi[1] as f64,
-            if z_exact { qi[2] as f64 } else { qz_units },
-        ];
+        let q = LoopQuery::new(qi, r, z_exact, qz_units);
         let mut scalar = 0.0;
         let mut undecided = |e: u32| {
             scalar += self.exact_edge_area::<W>(e as usize, qi, r, z_exact, qz_units);
@@ -471,9 +538,14 @@ impl BoundaryEdges {
         self.slots
     }
 
-    /// The chain vertices' `x`, `y`, `z` (grid units, padded) and the slot links.
-    pub(super) fn vertex_arrays(&self) -> (&[f64], &[f64], &[f64], &[f64]) {
-        (&self.xs, &self.ys, &self.zs, &self.link)
+    /// The chain vertices' `x`, `y`, `z` (grid units, padded; each as its `f64` rounding and
+    /// the rest, see [`LoopQuery`]) and the slot links.
+    pub(super) fn vertex_arrays(&self) -> ([&[f64]; 3], [&[f64]; 3], &[f64]) {
+        (
+            [&self.xs, &self.ys, &self.zs],
+            [&self.xs_lo, &self.ys_lo, &self.zs_lo],
+            &self.link,
+        )
     }
 
     /// Slots rounded up to a multiple of 4: the end of the last range a loop may visit.
@@ -498,8 +570,8 @@ impl BoundaryEdges {
     ///   that the residual could change the exact sign of that edge's numerator (or the
     ///   orientation is degenerate, where the segment test needs the exact z).
     ///
-    /// Otherwise the lattice evaluation has every sign of the exact query, and magnitudes within
-    /// half a cell: `≤ 2^-60·E/d` relative, negligible at `d ≥` the near-edge distance.
+    /// Otherwise the loop has every sign of the exact query, and the magnitudes of the exact
+    /// points within the error model of [`near_edge_pad`] ([`LoopQuery`]).
     pub fn needs_accurate_sum<W: Width>(&self, qi: [i64; 3], r: [f64; 3], z_exact: bool) -> bool {
         let mut flagged = false;
         self.for_each_flagged_edge(qi, r, z_exact, |_| {
@@ -656,56 +728,75 @@ impl BoundaryEdges {
         z_exact: bool,
         qz_units: f64,
     ) -> f64 {
-        let (qi, r) = (q.n, q.r);
-        let lattice_query = q.residual_exact();
-        // `p − q` in double-double: the lattice difference is exact, the residuals' difference is
-        // exact (two-sum), so near a vertex (same lattice point) the offset is exact however
-        // small — `1e-300` from a corner (the term's scaling is removed in the spherical formula).
-        let offset = |n: [i64; 3], s: [f64; 3]| -> [DoubleDouble; 3] {
-            let along =
-                |k: usize| DoubleDouble::from_i64(n[k] - qi[k]) + DoubleDouble::diff(s[k], r[k]);
-            let z = if z_exact {
-                along(2)
-            } else {
-                DoubleDouble::from_i64(n[2]) + DoubleDouble::diff(s[2], qz_units)
-            };
-            [along(0), along(1), z]
-        };
-        let tube = ray_tube(self.limit);
-        let (a, b) = (self.a[i], self.b[i]);
-        let off_lattice = self.inputs.as_ref().filter(|x| x.off_lattice[i]);
-        let (signs, ra, rb) = if off_lattice.is_some() || !lattice_query {
-            let (pa, pb) = match off_lattice {
-                Some(x) => (x.a[i], x.b[i]),
-                None => (InputPoint::lattice(a), InputPoint::lattice(b)),
-            };
-            let o = input_orient2d(q, &pa, &pb, &self.lattice);
-            let signs = EdgeSigns {
-                numerator: -o.sign,
-                query_inside_segment: o.degenerate
-                    && z_exact
-                    && input_inside_segment(q, &pa, &pb, &self.lattice),
-            };
-            (signs, offset(pa.n, pa.r), offset(pb.n, pb.r))
-        } else {
+        let (pa, pb) = self.edge_points(i);
+        let near = ill_conditioned(
+            self.a[i],
+            self.b[i],
+            q.n,
+            z_exact,
+            ray_tube(self.limit),
+            ACCURATE_TERM_PADS,
+        );
+        self.exact_segment_area::<W>(&pa, &pb, q, z_exact, qz_units, near)
+    }
+
+    /// The exact endpoints of edge `i`: its inputs when one is off the lattice, else its lattice
+    /// points.
+    pub(crate) fn edge_points(&self, i: usize) -> (InputPoint, InputPoint) {
+        match self.inputs.as_ref().filter(|x| x.off_lattice[i]) {
+            Some(x) => (x.a[i], x.b[i]),
+            None => (
+                InputPoint::lattice(self.a[i]),
+                InputPoint::lattice(self.b[i]),
+            ),
+        }
+    }
+
+    /// The term `Area(A, B, x1)` of the segment `pa → pb` between exact points at the exact
+    /// query `q` (a residual that underflowed included), through the exact predicates and the
+    /// limit formulas: the lattice ones (the `_at` forms for a query off the lattice) when both
+    /// ends are on the lattice and the query's residual is exact, the input ones otherwise. The
+    /// magnitudes come from [`exact_offsets`]: in double-double when `accurate` (near the
+    /// segment or its ray column), rounded once otherwise, the loop's error model
+    /// ([`LoopQuery`]).
+    pub(crate) fn exact_segment_area<W: Width>(
+        &self,
+        pa: &InputPoint,
+        pb: &InputPoint,
+        q: &InputPoint,
+        z_exact: bool,
+        qz_units: f64,
+        accurate: bool,
+    ) -> f64 {
+        let signs = if pa.on_lattice() && pb.on_lattice() && q.residual_exact() {
+            let (qi, r, a, b) = (q.n, q.r, pa.n, pb.n);
             let o = perturbed_orient2d_at::<W>(
                 [qi[0], qi[1]],
                 [r[0], r[1]],
                 [a[0], a[1]],
                 [b[0], b[1]],
             );
-            let signs = EdgeSigns {
+            EdgeSigns {
                 numerator: -o.sign,
                 query_inside_segment: o.degenerate
                     && z_exact
                     && query_inside_segment_at(qi, r, a, b),
-            };
-            (signs, offset(a, [0.0; 3]), offset(b, [0.0; 3]))
+            }
+        } else {
+            let o = input_orient2d(q, pa, pb, &self.lattice);
+            EdgeSigns {
+                numerator: -o.sign,
+                query_inside_segment: o.degenerate
+                    && z_exact
+                    && input_inside_segment(q, pa, pb, &self.lattice),
+            }
         };
-        if ill_conditioned(a, b, qi, z_exact, tube, ACCURATE_TERM_PADS) {
+        let ra = exact_offsets(pa, q, z_exact, qz_units);
+        let rb = exact_offsets(pb, q, z_exact, qz_units);
+        if accurate {
             antipodal_edge_area_accurate(ra, rb, signs)
         } else {
-            // `hi` is the offset rounded once (normalized pairs): the loop's error model.
+            // `hi` is the offset rounded once (normalized pairs).
             antipodal_edge_area(ra.map(|x| x.hi), rb.map(|x| x.hi), signs)
         }
     }
@@ -725,21 +816,22 @@ impl BoundaryEdges {
     /// [`AngleSum`]; `undecided(e)` is called for each edge the filter cannot sign.
     fn chain_angles(
         &self,
-        q: [f64; 3],
+        q: LoopQuery,
         slots: std::ops::Range<usize>,
         undecided: &mut impl FnMut(u32),
     ) -> AngleSum {
         let o = Portable;
-        let [qx, qy, qz] = q.map(f64x4::splat);
+        let [qx, qy, qz] = q.hi.map(f64x4::splat);
+        let [qx_lo, qy_lo, qz_lo] = q.lo.map(f64x4::splat);
         let (conv, rel) = self.filter_constants();
         let (conv, rel) = (o.splat(conv), o.splat(rel));
         let zero = o.splat(0.0);
         let lanes = |v: &[f64], j: usize| f64x4::from(lanes4(v, j));
         // Offsets x, y and the factors s, p (`vertex_factors!`) of the 4 vertices from slot `j`.
         let vertices = |j: usize| {
-            let x = o.sub(lanes(&self.xs, j), qx);
-            let y = o.sub(lanes(&self.ys, j), qy);
-            let z = o.sub(lanes(&self.zs, j), qz);
+            let x = split_offset!(o, (lanes(&self.xs, j), lanes(&self.xs_lo, j)), (qx, qx_lo));
+            let y = split_offset!(o, (lanes(&self.ys, j), lanes(&self.ys_lo, j)), (qy, qy_lo));
+            let z = split_offset!(o, (lanes(&self.zs, j), lanes(&self.zs_lo, j)), (qz, qz_lo));
             let (s, p) = vertex_factors!(o, horizontal_sq!(o, x, y), z);
             [x, y, s, p]
         };
@@ -774,22 +866,23 @@ impl BoundaryEdges {
     #[target_feature(enable = "avx2")]
     fn chain_angles_avx2(
         &self,
-        q: [f64; 3],
+        q: LoopQuery,
         slots: std::ops::Range<usize>,
         undecided: &mut impl FnMut(u32),
     ) -> AngleSum {
         use std::arch::x86_64::*;
         let o = Avx2;
         let load = |v: &[f64], j: usize| -> __m256d { bytemuck::cast(lanes4(v, j)) };
-        let [qx, qy, qz] = q.map(|c| o.splat(c));
+        let [qx, qy, qz] = q.hi.map(|c| o.splat(c));
+        let [qx_lo, qy_lo, qz_lo] = q.lo.map(|c| o.splat(c));
         let (conv, rel) = self.filter_constants();
         let (conv, rel) = (o.splat(conv), o.splat(rel));
         let zero = o.splat(0.0);
         macro_rules! vertices {
             ($j:expr) => {{
-                let x = o.sub(load(&self.xs, $j), qx);
-                let y = o.sub(load(&self.ys, $j), qy);
-                let z = o.sub(load(&self.zs, $j), qz);
+                let x = split_offset!(o, (load(&self.xs, $j), load(&self.xs_lo, $j)), (qx, qx_lo));
+                let y = split_offset!(o, (load(&self.ys, $j), load(&self.ys_lo, $j)), (qy, qy_lo));
+                let z = split_offset!(o, (load(&self.zs, $j), load(&self.zs_lo, $j)), (qz, qz_lo));
                 let (s, p) = vertex_factors!(o, horizontal_sq!(o, x, y), z);
                 [x, y, s, p]
             }};
@@ -833,9 +926,9 @@ impl BoundaryEdges {
         }
     }
 
-    /// One edge through the exact predicate and the limit formulas. An edge with an endpoint off
-    /// the lattice is signed on the exact inputs, the query `qi + r` included (the lattice sign
-    /// could be the snapped edge's); the magnitudes stay the lattice ones (within a cell).
+    /// One edge through the exact predicates and the limit formulas
+    /// ([`BoundaryEdges::exact_segment_area`] at the query `qi + r`): the loop's fallback for the
+    /// edges its filter cannot sign, and the heavy edges' terms.
     #[cold]
     pub(super) fn exact_edge_area<W: Width>(
         &self,
@@ -845,68 +938,54 @@ impl BoundaryEdges {
         z_exact: bool,
         qz_units: f64,
     ) -> f64 {
-        let (a, b) = (self.a[i], self.b[i]);
-        let Some(inputs) = self.inputs.as_ref().filter(|x| x.off_lattice[i]) else {
-            return segment_area::<W>(a, b, qi, z_exact, qz_units);
-        };
         let q = InputPoint {
             n: qi,
             r: [r[0], r[1], if z_exact { r[2] } else { 0.0 }],
             world: [0.0; 3],
             exact: [true; 3],
         };
-        let (pa, pb) = (&inputs.a[i], &inputs.b[i]);
-        let o = input_orient2d(&q, pa, pb, &self.lattice);
-        let signs = EdgeSigns {
-            numerator: -o.sign,
-            query_inside_segment: o.degenerate
-                && z_exact
-                && input_inside_segment(&q, pa, pb, &self.lattice),
-        };
-        let (ra, rb) = lattice_offsets(a, b, qi, z_exact, qz_units);
-        antipodal_edge_area(ra, rb, signs)
+        let (pa, pb) = self.edge_points(i);
+        self.exact_segment_area::<W>(&pa, &pb, &q, z_exact, qz_units, false)
     }
 }
 
-/// The term `Area(A, B, x1)` of any segment `a → b` (grid coordinates, frame) at the lattice
-/// query `qi` through the exact predicate and the limit formulas: the same sign as every other
-/// term (the hierarchy's spoke segments use it, see [`super::boundary_tree`]).
-pub(crate) fn segment_area<W: Width>(
-    a: [i64; 3],
-    b: [i64; 3],
-    qi: [i64; 3],
+/// The offset `p − q` of exact points (cells, frame) in double-double: the lattice difference is
+/// exact and so is the residuals' (two-sum), so near a vertex (same lattice point) the offset is
+/// exact however small — `1e-300` from a corner (the term's scaling is removed in the spherical
+/// formula). When `z_exact` is false, `z` is taken from `qz_units` (the query lies beyond the
+/// grid along the ray).
+fn exact_offsets(
+    p: &InputPoint,
+    q: &InputPoint,
     z_exact: bool,
     qz_units: f64,
-) -> f64 {
-    let o = perturbed_orient2d::<W>([qi[0], qi[1]], [a[0], a[1]], [b[0], b[1]]);
-    let (ra, rb) = lattice_offsets(a, b, qi, z_exact, qz_units);
-    let signs = EdgeSigns {
-        numerator: -o.sign,
-        query_inside_segment: o.degenerate && z_exact && query_inside_segment(qi, a, b),
+) -> [DoubleDouble; 3] {
+    let along =
+        |k: usize| DoubleDouble::from_i64(p.n[k] - q.n[k]) + DoubleDouble::diff(p.r[k], q.r[k]);
+    let z = if z_exact {
+        along(2)
+    } else {
+        DoubleDouble::from_i64(p.n[2]) + DoubleDouble::diff(p.r[2], qz_units)
     };
-    antipodal_edge_area(ra, rb, signs)
+    [along(0), along(1), z]
 }
 
-/// The offsets `a − q`, `b − q` in grid units (`f64`) from the lattice query (`z` from
-/// `qz_units` when `z_exact` is false).
-#[inline]
-fn lattice_offsets(
-    a: [i64; 3],
-    b: [i64; 3],
-    qi: [i64; 3],
+/// The offset `p − q` of exact points (cells, frame) in `f64`: the integer difference and the
+/// residuals' each rounded once, then their sum, so within `2u·|p − q| + 2^-50` cells
+/// (`u = 2^-53`), the error model of the loop ([`LoopQuery`]); for the hierarchy's spokes.
+pub(crate) fn rounded_offset(
+    p: &InputPoint,
+    q: &InputPoint,
     z_exact: bool,
     qz_units: f64,
-) -> ([f64; 3], [f64; 3]) {
-    let dz = |p: [i64; 3]| {
-        if z_exact {
-            (p[2] - qi[2]) as f64
-        } else {
-            p[2] as f64 - qz_units
-        }
+) -> [f64; 3] {
+    let along = |k: usize| (p.n[k] - q.n[k]) as f64 + (p.r[k] - q.r[k]);
+    let z = if z_exact {
+        along(2)
+    } else {
+        p.n[2] as f64 + (p.r[2] - qz_units)
     };
-    let ra = [(a[0] - qi[0]) as f64, (a[1] - qi[1]) as f64, dz(a)];
-    let rb = [(b[0] - qi[0]) as f64, (b[1] - qi[1]) as f64, dz(b)];
-    (ra, rb)
+    [along(0), along(1), z]
 }
 
 /// The Morton (Z-order) key of a grid point: the top 21 bits of each coordinate, interleaved.
@@ -981,7 +1060,14 @@ mod tests {
             {
                 let (a, b, q) = ([x, 1, za], [x, 1, zb], [qx, 1, qz]);
                 for z_exact in [true, false] {
-                    let area = segment_area::<W128>(a, b, q, z_exact, qz as f64 + 0.25);
+                    let area = BoundaryEdges::default().exact_segment_area::<W128>(
+                        &InputPoint::lattice(a),
+                        &InputPoint::lattice(b),
+                        &InputPoint::lattice(q),
+                        z_exact,
+                        qz as f64 + 0.25,
+                        false,
+                    );
                     assert_eq!(area, 0.0, "a {a:?} b {b:?} q {q:?}");
                     checked += 1;
                 }
@@ -1148,7 +1234,7 @@ mod tests {
                     next(11) as i64 - 5,
                 ];
                 let want: f64 = (0..a.len())
-                    .map(|i| weight[i] * segment_area::<W128>(a[i], b[i], q, true, 0.0))
+                    .map(|i| weight[i] * edges.exact_edge_area::<W128>(i, q, [0.0; 3], true, 0.0))
                     .sum();
                 let got = edges.area_sum::<W128>(q, [0.0; 3], true, 0.0);
                 assert!((got - want).abs() < 1e-9, "q {q:?}: {got} vs {want}");
@@ -1199,11 +1285,18 @@ mod tests {
                 let weight: Vec<f64> = (0..n).map(|_| (1 + rng.next(3)) as f64).collect();
                 let edges = BoundaryEdges::new(a, b, weight, 60);
                 for k in 0..20 {
-                    let q = if k < 5 {
-                        pts[rng.next(pts.len() as u64) as usize].map(|c| c as f64)
+                    let qi = if k < 5 {
+                        pts[rng.next(pts.len() as u64) as usize]
                     } else {
-                        [rng.coord(big), rng.coord(big), rng.coord(big)].map(|c| c as f64)
+                        [rng.coord(big), rng.coord(big), rng.coord(big)]
                     };
+                    // Half the queries off the lattice (dyadic residuals of up to 20 bits).
+                    let r: [f64; 3] = if k % 2 == 0 {
+                        [0.0; 3]
+                    } else {
+                        std::array::from_fn(|_| (rng.next(1 << 20) as f64 - 524288.0) / 1048576.0)
+                    };
+                    let q = LoopQuery::new(qi, r, true, 0.0);
                     let (mut u1, mut u2) = (Vec::new(), Vec::new());
                     let s1 = edges
                         .chain_angles(q, 0..edges.slots, &mut |e| u1.push(e))
@@ -1226,7 +1319,12 @@ mod tests {
                     let by_scalar: Vec<u32> = (0..edges.len() as u32)
                         .filter(|&e| {
                             let (a, b, _) = edges.edge(e as usize);
-                            let off = |p: [i64; 3]| [p[0] as f64 - q[0], p[1] as f64 - q[1]];
+                            // The split offsets of `split_offset!`, one coordinate at a time.
+                            let split = |p: i64, k: usize| {
+                                let hi = p as f64;
+                                (hi - q.hi[k]) + ((p - hi as i64) as f64 - q.lo[k])
+                            };
+                            let off = |p: [i64; 3]| [split(p[0], 0), split(p[1], 1)];
                             !is_parallel_to_ray(a, b)
                                 && orient2d_filtered(off(a), off(b), edges.limit).is_none()
                         })

@@ -19,7 +19,8 @@ use super::boundary_multipole::{
     COEFFICIENTS, Expansion, MAX_ORDER, Moments, add_fan_triangle, coefficients_up_to, shifted,
     truncation_bound,
 };
-use super::boundary_sum::{BoundaryEdges, segment_area};
+use super::boundary_sum::{BoundaryEdges, rounded_offset};
+use super::input_predicates::InputPoint;
 use super::predicates::{Width, orient2d_filtered};
 use super::spherical::{FOUR_PI, INV_4PI};
 use wide::f64x4;
@@ -43,10 +44,13 @@ const SPOKE_COST: f64 = 15.0;
 const NODE_COST: f64 = 100.0;
 
 /// Relative rounding allowance of a node's radius: the distances from the centre are a handful
-/// of `f64` operations on normalized coordinates (relative error `≲ 4u = 4.4e-16`), and the
-/// radius only has to be an upper bound, so `1e-15` (plus 4 cells for the normalization's own
-/// rounding) covers it.
+/// of `f64` operations on exact integer offsets (relative error `≲ 4u = 4.4e-16`), and the
+/// radius only has to be an upper bound, so `1e-15` covers it (plus [`RADIUS_CELLS`]).
 const RADIUS_ROUNDING: f64 = 1e-15;
+
+/// Absolute allowance of a node's radius, in cells: the vertices' residuals off the lattice
+/// (`≤ √3/2`) with room to spare; the radius is measured on the lattice points.
+const RADIUS_CELLS: f64 = 4.0;
 
 /// Relative rounding allowance of a node's fan area (the upper bound on its fan's total triangle
 /// area that the truncation bound takes): a sum of non-negative terms, its children's areas and
@@ -72,13 +76,16 @@ struct Node {
     /// Integer box of the node's vertices (frame).
     lo: [i64; 3],
     hi: [i64; 3],
+    /// Twice the centre of the ball holding `S` (`lo + hi`, cells, exact): offsets from the
+    /// centre are computed from it without cancellation ([`TreeQuery::offset_from_centre`]).
+    centre2: [i64; 3],
     /// Centre and radius of the ball holding `S` (normalized coordinates).
     centre: [f64; 3],
     radius: f64,
     /// Unsigned area of `S` (normalized units).
     area: f64,
-    /// Apex of the fan.
-    apex: [i64; 3],
+    /// Apex of the fan (the exact vertex).
+    apex: InputPoint,
     /// Open ends `(v, m_v)`: `ends[e0..e1]`.
     ends: (u32, u32),
     /// The area budget of the node at the evaluator's tolerance.
@@ -95,15 +102,59 @@ struct Node {
 pub struct BoundaryTree {
     nodes: Vec<Node>,
     expansions: Vec<Expansion>,
-    ends: Vec<([i64; 3], i32)>,
+    ends: Vec<(InputPoint, i32)>,
+    /// The grid's `2^(bits−1)` (normalized coordinates are cells divided by it).
+    limit: f64,
+}
+
+/// A query as the hierarchy sees it. Its offsets from the node centres
+/// ([`TreeQuery::offset_from_centre`]) decide which nodes are expanded and where their expansions are
+/// evaluated, so for a query in the grid they are computed from the exact query and the exact
+/// doubled centre, relative to the offset: rounding `q` and the centre to normalized `f64` first
+/// moved both by up to `2^6` cells, which a node `d` away turns into a relative error `2^6/d`
+/// of its expansion's value — beyond the certified bound for small nodes of huge meshes.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum TreeQuery {
+    /// A query in the grid across the ray: the exact point, and `qz_units` (its `z` in cells)
+    /// when `z_exact` is false.
+    Lattice {
+        q: InputPoint,
+        z_exact: bool,
+        qz_units: f64,
+    },
+    /// A query whose ray cannot approach the mesh (normalized coordinates): farther than the
+    /// extent from every node, where `f64` positions are accurate enough.
+    Far([f64; 3]),
+}
+
+impl TreeQuery {
+    /// `q − centre` of node `n`, normalized.
+    #[inline]
+    fn offset_from_centre(&self, n: &Node, limit: f64) -> [f64; 3] {
+        match self {
+            TreeQuery::Lattice {
+                q,
+                z_exact,
+                qz_units,
+            } => std::array::from_fn(|k| {
+                if k == 2 && !z_exact {
+                    (qz_units - n.centre2[2] as f64 * 0.5) / limit
+                } else {
+                    // Exact: |2q| ≤ 2^60 and |centre2| ≤ 2^60.
+                    ((2 * q.n[k] - n.centre2[k]) as f64 * 0.5 + q.r[k]) / limit
+                }
+            }),
+            TreeQuery::Far(q) => std::array::from_fn(|k| q[k] - n.centre[k]),
+        }
+    }
 }
 
 /// Moments of the nodes while building (in node order): values and magnitudes; and the leaves'.
 struct Building {
     moments: Vec<Moments>,
     leaves: Vec<LeafMoments>,
-    /// Every node's open ends, its apex included (sorted by position).
-    full_ends: Vec<Vec<([i64; 3], i32)>>,
+    /// Every node's open ends, its apex included (sorted by lattice position).
+    full_ends: Vec<Vec<(InputPoint, i32)>>,
 }
 
 /// The fan moments of one leaf chunk about its apex (the first edge's start).
@@ -118,19 +169,21 @@ fn leaf_moments(edges: &BoundaryEdges, range: std::ops::Range<usize>) -> LeafMom
     let mut area = 0.0;
     let mut apex = None;
     for e in range.filter_map(|j| edges.slot_edge(j)) {
-        let (a, b, _) = edges.edge(e);
+        let (a, b) = edges.edge_points(e);
         let p = *apex.get_or_insert(a);
-        area += add_fan_triangle(&mut m, rel(a, p, limit), rel(b, p, limit), 1.0);
+        area += add_fan_triangle(&mut m, rel(&a, &p, limit), rel(&b, &p, limit), 1.0);
     }
     LeafMoments { moments: m, area }
 }
 
-/// Sums the multiplicities of equal positions in a sorted list and drops the zeros.
-fn merge_ends(sorted: Vec<([i64; 3], i32)>) -> Vec<([i64; 3], i32)> {
-    let mut merged: Vec<([i64; 3], i32)> = Vec::with_capacity(sorted.len());
-    for (v, m) in sorted {
+/// Sorts open ends by lattice position, sums the multiplicities of equal positions (as the
+/// chains join edges: by lattice point) and drops the zeros.
+fn merge_ends(mut ends: Vec<(InputPoint, i32)>) -> Vec<(InputPoint, i32)> {
+    ends.sort_by_key(|(v, _)| v.n);
+    let mut merged: Vec<(InputPoint, i32)> = Vec::with_capacity(ends.len());
+    for (v, m) in ends {
         match merged.last_mut() {
-            Some((w, n)) if *w == v => *n += m,
+            Some((w, n)) if w.n == v.n => *n += m,
             _ => merged.push((v, m)),
         }
     }
@@ -182,6 +235,7 @@ impl BoundaryTree {
             nodes: Vec::new(),
             expansions: Vec::new(),
             ends: Vec::new(),
+            limit: edges.limit(),
         };
         // The tolerance is on w = Σ/(4π): the area budget is 4π times it.
         let per_edge = FOUR_PI * tolerance / total as f64;
@@ -221,11 +275,11 @@ impl BoundaryTree {
         (tree.nodes[0].subtree_reach.is_finite()).then_some(tree)
     }
 
-    /// Whether a query at `q` (normalized coordinates) can expand any node: otherwise the flat
-    /// loop is the same work without the traversal.
-    pub fn reaches(&self, q: [f64; 3]) -> bool {
+    /// Whether the query `q` can expand any node: otherwise the flat loop is the same work
+    /// without the traversal.
+    pub fn reaches(&self, q: &TreeQuery) -> bool {
         let n = &self.nodes[0];
-        let d: [f64; 3] = std::array::from_fn(|k| q[k] - n.centre[k]);
+        let d = q.offset_from_centre(n, self.limit);
         (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() + n.radius >= n.subtree_reach
     }
 
@@ -240,7 +294,6 @@ impl BoundaryTree {
     ) -> u32 {
         let index = self.nodes.len();
         let limit = edges.limit();
-        let norm = |p: [i64; 3]| p.map(|c| c as f64 / limit);
         let slot_edges: Vec<usize> = (j0..j1).filter_map(|j| edges.slot_edge(j)).collect();
         let endpoints = || {
             slot_edges.iter().flat_map(|&e| {
@@ -255,32 +308,32 @@ impl BoundaryTree {
                 hi[k] = hi[k].max(p[k]);
             }
         }
-        let apex = slot_edges.first().map_or([0; 3], |&e| edges.edge(e).0);
-        let centre: [f64; 3] = if slot_edges.is_empty() {
-            [0.0; 3]
+        let apex = slot_edges
+            .first()
+            .map_or(InputPoint::lattice([0; 3]), |&e| edges.edge_points(e).0);
+        let centre2: [i64; 3] = if slot_edges.is_empty() {
+            [0; 3]
         } else {
-            std::array::from_fn(|k| (lo[k] as f64 * 0.5 + hi[k] as f64 * 0.5) / limit)
+            std::array::from_fn(|k| lo[k] + hi[k])
         };
+        let centre: [f64; 3] = std::array::from_fn(|k| centre2[k] as f64 * 0.5 / limit);
         let radius = endpoints()
             .map(|p| {
-                let v = norm(p);
-                ((v[0] - centre[0]).powi(2)
-                    + (v[1] - centre[1]).powi(2)
-                    + (v[2] - centre[2]).powi(2))
-                .sqrt()
+                // Exact integer offsets (|2p − centre2| ≤ 2^61), each rounded once.
+                let d: [f64; 3] = std::array::from_fn(|k| (2 * p[k] - centre2[k]) as f64 * 0.5);
+                (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
             })
             .fold(0.0, f64::max);
-        let radius = radius * (1.0 + RADIUS_ROUNDING) + 4.0 / limit;
+        let radius = (radius * (1.0 + RADIUS_ROUNDING) + RADIUS_CELLS) / limit;
         // Open ends: m_v = (edges leaving v) − (edges arriving), merged by position (sorted).
         // Leaves sort their edges' ends; parents merge their children's lists.
-        let full_ends: Vec<([i64; 3], i32)> = if j1 - j0 <= LEAF_SLOTS {
-            let mut ends: Vec<([i64; 3], i32)> = Vec::with_capacity(2 * slot_edges.len());
+        let full_ends: Vec<(InputPoint, i32)> = if j1 - j0 <= LEAF_SLOTS {
+            let mut ends: Vec<(InputPoint, i32)> = Vec::with_capacity(2 * slot_edges.len());
             for &e in &slot_edges {
-                let (a, b, _) = edges.edge(e);
+                let (a, b) = edges.edge_points(e);
                 ends.push((a, 1));
                 ends.push((b, -1));
             }
-            ends.sort_unstable();
             merge_ends(ends)
         } else {
             Vec::new()
@@ -293,6 +346,7 @@ impl BoundaryTree {
             children: None,
             lo,
             hi,
+            centre2,
             centre,
             radius,
             area: 0.0,
@@ -316,27 +370,25 @@ impl BoundaryTree {
             self.nodes[index].children = Some((left, right));
             let mut ends = building.full_ends[left as usize].clone();
             ends.extend_from_slice(&building.full_ends[right as usize]);
-            ends.sort_unstable();
             building.full_ends[index] = merge_ends(ends);
-            let apex_c = norm(apex);
             let mut area = 0.0;
             for child in [left, right] {
                 let c = &self.nodes[child as usize];
                 if c.edges == 0 {
                     continue;
                 }
-                let delta: [f64; 3] = std::array::from_fn(|k| c.centre[k] - apex_c[k]);
+                let delta = centre_minus_point(c.centre2, &apex, limit);
                 let moved = shifted(&building.moments[child as usize], delta);
                 for i in 0..COEFFICIENTS {
                     m[i] += moved[i];
                 }
                 area += c.area;
-                if c.apex != apex {
+                if (c.apex.n, c.apex.r) != (apex.n, apex.r) {
                     // S_child is the fan from the child's apex p_k; the node's fan from p adds,
                     // per open end v of the child, −m_v times the triangle (p, p_k, v) (Eq. 9).
                     let child_apex = c.apex;
                     for &(v, mv) in &building.full_ends[child as usize] {
-                        let (ra, rb) = (rel(child_apex, apex, limit), rel(v, apex, limit));
+                        let (ra, rb) = (rel(&child_apex, &apex, limit), rel(&v, &apex, limit));
                         let weight = -f64::from(mv);
                         for _ in 0..mv.unsigned_abs() {
                             area += add_fan_triangle(&mut m, ra, rb, weight.signum());
@@ -346,14 +398,14 @@ impl BoundaryTree {
             }
             area
         };
-        let delta: [f64; 3] = std::array::from_fn(|k| norm(apex)[k] - centre[k]);
+        let delta = centre_minus_point(centre2, &apex, limit).map(|c| -c);
         building.moments[index] = shifted(&m, delta);
         self.nodes[index].area = area * (1.0 + AREA_ROUNDING);
         let e0 = self.ends.len() as u32;
         self.ends.extend(
             building.full_ends[index]
                 .iter()
-                .filter(|&&(v, _)| v != apex),
+                .filter(|&&(v, _)| v.n != apex.n),
         );
         self.nodes[index].ends = (e0, self.ends.len() as u32);
         index as u32
@@ -370,7 +422,17 @@ impl BoundaryTree {
         qz_units: f64,
     ) -> TreeSum {
         let limit = edges.limit();
-        let q = lattice_query(edges, qi, z_exact, qz_units);
+        let q = InputPoint {
+            n: qi,
+            r,
+            world: [0.0; 3],
+            exact: [true; 3],
+        };
+        let at = TreeQuery::Lattice {
+            q,
+            z_exact,
+            qz_units,
+        };
         // The ray from q (+z) misses a node's box, with a one-cell margin for the residual.
         let misses = |lo: [i64; 3], hi: [i64; 3]| {
             qi[0] < lo[0] - 1
@@ -389,9 +451,9 @@ impl BoundaryTree {
             }
             scalar += s;
         };
-        let mut spokes = SpokeSum::new(qi, z_exact, qz_units, limit);
-        let mut spoke = |p: [i64; 3], v: [i64; 3], m: i32| spokes.subtract::<W>(p, v, m);
-        let mut sum = self.traverse(q, misses, &mut run_exact, &mut spoke);
+        let mut spokes = SpokeSum::new(edges, q, z_exact, qz_units, limit);
+        let mut spoke = |p: &InputPoint, v: &InputPoint, m: i32| spokes.subtract::<W>(p, v, m);
+        let mut sum = self.traverse(&at, misses, &mut run_exact, &mut spoke);
         let (spoke_angles, spoke_scalar) = spokes.finish();
         if let Some(a) = &mut angles {
             a.absorb(&spoke_angles);
@@ -407,24 +469,22 @@ impl BoundaryTree {
     /// [`BoundaryEdges::area_sum`] bit for bit (one range over every slot; the identity factors of
     /// the padding and of an empty spoke product are exact): the query is closer to the root than
     /// any node's reach. Column evaluation batches such queries.
-    pub fn is_flat_at(
-        &self,
-        edges: &BoundaryEdges,
-        qi: [i64; 3],
-        z_exact: bool,
-        qz_units: f64,
-    ) -> bool {
-        !self.reaches(lattice_query(edges, qi, z_exact, qz_units))
+    pub fn is_flat_at(&self, q: InputPoint, z_exact: bool, qz_units: f64) -> bool {
+        !self.reaches(&TreeQuery::Lattice {
+            q,
+            z_exact,
+            qz_units,
+        })
     }
 
     /// The traversal shared by lattice and far queries: expanded nodes' terms and bounds; the
     /// slot ranges left to the exact loop go to `exact` (in slot order, adjacent ones merged).
     pub(crate) fn traverse(
         &self,
-        q: [f64; 3],
+        q: &TreeQuery,
         misses: impl Fn([i64; 3], [i64; 3]) -> bool,
         exact: &mut impl FnMut(std::ops::Range<usize>),
-        spoke: &mut impl FnMut([i64; 3], [i64; 3], i32),
+        spoke: &mut impl FnMut(&InputPoint, &InputPoint, i32),
     ) -> TreeSum {
         let mut out = TreeSum::default();
         let mut pending: Option<std::ops::Range<usize>> = None;
@@ -452,7 +512,7 @@ impl BoundaryTree {
                 continue;
             }
             let range = n.j0 as usize..n.j1 as usize;
-            let d: [f64; 3] = std::array::from_fn(|k| q[k] - n.centre[k]);
+            let d = q.offset_from_centre(n, self.limit);
             let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
             // Every node below lies within the ball: closer than any reach below, loop over all.
             if r + n.radius < n.subtree_reach {
@@ -462,12 +522,12 @@ impl BoundaryTree {
             if r >= n.subtree_reach && misses(n.lo, n.hi) {
                 if let Some(k) = (1..=MAX_ORDER).find(|&k| r >= n.reach[k - 1]) {
                     let bound = truncation_bound(n.area, n.radius, r, k);
-                    let (omega, rounding) = self.expansions[i as usize].evaluate(n.centre, q, k);
+                    let (omega, rounding) = self.expansions[i as usize].evaluate(d.map(|c| -c), k);
                     let bound = bound + rounding;
                     if bound <= n.budget {
                         let (e0, e1) = n.ends;
-                        for &(v, m) in &self.ends[e0 as usize..e1 as usize] {
-                            spoke(n.apex, v, m);
+                        for (v, m) in &self.ends[e0 as usize..e1 as usize] {
+                            spoke(&n.apex, v, *m);
                         }
                         out.area += omega;
                         out.bound += bound * INV_4PI;
@@ -521,23 +581,13 @@ fn scoped_map<T: Send>(count: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
     })
 }
 
-/// A lattice query in the tree's normalized coordinates (`z` in grid units when it is not exact).
-fn lattice_query(edges: &BoundaryEdges, qi: [i64; 3], z_exact: bool, qz_units: f64) -> [f64; 3] {
-    let limit = edges.limit();
-    [
-        qi[0] as f64 / limit,
-        qi[1] as f64 / limit,
-        if z_exact { qi[2] as f64 } else { qz_units } / limit,
-    ]
-}
-
 /// The spoke terms `−Σ m_v·Area(p, v)` of the expanded nodes at one lattice query, as one angle
 /// product like the boundary loop's (no `atan2` per spoke). The ray misses the node's box, so the
 /// term has no branch near: the `f64` form of the loop applies whenever the filter signs the
 /// numerator, and the exact scalar term (the same perturbed predicate) otherwise.
-struct SpokeSum {
-    q: [i64; 3],
-    qz: f64,
+struct SpokeSum<'a> {
+    edges: &'a BoundaryEdges,
+    q: InputPoint,
     z_exact: bool,
     qz_units: f64,
     limit: f64,
@@ -548,11 +598,17 @@ struct SpokeSum {
     scalar: f64,
 }
 
-impl SpokeSum {
-    fn new(q: [i64; 3], z_exact: bool, qz_units: f64, limit: f64) -> Self {
+impl<'a> SpokeSum<'a> {
+    fn new(
+        edges: &'a BoundaryEdges,
+        q: InputPoint,
+        z_exact: bool,
+        qz_units: f64,
+        limit: f64,
+    ) -> Self {
         SpokeSum {
+            edges,
             q,
-            qz: if z_exact { q[2] as f64 } else { qz_units },
             z_exact,
             qz_units,
             limit,
@@ -564,20 +620,22 @@ impl SpokeSum {
         }
     }
 
-    /// Adds `−m·Area(p, v)`.
+    /// Adds `−m·Area(p, v)` (exact points: the magnitudes of the input vertices, like the
+    /// loop's, so that a node's spokes and the loop's terms at the same vertex agree).
     #[inline]
-    fn subtract<W: Width>(&mut self, p: [i64; 3], v: [i64; 3], m: i32) {
-        let offset = |a: [i64; 3]| {
-            [
-                (a[0] - self.q[0]) as f64,
-                (a[1] - self.q[1]) as f64,
-                a[2] as f64 - self.qz,
-            ]
-        };
+    fn subtract<W: Width>(&mut self, p: &InputPoint, v: &InputPoint, m: i32) {
+        let offset = |a: &InputPoint| rounded_offset(a, &self.q, self.z_exact, self.qz_units);
         let (a, b) = (offset(p), offset(v));
         let Some(sign) = orient2d_filtered([a[0], a[1]], [b[0], b[1]], self.limit) else {
-            self.scalar -=
-                f64::from(m) * segment_area::<W>(p, v, self.q, self.z_exact, self.qz_units);
+            self.scalar -= f64::from(m)
+                * self.edges.exact_segment_area::<W>(
+                    p,
+                    v,
+                    &self.q,
+                    self.z_exact,
+                    self.qz_units,
+                    false,
+                );
             return;
         };
         // The boundary loop's factors: s = |r| + |r_z|, (|r| − r_z)·s = h² or s².
@@ -618,9 +676,16 @@ impl SpokeSum {
     }
 }
 
-/// `b − a` in normalized coordinates (exact integer difference, one rounding).
-fn rel(b: [i64; 3], a: [i64; 3], limit: f64) -> [f64; 3] {
-    std::array::from_fn(|k| (b[k] - a[k]) as f64 / limit)
+/// `b − a` of exact points in normalized coordinates (the integer difference and the residuals'
+/// each rounded once, then their sum).
+fn rel(b: &InputPoint, a: &InputPoint, limit: f64) -> [f64; 3] {
+    std::array::from_fn(|k| ((b.n[k] - a.n[k]) as f64 + (b.r[k] - a.r[k])) / limit)
+}
+
+/// `centre − p` in normalized coordinates for a node's doubled centre `centre2` and an exact
+/// point `p` (exact integer difference, then the residual).
+fn centre_minus_point(centre2: [i64; 3], p: &InputPoint, limit: f64) -> [f64; 3] {
+    std::array::from_fn(|k| ((centre2[k] - 2 * p.n[k]) as f64 * 0.5 - p.r[k]) / limit)
 }
 
 /// The distance from which order `k` meets `budget` (the bound decreases with the distance:

@@ -161,6 +161,76 @@ fn the_hierarchy_agrees_with_the_direct_sum() {
     assert!(used > 50, "only {used} queries used the hierarchy");
 }
 
+/// A ring-shaped open cap of 2,000 boundary edges (radius 40, full-precision coordinates)
+/// beside a closed tetrahedron at `1e15`, which sets the extent: the 60-bit cell is `2^-8` and
+/// the cap's vertices are off the lattice. With a tolerance of `1e-6`, every value must be
+/// within its bound of the direct sum. Before, the loop's offsets and the hierarchy's positions
+/// (moments, centres, spokes, the query) were the lattice points rounded to `f64`, up to `2^6`
+/// cells off: values were up to `1e-4` from the direct sum with a reported bound of `0`.
+#[test]
+fn the_bound_holds_on_a_small_boundary_in_a_huge_box() {
+    let mut rng = common::Rng(7);
+    let ring = 2000;
+    let centre = [0.3127, -0.1171, 2.7113];
+    let mut p = vec![centre];
+    for i in 0..ring {
+        let a = std::f64::consts::TAU * (i as f64 + rng.range(-0.2, 0.2)) / ring as f64;
+        let r = rng.range(40.0, 41.0);
+        p.push([
+            centre[0] + r * a.cos(),
+            centre[1] + r * a.sin(),
+            centre[2] - rng.range(0.5, 3.0),
+        ]);
+    }
+    let far = p.len() as u32;
+    let f = 1e15;
+    p.extend([[f, f, f], [f + 1.0, f, f], [f, f + 1.0, f], [f, f, f + 1.0]]);
+    let mut t: Vec<[u32; 3]> = (0..ring as u32)
+        .map(|i| [0, 1 + i, 1 + (i + 1) % ring as u32])
+        .collect();
+    t.extend([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]].map(|f| f.map(|i| far + i)));
+    let mesh = Mesh::from_slices(&p, &t).unwrap();
+    // Around the ring (its nodes are expanded from a few node sizes away) and farther out.
+    let queries: Vec<[f64; 3]> = (0..150)
+        .map(|i| {
+            let (r, a) = (rng.range(30.0, 55.0 + f64::from(i)), rng.range(0.0, 6.3));
+            [
+                centre[0] + r * a.cos(),
+                centre[1] + r * a.sin(),
+                centre[2] + rng.range(-20.0, 20.0),
+            ]
+        })
+        .collect();
+    for ray in [RayAxis::PosX, RayAxis::NegZ] {
+        let tree = with_tolerance(&mesh, 1e-6, ray);
+        assert!(
+            tree.snapping().cell >= 2f64.powi(-9),
+            "{:?}",
+            tree.snapping()
+        );
+        let used: usize = queries
+            .par_iter()
+            .map(|&q| {
+                let (w, bound) = tree.eval_with_bound(q);
+                let direct = gwn::eval::direct::winding_number_direct(&mesh, q);
+                assert!(
+                    (w - direct).abs() <= bound + 1e-12,
+                    "{ray:?}: {w} vs direct {direct} (bound {bound:e}) at {q:?}"
+                );
+                usize::from(bound > 0.0)
+            })
+            .sum();
+        println!(
+            "{ray:?}: {used} of {} queries used the hierarchy",
+            queries.len()
+        );
+        assert!(
+            used >= 20,
+            "{ray:?}: only {used} queries used the hierarchy"
+        );
+    }
+}
+
 #[test]
 fn the_lazy_tree_is_built_safely_from_a_parallel_batch() {
     // The hierarchy is built on first use, typically inside `eval_batch`'s rayon workers: many

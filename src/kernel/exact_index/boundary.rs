@@ -5,7 +5,7 @@
 use super::ExactIndex;
 use crate::base::compensated::NeumaierSum;
 use crate::kernel::boundary_column::ColumnQuery;
-use crate::kernel::boundary_tree::BoundaryTree;
+use crate::kernel::boundary_tree::{BoundaryTree, TreeQuery};
 use crate::kernel::input_predicates::InputPoint;
 use crate::kernel::predicates::{Width, far_query_numerator_sign};
 use crate::kernel::spherical::{EdgeSigns, INV_4PI, antipodal_edge_area, segment_gradient};
@@ -62,7 +62,7 @@ impl<W: Width> ExactIndex<W> {
         };
         let limit = self.boundary.limit();
         let q = std::array::from_fn(|k| (qf[k] - self.origin[k]) / self.cell / limit);
-        let Some(tree) = tree.filter(|t| t.reaches(q)) else {
+        let Some(tree) = tree.filter(|t| t.reaches(&TreeQuery::Far(q))) else {
             let mut sum = 0.0;
             for i in 0..self.boundary.len() {
                 let (a, b, weight) = self.boundary.edge(i);
@@ -80,8 +80,11 @@ impl<W: Width> ExactIndex<W> {
             }
         };
         let mut spokes = 0.0;
-        let mut spoke = |p: [i64; 3], v: [i64; 3], m: i32| spokes -= f64::from(m) * term(p, v);
-        let sum = tree.traverse(q, |_, _| true, &mut exact, &mut spoke);
+        // Far from the mesh: the lattice points are accurate enough (see `TreeQuery::Far`).
+        let mut spoke = |p: &InputPoint, v: &InputPoint, m: i32| {
+            spokes -= f64::from(m) * term(p.n, v.n);
+        };
+        let sum = tree.traverse(&TreeQuery::Far(q), |_, _| true, &mut exact, &mut spoke);
         let mut area = sum.area + exact_sum + spokes;
         for e in self.boundary.heavy_edges() {
             let (a, b, weight) = self.boundary.edge(e);
@@ -153,7 +156,15 @@ impl<W: Width> ExactIndex<W> {
         tree: Option<&BoundaryTree>,
     ) -> bool {
         !self.boundary.needs_accurate_sum::<W>(qi, r, z_exact)
-            && tree.is_none_or(|t| t.is_flat_at(&self.boundary, qi, z_exact, qz_units))
+            && tree.is_none_or(|t| {
+                let q = InputPoint {
+                    n: qi,
+                    r,
+                    world: [0.0; 3],
+                    exact: [true; 3],
+                };
+                t.is_flat_at(q, z_exact, qz_units)
+            })
     }
 
     /// The query's frame `z` in grid units (the magnitude of a query clamped along the ray).
