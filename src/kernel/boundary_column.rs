@@ -18,30 +18,25 @@ use super::angle_sum::AngleSum;
 use super::angle_sum::AngleSumAvx2;
 use super::boundary_sum::BoundaryEdges;
 #[cfg(target_arch = "x86_64")]
-use super::boundary_sum::LoopQuery;
-#[cfg(target_arch = "x86_64")]
 use super::boundary_sum::shift_one_avx2;
+use super::input_predicates::InputPoint;
 #[cfg(target_arch = "x86_64")]
-use super::lanes::{Avx2, edge_term, horizontal_sq, projected_dot, split_offset, vertex_factors};
+use super::lanes::{Avx2, edge_term, horizontal_sq, projected_dot, vertex_factors};
 use super::predicates::Width;
 #[cfg(target_arch = "x86_64")]
 use super::predicates::orient2d_filter_lanes;
 
-/// One query of a column: its lattice `z` (or, when `z_exact` is false, the clamped `z` of a
-/// query outside the grid along the ray with `qz_units` its `z` in grid units; see
-/// [`BoundaryEdges::area_sum`]).
+/// One query of a column: the exact point (its lattice `x, y`, residuals and world `x, y` those
+/// of the whole column), and, when `z_exact` is false, the clamped `z` of a query outside the
+/// grid along the ray with `qz_units` its `z` in cells (see [`BoundaryEdges::area_sum`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ColumnQuery {
-    /// Lattice `z` (frame).
-    pub z: i64,
-    /// Whether `z` is the query's exact lattice coordinate.
+    /// The query (frame; `r[2] = 0` when `z_exact` is false).
+    pub point: InputPoint,
+    /// Whether `point.n[2]` is the query's exact lattice coordinate.
     pub z_exact: bool,
-    /// The query's `z` in grid units when `z_exact` is false.
+    /// The query's `z` in cells when `z_exact` is false.
     pub qz_units: f64,
-    /// The query's exact residual in cells (`r[2] = 0` when `z_exact` is false; `r[0]`, `r[1]`
-    /// the same for the whole column): the magnitudes, and the signs of edges off the lattice,
-    /// are taken at `(x, y, z) + r` (see [`BoundaryEdges::area_sum`]).
-    pub r: [f64; 3],
 }
 
 /// Queries per pass: the shared work is split four ways, and four angle products in flight hide
@@ -53,56 +48,45 @@ const QUERIES: usize = 4;
 const CHUNK: usize = 64;
 
 impl BoundaryEdges {
-    /// [`BoundaryEdges::area_sum`] of every query of the column at lattice `x, y = qxy`, written
-    /// to `out` (same length as `queries`), each bit-identical to its own `area_sum`.
-    pub fn column_area_sums<W: Width>(
-        &self,
-        qxy: [i64; 2],
-        queries: &[ColumnQuery],
-        out: &mut [f64],
-    ) {
+    /// [`BoundaryEdges::area_sum`] of every query of one column (the same lattice, residual
+    /// and world `x, y`), written to `out` (same length as `queries`), each bit-identical to its
+    /// own `area_sum`.
+    pub fn column_area_sums<W: Width>(&self, queries: &[ColumnQuery], out: &mut [f64]) {
         assert_eq!(queries.len(), out.len());
-        let single =
-            |c: &ColumnQuery| self.area_sum::<W>([qxy[0], qxy[1], c.z], c.r, c.z_exact, c.qz_units);
+        debug_assert!(queries.windows(2).all(|w| {
+            let (a, b) = (&w[0].point, &w[1].point);
+            a.n[..2] == b.n[..2] && a.r[..2] == b.r[..2] && a.world[..2] == b.world[..2]
+        }));
+        let single = |c: &ColumnQuery| self.area_sum::<W>(&c.point, c.z_exact, c.qz_units);
         #[cfg(target_arch = "x86_64")]
         if !self.is_empty() && std::arch::is_x86_feature_detected!("avx2") {
             for (batch, out) in queries.chunks(QUERIES).zip(out.chunks_mut(QUERIES)) {
                 // A short last batch repeats its last query (the extra results are dropped).
                 let pick = |k: usize| batch[k.min(batch.len() - 1)];
-                // The column shares `x, y` and their residuals; each query has its own `z`.
-                let loop_query = |c: ColumnQuery| {
-                    LoopQuery::new([qxy[0], qxy[1], c.z], c.r, c.z_exact, c.qz_units)
-                };
-                let zs: [(f64, f64); QUERIES] = std::array::from_fn(|k| {
-                    let q = loop_query(pick(k));
-                    (q.hi[2], q.lo[2])
-                });
-                let first = loop_query(batch[0]);
-                debug_assert!(batch.iter().all(|c| c.r[..2] == batch[0].r[..2]));
+                let frame = self.frame();
+                let at = |c: &ColumnQuery| frame.query(&c.point, c.z_exact, c.qz_units);
+                let zs: [f64; QUERIES] = std::array::from_fn(|k| at(&pick(k))[2]);
+                let xy = at(&batch[0]);
                 let mut undecided = Vec::new();
                 // SAFETY: `column_angles_avx2` only needs the AVX2 instructions it is compiled
                 // with, and the CPU was just checked to have them.
                 #[allow(unsafe_code)]
                 let angles = unsafe {
-                    self.column_angles_avx2(
-                        ([first.hi[0], first.hi[1]], [first.lo[0], first.lo[1]]),
-                        zs,
-                        0..self.slots(),
-                        &mut |e| undecided.push(e),
-                    )
+                    self.column_angles_avx2([xy[0], xy[1]], zs, 0..self.slots(), &mut |e| {
+                        undecided.push(e)
+                    })
                 };
                 for (k, out) in out.iter_mut().enumerate() {
-                    let c = batch[k];
-                    let qi = [qxy[0], qxy[1], c.z];
+                    let c = &batch[k];
                     // The single-query loop adds the exact terms in slot order too.
                     let mut scalar = 0.0;
                     for &e in &undecided {
                         scalar +=
-                            self.exact_edge_area::<W>(e as usize, qi, c.r, c.z_exact, c.qz_units);
+                            self.exact_edge_area::<W>(e as usize, &c.point, c.z_exact, c.qz_units);
                     }
                     *out = 2.0 * angles[k].total()
                         + scalar
-                        + self.heavy_area_sum::<W>(qi, c.r, c.z_exact, c.qz_units);
+                        + self.heavy_area_sum::<W>(&c.point, c.z_exact, c.qz_units);
                 }
             }
             return;
@@ -119,13 +103,13 @@ impl BoundaryEdges {
     #[target_feature(enable = "avx2")]
     fn column_angles_avx2(
         &self,
-        (xy, xy_lo): ([f64; 2], [f64; 2]),
-        zs: [(f64, f64); QUERIES],
+        xy: [f64; 2],
+        zs: [f64; QUERIES],
         slots: std::ops::Range<usize>,
         undecided: &mut impl FnMut(u32),
     ) -> [AngleSum; QUERIES] {
         use std::arch::x86_64::*;
-        let ([xs, ys, vz], [xs_lo, ys_lo, vz_lo], link) = self.vertex_arrays();
+        let (xs, ys, vz, link) = self.vertex_arrays();
         let load = |v: &[f64], j: usize| -> __m256d {
             bytemuck::cast(<[f64; 4]>::try_from(&v[j..j + 4]).unwrap())
         };
@@ -135,7 +119,6 @@ impl BoundaryEdges {
         };
         let o = Avx2;
         let (qx, qy) = (o.splat(xy[0]), o.splat(xy[1]));
-        let (qx_lo, qy_lo) = (o.splat(xy_lo[0]), o.splat(xy_lo[1]));
         let (conv, rel) = self.filter_constants();
         let (conv, rel) = (o.splat(conv), o.splat(rel));
         let zero = o.splat(0.0);
@@ -152,22 +135,16 @@ impl BoundaryEdges {
             // Vertices j0 .. j0 + 4·blocks + 4: every block's edges end one vertex further.
             for b in 0..=blocks {
                 let (i, j) = (4 * b, j0 + 4 * b);
-                let x = split_offset!(o, (load(xs, j), load(xs_lo, j)), (qx, qx_lo));
-                let y = split_offset!(o, (load(ys, j), load(ys_lo, j)), (qy, qy_lo));
+                let x = o.sub(load(xs, j), qx);
+                let y = o.sub(load(ys, j), qy);
                 store(&mut h, i, horizontal_sq!(o, x, y));
             }
             for b in 0..blocks {
                 let (i, j) = (4 * b, j0 + 4 * b);
                 // The edge ends' offsets straight from the vertex arrays (unaligned loads of
                 // data not written here: no store forwarding, no shuffles).
-                let (ax, ay) = (
-                    split_offset!(o, (load(xs, j), load(xs_lo, j)), (qx, qx_lo)),
-                    split_offset!(o, (load(ys, j), load(ys_lo, j)), (qy, qy_lo)),
-                );
-                let (bx, by) = (
-                    split_offset!(o, (load(xs, j + 1), load(xs_lo, j + 1)), (qx, qx_lo)),
-                    split_offset!(o, (load(ys, j + 1), load(ys_lo, j + 1)), (qy, qy_lo)),
-                );
+                let (ax, ay) = (o.sub(load(xs, j), qx), o.sub(load(ys, j), qy));
+                let (bx, by) = (o.sub(load(xs, j + 1), qx), o.sub(load(ys, j + 1), qy));
                 let real = o.gt(load(link, j), zero);
                 let (d, lane_ok) = orient2d_filter_lanes!(o, [ax, ay, bx, by], real, conv, rel);
                 store(&mut ok, i, lane_ok);
@@ -177,7 +154,7 @@ impl BoundaryEdges {
                 self.report_undecided(j, mask, undecided);
             }
             for (k, acc) in acc.iter_mut().enumerate() {
-                let (qz, qz_lo) = (o.splat(zs[k].0), o.splat(zs[k].1));
+                let qz = o.splat(zs[k]);
                 // s and p of vertex block `b` (one `sqrt` per vertex), kept in registers: the
                 // next block's are computed before this block's products, so that the square
                 // roots overlap with them, and the edge ends come by lane shifts (a load
@@ -185,8 +162,7 @@ impl BoundaryEdges {
                 macro_rules! vertices {
                     ($b:expr) => {{
                         let (i, j) = (4 * $b, j0 + 4 * $b);
-                        let z = split_offset!(o, (load(vz, j), load(vz_lo, j)), (qz, qz_lo));
-                        vertex_factors!(o, load(&h, i), z)
+                        vertex_factors!(o, load(&h, i), o.sub(load(vz, j), qz))
                     }};
                 }
                 let mut cur = vertices!(0);
@@ -225,14 +201,32 @@ mod tests {
     /// Every query of a column equals its own `area_sum` to the bit: small grids (queries on
     /// vertices and edges, undecided lanes, vertical edges), 60-bit coordinates, boundaries long
     /// enough for several chunks, columns of 1 to 11 queries (short last batches), heavy edges,
-    /// queries outside the grid along the ray.
+    /// queries outside the grid along the ray; in the lattice frame and, with residuals on the
+    /// vertices and the queries, in the unshifted frame.
     #[test]
     fn column_sums_are_bit_identical_to_single_queries() {
+        use crate::kernel::input_predicates::LatticeFrame;
         let mut rng = crate::kernel::test_rng::TestRng::new(3);
         let mut next = |m: u64| rng.below(m);
         let mut undecided_seen = false;
-        for case in 0..120 {
+        // A residual of up to 20 bits (cells), or none.
+        let residual = |next: &mut dyn FnMut(u64) -> u64, on: bool| {
+            if on {
+                (next(1 << 20) as f64 - 524288.0) / 1048576.0
+            } else {
+                0.0
+            }
+        };
+        // With the unshifted frame of shift 0 and origin 0, a point's world value is `n + r`.
+        let point = |n: [i64; 3], r: [f64; 3]| InputPoint {
+            n,
+            r,
+            world: std::array::from_fn(|k| n[k] as f64 + r[k]),
+            exact: [true; 3],
+        };
+        for case in 0..240 {
             let big = case % 2 == 1;
+            let unshifted = case % 4 >= 2;
             let coord = |next: &mut dyn FnMut(u64) -> u64| {
                 if big {
                     ((next(1 << 31) << 29) as i64) - (1_i64 << 59)
@@ -241,34 +235,39 @@ mod tests {
                 }
             };
             let n = 1 + next(if case % 3 == 0 { 400 } else { 40 }) as usize;
-            let pts: Vec<[i64; 3]> = (0..=n)
-                .map(|_| [coord(&mut next), coord(&mut next), coord(&mut next)])
+            let pts: Vec<InputPoint> = (0..=n)
+                .map(|_| {
+                    let p = [coord(&mut next), coord(&mut next), coord(&mut next)];
+                    let on = unshifted && !big && next(2) == 0;
+                    point(p, std::array::from_fn(|_| residual(&mut next, on)))
+                })
                 .collect();
-            let a: Vec<[i64; 3]> = (0..n).map(|i| pts[i]).collect();
-            let b: Vec<[i64; 3]> = (0..n)
+            let a: Vec<InputPoint> = (0..n).map(|i| pts[i]).collect();
+            let b: Vec<InputPoint> = (0..n)
                 .map(|i| pts[(i + 1 + next(2) as usize) % (n + 1)])
                 .collect();
             let weight: Vec<f64> = (0..n)
                 .map(|_| [1.0, 2.0, 3.0, 6.0][next(4) as usize])
                 .collect();
-            let edges = BoundaryEdges::new(a, b, weight, 60);
+            let lattice = |v: &[InputPoint]| v.iter().map(|p| p.n).collect::<Vec<_>>();
+            let edges = if unshifted {
+                let frame = LatticeFrame {
+                    shift: 0,
+                    origin_cells: [0; 3],
+                };
+                BoundaryEdges::unshifted(lattice(&a), lattice(&b), weight, (a, b), frame)
+            } else {
+                BoundaryEdges::new(lattice(&a), lattice(&b), weight, 60)
+            };
             for _ in 0..6 {
-                let on_vertex = pts[next(pts.len() as u64) as usize];
+                let on_vertex = pts[next(pts.len() as u64) as usize].n;
                 let qxy = if next(3) == 0 {
                     [on_vertex[0], on_vertex[1]]
                 } else {
                     [coord(&mut next), coord(&mut next)]
                 };
-                // Residuals (cells): shared across the column in x, y, each query's own in z.
-                let residual = |next: &mut dyn FnMut(u64) -> u64| {
-                    (next(1 << 20) as f64 - 524288.0) / 1048576.0
-                };
-                let off_lattice = next(2) == 0;
-                let rxy = if off_lattice {
-                    [residual(&mut next), residual(&mut next)]
-                } else {
-                    [0.0; 2]
-                };
+                let off = unshifted && !big && next(2) == 0;
+                let rxy = [residual(&mut next, off), residual(&mut next, off)];
                 let queries: Vec<ColumnQuery> = (0..1 + next(11))
                     .map(|_| {
                         let z_exact = next(5) != 0;
@@ -277,27 +276,18 @@ mod tests {
                         } else {
                             coord(&mut next)
                         };
+                        let rz = residual(&mut next, off && z_exact);
                         ColumnQuery {
-                            z,
+                            point: point([qxy[0], qxy[1], z], [rxy[0], rxy[1], rz]),
                             z_exact,
                             qz_units: if z_exact { 0.0 } else { z as f64 * 3.0 + 0.5 },
-                            r: [
-                                rxy[0],
-                                rxy[1],
-                                if off_lattice && z_exact {
-                                    residual(&mut next)
-                                } else {
-                                    0.0
-                                },
-                            ],
                         }
                     })
                     .collect();
                 let mut got = vec![0.0; queries.len()];
-                edges.column_area_sums::<W128>(qxy, &queries, &mut got);
+                edges.column_area_sums::<W128>(&queries, &mut got);
                 for (c, got) in queries.iter().zip(&got) {
-                    let want =
-                        edges.area_sum::<W128>([qxy[0], qxy[1], c.z], c.r, c.z_exact, c.qz_units);
+                    let want = edges.area_sum::<W128>(&c.point, c.z_exact, c.qz_units);
                     assert_eq!(
                         got.to_bits(),
                         want.to_bits(),

@@ -23,9 +23,7 @@ use super::double_double::DoubleDouble;
 use super::input_predicates::{InputPoint, LatticeFrame, input_inside_segment, input_orient2d};
 #[cfg(target_arch = "x86_64")]
 use super::lanes::Avx2;
-use super::lanes::{
-    Portable, edge_term, horizontal_sq, projected_dot, split_offset, vertex_factors,
-};
+use super::lanes::{Portable, edge_term, horizontal_sq, projected_dot, vertex_factors};
 use super::predicates::{
     ORIENT2D_FILTER_CONVERSION, ORIENT2D_FILTER_RELATIVE, Width, orient2d_filter_lanes,
     perturbed_orient2d_at, query_inside_segment_at,
@@ -60,50 +58,79 @@ pub(super) fn shift_one_avx2(
     _mm256_shuffle_pd::<0b0101>(a, mid)
 }
 
-/// Splits the exact coordinate `n + r` (lattice point, residual; cells) of a chain vertex into
-/// `n` rounded to `f64` (returned) and the rest (pushed onto `lo`): `n − fl(n)` is an integer of
-/// at most `2^5` (exact), and adding `|r| ≤ 1/2` rounds by at most `2^-48` cells.
-fn split_coordinates(n: [i64; 3], r: [f64; 3], lo: &mut [Vec<f64>; 3]) -> [f64; 3] {
-    std::array::from_fn(|k| {
-        let hi = n[k] as f64;
-        lo[k].push((n[k] - hi as i64) as f64 + r[k]);
-        hi
-    })
-}
-
-/// A query as the loops see it: each coordinate split like the chain vertices'
-/// ([`split_coordinates`]), so that an offset is `(x_hi − q_hi) + (x_lo − q_lo)`
-/// ([`split_offset!`]) — the difference of the *input* points, vertex residual and query
-/// residual included, rounded three times: within `2u·|offset| + 2^-46` cells (`u = 2^-53`).
+/// The coordinates the boundary loops compute their offsets in (one per evaluator).
 ///
-/// Why: the offsets were `fl(x) − fl(q)` of the lattice points, off by up to `2^6` cells from
-/// rounding 59-bit integers and by half a cell per point from snapping, whatever the offset's
-/// size. The near-edge tube ([`near_edge_pad`]) assumed relative error, so a query a few cells
-/// beyond it from a short edge (a mesh of extent `1e15` with edges of length 10) got magnitudes
-/// wrong in the fourth digit while every sign stayed exact (issue 11's promise: exact to the
-/// input bits, for the magnitudes as for the signs).
-#[derive(Clone, Copy, Debug)]
-pub(super) struct LoopQuery {
-    pub hi: [f64; 3],
-    pub lo: [f64; 3],
+/// Why not the lattice points: an offset `fl(x) − fl(q)` of 59-bit lattice coordinates is off by
+/// up to `2^6` cells from their conversions, and by half a cell per point from snapping, whatever
+/// the offset's size. The near-edge tube ([`near_edge_pad`]) assumes relative error, so a query
+/// a few cells beyond it from a short edge (a mesh of extent `1e15` with edges of length 10) got
+/// magnitudes wrong in the fifth digit while every sign stayed exact. In
+/// [`LoopFrame::Unshifted`] each point is its world coordinate times the grid's power of two:
+/// exact (the input's own bits), so an offset is the exact difference rounded once.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) enum LoopFrame {
+    /// Lattice coordinates (cells from the grid origin): the evaluated geometry of the 30-bit
+    /// grid (exact in `f64` there), and the unit tests' edges.
+    #[default]
+    Lattice,
+    /// `x_world · 2^shift` (cells, not shifted by the grid origin): exact, the input itself.
+    /// `origin_z` (the origin's frame `z` in cells) places a query clamped along the ray.
+    Unshifted { shift: i64, origin_z: f64 },
 }
 
-impl LoopQuery {
-    /// The query `qi + r` (lattice point, residual in cells; frame). When `z_exact` is false
-    /// the query lies beyond the grid along the ray and `qz_units` is its `z` (then `r[2]` is 0
-    /// and the `f64` value is all there is: it is farther than the extent from every vertex).
-    pub fn new(qi: [i64; 3], r: [f64; 3], z_exact: bool, qz_units: f64) -> LoopQuery {
-        let split = |k: usize| {
-            let hi = qi[k] as f64;
-            (hi, (qi[k] - hi as i64) as f64 + r[k])
-        };
-        let (x, y, z) = (split(0), split(1), split(2));
-        let z = if z_exact { z } else { (qz_units, 0.0) };
-        LoopQuery {
-            hi: [x.0, y.0, z.0],
-            lo: [x.1, y.1, z.1],
+/// Centres farther than this from the world origin (in cells) cannot be held unshifted: points
+/// of the padded box (`±2^59` cells around the centre) must stay far from `f64`'s range.
+const UNSHIFTED_LIMIT: f64 = 1e280;
+
+impl LoopFrame {
+    /// The frame for a grid of `bits` with lattice frame `lattice`: unshifted at 60 bits
+    /// unless the grid's origin is beyond [`UNSHIFTED_LIMIT`] (a mesh of extent `1` at
+    /// `1e260`; there the lattice frame's rounding is the documented limit).
+    pub fn for_grid(bits: u32, lattice: &LatticeFrame) -> LoopFrame {
+        let far = lattice
+            .origin_cells
+            .iter()
+            .any(|&c| (c as f64).abs() > UNSHIFTED_LIMIT);
+        if bits <= 30 || far {
+            LoopFrame::Lattice
+        } else {
+            LoopFrame::Unshifted {
+                shift: lattice.shift,
+                origin_z: lattice.origin_cells[2] as f64,
+            }
         }
     }
+
+    /// A vertex's coordinates in this frame.
+    fn vertex(&self, p: &InputPoint) -> [f64; 3] {
+        match *self {
+            LoopFrame::Lattice => p.n.map(|c| c as f64),
+            LoopFrame::Unshifted { shift, .. } => p.world.map(|c| scaled_by_power_of_two(c, shift)),
+        }
+    }
+
+    /// The query `q` in this frame. When `z_exact` is false the query lies beyond the grid along
+    /// the ray and `qz_units` is its `z` in cells from the origin (`f64`: it is farther than the
+    /// extent from every vertex).
+    pub fn query(&self, q: &InputPoint, z_exact: bool, qz_units: f64) -> [f64; 3] {
+        let [x, y, z] = self.vertex(q);
+        let z = match *self {
+            _ if z_exact => z,
+            LoopFrame::Lattice => qz_units,
+            LoopFrame::Unshifted { origin_z, .. } => qz_units + origin_z,
+        };
+        [x, y, z]
+    }
+}
+
+/// `x · 2^e`, exact unless the result is subnormal (then within `2^-1074`: a tiny coordinate of a
+/// huge mesh, whose magnitude that does not change) or beyond `f64` (excluded by
+/// [`UNSHIFTED_LIMIT`]). Two steps, so that `|e|` up to 2046 needs no intermediate overflow.
+fn scaled_by_power_of_two(x: f64, e: i64) -> f64 {
+    let power = |e: i64| f64::from_bits(((e + 1023) as u64) << 52);
+    let half = (e / 2).clamp(-1022, 1023);
+    let rest = (e - half).clamp(-1022, 1023);
+    x * power(half) * power(rest)
 }
 
 /// Boundary edges of one mesh in the ray frame, in grid units.
@@ -118,19 +145,13 @@ pub struct BoundaryEdges {
     a: Vec<[i64; 3]>,
     b: Vec<[i64; 3]>,
     weight: Vec<f64>,
-    /// Chain vertices (structure of arrays, `f64` grid coordinates rounded to nearest), padded
-    /// with copies of the last vertex so that every block reads in bounds.
+    /// Chain vertices (structure of arrays, cells in [`BoundaryEdges::frame`]), padded with
+    /// copies of the last vertex so that every block reads in bounds.
     xs: Vec<f64>,
     ys: Vec<f64>,
     zs: Vec<f64>,
-    /// What `xs`, `ys`, `zs` leave out of the exact input coordinate (cells): the lattice
-    /// coordinate's rounding to `f64` (an integer, up to `2^5` cells at 59 bits) plus the
-    /// vertex's residual off the lattice. The loops' offsets are the split differences
-    /// ([`split_offset!`]), so the magnitudes are those of the input points (see
-    /// [`LoopQuery`]).
-    xs_lo: Vec<f64>,
-    ys_lo: Vec<f64>,
-    zs_lo: Vec<f64>,
+    /// The frame of `xs`, `ys`, `zs` (and of the query the loops subtract).
+    frame: LoopFrame,
     /// `link[j] = 1` when slot `j` → `j + 1` is an edge, `0` for a break or padding.
     link: Vec<f64>,
     /// The edge (index into `a`, `b`) of each linked slot, for the exact fallback.
@@ -169,8 +190,8 @@ struct EdgeInputs {
 /// see [`BoundaryEdges::needs_accurate_sum`]).
 ///
 /// Error model of the `f64` term at distance `d` from the edge: the offsets are the exact
-/// inputs' differences rounded (relative `2u`, `u = 2^-53`, plus `2^-45` cells: [`LoopQuery`];
-/// before it they were off by up to `2^6` cells whatever `d`, see there); near the segment both `atan2` arguments are
+/// inputs' differences rounded once (relative `u = 2^-53`; at 60 bits, [`LoopFrame`]: before it
+/// they were off by up to `2^6` cells whatever `d`, see there); near the segment both `atan2` arguments are
 /// `≈ |a−q||b−q|·θ`, `θ ≈ d·len/(|a−q||b−q|)`, while their rounding errors are `≈ 2u·|a−q||b−q|`,
 /// so the term errs by `≲ 2u/θ ≤ u·len/(2d)` (`|a−q||b−q| ≤ len²/4` on the segment, less
 /// elsewhere; we allow `4u·len/d`). At `d ≥ 2^-7·len/√3` that is `≤ 900u = 1e-13`. Only a thin
@@ -249,9 +270,9 @@ fn ill_conditioned(
 /// Why: a vertex `v` seen almost along the ray (transverse offset `h ≪ |v − q|`) enters its
 /// terms through the azimuth of `v − q` around the ray (the on-ray limit of
 /// docs/robustness.md §3), so an absolute error `δ` in the transverse offset moves the term by
-/// `≈ 2δ/h` whatever the distance along the ray. The loop's offsets carry `δ ≤ 2u·|v − q| +
-/// 2^-45` cells ([`LoopQuery`]; the column was sized when they carried `2^7` cells, two
-/// conversions of 59-bit integers and half a cell of snapping); outside the column the term
+/// `≈ 2δ/h` whatever the distance along the ray. The loop's offsets carry `δ ≤ u·|v − q|`
+/// ([`LoopFrame`]; the column was sized when they carried `2^7` cells, two conversions of
+/// 59-bit integers and half a cell of snapping); outside the column the term
 /// errs by `≤ 2·2^7/2^45 = 2^-37` in area, `≤ 6e-13` on `w`, now far less. Queries in the
 /// column are rare (`π(1e-5)²` of the box per boundary vertex), so the slow path stays rare.
 #[inline]
@@ -285,6 +306,19 @@ impl BoundaryEdges {
         Self::build(a, b, weight, bits, None, LatticeFrame::default())
     }
 
+    /// [`BoundaryEdges::new`] whose loops run in the unshifted frame of `lattice`
+    /// ([`LoopFrame::Unshifted`]) with the endpoints `(a_in, b_in)` (the column tests).
+    #[cfg(test)]
+    pub fn unshifted(
+        a: Vec<[i64; 3]>,
+        b: Vec<[i64; 3]>,
+        weight: Vec<f64>,
+        (a_in, b_in): (Vec<InputPoint>, Vec<InputPoint>),
+        lattice: LatticeFrame,
+    ) -> Self {
+        Self::with_inputs(a, b, weight, 60, (a_in, b_in), lattice)
+    }
+
     /// [`BoundaryEdges::new`] with the exact endpoints (`a_in[i]`, `b_in[i]` of edge `i`, whose
     /// lattice points are `a[i]`, `b[i]`): kept when some endpoint is off the lattice. Every sign
     /// the loops cannot take from their `f64` filter is then decided on these (the filter's own
@@ -301,17 +335,7 @@ impl BoundaryEdges {
         lattice: LatticeFrame,
     ) -> Self {
         debug_assert!(a_in.len() == a.len() && b_in.len() == b.len());
-        let off_lattice: Vec<bool> = a_in
-            .iter()
-            .zip(&b_in)
-            .map(|(p, q)| !p.on_lattice() || !q.on_lattice())
-            .collect();
-        let inputs = off_lattice.iter().any(|&x| x).then_some(EdgeInputs {
-            a: a_in,
-            b: b_in,
-            off_lattice,
-        });
-        Self::build(a, b, weight, bits, inputs, lattice)
+        Self::build(a, b, weight, bits, Some((a_in, b_in)), lattice)
     }
 
     fn build(
@@ -319,9 +343,39 @@ impl BoundaryEdges {
         b: Vec<[i64; 3]>,
         weight: Vec<f64>,
         bits: u32,
-        inputs: Option<EdgeInputs>,
+        endpoints: Option<(Vec<InputPoint>, Vec<InputPoint>)>,
         lattice: LatticeFrame,
     ) -> Self {
+        let frame = match endpoints {
+            Some(_) => LoopFrame::for_grid(bits, &lattice),
+            None => LoopFrame::Lattice,
+        };
+        let point = |e: u32, start: bool| match &endpoints {
+            Some((a_in, b_in)) => {
+                let p = if start {
+                    &a_in[e as usize]
+                } else {
+                    &b_in[e as usize]
+                };
+                frame.vertex(p)
+            }
+            None => (if start { a[e as usize] } else { b[e as usize] }).map(|c| c as f64),
+        };
+        let coordinates: Vec<([f64; 3], [f64; 3])> = (0..a.len() as u32)
+            .map(|e| (point(e, true), point(e, false)))
+            .collect();
+        let inputs = endpoints.and_then(|(a_in, b_in)| {
+            let off_lattice: Vec<bool> = a_in
+                .iter()
+                .zip(&b_in)
+                .map(|(p, q)| !p.on_lattice() || !q.on_lattice())
+                .collect();
+            off_lattice.iter().any(|&x| x).then_some(EdgeInputs {
+                a: a_in,
+                b: b_in,
+                off_lattice,
+            })
+        });
         let parallel: Vec<bool> = (0..a.len())
             .map(|i| {
                 is_parallel_to_ray(a[i], b[i]) && inputs.as_ref().is_none_or(|x| !x.off_lattice[i])
@@ -335,28 +389,25 @@ impl BoundaryEdges {
         let mut xs = Vec::new();
         let mut ys = Vec::new();
         let mut zs = Vec::new();
-        let mut lo: [Vec<f64>; 3] = Default::default();
         let mut link = Vec::new();
         let mut edge_of = Vec::new();
-        let exact_a = |e: u32| inputs.as_ref().map_or([0.0; 3], |x| x.a[e as usize].r);
-        let exact_b = |e: u32| inputs.as_ref().map_or([0.0; 3], |x| x.b[e as usize].r);
         for chain in &chains {
             let v0 = chain[0];
-            let mut push = |v: [i64; 3], r: [f64; 3], l: f64, e: u32| {
-                let hi = split_coordinates(v, r, &mut lo);
-                xs.push(hi[0]);
-                ys.push(hi[1]);
-                zs.push(hi[2]);
+            let mut push = |v: [f64; 3], l: f64, e: u32| {
+                xs.push(v[0]);
+                ys.push(v[1]);
+                zs.push(v[2]);
                 link.push(l);
                 edge_of.push(e);
             };
-            push(a[v0 as usize], exact_a(v0), 1.0, v0);
+            // A chain vertex is the end of one edge and the start of the next: the same lattice
+            // point, and (but for two inputs snapped to one point) the same input.
+            push(coordinates[v0 as usize].0, 1.0, v0);
             for (k, &e) in chain.iter().enumerate() {
                 let last = k + 1 == chain.len();
                 let next = if last { 0 } else { chain[k + 1] };
                 push(
-                    b[e as usize],
-                    exact_b(e),
+                    coordinates[e as usize].1,
                     if last { 0.0 } else { 1.0 },
                     if last { u32::MAX } else { next },
                 );
@@ -388,14 +439,10 @@ impl BoundaryEdges {
             ys.last().copied().unwrap_or(0.0),
             zs.last().copied().unwrap_or(0.0),
         );
-        let last_lo = lo.each_ref().map(|v| v.last().copied().unwrap_or(0.0));
         for _ in 0..pad {
             xs.push(lx);
             ys.push(ly);
             zs.push(lz);
-            for k in 0..3 {
-                lo[k].push(last_lo[k]);
-            }
             link.push(0.0);
             edge_of.push(u32::MAX);
         }
@@ -419,7 +466,6 @@ impl BoundaryEdges {
             })
             .collect();
         let near = RayBvh::build(&near_boxes);
-        let [xs_lo, ys_lo, zs_lo] = lo;
         BoundaryEdges {
             a,
             b,
@@ -427,9 +473,7 @@ impl BoundaryEdges {
             xs,
             ys,
             zs,
-            xs_lo,
-            ys_lo,
-            zs_lo,
+            frame,
             link,
             edge_of,
             edge_slots_start,
@@ -462,21 +506,15 @@ impl BoundaryEdges {
     /// query's z lies outside the grid: `qz_units` (its z in grid units, `f64`) is used for the
     /// magnitudes and `qi[2]` (clamped) for nothing but the predicates, which do not involve z.
     /// `r` is the query's exact residual (cells; `r[2] = 0` when `z_exact` is false): the
-    /// magnitudes are the exact query's and the exact vertices' ([`LoopQuery`]), every sign the
+    /// magnitudes are the exact query's and the exact vertices' ([`LoopFrame`]), every sign the
     /// exact query's (see [`BoundaryEdges::exact_edge_area`]; the caller has checked with
     /// [`BoundaryEdges::needs_accurate_sum`] that `r` changes no lattice edge's sign).
-    pub fn area_sum<W: Width>(
-        &self,
-        qi: [i64; 3],
-        r: [f64; 3],
-        z_exact: bool,
-        qz_units: f64,
-    ) -> f64 {
+    pub fn area_sum<W: Width>(&self, q: &InputPoint, z_exact: bool, qz_units: f64) -> f64 {
         if self.a.is_empty() {
             return 0.0;
         }
-        let (angles, scalar) = self.range_area_sum::<W>(qi, r, z_exact, qz_units, 0..self.slots);
-        2.0 * angles.total() + scalar + self.heavy_area_sum::<W>(qi, r, z_exact, qz_units)
+        let (angles, scalar) = self.range_area_sum::<W>(q, z_exact, qz_units, 0..self.slots);
+        2.0 * angles.total() + scalar + self.heavy_area_sum::<W>(q, z_exact, qz_units)
     }
 
     /// The chained edges of the slots `range` (a multiple of 4 at the start; see
@@ -484,17 +522,16 @@ impl BoundaryEdges {
     /// can serve many ranges, [`AngleSum::absorb`]) and the sum of the terms recomputed exactly.
     pub(crate) fn range_area_sum<W: Width>(
         &self,
-        qi: [i64; 3],
-        r: [f64; 3],
+        q_exact: &InputPoint,
         z_exact: bool,
         qz_units: f64,
         range: std::ops::Range<usize>,
     ) -> (AngleSum, f64) {
         debug_assert!(range.start.is_multiple_of(4) && range.end <= self.padded_slots());
-        let q = LoopQuery::new(qi, r, z_exact, qz_units);
+        let q = self.frame.query(q_exact, z_exact, qz_units);
         let mut scalar = 0.0;
         let mut undecided = |e: u32| {
-            scalar += self.exact_edge_area::<W>(e as usize, qi, r, z_exact, qz_units);
+            scalar += self.exact_edge_area::<W>(e as usize, q_exact, z_exact, qz_units);
         };
         #[cfg(target_arch = "x86_64")]
         let range_angles = if std::arch::is_x86_feature_detected!("avx2") {
@@ -515,15 +552,14 @@ impl BoundaryEdges {
     /// The edges too heavy to chain (each one exact term times its weight).
     pub(crate) fn heavy_area_sum<W: Width>(
         &self,
-        qi: [i64; 3],
-        r: [f64; 3],
+        q: &InputPoint,
         z_exact: bool,
         qz_units: f64,
     ) -> f64 {
         let mut sum = 0.0;
         for &e in &self.heavy {
             let e = e as usize;
-            sum += self.weight[e] * self.exact_edge_area::<W>(e, qi, r, z_exact, qz_units);
+            sum += self.weight[e] * self.exact_edge_area::<W>(e, q, z_exact, qz_units);
         }
         sum
     }
@@ -538,14 +574,14 @@ impl BoundaryEdges {
         self.slots
     }
 
-    /// The chain vertices' `x`, `y`, `z` (grid units, padded; each as its `f64` rounding and
-    /// the rest, see [`LoopQuery`]) and the slot links.
-    pub(super) fn vertex_arrays(&self) -> ([&[f64]; 3], [&[f64]; 3], &[f64]) {
-        (
-            [&self.xs, &self.ys, &self.zs],
-            [&self.xs_lo, &self.ys_lo, &self.zs_lo],
-            &self.link,
-        )
+    /// The chain vertices' `x`, `y`, `z` (cells in the loops' frame, padded) and the slot links.
+    pub(super) fn vertex_arrays(&self) -> (&[f64], &[f64], &[f64], &[f64]) {
+        (&self.xs, &self.ys, &self.zs, &self.link)
+    }
+
+    /// The loops' frame.
+    pub(super) fn frame(&self) -> LoopFrame {
+        self.frame
     }
 
     /// Slots rounded up to a multiple of 4: the end of the last range a loop may visit.
@@ -571,7 +607,7 @@ impl BoundaryEdges {
     ///   orientation is degenerate, where the segment test needs the exact z).
     ///
     /// Otherwise the loop has every sign of the exact query, and the magnitudes of the exact
-    /// points within the error model of [`near_edge_pad`] ([`LoopQuery`]).
+    /// points within the error model of [`near_edge_pad`] ([`LoopFrame`]).
     pub fn needs_accurate_sum<W: Width>(&self, qi: [i64; 3], r: [f64; 3], z_exact: bool) -> bool {
         let mut flagged = false;
         self.for_each_flagged_edge(qi, r, z_exact, |_| {
@@ -651,7 +687,6 @@ impl BoundaryEdges {
         qz_units: f64,
         accurate: &[u32],
     ) -> f64 {
-        let (qi, r) = (q.n, q.r);
         let mut blocks: Vec<usize> = accurate
             .iter()
             .flat_map(|&e| self.slots_of_edge(e as usize))
@@ -666,7 +701,7 @@ impl BoundaryEdges {
             if range.is_empty() {
                 return;
             }
-            let (a, s) = self.range_area_sum::<W>(qi, r, z_exact, qz_units, range);
+            let (a, s) = self.range_area_sum::<W>(q, z_exact, qz_units, range);
             match angles {
                 Some(acc) => acc.absorb(&a),
                 None => *angles = Some(a),
@@ -690,7 +725,7 @@ impl BoundaryEdges {
             let term = if accurate.binary_search(&(e as u32)).is_ok() {
                 self.accurate_edge_area::<W>(e, q, z_exact, qz_units)
             } else {
-                self.exact_edge_area::<W>(e, qi, r, z_exact, qz_units)
+                self.exact_edge_area::<W>(e, q, z_exact, qz_units)
             };
             terms.add(self.weight[e] * term);
         }
@@ -758,7 +793,7 @@ impl BoundaryEdges {
     /// ends are on the lattice and the query's residual is exact, the input ones otherwise. The
     /// magnitudes come from [`exact_offsets`]: in double-double when `accurate` (near the
     /// segment or its ray column), rounded once otherwise, the loop's error model
-    /// ([`LoopQuery`]).
+    /// ([`LoopFrame`]).
     pub(crate) fn exact_segment_area<W: Width>(
         &self,
         pa: &InputPoint,
@@ -816,22 +851,21 @@ impl BoundaryEdges {
     /// [`AngleSum`]; `undecided(e)` is called for each edge the filter cannot sign.
     fn chain_angles(
         &self,
-        q: LoopQuery,
+        q: [f64; 3],
         slots: std::ops::Range<usize>,
         undecided: &mut impl FnMut(u32),
     ) -> AngleSum {
         let o = Portable;
-        let [qx, qy, qz] = q.hi.map(f64x4::splat);
-        let [qx_lo, qy_lo, qz_lo] = q.lo.map(f64x4::splat);
+        let [qx, qy, qz] = q.map(f64x4::splat);
         let (conv, rel) = self.filter_constants();
         let (conv, rel) = (o.splat(conv), o.splat(rel));
         let zero = o.splat(0.0);
         let lanes = |v: &[f64], j: usize| f64x4::from(lanes4(v, j));
         // Offsets x, y and the factors s, p (`vertex_factors!`) of the 4 vertices from slot `j`.
         let vertices = |j: usize| {
-            let x = split_offset!(o, (lanes(&self.xs, j), lanes(&self.xs_lo, j)), (qx, qx_lo));
-            let y = split_offset!(o, (lanes(&self.ys, j), lanes(&self.ys_lo, j)), (qy, qy_lo));
-            let z = split_offset!(o, (lanes(&self.zs, j), lanes(&self.zs_lo, j)), (qz, qz_lo));
+            let x = o.sub(lanes(&self.xs, j), qx);
+            let y = o.sub(lanes(&self.ys, j), qy);
+            let z = o.sub(lanes(&self.zs, j), qz);
             let (s, p) = vertex_factors!(o, horizontal_sq!(o, x, y), z);
             [x, y, s, p]
         };
@@ -866,23 +900,22 @@ impl BoundaryEdges {
     #[target_feature(enable = "avx2")]
     fn chain_angles_avx2(
         &self,
-        q: LoopQuery,
+        q: [f64; 3],
         slots: std::ops::Range<usize>,
         undecided: &mut impl FnMut(u32),
     ) -> AngleSum {
         use std::arch::x86_64::*;
         let o = Avx2;
         let load = |v: &[f64], j: usize| -> __m256d { bytemuck::cast(lanes4(v, j)) };
-        let [qx, qy, qz] = q.hi.map(|c| o.splat(c));
-        let [qx_lo, qy_lo, qz_lo] = q.lo.map(|c| o.splat(c));
+        let [qx, qy, qz] = q.map(|c| o.splat(c));
         let (conv, rel) = self.filter_constants();
         let (conv, rel) = (o.splat(conv), o.splat(rel));
         let zero = o.splat(0.0);
         macro_rules! vertices {
             ($j:expr) => {{
-                let x = split_offset!(o, (load(&self.xs, $j), load(&self.xs_lo, $j)), (qx, qx_lo));
-                let y = split_offset!(o, (load(&self.ys, $j), load(&self.ys_lo, $j)), (qy, qy_lo));
-                let z = split_offset!(o, (load(&self.zs, $j), load(&self.zs_lo, $j)), (qz, qz_lo));
+                let x = o.sub(load(&self.xs, $j), qx);
+                let y = o.sub(load(&self.ys, $j), qy);
+                let z = o.sub(load(&self.zs, $j), qz);
                 let (s, p) = vertex_factors!(o, horizontal_sq!(o, x, y), z);
                 [x, y, s, p]
             }};
@@ -933,19 +966,12 @@ impl BoundaryEdges {
     pub(super) fn exact_edge_area<W: Width>(
         &self,
         i: usize,
-        qi: [i64; 3],
-        r: [f64; 3],
+        q: &InputPoint,
         z_exact: bool,
         qz_units: f64,
     ) -> f64 {
-        let q = InputPoint {
-            n: qi,
-            r: [r[0], r[1], if z_exact { r[2] } else { 0.0 }],
-            world: [0.0; 3],
-            exact: [true; 3],
-        };
         let (pa, pb) = self.edge_points(i);
-        self.exact_segment_area::<W>(&pa, &pb, &q, z_exact, qz_units, false)
+        self.exact_segment_area::<W>(&pa, &pb, q, z_exact, qz_units, false)
     }
 }
 
@@ -972,7 +998,7 @@ fn exact_offsets(
 
 /// The offset `p − q` of exact points (cells, frame) in `f64`: the integer difference and the
 /// residuals' each rounded once, then their sum, so within `2u·|p − q| + 2^-50` cells
-/// (`u = 2^-53`), the error model of the loop ([`LoopQuery`]); for the hierarchy's spokes.
+/// (`u = 2^-53`), the error model of the loop ([`LoopFrame`]); for the hierarchy's spokes.
 pub(crate) fn rounded_offset(
     p: &InputPoint,
     q: &InputPoint,
@@ -1189,7 +1215,7 @@ mod tests {
             assert_eq!(flagged, dist <= 1.5, "case {s}: distance {dist} pads");
             if !flagged {
                 outside += 1;
-                let fast = edges.area_sum::<W128>(q, [0.0; 3], true, 0.0);
+                let fast = edges.area_sum::<W128>(&InputPoint::lattice(q), true, 0.0);
                 let accurate = edges.area_sum_accurate::<W128>(&InputPoint::lattice(q), true, 0.0);
                 assert!(
                     (fast - accurate).abs() <= 1e-12,
@@ -1234,9 +1260,12 @@ mod tests {
                     next(11) as i64 - 5,
                 ];
                 let want: f64 = (0..a.len())
-                    .map(|i| weight[i] * edges.exact_edge_area::<W128>(i, q, [0.0; 3], true, 0.0))
+                    .map(|i| {
+                        let q = InputPoint::lattice(q);
+                        weight[i] * edges.exact_edge_area::<W128>(i, &q, true, 0.0)
+                    })
                     .sum();
-                let got = edges.area_sum::<W128>(q, [0.0; 3], true, 0.0);
+                let got = edges.area_sum::<W128>(&InputPoint::lattice(q), true, 0.0);
                 assert!((got - want).abs() < 1e-9, "q {q:?}: {got} vs {want}");
             }
         }
@@ -1285,18 +1314,11 @@ mod tests {
                 let weight: Vec<f64> = (0..n).map(|_| (1 + rng.next(3)) as f64).collect();
                 let edges = BoundaryEdges::new(a, b, weight, 60);
                 for k in 0..20 {
-                    let qi = if k < 5 {
-                        pts[rng.next(pts.len() as u64) as usize]
+                    let q = if k < 5 {
+                        pts[rng.next(pts.len() as u64) as usize].map(|c| c as f64)
                     } else {
-                        [rng.coord(big), rng.coord(big), rng.coord(big)]
+                        [rng.coord(big), rng.coord(big), rng.coord(big)].map(|c| c as f64)
                     };
-                    // Half the queries off the lattice (dyadic residuals of up to 20 bits).
-                    let r: [f64; 3] = if k % 2 == 0 {
-                        [0.0; 3]
-                    } else {
-                        std::array::from_fn(|_| (rng.next(1 << 20) as f64 - 524288.0) / 1048576.0)
-                    };
-                    let q = LoopQuery::new(qi, r, true, 0.0);
                     let (mut u1, mut u2) = (Vec::new(), Vec::new());
                     let s1 = edges
                         .chain_angles(q, 0..edges.slots, &mut |e| u1.push(e))
@@ -1319,12 +1341,7 @@ mod tests {
                     let by_scalar: Vec<u32> = (0..edges.len() as u32)
                         .filter(|&e| {
                             let (a, b, _) = edges.edge(e as usize);
-                            // The split offsets of `split_offset!`, one coordinate at a time.
-                            let split = |p: i64, k: usize| {
-                                let hi = p as f64;
-                                (hi - q.hi[k]) + ((p - hi as i64) as f64 - q.lo[k])
-                            };
-                            let off = |p: [i64; 3]| [split(p[0], 0), split(p[1], 1)];
+                            let off = |p: [i64; 3]| [p[0] as f64 - q[0], p[1] as f64 - q[1]];
                             !is_parallel_to_ray(a, b)
                                 && orient2d_filtered(off(a), off(b), edges.limit).is_none()
                         })

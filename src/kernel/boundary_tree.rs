@@ -416,20 +416,14 @@ impl BoundaryTree {
     pub fn area_sum<W: Width>(
         &self,
         edges: &BoundaryEdges,
-        qi: [i64; 3],
-        r: [f64; 3],
+        q: &InputPoint,
         z_exact: bool,
         qz_units: f64,
     ) -> TreeSum {
         let limit = edges.limit();
-        let q = InputPoint {
-            n: qi,
-            r,
-            world: [0.0; 3],
-            exact: [true; 3],
-        };
+        let qi = q.n;
         let at = TreeQuery::Lattice {
-            q,
+            q: *q,
             z_exact,
             qz_units,
         };
@@ -444,14 +438,14 @@ impl BoundaryTree {
         let mut angles: Option<AngleSum> = None;
         let mut scalar = 0.0;
         let mut run_exact = |range: std::ops::Range<usize>| {
-            let (a, s) = edges.range_area_sum::<W>(qi, r, z_exact, qz_units, range);
+            let (a, s) = edges.range_area_sum::<W>(q, z_exact, qz_units, range);
             match &mut angles {
                 Some(acc) => acc.absorb(&a),
                 None => angles = Some(a),
             }
             scalar += s;
         };
-        let mut spokes = SpokeSum::new(edges, q, z_exact, qz_units, limit);
+        let mut spokes = SpokeSum::new(edges, *q, z_exact, qz_units, limit);
         let mut spoke = |p: &InputPoint, v: &InputPoint, m: i32| spokes.subtract::<W>(p, v, m);
         let mut sum = self.traverse(&at, misses, &mut run_exact, &mut spoke);
         let (spoke_angles, spoke_scalar) = spokes.finish();
@@ -461,7 +455,7 @@ impl BoundaryTree {
             angles = Some(spoke_angles);
         }
         sum.area += angles.map_or(0.0, |a| 2.0 * a.total()) + scalar + spoke_scalar;
-        sum.area += edges.heavy_area_sum::<W>(qi, r, z_exact, qz_units);
+        sum.area += edges.heavy_area_sum::<W>(q, z_exact, qz_units);
         sum
     }
 

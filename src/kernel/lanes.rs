@@ -156,19 +156,6 @@ macro_rules! vertex_factors {
 }
 pub(super) use vertex_factors;
 
-/// The offset `x − q` of lanes of chain vertices from the query, each split into its `f64`
-/// rounding and the rest (`BoundaryEdges`' `xs`/`xs_lo`, `LoopQuery`'s `hi`/`lo`): the high
-/// parts are within `2^6` cells of each other's true difference, so their difference is rounded
-/// relative to the offset, and the low parts (at most `2^5 + 1/2` cells) add what the rounding
-/// and the snapping left out.
-macro_rules! split_offset {
-    ($o:expr, ($hi:expr, $lo:expr), ($q_hi:expr, $q_lo:expr)) => {{
-        let o = $o;
-        o.add(o.sub($hi, $q_hi), o.sub($lo, $q_lo))
-    }};
-}
-pub(super) use split_offset;
-
 /// `x² + y²` of a vertex's offsets from the query (shared by a column's queries).
 macro_rules! horizontal_sq {
     ($o:expr, $x:expr, $y:expr) => {{

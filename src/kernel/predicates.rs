@@ -214,9 +214,10 @@ pub const ORIENT2D_FILTER_RELATIVE: f64 = 2.0 * 4.0 * (f64::EPSILON * 0.5);
 // of each offset by `≤ 1/2` changes `D` by at most `Σ + 2 ≤ 3Σ` (`Σ ≥ 1`; `Σ = 0` gives `d = 0`,
 // never decided). A decided `|d|` exceeds the bound, twice the rounding error, so the lattice
 // `|D| >` half the bound `≥ CONVERSION/2 · limit · Σ = 128·Σ` at `limit = 2^59`: the snapping
-// cannot reach zero. So only the filter's undecided edges need the exact inputs. (The boundary
-// loops now compute their offsets from the exact inputs themselves, `boundary_sum::LoopQuery`,
-// within `2u` relative plus `2^-45` cells: their `d` is closer still to the inputs' `D`.)
+// cannot reach zero. So only the filter's undecided edges need the exact inputs. (At 60 bits the
+// boundary loops now take their offsets from the exact inputs themselves,
+// `boundary_sum::LoopFrame::Unshifted`, one rounding of the exact difference: their `d` is
+// closer still to the inputs' `D`.)
 // (Checked at compile time: a constant only a `const _` reads counts as unused on Rust 1.88.)
 const _: () = assert!(ORIENT2D_FILTER_CONVERSION * 0.5 * ((1_u64 << 59) as f64) >= 3.0);
 

@@ -41,10 +41,10 @@ impl<W: Width> ExactIndex<W> {
         }
         match tree {
             Some(tree) => {
-                let sum = tree.area_sum::<W>(&self.boundary, qi, r, z_exact, qz_units);
+                let sum = tree.area_sum::<W>(&self.boundary, q, z_exact, qz_units);
                 (sum.area, sum.bound)
             }
-            None => (self.boundary.area_sum::<W>(qi, r, z_exact, qz_units), 0.0),
+            None => (self.boundary.area_sum::<W>(q, z_exact, qz_units), 0.0),
         }
     }
 
@@ -135,12 +135,12 @@ impl<W: Width> ExactIndex<W> {
         self.grid.gradient_to_world(g)
     }
 
-    /// The boundary sums of a column's points at lattice `x, y` whose sum is the flat loop, all in
-    /// one pass of the column loop (shared `x, y` work; each value bit-identical to its own
-    /// [`ExactIndex::boundary_sum`]).
-    pub(super) fn column_area_sums(&self, xy: [i64; 2], queries: &[ColumnQuery]) -> Vec<f64> {
+    /// The boundary sums of a column's points (one lattice `x, y`) whose sum is the flat loop,
+    /// all in one pass of the column loop (shared `x, y` work; each value bit-identical to its
+    /// own [`ExactIndex::boundary_sum`]).
+    pub(super) fn column_area_sums(&self, queries: &[ColumnQuery]) -> Vec<f64> {
         let mut areas = vec![0.0; queries.len()];
-        self.boundary.column_area_sums::<W>(xy, queries, &mut areas);
+        self.boundary.column_area_sums::<W>(queries, &mut areas);
         areas
     }
 

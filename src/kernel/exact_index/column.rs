@@ -108,10 +108,9 @@ impl<W: Width> ExactIndex<W> {
             let qz_units = self.z_in_cells(p.qz);
             if p.rz_exact && self.boundary_sum_is_flat(qi, r, p.z_exact, qz_units, tree) {
                 let query = ColumnQuery {
-                    z: p.z,
+                    point: input_point(p),
                     z_exact: p.z_exact,
                     qz_units,
-                    r,
                 };
                 batch.push((k, query));
             } else {
@@ -120,7 +119,7 @@ impl<W: Width> ExactIndex<W> {
             }
         }
         let queries: Vec<ColumnQuery> = batch.iter().map(|&(_, c)| c).collect();
-        let areas = self.column_area_sums([x, y], &queries);
+        let areas = self.column_area_sums(&queries);
         for (&(k, _), area) in batch.iter().zip(areas) {
             out[k] = (w_of_parts(chis[k], area), 0.0);
         }
