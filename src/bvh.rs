@@ -74,7 +74,13 @@ impl RayBvh {
         if boxes.is_empty() {
             return RayBvh::default();
         }
-        let padded: Vec<Box3> = boxes
+        // Equal boxes are one primitive for the build, expanded into a leaf of all of them
+        // afterwards (`groups`). PLOC pairs equal boxes into a chain: 6,000 boundary edges of a
+        // 40-unit hole in a mesh of extent `1e15` (one `f32` box) gave a tree 5,600 deep, whose
+        // traversal visits every node and whose debug-build validation in `obvhs` overflowed the
+        // stack; stacks of duplicated faces do the same. Equal boxes are hit together anyway.
+        let (unique, groups) = equal_box_groups(boxes);
+        let padded: Vec<Box3> = unique
             .iter()
             .map(|(lo, hi)| (lo.map(|v| v - PAD), hi.map(|v| v + PAD)))
             .collect();
@@ -93,11 +99,11 @@ impl RayBvh {
             collapse_traversal_cost: 1.0,
             ..BvhBuildParams::fast_build()
         };
-        let bvh = build_bvh2(&aabbs, params, &mut t);
-        let src = &bvh.nodes;
-        let prims = bvh.primitive_indices;
+        let mut bvh = build_bvh2(&aabbs, params, &mut t);
         // True (unflattened) padded boxes of every source node, children before parents.
-        let boxes = true_boxes(src, &prims, &padded);
+        let boxes = true_boxes(&bvh.nodes, &bvh.primitive_indices, &padded);
+        let prims = groups.expand(&mut bvh.nodes, &bvh.primitive_indices);
+        let src = &bvh.nodes;
         if src[0].prim_count > 0 {
             return RayBvh {
                 nodes: Vec::new(),
@@ -231,6 +237,69 @@ impl RayBvh {
     }
 }
 
+/// The primitives of each distinct box: `members[start[u]..start[u + 1]]` have box `u`.
+struct BoxGroups {
+    start: Vec<u32>,
+    members: Vec<u32>,
+}
+
+/// The distinct boxes of `boxes` (by their bits) and the primitives of each.
+fn equal_box_groups(boxes: &[Box3]) -> (Vec<Box3>, BoxGroups) {
+    let key = |b: &Box3| {
+        let (lo, hi) = b;
+        [lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]].map(f32::to_bits)
+    };
+    let mut order: Vec<u32> = (0..boxes.len() as u32).collect();
+    order.sort_by_key(|&i| (key(&boxes[i as usize]), i));
+    let mut unique = Vec::new();
+    let mut start = Vec::new();
+    for (k, &i) in order.iter().enumerate() {
+        let b = boxes[i as usize];
+        if k == 0 || key(&b) != key(&boxes[order[k - 1] as usize]) {
+            unique.push(b);
+            start.push(k as u32);
+        }
+    }
+    start.push(order.len() as u32);
+    (
+        unique,
+        BoxGroups {
+            start,
+            members: order,
+        },
+    )
+}
+
+impl BoxGroups {
+    /// Rewrites the leaves of a hierarchy built over the distinct boxes (`prims`: its primitive
+    /// order, distinct-box indices) to ranges of the original primitives; returns their order.
+    fn expand(&self, nodes: &mut [obvhs::bvh2::node::Bvh2Node], prims: &[u32]) -> Vec<u32> {
+        let size = |u: u32| self.start[u as usize + 1] - self.start[u as usize];
+        // `offset[k]`: where distinct box `prims[k]`'s members begin in the expanded order.
+        let mut offset = Vec::with_capacity(prims.len() + 1);
+        let mut expanded = Vec::with_capacity(self.members.len());
+        for &u in prims {
+            offset.push(expanded.len() as u32);
+            let (s, e) = (self.start[u as usize], self.start[u as usize + 1]);
+            expanded.extend_from_slice(&self.members[s as usize..e as usize]);
+        }
+        offset.push(expanded.len() as u32);
+        for n in nodes.iter_mut().filter(|n| n.prim_count > 0) {
+            let (first, count) = (n.first_index as usize, n.prim_count as usize);
+            debug_assert_eq!(
+                offset[first + count] - offset[first],
+                prims[first..first + count]
+                    .iter()
+                    .map(|&u| size(u))
+                    .sum::<u32>()
+            );
+            n.first_index = offset[first];
+            n.prim_count = offset[first + count] - offset[first];
+        }
+        expanded
+    }
+}
+
 /// The padded boxes of every node of an `obvhs` hierarchy, recomputed from its primitives (the
 /// hierarchy was built on boxes flattened along z).
 fn true_boxes(src: &[obvhs::bvh2::node::Bvh2Node], prims: &[u32], padded: &[Box3]) -> Vec<Box3> {
@@ -265,6 +334,65 @@ fn true_boxes(src: &[obvhs::bvh2::node::Bvh2Node], prims: &[u32], padded: &[Box3
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Depth of the 4-wide hierarchy (1 for a root leaf).
+    fn depth(bvh: &RayBvh) -> usize {
+        if bvh.nodes.is_empty() {
+            return 1;
+        }
+        let mut deepest = 0;
+        let mut stack = vec![(0u32, 1usize)];
+        while let Some((i, d)) = stack.pop() {
+            deepest = deepest.max(d);
+            let n = &bvh.nodes[i as usize];
+            for c in 0..4 {
+                if n.child[c] & LEAF == 0 && n.count[c] == 0 && n.child[c] != 0 {
+                    stack.push((n.child[c], d + 1));
+                }
+            }
+        }
+        deepest
+    }
+
+    /// Thousands of equal boxes (a small cluster in a huge box rounds to one `f32` box; stacks
+    /// of duplicated faces) beside distinct ones: a shallow tree that still reports every box on
+    /// the ray exactly once. Before, the build chained them (depth ~n; the debug build of
+    /// `obvhs` then overflowed the stack validating it).
+    #[test]
+    fn equal_boxes_make_one_leaf_not_a_chain() {
+        let mut boxes = vec![([0.25f32, 0.25, 0.25], [0.25f32, 0.25, 0.25]); 20_000];
+        for i in 0..300 {
+            let x = i as f32 / 300.0 - 0.5;
+            boxes.push(([x, -0.5, 0.0], [x + 0.01, 0.5, 0.1]));
+            boxes.push(([0.25 + x, 0.25, 0.25], [0.26 + x, 0.26, 0.26]));
+        }
+        let bvh = RayBvh::build(&boxes);
+        assert!(depth(&bvh) <= 24, "depth {}", depth(&bvh));
+        for (x, y, z) in [
+            (0.25, 0.25, -1.0),
+            (0.25, 0.25, 0.25),
+            (0.0, 0.0, 0.0),
+            (0.9, 0.9, 0.0),
+        ] {
+            let mut got = Vec::new();
+            bvh.for_each_on_ray(x, y, z, |p| got.push(p));
+            got.sort_unstable();
+            let want: Vec<u32> = (0..boxes.len() as u32)
+                .filter(|&i| {
+                    let (lo, hi) = boxes[i as usize];
+                    x >= lo[0] && x <= hi[0] && y >= lo[1] && y <= hi[1] && hi[2] >= z
+                })
+                .collect();
+            // The padding may add boxes within 2^-20; none may be missed or repeated.
+            let n = got.len();
+            got.dedup();
+            assert_eq!(n, got.len(), "duplicates at ({x}, {y}, {z})");
+            assert!(
+                want.iter().all(|w| got.binary_search(w).is_ok()),
+                "missed at ({x}, {y}, {z})"
+            );
+        }
+    }
 
     #[test]
     fn reports_every_box_on_the_ray_once() {
