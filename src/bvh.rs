@@ -250,7 +250,7 @@ fn equal_box_groups(boxes: &[Box3]) -> (Vec<Box3>, BoxGroups) {
         [lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]].map(f32::to_bits)
     };
     let mut order: Vec<u32> = (0..boxes.len() as u32).collect();
-    order.sort_by_key(|&i| (key(&boxes[i as usize]), i));
+    order.sort_unstable_by_key(|&i| (key(&boxes[i as usize]), i));
     let mut unique = Vec::new();
     let mut start = Vec::new();
     for (k, &i) in order.iter().enumerate() {

@@ -152,6 +152,8 @@ pub struct BoundaryEdges {
     zs: Vec<f64>,
     /// The frame of `xs`, `ys`, `zs` (and of the query the loops subtract).
     frame: LoopFrame,
+    /// [`ray_tube`] of the frame.
+    tube: i64,
     /// `link[j] = 1` when slot `j` → `j + 1` is an edge, `0` for a break or padding.
     link: Vec<f64>,
     /// The edge (index into `a`, `b`) of each linked slot, for the exact fallback.
@@ -265,19 +267,25 @@ fn ill_conditioned(
 }
 
 /// Half-width (grid units) of the column above each boundary vertex in which a query takes the
-/// double-double path: `limit / 2^14` (`2^45` cells at 60 bits, about `1e-5` of the extent).
+/// double-double path, for the loops' frame.
 ///
 /// Why: a vertex `v` seen almost along the ray (transverse offset `h ≪ |v − q|`) enters its
 /// terms through the azimuth of `v − q` around the ray (the on-ray limit of
-/// docs/robustness.md §3), so an absolute error `δ` in the transverse offset moves the term by
-/// `≈ 2δ/h` whatever the distance along the ray. The loop's offsets carry `δ ≤ u·|v − q|`
-/// ([`LoopFrame`]; the column was sized when they carried `2^7` cells, two conversions of
-/// 59-bit integers and half a cell of snapping); outside the column the term
-/// errs by `≤ 2·2^7/2^45 = 2^-37` in area, `≤ 6e-13` on `w`, now far less. Queries in the
-/// column are rare (`π(1e-5)²` of the box per boundary vertex), so the slow path stays rare.
-#[inline]
-fn ray_tube(limit: f64) -> i64 {
-    (limit as i64) >> 14
+/// docs/robustness.md §3), so an error `δ` in the transverse offset moves the term by `≈ 2δ/h`
+/// whatever the distance along the ray. In the lattice frame that error is absolute, `δ ≤ 2^7`
+/// cells at 60 bits (two conversions of 59-bit integers to `f64`, half a cell of snapping): the
+/// column is `limit / 2^14` (`2^45` cells, about `1e-5` of the extent), outside which the term
+/// errs by `≤ 2·2^7/2^45 = 2^-37` in area, `≤ 6e-13` on `w`. In the unshifted frame each
+/// transverse offset is its exact value rounded once, `δ ≤ u·h`, so the azimuth errs by `~2u`
+/// whatever `h`: no column beyond the query's own lattice one (where `h` may be below a cell).
+/// The column had been the slow path of meshes with small parts in a huge box: `2^-14` of a
+/// `1e15` extent is `6e10` units, so every query near a 40-unit hole took the double-double
+/// terms of all its edges (docs/benchmarks.md, "Exact magnitudes").
+fn ray_tube(frame: LoopFrame, limit: f64) -> i64 {
+    match frame {
+        LoopFrame::Lattice => (limit as i64) >> 14,
+        LoopFrame::Unshifted { .. } => 0,
+    }
 }
 
 /// Whether edge `a → b` is parallel to the ray (equal `x, y` in the frame; zero length included).
@@ -450,13 +458,13 @@ impl BoundaryEdges {
             .filter(|&i| weight[i as usize] > MAX_CHAINED_WEIGHT && !parallel[i as usize])
             .collect();
         let limit = (1_i64 << (bits - 1)) as f64;
+        let tube = ray_tube(frame, limit);
         let to_unit = 1.0 / limit;
         let near_boxes: Vec<([f32; 3], [f32; 3])> = a
             .iter()
             .zip(&b)
             .map(|(&p, &q)| {
                 let pad = near_edge_pad(p, q);
-                let tube = ray_tube(limit);
                 let pad = |k: usize| if k < 2 { pad.max(tube) } else { pad };
                 let lo =
                     std::array::from_fn(|k| ((p[k].min(q[k]) - pad(k)) as f64 * to_unit) as f32);
@@ -474,6 +482,7 @@ impl BoundaryEdges {
             ys,
             zs,
             frame,
+            tube,
             link,
             edge_of,
             edge_slots_start,
@@ -644,7 +653,7 @@ impl BoundaryEdges {
             return;
         }
         let residual = r != [0.0; 3];
-        let tube = ray_tube(self.limit);
+        let tube = self.tube;
         let u = |v: i64| (v as f64 / self.limit) as f32;
         let z_min = if residual {
             f32::NEG_INFINITY
@@ -769,7 +778,7 @@ impl BoundaryEdges {
             self.b[i],
             q.n,
             z_exact,
-            ray_tube(self.limit),
+            self.tube,
             ACCURATE_TERM_PADS,
         );
         self.exact_segment_area::<W>(&pa, &pb, q, z_exact, qz_units, near)

@@ -791,3 +791,57 @@ fn small_open_parts_of_huge_meshes_get_exact_fractions() {
     }
     println!("small open cap in a 1e15 box: worst |w − direct| = {worst:e}");
 }
+
+/// Queries on and next to the lines through boundary vertices along each ray, the configuration
+/// the loop's ray column sent to the double-double path while offsets carried absolute errors:
+/// the vertex's azimuth around the ray is then all its term sees. With offsets taken from the
+/// exact inputs (one rounding each) the loop itself must match the direct sum to 1e-12 — for
+/// transverse distances 0, 1e-13 … 1e-3 of the vertex's distance along the ray, on every ray.
+#[test]
+fn queries_along_the_ray_through_boundary_vertices_are_accurate() {
+    let mut rng = common::Rng(48);
+    // An open fan with full-precision coordinates (a cap with a ragged rim).
+    let centre = [0.1234567, -0.7654321, 0.3141592];
+    let ring = 40;
+    let mut p = vec![centre];
+    for i in 0..ring {
+        let a = std::f64::consts::TAU * (i as f64 + rng.range(-0.3, 0.3)) / ring as f64;
+        let r = rng.range(0.8, 1.2);
+        p.push([
+            centre[0] + r * a.cos(),
+            centre[1] + r * a.sin(),
+            centre[2] + rng.range(-0.4, 0.4),
+        ]);
+    }
+    let t: Vec<[u32; 3]> = (0..ring as u32)
+        .map(|i| [0, 1 + i, 1 + (i + 1) % ring as u32])
+        .collect();
+    let mesh = Mesh::from_slices(&p, &t).unwrap();
+    let mut worst: f64 = 0.0;
+    for (ray, wn) in all_rays(&mesh) {
+        let [(along, _), (u, _), (v, _)] = {
+            let m = ray.map();
+            [m[2], m[0], m[1]]
+        };
+        for k in 1..=ring {
+            let vertex = p[k];
+            for &dist in &[0.05, 0.7, 3.0, -0.5, -4.0] {
+                for &side in &[0.0, 1e-13, 1e-10, 1e-7, 1e-3] {
+                    let mut q = vertex;
+                    q[along] += dist;
+                    let angle = rng.range(0.0, std::f64::consts::TAU);
+                    q[u] += side * dist.abs() * angle.cos();
+                    q[v] += side * dist.abs() * angle.sin();
+                    let want = direct::winding_number_direct(&mesh, q);
+                    let w = wn.eval(q);
+                    worst = worst.max((w - want).abs());
+                    assert!(
+                        (w - want).abs() <= 1e-12,
+                        "{ray:?} vertex {k} dist {dist} side {side:e}: {w} vs direct {want}"
+                    );
+                }
+            }
+        }
+    }
+    println!("along the rays through boundary vertices: worst |w − direct| = {worst:e}");
+}
