@@ -823,8 +823,7 @@ fn queries_along_the_ray_through_boundary_vertices_are_accurate() {
             let m = ray.map();
             [m[2], m[0], m[1]]
         };
-        for k in 1..=ring {
-            let vertex = p[k];
+        for (k, &vertex) in p.iter().enumerate().skip(1) {
             for &dist in &[0.05, 0.7, 3.0, -0.5, -4.0] {
                 for &side in &[0.0, 1e-13, 1e-10, 1e-7, 1e-3] {
                     let mut q = vertex;
