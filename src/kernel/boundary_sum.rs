@@ -126,7 +126,7 @@ impl LoopFrame {
 /// `x · 2^e`, exact unless the result is subnormal (then within `2^-1074`: a tiny coordinate of a
 /// huge mesh, whose magnitude that does not change) or beyond `f64` (excluded by
 /// [`UNSHIFTED_LIMIT`]). Two steps, so that `|e|` up to 2046 needs no intermediate overflow.
-fn scaled_by_power_of_two(x: f64, e: i64) -> f64 {
+pub(crate) fn scaled_by_power_of_two(x: f64, e: i64) -> f64 {
     let power = |e: i64| f64::from_bits(((e + 1023) as u64) << 52);
     let half = (e / 2).clamp(-1022, 1023);
     let rest = (e - half).clamp(-1022, 1023);
@@ -152,6 +152,8 @@ pub struct BoundaryEdges {
     zs: Vec<f64>,
     /// The frame of `xs`, `ys`, `zs` (and of the query the loops subtract).
     frame: LoopFrame,
+    /// Each edge's endpoints in that frame (the gradient's sum runs over edges, not chains).
+    ends_in_frame: Vec<([f64; 3], [f64; 3])>,
     /// [`ray_tube`] of the frame.
     tube: i64,
     /// `link[j] = 1` when slot `j` → `j + 1` is an edge, `0` for a break or padding.
@@ -482,6 +484,7 @@ impl BoundaryEdges {
             ys,
             zs,
             frame,
+            ends_in_frame: coordinates,
             tube,
             link,
             edge_of,
@@ -591,6 +594,11 @@ impl BoundaryEdges {
     /// The loops' frame.
     pub(super) fn frame(&self) -> LoopFrame {
         self.frame
+    }
+
+    /// Edge `i`'s endpoints in the loops' frame.
+    pub(super) fn edge_in_frame(&self, i: usize) -> ([f64; 3], [f64; 3]) {
+        self.ends_in_frame[i]
     }
 
     /// Slots rounded up to a multiple of 4: the end of the last range a loop may visit.

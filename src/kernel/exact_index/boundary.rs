@@ -5,6 +5,7 @@
 use super::ExactIndex;
 use crate::base::compensated::NeumaierSum;
 use crate::kernel::boundary_column::ColumnQuery;
+use crate::kernel::boundary_sum::{LoopFrame, scaled_by_power_of_two};
 use crate::kernel::boundary_tree::{BoundaryTree, TreeQuery};
 use crate::kernel::input_predicates::InputPoint;
 use crate::kernel::predicates::{Width, far_query_numerator_sign};
@@ -121,11 +122,36 @@ impl<W: Width> ExactIndex<W> {
         });
         let exponent = (span.to_bits() >> 52) & 0x7ff;
         let scale = f64::from_bits((2046 - exponent) << 52);
+        // At 60 bits the offsets are the exact inputs' differences rounded once (the loops'
+        // unshifted frame, cells, times the cell: a power of two); the lattice points' were off
+        // by up to `2^6` cells whatever the distance (a small part of a huge mesh). A query too
+        // far for the frame's range takes the lattice points, relative to its distance.
+        let unshifted_query = match self.boundary.frame() {
+            LoopFrame::Unshifted { shift, .. } => {
+                let qu = self
+                    .ray
+                    .to_frame(q)
+                    .map(|c| scaled_by_power_of_two(c, shift));
+                qu.iter().all(|c| c.abs() < 1e300).then_some(qu)
+            }
+            LoopFrame::Lattice => None,
+        };
         let mut g = [NeumaierSum::new(); 3];
         for i in 0..self.boundary.len() {
             let (a, b, weight) = self.boundary.edge(i);
-            let ra = self.rel_f64(a, qf).map(|v| v * scale);
-            let rb = self.rel_f64(b, qf).map(|v| v * scale);
+            let (ra, rb) = match unshifted_query {
+                Some(qu) => {
+                    let (au, bu) = self.boundary.edge_in_frame(i);
+                    let offset = |p: [f64; 3]| -> [f64; 3] {
+                        std::array::from_fn(|k| (p[k] - qu[k]) * self.cell * scale)
+                    };
+                    (offset(au), offset(bu))
+                }
+                None => (
+                    self.rel_f64(a, qf).map(|v| v * scale),
+                    self.rel_f64(b, qf).map(|v| v * scale),
+                ),
+            };
             let e = segment_gradient(ra, rb);
             for k in 0..3 {
                 g[k].add(weight * e[k]);
