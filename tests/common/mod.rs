@@ -128,6 +128,40 @@ impl Rng {
 
 pub use gwn::testing::direct_at_perturbed;
 
+/// Centre of [`cap_beside_far_tetrahedron`]'s cap (full-precision coordinates).
+pub const CAP_CENTRE: [f64; 3] = [0.3127, -0.1171, 2.7113];
+
+/// A small open cap — a fan of `ring` triangles from [`CAP_CENTRE`] to a ragged rim of radius in
+/// `radius`, below the centre by 0.5 … 3 — beside a closed unit tetrahedron at `(far, far, far)`,
+/// which sets the extent when `far` is huge (at `1e15` the 60-bit cell is `2^-8` and the cap
+/// is off the lattice). Returns the mesh and its positions (the centre, the rim, the tetrahedron).
+pub fn cap_beside_far_tetrahedron(
+    rng: &mut Rng,
+    ring: usize,
+    radius: (f64, f64),
+    far: f64,
+) -> (Mesh, Vec<[f64; 3]>) {
+    let centre = CAP_CENTRE;
+    let mut p = vec![centre];
+    for i in 0..ring {
+        let a = std::f64::consts::TAU * (i as f64 + rng.range(-0.2, 0.2)) / ring as f64;
+        let r = rng.range(radius.0, radius.1);
+        p.push([
+            centre[0] + r * a.cos(),
+            centre[1] + r * a.sin(),
+            centre[2] - rng.range(0.5, 3.0),
+        ]);
+    }
+    let first = p.len() as u32;
+    let f = far;
+    p.extend([[f, f, f], [f + 1.0, f, f], [f, f + 1.0, f], [f, f, f + 1.0]]);
+    let mut t: Vec<[u32; 3]> = (0..ring as u32)
+        .map(|i| [0, 1 + i, 1 + (i + 1) % ring as u32])
+        .collect();
+    t.extend([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]].map(|f| f.map(|i| first + i)));
+    (Mesh::from_slices(&p, &t).unwrap(), p)
+}
+
 /// The unit sphere as 8 rational biquadratic patches (quarter circles × half meridians),
 /// outward.
 pub fn rational_sphere_patches() -> Vec<gwn::patch::Patch> {

@@ -170,26 +170,8 @@ fn the_hierarchy_agrees_with_the_direct_sum() {
 #[test]
 fn the_bound_holds_on_a_small_boundary_in_a_huge_box() {
     let mut rng = common::Rng(7);
-    let ring = 2000;
-    let centre = [0.3127, -0.1171, 2.7113];
-    let mut p = vec![centre];
-    for i in 0..ring {
-        let a = std::f64::consts::TAU * (i as f64 + rng.range(-0.2, 0.2)) / ring as f64;
-        let r = rng.range(40.0, 41.0);
-        p.push([
-            centre[0] + r * a.cos(),
-            centre[1] + r * a.sin(),
-            centre[2] - rng.range(0.5, 3.0),
-        ]);
-    }
-    let far = p.len() as u32;
-    let f = 1e15;
-    p.extend([[f, f, f], [f + 1.0, f, f], [f, f + 1.0, f], [f, f, f + 1.0]]);
-    let mut t: Vec<[u32; 3]> = (0..ring as u32)
-        .map(|i| [0, 1 + i, 1 + (i + 1) % ring as u32])
-        .collect();
-    t.extend([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]].map(|f| f.map(|i| far + i)));
-    let mesh = Mesh::from_slices(&p, &t).unwrap();
+    let (mesh, _) = common::cap_beside_far_tetrahedron(&mut rng, 2000, (40.0, 41.0), 1e15);
+    let centre = common::CAP_CENTRE;
     // Around the ring (its nodes are expanded from a few node sizes away) and farther out.
     let queries: Vec<[f64; 3]> = (0..150)
         .map(|i| {

@@ -136,26 +136,8 @@ fn far_gradients_keep_their_relative_accuracy_and_never_overflow() {
 #[test]
 fn gradients_of_small_parts_in_huge_meshes_are_accurate() {
     let mut rng = common::Rng(52);
-    let centre = [0.3127, -0.1171, 2.7113];
     let ring = 24;
-    let mut p = vec![centre];
-    for i in 0..ring {
-        let a = std::f64::consts::TAU * (i as f64 + rng.range(-0.2, 0.2)) / ring as f64;
-        let r = rng.range(4.0, 6.0);
-        p.push([
-            centre[0] + r * a.cos(),
-            centre[1] + r * a.sin(),
-            centre[2] - rng.range(0.5, 3.0),
-        ]);
-    }
-    let far = p.len() as u32;
-    let f = 1e15;
-    p.extend([[f, f, f], [f + 1.0, f, f], [f, f + 1.0, f], [f, f, f + 1.0]]);
-    let mut t: Vec<[u32; 3]> = (0..ring as u32)
-        .map(|i| [0, 1 + i, 1 + (i + 1) % ring as u32])
-        .collect();
-    t.extend([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]].map(|f| f.map(|i| far + i)));
-    let mesh = Mesh::from_slices(&p, &t).unwrap();
+    let (mesh, p) = common::cap_beside_far_tetrahedron(&mut rng, ring, (4.0, 6.0), 1e15);
     for ray in [RayAxis::PosZ, RayAxis::NegX, RayAxis::PosY] {
         let wn = WindingNumber::with_options(
             &mesh,

@@ -717,30 +717,9 @@ fn near_holes_of_full_precision_meshes_the_fraction_is_right() {
 #[test]
 fn small_open_parts_of_huge_meshes_get_exact_fractions() {
     let mut rng = common::Rng(36);
-    let centre = [0.3127, -0.1171, 2.7113];
     let ring = 12;
-    let mut p = vec![centre];
-    for i in 0..ring {
-        let a = std::f64::consts::TAU * (i as f64 + rng.range(-0.2, 0.2)) / ring as f64;
-        let r = rng.range(4.0, 6.0);
-        p.push([
-            centre[0] + r * a.cos(),
-            centre[1] + r * a.sin(),
-            centre[2] - rng.range(0.5, 3.0),
-        ]);
-    }
-    let far = p.len() as u32;
-    p.extend([
-        [1e15, 1e15, 1e15],
-        [1e15 + 1.0, 1e15, 1e15],
-        [1e15, 1e15 + 1.0, 1e15],
-        [1e15, 1e15, 1e15 + 1.0],
-    ]);
-    let mut t: Vec<[u32; 3]> = (0..ring as u32)
-        .map(|i| [0, 1 + i, 1 + (i + 1) % ring as u32])
-        .collect();
-    t.extend([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]].map(|f| f.map(|i| far + i)));
-    let mesh = Mesh::from_slices(&p, &t).unwrap();
+    let (mesh, p) = common::cap_beside_far_tetrahedron(&mut rng, ring, (4.0, 6.0), 1e15);
+    let centre = common::CAP_CENTRE;
     let rays = all_rays(&mesh);
     let snapping = rays[0].1.snapping();
     assert!(
