@@ -9,16 +9,21 @@ use gwn::RayAxis;
 use gwn::eval::antipodal::{Options, WindingNumber};
 use gwn::eval::direct::winding_number_gradient_direct;
 
+/// The exact evaluator of `mesh` with `ray` and the other options at their defaults.
+fn with_ray(mesh: &Mesh, ray: RayAxis) -> WindingNumber {
+    WindingNumber::with_options(
+        mesh,
+        Options {
+            ray,
+            ..Default::default()
+        },
+    )
+    .unwrap()
+}
+
 fn check(mesh: &Mesh, queries: &[[f64; 3]], h: f64) {
     for ray in [RayAxis::PosZ, RayAxis::NegX] {
-        let wn = WindingNumber::with_options(
-            mesh,
-            Options {
-                ray,
-                ..Default::default()
-            },
-        )
-        .unwrap();
+        let wn = with_ray(mesh, ray);
         for &q in queries {
             let g = wn.gradient(q);
             let gd = winding_number_gradient_direct(mesh, q);
@@ -93,14 +98,7 @@ fn far_gradients_keep_their_relative_accuracy_and_never_overflow() {
     // formula divides by 1 + A·x1, which vanishes when the boundary is seen along the ray).
     let mesh = common::open_cube();
     for ray in [RayAxis::PosZ, RayAxis::NegZ, RayAxis::PosX] {
-        let wn = WindingNumber::with_options(
-            &mesh,
-            Options {
-                ray,
-                ..Default::default()
-            },
-        )
-        .unwrap();
+        let wn = with_ray(&mesh, ray);
         for d in [1e2, 1e4, 1e6, 1e8, 1e12] {
             for q in [[0.3, 0.6, -d], [0.3, 0.6, d], [d, 0.4, 0.5], [0.7, -d, 0.2]] {
                 let g = wn.gradient(q);
@@ -139,14 +137,7 @@ fn gradients_of_small_parts_in_huge_meshes_are_accurate() {
     let ring = 24;
     let (mesh, p) = common::cap_beside_far_tetrahedron(&mut rng, ring, (4.0, 6.0), 1e15);
     for ray in [RayAxis::PosZ, RayAxis::NegX, RayAxis::PosY] {
-        let wn = WindingNumber::with_options(
-            &mesh,
-            Options {
-                ray,
-                ..Default::default()
-            },
-        )
-        .unwrap();
+        let wn = with_ray(&mesh, ray);
         assert!(wn.snapping().cell >= 2f64.powi(-9), "{:?}", wn.snapping());
         for _ in 0..100 {
             let d = 10f64.powf(rng.range(-2.0, 1.5));
