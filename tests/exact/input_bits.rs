@@ -875,3 +875,96 @@ proptest! {
         }
     }
 }
+
+/// Parts smaller than one cell of the 60-bit lattice: a cap of radius 1e-20 at the origin beside
+/// a unit tetrahedron (cell ≈ 1.7e-18), so all its vertices share one or two lattice points. The
+/// boundary term must still come from the input bits: every ray, flat and with the hierarchy,
+/// equals the rational oracle next to the rim.
+#[test]
+fn parts_smaller_than_a_lattice_cell_get_the_oracles_value() {
+    // The 60-bit cell of a mesh of extent 2 (the two unit tetrahedra at ±1).
+    const CELL: f64 = 3.5e-18;
+    let mut rng = common::Rng(11);
+    for (radius, far) in [
+        (1e-20, 1.0),
+        (1e-18, 1.0),
+        (2e-18, 1.0),
+        (1e-12, 1e6),
+        (3e-300, 1.0),
+        (1e-3, 1e15),
+    ] {
+        for ring in [3usize, 7, 24] {
+            // The cap of `cap_beside_far_tetrahedron`, built at the origin (its rim would round
+            // away next to the shared helper's centre).
+            let (cap, far_cap) =
+                common::cap_beside_far_tetrahedron(&mut rng, ring, (1.0, 1.1), far);
+            let c = common::CAP_CENTRE;
+            let p: Vec<[f64; 3]> = far_cap
+                .iter()
+                .enumerate()
+                .map(|(i, v)| {
+                    if i <= ring {
+                        std::array::from_fn(|j| (v[j] - c[j]) * radius)
+                    } else {
+                        *v
+                    }
+                })
+                .collect();
+            // A mirrored tetrahedron puts the cap at the box's centre, where the frame's
+            // normalized coordinates (and the `f32` boxes built on them) are finest.
+            let mut p = p;
+            let mut t = cap.triangles().to_vec();
+            let n = p.len() as u32;
+            let mirrored: Vec<[f64; 3]> = p[ring + 1..].iter().map(|v| v.map(|x| -x)).collect();
+            let faces: Vec<[u32; 3]> = t[ring..]
+                .iter()
+                .map(|&[a, b, c]| [a, c, b].map(|i| i + n - ring as u32 - 1))
+                .collect();
+            p.extend(mirrored);
+            t.extend(faces);
+            let mesh = Mesh::from_slices(&p, &t).unwrap();
+            let evaluators: Vec<(RayAxis, f64, WindingNumber)> = RayAxis::ALL
+                .iter()
+                .flat_map(|&ray| [0.0, 1e-10].map(move |tolerance| (ray, tolerance)))
+                .map(|(ray, tolerance)| {
+                    let options = Options {
+                        ray,
+                        tolerance,
+                        ..Default::default()
+                    };
+                    (
+                        ray,
+                        tolerance,
+                        WindingNumber::with_options(&mesh, options).unwrap(),
+                    )
+                })
+                .collect();
+            for k in 0..40 {
+                let rim = p[1 + (rng.next_u64() % ring as u64) as usize];
+                // Near the part (its own scale), and 16–80 cells away beside it, where a ray along
+                // z passes outside every edge's near-edge tube.
+                let (d, t) = (
+                    radius * 10f64.powf(rng.range(-3.0, 3.0)),
+                    rng.range(0.0, 6.3),
+                );
+                let dir = [t.cos(), t.sin(), rng.range(-1.0, 1.0)];
+                let (d, dir) = if k % 2 == 0 {
+                    (d, dir)
+                } else {
+                    (CELL * rng.range(16.0, 80.0), [dir[0], dir[1], 0.1 * dir[2]])
+                };
+                let q: [f64; 3] = std::array::from_fn(|j| rim[j] + d * dir[j]);
+                for (ray, tolerance, wn) in &evaluators {
+                    let want = exact_winding_number_rational(&mesh, q, *ray);
+                    let (w, bound) = wn.eval_with_bound(q);
+                    assert!(
+                        want.contains(w, 1e-10 + bound),
+                        "radius {radius:e} ring {ring} {ray:?} tolerance {tolerance:e} q={q:?}: {w} not in [{}, {}]",
+                        want.lo,
+                        want.hi
+                    );
+                }
+            }
+        }
+    }
+}
