@@ -1,4 +1,4 @@
-"""gwn: robust generalized winding numbers of triangle meshes (and trimmed STEP models), numpy-native.
+"""gwn: robust generalized winding numbers of triangle meshes (and Bezier patches and trimmed STEP models), numpy-native.
 
 Exact (Antipodal method: never off by an integer, also on the surface), direct (solid-angle
 sum) and fast (Barnes-Hut) evaluators; voxel grids, signed distance, slices, face
@@ -13,6 +13,7 @@ import json as _json
 import os as _os
 
 from ._gwn import (
+    PatchSet,
     StepModel,
     WindingNumber,
     __version__,
@@ -40,6 +41,7 @@ from ._gwn import (
 WindingNumber.__call__ = WindingNumber.eval
 
 __all__ = [
+    "PatchSet",
     "StepModel",
     "WindingNumber",
     "__version__",

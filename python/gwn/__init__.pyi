@@ -36,8 +36,24 @@ class StepModel:
     @property
     def bounding_box(self) -> Tuple[_F64, _F64]: ...
 
+class PatchSet:
+    """(Rational) Bezier patches read from a ``.bpt``/``.rbpt`` file by ``load("teapot.bpt")``;
+    evaluate them with ``WindingNumber(patches, tolerance=1e-10)`` (``method="direct"``: the
+    surface quadrature), remesh them with ``remesh(patches, res=...)``. Pickles by its path."""
+
+    @property
+    def path(self) -> str: ...
+    @property
+    def info(self) -> dict:
+        """``{"patches": n, "rational": bool, "max_degree": (m, n)}``."""
+    @property
+    def bounding_box(self) -> Tuple[_F64, _F64]: ...
+    def __len__(self) -> int: ...
+
+_Curved = Union[StepModel, PatchSet]
+
 class WindingNumber:
-    """Winding-number evaluator of one mesh, oriented point cloud or STEP model, built once.
+    """Winding-number evaluator of one mesh, oriented point cloud, STEP model or patch set, built once.
 
     ``method``: "exact" (Antipodal method, default), "direct" (solid-angle sum) or "fast"
     (Barnes-Hut with accuracy ``beta``, default 2, and expansion ``order``, default 2).
@@ -52,12 +68,14 @@ class WindingNumber:
     ``WindingNumber(model, tolerance=1e-10)`` with a ``StepModel``: the trimmed B-rep evaluator
     of ``gwn eval part.step`` (``tolerance > 0``; the other options do not apply). Uncertified
     values (on or near the surface or an edge) raise a ``RuntimeWarning``; see
-    ``eval_with_status``.
+    ``eval_with_status``. ``WindingNumber(patches)`` with a ``PatchSet``: the exact method
+    (``ray`` and ``tolerance`` apply, its uncertified values warn the same way) or
+    ``method="direct"`` (the surface quadrature, ``tolerance`` only).
     """
 
     def __init__(
         self,
-        V: Union[_Floats, StepModel],
+        V: Union[_Floats, _Curved],
         F: Optional[_Indices] = None,
         method: _Method = "exact",
         beta: Optional[float] = None,
@@ -180,7 +198,7 @@ def voxelize(
 
 @overload
 def remesh(
-    V: Union[_Floats, StepModel],
+    V: Union[_Floats, _Curved],
     F: Optional[_Indices] = None,
     res: int = 128,
     *,
@@ -199,11 +217,11 @@ def remesh(
     samples: int = 10000,
     time_limit: Optional[float] = None,
 ) -> Tuple[_F64, _I64]:
-    """A closed, manifold, oriented surface of the solid w > 1/2 as (V float64 (n, 3), F int64 (m, 3)); simplify=False: the raw marching-tetrahedra surface; refine_plates=False keeps the lattice of res alone. remesh(model, res=...) of a StepModel takes no F."""
+    """A closed, manifold, oriented surface of the solid w > 1/2 as (V float64 (n, 3), F int64 (m, 3)); simplify=False: the raw marching-tetrahedra surface; refine_plates=False keeps the lattice of res alone. remesh(model, res=...) of a StepModel or PatchSet takes no F."""
 
 @overload
 def remesh(
-    V: Union[_Floats, StepModel],
+    V: Union[_Floats, _Curved],
     F: Optional[_Indices] = None,
     res: int = 128,
     *,
@@ -318,8 +336,8 @@ def gauwn(
 def load(path: _Path, weld: Optional[bool] = None) -> Tuple[_F64, _I64]:
     """Reads a mesh (OBJ, STL, OFF, PLY, glTF/GLB) as (V float64 (n, 3), F int64 (m, 3))."""
 @overload
-def load(path: _Path, weld: None = None) -> StepModel:
-    """A ``.step``/``.stp`` path gives a ``StepModel``."""
+def load(path: _Path, weld: None = None) -> _Curved:
+    """A ``.step``/``.stp`` path gives a ``StepModel``, a ``.bpt``/``.rbpt`` path a ``PatchSet``."""
 
 def load_point_cloud(path: _Path) -> Tuple[_F64, _F64, Optional[_F64]]:
     """Reads an oriented point cloud as (P, N, A or None)."""

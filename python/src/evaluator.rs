@@ -8,7 +8,9 @@ use gwn::eval::antipodal::{DEFAULT_TOLERANCE, WindingNumber};
 use gwn::eval::direct::{winding_number_direct_batch, winding_number_gradient_direct};
 use gwn::eval::fast::{Admissibility, FastWindingNumber, PointCloudWindingNumber};
 use gwn::input::InputKind;
-use gwn::patch::step::{StepEvaluation, StepModel, StepWindingNumber};
+use gwn::patch::step::{StepModel, StepWindingNumber};
+use gwn::patch::surface_quadrature::SurfaceQuadrature;
+use gwn::patch::{PatchSet, PatchWindingNumber};
 use gwn::spec::{EvaluatorSpec, Method, SpecError};
 use gwn::{Precision, RayAxis};
 use rayon::prelude::*;
@@ -21,6 +23,7 @@ const _: () = assert!(PY_DEFAULT_TOLERANCE == DEFAULT_TOLERANCE);
 /// The library's spec of Python's keyword arguments (`None`: not given, the library's default).
 /// Values are checked by the library ([`EvaluatorSpec::validate`]), so Python and the CLI
 /// refuse the same options with the same message.
+#[derive(Clone, Copy)]
 pub struct SpecArgs<'a> {
     /// `method=`.
     pub method: Option<&'a str>,
@@ -89,6 +92,28 @@ pub enum Evaluator {
     /// A trimmed B-rep (STEP) model: crossings of the trimmed faces plus the surface-boundary
     /// integral (boxed: the model is large).
     Step(Box<StepWindingNumber>),
+    /// Bézier patches, exact method: ray crossings plus the boundary integral.
+    Patches(Box<PatchWindingNumber>),
+    /// Bézier patches, direct method: the surface quadrature (it borrows the set, so it is
+    /// made per batch, which costs nothing).
+    PatchesDirect {
+        /// The patches.
+        set: Arc<PatchSet>,
+        /// The quadrature's tolerance.
+        tolerance: f64,
+    },
+}
+
+/// One value of a curved input with its certificate (the flags of docs/patches.md).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Certified {
+    /// The winding number.
+    pub value: f64,
+    /// The estimate of its error (the boundary integrals').
+    pub error_estimate: f64,
+    /// The value could not be certified (query on or within the margins of the surface, or
+    /// the work cap reached).
+    pub uncertified: bool,
 }
 
 impl Evaluator {
@@ -112,6 +137,21 @@ impl Evaluator {
         Ok(Evaluator::Step(Box::new(step_evaluator(model, spec)?)))
     }
 
+    /// Builds the patch-set evaluator `spec` describes (checked by the library for patch sets:
+    /// the exact or the direct method, no `precision=` or fast options).
+    pub fn for_patches(set: &Arc<PatchSet>, spec: &EvaluatorSpec) -> Result<Self, SpecError> {
+        Ok(match spec.check(InputKind::Patches)? {
+            Method::Exact => Evaluator::Patches(Box::new(
+                PatchWindingNumber::with_options(set, spec.patch_options())
+                    .map_err(|e| SpecError::refused_tolerance(e, InputKind::Patches))?,
+            )),
+            _ => Evaluator::PatchesDirect {
+                set: set.clone(),
+                tolerance: spec.tolerance.unwrap_or(DEFAULT_TOLERANCE),
+            },
+        })
+    }
+
     /// What `Unsupported` calls this evaluator.
     fn description(&self) -> &'static str {
         match self {
@@ -120,6 +160,8 @@ impl Evaluator {
             Evaluator::FastSoup(_) => "fast",
             Evaluator::FastCloud(_) => "fast point-cloud",
             Evaluator::Step(_) => "trimmed B-rep (STEP)",
+            Evaluator::Patches(_) => "exact (patches)",
+            Evaluator::PatchesDirect { .. } => "direct (patches)",
         }
     }
 
@@ -131,14 +173,49 @@ impl Evaluator {
             Evaluator::FastSoup(f) => f.eval_batch(points),
             Evaluator::FastCloud(f) => f.eval_batch(points),
             Evaluator::Step(s) => s.eval_batch(points),
+            Evaluator::Patches(p) => p.eval_batch(points),
+            Evaluator::PatchesDirect { set, tolerance } => {
+                gwn::eval::Evaluator::eval_batch(&SurfaceQuadrature::new(set, *tolerance), points)
+            }
         }
     }
 
-    /// Evaluations with diagnostics (STEP models only), in parallel on the current rayon pool.
-    pub fn step_batch(&self, points: &[[f64; 3]]) -> Option<Vec<StepEvaluation>> {
+    /// Evaluations with their certificates (STEP models and the exact method on patches), in
+    /// parallel on the current rayon pool.
+    pub fn certified_batch(&self, points: &[[f64; 3]]) -> Option<Vec<Certified>> {
         match self {
-            Evaluator::Step(s) => Some(points.par_iter().map(|&q| s.evaluate(q)).collect()),
+            Evaluator::Step(s) => Some(
+                points
+                    .par_iter()
+                    .map(|&q| {
+                        let e = s.evaluate(q);
+                        Certified {
+                            value: e.value,
+                            error_estimate: e.error_estimate,
+                            uncertified: e.uncertified,
+                        }
+                    })
+                    .collect(),
+            ),
+            Evaluator::Patches(p) => Some(
+                p.evaluate_batch(points)
+                    .iter()
+                    .map(|e| Certified {
+                        value: e.value,
+                        error_estimate: e.error_estimate,
+                        uncertified: !e.certified,
+                    })
+                    .collect(),
+            ),
             _ => None,
+        }
+    }
+
+    /// The warning's words for what an uncertified value of this evaluator is near (the CLI's).
+    pub fn uncertified_near(&self) -> &'static str {
+        match self {
+            Evaluator::Step(_) => "on or within the margins of the surface or an edge",
+            _ => "on or within rounding of the surface",
         }
     }
 
@@ -192,11 +269,73 @@ impl Evaluator {
     }
 
     /// Number of boundary edges (exact method; STEP models: edge uses left as the surface
-    /// boundary).
+    /// boundary; patch sets: patch edges no other patch shares).
     pub fn boundary_edge_count(&self) -> Option<usize> {
         match self {
             Evaluator::Step(s) => Some(s.model().info().boundary_edges),
+            Evaluator::Patches(p) => Some(p.edge_counts().0),
             _ => self.exact().map(WindingNumber::boundary_edge_count),
+        }
+    }
+}
+
+/// A curved input of `WindingNumber` and `remesh`: a STEP model or a patch set (Python objects
+/// that come without `F`).
+pub enum Curved {
+    /// `gwn.StepModel`.
+    Step(Arc<StepModel>),
+    /// `gwn.PatchSet`.
+    Patches(Arc<PatchSet>),
+}
+
+impl Curved {
+    /// The input kind, for the library's rules and messages.
+    pub fn kind(&self) -> InputKind {
+        match self {
+            Curved::Step(_) => InputKind::Step,
+            Curved::Patches(_) => InputKind::Patches,
+        }
+    }
+
+    /// A box containing the input.
+    pub fn bounding_box(&self) -> gwn::BoundingBox {
+        let (min, max) = match self {
+            Curved::Step(model) => model.bounding_box(),
+            Curved::Patches(set) => set.bounding_box(),
+        };
+        gwn::BoundingBox { min, max }
+    }
+
+    /// Runs `f` with the library evaluator `spec` describes for this input (what the remesher
+    /// takes).
+    pub fn with_evaluator<R>(
+        &self,
+        spec: &EvaluatorSpec,
+        f: impl FnOnce(&dyn gwn::eval::Evaluator) -> R,
+    ) -> Result<R, SpecError> {
+        match self {
+            Curved::Step(model) => Ok(f(&step_evaluator(model, spec)?)),
+            Curved::Patches(set) => Ok(match Evaluator::for_patches(set, spec)? {
+                Evaluator::Patches(wn) => f(wn.as_ref()),
+                Evaluator::PatchesDirect { set, tolerance } => {
+                    f(&SurfaceQuadrature::new(&set, tolerance))
+                }
+                _ => unreachable!("for_patches builds one of the two"),
+            }),
+        }
+    }
+
+    /// The tessellation the remesh report measures the Hausdorff distance to, at `cell_size`.
+    pub fn surface_for_distance(
+        &self,
+        cell_size: f64,
+    ) -> Option<gwn::products::remesh::report::CurvedSurface> {
+        use gwn::products::remesh::report::{
+            patch_surface_for_distance, step_surface_for_distance,
+        };
+        match self {
+            Curved::Step(model) => step_surface_for_distance(model, cell_size),
+            Curved::Patches(set) => patch_surface_for_distance(set, cell_size),
         }
     }
 }

@@ -12,6 +12,7 @@ mod errors;
 mod evaluator;
 mod loaders;
 mod oneshot;
+mod patches;
 mod products;
 mod step;
 mod threads;
@@ -23,6 +24,7 @@ use pyo3::prelude::*;
 fn _gwn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<winding_number::PyWindingNumber>()?;
     m.add_class::<step::PyStepModel>()?;
+    m.add_class::<patches::PyPatchSet>()?;
     m.add_function(wrap_pyfunction!(oneshot::winding_number, m)?)?;
     m.add_function(wrap_pyfunction!(oneshot::fast_winding_number, m)?)?;
     m.add_function(wrap_pyfunction!(products::voxelize, m)?)?;

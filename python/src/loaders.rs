@@ -10,6 +10,7 @@ use pyo3::types::{PyList, PyTuple};
 
 use crate::arrays::{array1, array2};
 use crate::errors::{load_error, os_error, value_error};
+use crate::patches::load_patch_set;
 use crate::step::load_step_model;
 
 fn widen<const N: usize>(rows: Vec<[u32; N]>) -> Vec<[i64; N]> {
@@ -20,10 +21,12 @@ fn widen<const N: usize>(rows: Vec<[u32; N]>) -> Vec<[i64; N]> {
 /// extension, else by content) as ``(V, F)``: float64 (n, 3) and int64 (m, 3). Polygons are
 /// fan-triangulated. ``weld``: merge bit-identical vertices (default: on for STL and glTF/GLB only).
 /// A STEP file (``.step``/``.stp``: trimmed B-rep, AP203/AP214/AP242) gives a
-/// :class:`StepModel` instead, for ``WindingNumber(model)``.
+/// :class:`StepModel` instead, and a patch file (``.bpt``/``.rbpt``: Bézier patches) a
+/// :class:`PatchSet`, for ``WindingNumber(model)`` and ``remesh(model, res=...)``.
 /// ``OSError`` when the file (or a glTF buffer file it refers to) cannot be read:
 /// ``FileNotFoundError`` when missing, ``PermissionError`` when not readable; ``ValueError`` when
-/// it is not a valid mesh (or STEP model: the message names the entity and its ``#id``).
+/// it is not a valid mesh (or STEP model: the message names the entity and its ``#id``; or
+/// patch set: the line).
 #[pyfunction]
 #[pyo3(signature = (path, weld = None))]
 pub fn load<'py>(
@@ -38,6 +41,14 @@ pub fn load<'py>(
             ));
         }
         return Ok(Bound::new(py, load_step_model(py, path)?)?.into_any());
+    }
+    if gwn::patch::is_patch_path(&path) {
+        if weld.is_some() {
+            return Err(PyValueError::new_err(
+                "weld does not apply to patch sets (their patches are curved surfaces)",
+            ));
+        }
+        return Ok(Bound::new(py, load_patch_set(py, path)?)?.into_any());
     }
     let loaded = py
         .allow_threads(|| gwn::io::load_mesh_with(&path, &LoadOptions { weld }))

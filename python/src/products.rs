@@ -488,54 +488,52 @@ pub fn remesh<'py>(
     let samples = if report { samples } else { 0 };
     RemeshReport::check_samples(samples)
         .map_err(|e| PyValueError::new_err(format!("samples={samples}: {e}")))?;
-    if let Ok(model) = V.downcast::<crate::step::PyStepModel>() {
+    if let Some(curved) = crate::patches::curved_of(V) {
+        let kind = curved.kind();
         if F.is_some_and(|f| !f.is_none()) {
-            return Err(PyValueError::new_err(
-                "remesh(model): a gwn.StepModel takes no F (pass res= by name)",
-            ));
+            return Err(PyValueError::new_err(format!(
+                "remesh(model): {kind} takes no F (pass res= by name)"
+            )));
         }
         if thicken.is_some() {
-            return Err(PyValueError::new_err(
-                "thicken= needs triangles (a mesh or soup), not a STEP model",
-            ));
+            return Err(PyValueError::new_err(format!(
+                "thicken= needs triangles (a mesh or soup), not {kind}"
+            )));
         }
-        let model = &model.get().model;
-        let (lo, hi) = model.bounding_box();
-        let bounds = gwn::BoundingBox { min: lo, max: hi };
-        // The model's trimmed B-rep evaluator, vertices placed at its own surface hits (as
-        // `gwn remesh part.step`); measured against its trimmed tessellation.
+        let bounds = curved.bounding_box();
+        // The input's own evaluator, vertices placed at its own surface hits (as `gwn remesh
+        // part.step` / `teapot.bpt`); measured against its tessellation.
         let out = threads::run(py, threads, || {
-            let wn = crate::evaluator::step_evaluator(model, &method)?;
-            let start = std::time::Instant::now();
-            let clock = PhaseClock::start();
-            let out = remesh_guided(&wn, None, bounds, &options, &|phase| clock.mark(phase))?;
-            let seconds = start.elapsed().as_secs_f64();
-            let phase_seconds = clock.seconds();
-            let curved = (report && samples > 0)
-                .then(|| {
-                    gwn::products::remesh::report::step_surface_for_distance(model, out.cell_size)
-                })
-                .flatten();
-            let reference = curved
-                .as_ref()
-                .map_or(DistanceReference::None, DistanceReference::Curved);
-            let request = report.then_some(ReportRequest {
-                options: &options,
-                reference,
-                bounds,
-                samples,
-                seconds,
-                phase_seconds,
-                thicken: None,
-            });
-            measured(out, &wn, request)
+            curved.with_evaluator(&method, |wn| {
+                let start = std::time::Instant::now();
+                let clock = PhaseClock::start();
+                let out = remesh_guided(wn, None, bounds, &options, &|phase| clock.mark(phase))?;
+                let seconds = start.elapsed().as_secs_f64();
+                let phase_seconds = clock.seconds();
+                let surface = (report && samples > 0)
+                    .then(|| curved.surface_for_distance(out.cell_size))
+                    .flatten();
+                let reference = surface
+                    .as_ref()
+                    .map_or(DistanceReference::None, DistanceReference::Curved);
+                let request = report.then_some(ReportRequest {
+                    options: &options,
+                    reference,
+                    bounds,
+                    samples,
+                    seconds,
+                    phase_seconds,
+                    thicken: None,
+                });
+                measured(out, wn, request)
+            })?
         })?
         .map_err(remesh_error)?;
         return surface_tuple(py, out);
     }
     let Some(F) = F else {
         return Err(PyValueError::new_err(
-            "remesh(V, F): F is required for a mesh (only a gwn.StepModel comes alone)",
+            "remesh(V, F): F is required for a mesh (only a gwn.StepModel or gwn.PatchSet comes alone)",
         ));
     };
     let mesh = mesh_from(V, F, "V", "F")?;

@@ -12,6 +12,7 @@ use pyo3::types::{PyDict, PyTuple};
 
 use crate::arrays::array1;
 use crate::errors::os_error;
+use crate::evaluator::Certified;
 
 /// A STEP file that cannot be read is an `OSError` (`FileNotFoundError` when missing,
 /// `PermissionError` when not readable); one that is read but is not a supported B-rep model is
@@ -134,11 +135,9 @@ impl PyStepModel {
     }
 }
 
-/// Warns (``RuntimeWarning``) when some values are uncertified, with the CLI's text.
-pub fn warn_uncertified(
-    py: Python<'_>,
-    evaluations: &[gwn::patch::step::StepEvaluation],
-) -> PyResult<()> {
+/// Warns (``RuntimeWarning``) when some values are uncertified, with the CLI's text (`near`:
+/// what such a value is near, [`crate::evaluator::Evaluator::uncertified_near`]).
+pub fn warn_uncertified(py: Python<'_>, evaluations: &[Certified], near: &str) -> PyResult<()> {
     let uncertified = evaluations.iter().filter(|e| e.uncertified).count();
     if uncertified == 0 {
         return Ok(());
@@ -147,22 +146,16 @@ pub fn warn_uncertified(
         .iter()
         .filter(|e| e.uncertified)
         .fold(0.0f64, |a, e| a.max(e.error_estimate));
-    let message =
-        std::ffi::CString::new(uncertified_message(uncertified, evaluations.len(), worst))
-            .unwrap_or_default();
+    let message = std::ffi::CString::new(format!(
+        "{uncertified} of {} values uncertified ({near}, or work cap reached; largest error \
+         estimate {worst:.1e}); see docs/patches.md",
+        evaluations.len()
+    ))
+    .unwrap_or_default();
     PyErr::warn(
         py,
         &py.get_type::<PyRuntimeWarning>(),
         message.as_c_str(),
         1,
-    )
-}
-
-/// The warning `gwn eval` prints for uncertified STEP values.
-pub fn uncertified_message(uncertified: usize, total: usize, worst: f64) -> String {
-    format!(
-        "{uncertified} of {total} values uncertified (on or within the margins of the \
-         surface or an edge, or work cap reached; largest error estimate {worst:.1e}); see \
-         docs/patches.md"
     )
 }

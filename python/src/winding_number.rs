@@ -15,7 +15,9 @@ use crate::arrays::{
     array1, array2, indices_vec, one_or_many, points_vec, values_out, values_vec, with_points,
 };
 use crate::errors::{mesh_error, value_error};
+use crate::evaluator::Certified;
 use crate::evaluator::{Evaluator, SpecArgs};
+use crate::patches::PyPatchSet;
 use crate::step::{PyStepModel, warn_uncertified};
 use crate::threads::{self, Threads};
 
@@ -46,6 +48,8 @@ enum Source {
     },
     /// A STEP model (`gwn.load("part.step")`).
     Step(Py<PyStepModel>),
+    /// A patch set (`gwn.load("teapot.bpt")`).
+    Patches(Py<PyPatchSet>),
 }
 
 /// Winding-number evaluator of one mesh or oriented point cloud, built once.
@@ -144,44 +148,65 @@ impl PyWindingNumber {
         }
     }
 
-    /// Builds the evaluator of a STEP model: the library's rules and messages for the options
-    /// (`EvaluatorSpec::check` on `InputKind::Step`), plus `F`, which only Python can pass.
-    fn from_step(
+    /// Builds the evaluator of a STEP model or patch set `v` (`None` when `v` is neither): the
+    /// library's rules and messages for the options (`EvaluatorSpec::check` on its input
+    /// kind), plus `F`, which only Python can pass.
+    fn from_curved(
         py: Python<'_>,
-        model: Bound<'_, PyStepModel>,
+        v: &Bound<'_, PyAny>,
         f: Option<&Bound<'_, PyAny>>,
         args: SpecArgs<'_>,
-    ) -> PyResult<Self> {
+    ) -> PyResult<Option<Self>> {
+        let (kind, source) = if let Ok(model) = v.downcast::<PyStepModel>() {
+            (InputKind::Step, Source::Step(model.clone().unbind()))
+        } else if let Ok(set) = v.downcast::<PyPatchSet>() {
+            (InputKind::Patches, Source::Patches(set.clone().unbind()))
+        } else {
+            return Ok(None);
+        };
         if f.is_some_and(|f| !f.is_none()) {
-            return Err(value_error(
-                "F does not apply to a STEP model (pass the model alone)",
-            ));
+            return Err(value_error(format!(
+                "F does not apply to {kind} (pass it alone)"
+            )));
         }
         let spec = args.spec().map_err(value_error)?;
-        let shared = model.get().model.clone();
-        let evaluator = py
-            .allow_threads(|| Evaluator::for_step(&shared, &spec))
-            .map_err(value_error)?;
-        Ok(PyWindingNumber {
+        let evaluator = match &source {
+            Source::Step(model) => {
+                let shared = model.get().model.clone();
+                py.allow_threads(|| Evaluator::for_step(&shared, &spec))
+            }
+            Source::Patches(set) => {
+                let shared = set.get().set.clone();
+                py.allow_threads(|| Evaluator::for_patches(&shared, &spec))
+            }
+            Source::Mesh(_) | Source::Cloud { .. } => unreachable!("matched above"),
+        }
+        .map_err(value_error)?;
+        Ok(Some(PyWindingNumber {
             evaluator,
-            source: Source::Step(model.unbind()),
-            method: spec.method_for(InputKind::Step),
+            source,
+            method: spec.method_for(kind),
             spec,
-        })
+        }))
     }
 
-    /// The STEP evaluations at the rows of `q` (n, 3), interruptible.
-    fn step_evaluations(
+    /// The certified evaluations at the rows of `q` (n, 3), interruptible (`None`: this
+    /// evaluator has no certificates).
+    fn certified_evaluations(
         &self,
         py: Python<'_>,
         q: &Bound<'_, PyAny>,
         threads: Option<Threads>,
-    ) -> PyResult<Vec<gwn::patch::step::StepEvaluation>> {
+    ) -> PyResult<Option<Vec<Certified>>> {
+        if self.evaluator.certified_batch(&[]).is_none() {
+            return Ok(None);
+        }
         with_points(q, "Q", |q| {
             threads::run_batch(py, threads, q, |piece| {
-                self.evaluator.step_batch(piece).unwrap_or_default()
+                self.evaluator.certified_batch(piece).unwrap_or_default()
             })
         })
+        .map(Some)
     }
 
     /// The exact evaluator and mesh, for products that need both.
@@ -216,14 +241,17 @@ impl PyWindingNumber {
             ray,
             tolerance,
         };
-        if let Ok(model) = V.downcast::<PyStepModel>() {
-            return Self::from_step(py, model.clone(), F, args);
-        }
         let Some(F) = F.filter(|f| !f.is_none()) else {
-            return Err(value_error(
-                "F (the triangles) is required unless V is a gwn.StepModel",
-            ));
+            return match Self::from_curved(py, V, None, args)? {
+                Some(curved) => Ok(curved),
+                None => Err(value_error(
+                    "F (the triangles) is required unless V is a gwn.StepModel or gwn.PatchSet",
+                )),
+            };
         };
+        if let Some(curved) = Self::from_curved(py, V, Some(F), args)? {
+            return Ok(curved);
+        }
         Self::from_mesh_arrays(py, V, F, args)
     }
 
@@ -301,9 +329,8 @@ impl PyWindingNumber {
         threads: Option<Threads>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (q, single) = one_or_many::<3>(Q, "Q")?;
-        if let Evaluator::Step(_) = self.evaluator {
-            let evaluations = self.step_evaluations(py, &q, threads)?;
-            warn_uncertified(py, &evaluations)?;
+        if let Some(evaluations) = self.certified_evaluations(py, &q, threads)? {
+            warn_uncertified(py, &evaluations, self.evaluator.uncertified_near())?;
             let values = evaluations.iter().map(|e| e.value).collect();
             return values_out(py, values, single);
         }
@@ -326,13 +353,12 @@ impl PyWindingNumber {
         Q: &Bound<'py, PyAny>,
         threads: Option<Threads>,
     ) -> PyResult<WithStatus<'py>> {
-        if !matches!(self.evaluator, Evaluator::Step(_)) {
+        let Some(evaluations) = self.certified_evaluations(py, Q, threads)? else {
             return Err(value_error(crate::evaluator::Unsupported {
                 what: "eval_with_status",
-                method: "mesh or point-cloud",
+                method: "mesh, point-cloud or direct",
             }));
-        }
-        let evaluations = self.step_evaluations(py, Q, threads)?;
+        };
         Ok((
             array1(py, evaluations.iter().map(|e| e.value).collect()),
             array1(py, evaluations.iter().map(|e| e.error_estimate).collect()),
@@ -421,6 +447,7 @@ impl PyWindingNumber {
             Source::Mesh(m) => m.triangles().len(),
             Source::Cloud { .. } => 0,
             Source::Step(m) => m.get().model.info().faces,
+            Source::Patches(p) => p.get().set.patches().len(),
         }
     }
 
@@ -454,6 +481,13 @@ impl PyWindingNumber {
                 m.get().path().display().to_string(),
                 m.get().model.info().faces,
                 self.spec.step_options().tolerance
+            ),
+            Source::Patches(p) => format!(
+                "gwn.WindingNumber(patch_set={:?}, method={:?}, patches={}, tolerance={:e})",
+                p.get().path().display().to_string(),
+                self.method.name(),
+                p.get().set.patches().len(),
+                self.spec.patch_options().tolerance
             ),
         }
     }
@@ -513,6 +547,25 @@ impl PyWindingNumber {
                     None::<u32>,
                     None::<String>,
                     self.spec.step_options().tolerance,
+                    None::<String>,
+                )
+                    .into_pyobject(py)?;
+                Ok((cls, args))
+            }
+            Source::Patches(p) => {
+                let cls = py.get_type::<PyWindingNumber>().into_any();
+                // The ray applies to the exact method only, the tolerance to both.
+                let options = self.spec.patch_options();
+                let ray = (self.method == Method::Exact).then(|| options.ray.to_string());
+                let args = (
+                    p.clone_ref(py),
+                    py.None(),
+                    self.method.name(),
+                    None::<f64>,
+                    None::<u8>,
+                    None::<u32>,
+                    ray,
+                    options.tolerance,
                     None::<String>,
                 )
                     .into_pyobject(py)?;

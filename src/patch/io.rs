@@ -39,19 +39,19 @@ pub fn is_patch_path(path: &Path) -> bool {
 
 /// Reads a `.bpt` or `.rbpt` file (by extension). Errors are one line naming the file.
 pub fn load_patches(path: &Path) -> Result<PatchSet, PatchError> {
-    let format = PatchFormat::from_path(path).ok_or_else(|| {
-        PatchError::Io(format!(
-            "{}: not a patch file (expected .bpt or .rbpt)",
-            path.display()
-        ))
-    })?;
+    let format =
+        PatchFormat::from_path(path).ok_or_else(|| PatchError::NotPatchFile(path.into()))?;
     // Opened without blocking (a FIFO without a writer reads as empty); a pipe or device is read
     // up to 256 MiB.
-    let text = crate::base::file::read_text_nonblocking(path, 1 << 28)
-        .map_err(|e| PatchError::Io(format!("{}: {e}", path.display())))?;
-    parse_patches(&text, format).map_err(|e| match e {
-        PatchError::Io(m) => PatchError::Io(m),
-        other => PatchError::Io(format!("{}: {other}", path.display())),
+    let text =
+        crate::base::file::read_text_nonblocking(path, 1 << 28).map_err(|e| PatchError::Io {
+            path: path.into(),
+            kind: e.kind(),
+            message: e.to_string(),
+        })?;
+    parse_patches(&text, format).map_err(|e| PatchError::InFile {
+        path: path.into(),
+        error: Box::new(e),
     })
 }
 
@@ -195,5 +195,48 @@ mod tests {
         assert!(matches!(e, Err(PatchError::DegreeTooHigh { .. })), "{e:?}");
         let e = parse_patches("1\n0 0\n1 2 3\nextra\n", PatchFormat::Bpt);
         assert!(matches!(e, Err(PatchError::Parse { line: 4, .. })), "{e:?}");
+    }
+
+    /// Files name themselves in every error; an unreadable one keeps the system's error kind
+    /// (Python raises `FileNotFoundError` for it), a readable invalid one is `InFile`.
+    #[test]
+    fn file_errors_keep_the_path_and_the_kind() {
+        let dir = std::env::temp_dir().join(format!("gwn-patch-io-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let missing = dir.join("missing.bpt");
+        let e = load_patches(&missing).unwrap_err();
+        assert!(
+            matches!(
+                &e,
+                PatchError::Io {
+                    kind: std::io::ErrorKind::NotFound,
+                    ..
+                }
+            ),
+            "{e:?}"
+        );
+        assert!(
+            e.to_string().starts_with(&missing.display().to_string()),
+            "{e}"
+        );
+        let bad = dir.join("bad.bpt");
+        std::fs::write(&bad, "1\n1 1\n0 0 0\n").unwrap();
+        let e = load_patches(&bad).unwrap_err();
+        assert!(
+            matches!(&e, PatchError::InFile { error, .. } if matches!(**error, PatchError::Parse { .. })),
+            "{e:?}"
+        );
+        assert!(
+            e.to_string()
+                .starts_with(&format!("{}: line", bad.display())),
+            "{e}"
+        );
+        let e = load_patches(&dir.join("x.obj")).unwrap_err();
+        assert_eq!(e, PatchError::NotPatchFile(dir.join("x.obj")));
+        assert!(
+            e.to_string()
+                .ends_with("not a patch file (expected .bpt or .rbpt)")
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

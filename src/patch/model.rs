@@ -56,7 +56,24 @@ pub enum PatchError {
         message: String,
     },
     /// The file could not be read.
-    Io(String),
+    Io {
+        /// The file.
+        path: std::path::PathBuf,
+        /// The operating system's error kind (`NotFound`, `PermissionDenied`, …): Python raises
+        /// the matching `OSError` subclass.
+        kind: std::io::ErrorKind,
+        /// Its message.
+        message: String,
+    },
+    /// The path does not name a patch file (`.bpt` or `.rbpt`).
+    NotPatchFile(std::path::PathBuf),
+    /// The file was read, and its content is not a valid patch set.
+    InFile {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What is wrong in it.
+        error: Box<PatchError>,
+    },
     /// The set has no patch.
     Empty,
 }
@@ -90,7 +107,13 @@ impl fmt::Display for PatchError {
                 "patch {patch}, control point {point}: weight {weight} is not a finite positive number"
             ),
             PatchError::Parse { line, message } => write!(f, "line {line}: {message}"),
-            PatchError::Io(m) => write!(f, "{m}"),
+            PatchError::Io { path, message, .. } => write!(f, "{}: {message}", path.display()),
+            PatchError::NotPatchFile(path) => write!(
+                f,
+                "{}: not a patch file (expected .bpt or .rbpt)",
+                path.display()
+            ),
+            PatchError::InFile { path, error } => write!(f, "{}: {error}", path.display()),
             PatchError::Empty => write!(f, "the patch set has no patch"),
         }
     }
