@@ -1,9 +1,10 @@
-//! `gwn info MESH`: format, size and topology of a mesh file.
+//! `gwn info MESH`: format, size and topology of a mesh file (or what a point cloud, patch set or
+//! STEP model holds).
 
 use std::io::Write;
 use std::path::PathBuf;
 
-use gwn::io::load_mesh_with;
+use gwn::io::{MeshOrCloud, load_mesh_or_cloud};
 use gwn::mesh::stats::MeshStats;
 
 use crate::common::CliError;
@@ -11,8 +12,9 @@ use crate::common::CliError;
 /// Arguments of `gwn info`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Mesh file (.obj, .stl, .off, .ply; detected by content if the extension is unknown), or
-    /// Bézier patch set (.bpt, rational .rbpt), or trimmed B-rep model (.step, .stp).
+    /// Mesh file (.obj, .stl, .off, .ply, .gltf, .glb; detected by content if the extension is
+    /// unknown), oriented point cloud (.xyz, .pts, .txt, .csv, or a PLY with normals and no
+    /// faces), Bézier patch set (.bpt, rational .rbpt), or trimmed B-rep model (.step, .stp).
     pub mesh: PathBuf,
     #[command(flatten)]
     pub weld: crate::common::WeldArgs,
@@ -30,7 +32,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
         crate::common::write_stdout(format_args!("{}", patch_report(&args.mesh, &set)))?;
         return Ok(());
     }
-    let loaded = load_mesh_with(&args.mesh, &args.weld.load_options())?;
+    // Meshes and clouds as every other subcommand reads them (a PLY without faces is a cloud).
+    let loaded = match load_mesh_or_cloud(&args.mesh, &args.weld.load_options())? {
+        MeshOrCloud::Mesh(loaded) => loaded,
+        MeshOrCloud::Cloud(cloud, warnings) => {
+            crate::common::print_load_warnings(&args.mesh, &warnings);
+            crate::common::write_stdout(format_args!("{}", cloud_report(&args.mesh, &cloud)))?;
+            return Ok(());
+        }
+    };
     crate::common::print_load_warnings(&args.mesh, &loaded.warnings);
     let s = MeshStats::compute(&loaded.mesh);
     std::io::stdout()
@@ -74,16 +84,7 @@ fn step_report(path: &std::path::Path, model: &gwn::patch::step::StepModel) -> S
         ("bbox min", format!("{lo:?}")),
         ("bbox max", format!("{hi:?}")),
     ];
-    let width = rows
-        .iter()
-        .map(|(k, _)| k.chars().count())
-        .max()
-        .unwrap_or(0);
-    let mut out = String::new();
-    for (k, v) in rows {
-        out.push_str(&format!("{k:<width$}  {v}\n"));
-    }
-    out
+    aligned(&rows)
 }
 
 /// The text block `gwn info` prints for a Bézier patch set.
@@ -121,7 +122,44 @@ fn patch_report(path: &std::path::Path, set: &gwn::patch::PatchSet) -> String {
         ("bbox min", format!("{lo:?}")),
         ("bbox max", format!("{hi:?}")),
     ];
-    let width = rows.iter().map(|(k, _)| k.len()).max().unwrap_or(0);
+    aligned(&rows)
+}
+
+/// The text block `gwn info` prints for an oriented point cloud.
+fn cloud_report(path: &std::path::Path, cloud: &gwn::mesh::PointCloud) -> String {
+    let mut rows: Vec<(&str, String)> = vec![
+        ("file", path.display().to_string()),
+        ("format", "oriented point cloud".into()),
+        ("points", cloud.len().to_string()),
+        (
+            "areas",
+            match cloud.areas() {
+                Some(_) => "given".into(),
+                None => "none (estimated from the 20 nearest neighbours when evaluated)".into(),
+            },
+        ),
+    ];
+    if let Some(b) = gwn::BoundingBox::of_points(cloud.positions()) {
+        let diagonal = (0..3)
+            .map(|k| (b.max[k] - b.min[k]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        rows.push(("bbox min", format!("{:?}", b.min)));
+        rows.push(("bbox max", format!("{:?}", b.max)));
+        rows.push(("diagonal", format!("{diagonal:?}")));
+    }
+    let mut out = aligned(&rows);
+    out.push_str("a point cloud: w is the fast (Barnes-Hut) method's estimate\n");
+    out
+}
+
+/// `rows` as `key  value` lines, the values aligned.
+fn aligned(rows: &[(&str, String)]) -> String {
+    let width = rows
+        .iter()
+        .map(|(k, _)| k.chars().count())
+        .max()
+        .unwrap_or(0);
     let mut out = String::new();
     for (k, v) in rows {
         out.push_str(&format!("{k:<width$}  {v}\n"));
@@ -187,11 +225,7 @@ fn report(path: &std::path::Path, l: &gwn::io::LoadedMesh, s: &MeshStats) -> Str
         };
         rows.push(("60-bit snapping", value));
     }
-    let width = rows.iter().map(|(k, _)| k.len()).max().unwrap_or(0);
-    let mut out = String::new();
-    for (k, v) in rows {
-        out.push_str(&format!("{k:<width$}  {v}\n"));
-    }
+    let mut out = aligned(&rows);
     if s.oriented_closed {
         out.push_str("signed boundary is empty: w is an integer off the surface\n");
     } else if s.geometric_boundary_edges == 0 {

@@ -172,9 +172,10 @@ pub fn load_mesh_with(
     )
 }
 
-/// What a mesh-or-cloud file holds ([`crate::input::load_input`]).
+/// What a mesh-or-cloud file holds ([`load_mesh_or_cloud`]; [`crate::input::load_input`] also
+/// reads curved inputs, but keeps only the mesh of a [`LoadedMesh`]).
 #[derive(Debug)]
-pub(crate) enum MeshOrCloud {
+pub enum MeshOrCloud {
     /// A triangle mesh.
     Mesh(LoadedMesh),
     /// An oriented point cloud and the reader's warnings.
@@ -183,11 +184,8 @@ pub(crate) enum MeshOrCloud {
 
 /// Reads a mesh or an oriented point cloud, parsing the file once: text point formats
 /// (by extension) are clouds; a PLY (by extension, or by content without one) is a mesh when it
-/// has faces and a cloud otherwise; anything else is a mesh.
-pub(crate) fn load_mesh_or_cloud(
-    path: &Path,
-    options: &LoadOptions,
-) -> Result<MeshOrCloud, LoadError> {
+/// has faces and a cloud otherwise; anything else is a mesh. What `gwn info` reads.
+pub fn load_mesh_or_cloud(path: &Path, options: &LoadOptions) -> Result<MeshOrCloud, LoadError> {
     use cloud::CloudFormat;
     if cloud::cloud_format_from_extension(path) == Some(CloudFormat::Text) {
         let (cloud, warnings) = cloud::load_point_cloud_with_warnings(path)?;

@@ -101,3 +101,59 @@ fn cli_step_errors_are_one_line_naming_the_file() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `gwn info` reads what every other subcommand reads: an oriented point cloud (text, or a PLY
+/// with normals and no faces) gets its own report instead of "unknown format", and a PLY with
+/// neither faces nor normals gets `gwn eval`'s message.
+#[test]
+fn cli_info_on_point_clouds_and_faceless_ply() {
+    let exe = env!("CARGO_BIN_EXE_gwn");
+    let dir = std::env::temp_dir().join(format!("gwn-info-cloud-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let xyz = dir.join("c.xyz");
+    std::fs::write(&xyz, "0 0 0 0 0 1 0.5\n1 0 0 0 0 1 0.5\n0 1 0 0 0 2 0.5\n").unwrap();
+    let ply = dir.join("c.ply");
+    std::fs::write(
+        &ply,
+        "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n\
+         property float z\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n\
+         0 0 0 1 0 0\n2 3 4 0 1 0\n",
+    )
+    .unwrap();
+    for (path, points, areas, max) in [
+        (&xyz, "3", "given", "[1.0, 1.0, 0.0]"),
+        (&ply, "2", "none", "[2.0, 3.0, 4.0]"),
+    ] {
+        let out = Command::new(exe).arg("info").arg(path).output().unwrap();
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let row = |key: &str| {
+            stdout
+                .lines()
+                .find(|l| l.starts_with(key))
+                .map(|l| l[key.len()..].trim().to_string())
+                .unwrap_or_else(|| panic!("no {key} in {stdout}"))
+        };
+        assert_eq!(row("format"), "oriented point cloud");
+        assert_eq!(row("points"), points);
+        assert!(row("areas").starts_with(areas), "{stdout}");
+        assert_eq!(row("bbox max"), max);
+    }
+    let empty = fixture("broken_empty.ply");
+    let info = Command::new(exe).arg("info").arg(&empty).output().unwrap();
+    let eval = Command::new(exe)
+        .args(["eval", "--points"])
+        .arg(&xyz)
+        .arg(&empty)
+        .output()
+        .unwrap();
+    assert!(!info.status.success() && !eval.status.success());
+    let message = String::from_utf8_lossy(&info.stderr);
+    assert!(message.contains("broken_empty.ply: no faces"), "{message}");
+    assert_eq!(message, String::from_utf8_lossy(&eval.stderr));
+    std::fs::remove_dir_all(&dir).ok();
+}
