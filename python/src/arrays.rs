@@ -273,3 +273,14 @@ pub fn array_nd<'py>(
     let flat = PyArray1::from_vec(py, values);
     Ok(flat.reshape(shape.to_vec())?.into_any())
 }
+
+/// A box's corners as Python's ``(lo, hi)``: float64 (3,) each.
+pub fn box_corners<'py>(
+    py: Python<'py>,
+    (lo, hi): ([f64; 3], [f64; 3]),
+) -> (Bound<'py, PyAny>, Bound<'py, PyAny>) {
+    (
+        array1(py, lo.to_vec()).into_any(),
+        array1(py, hi.to_vec()).into_any(),
+    )
+}

@@ -9,7 +9,7 @@ use gwn::patch::{PatchError, PatchSet};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
-use crate::arrays::array1;
+use crate::arrays::box_corners;
 use crate::errors::os_error;
 use crate::evaluator::Curved;
 use crate::step::PyStepModel;
@@ -87,11 +87,7 @@ impl PyPatchSet {
     /// points' box).
     #[getter]
     fn bounding_box<'py>(&self, py: Python<'py>) -> (Bound<'py, PyAny>, Bound<'py, PyAny>) {
-        let (lo, hi) = self.set.bounding_box();
-        (
-            array1(py, lo.to_vec()).into_any(),
-            array1(py, hi.to_vec()).into_any(),
-        )
+        box_corners(py, self.set.bounding_box())
     }
 
     fn __len__(&self) -> usize {

@@ -10,7 +10,7 @@ use pyo3::exceptions::PyRuntimeWarning;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
-use crate::arrays::array1;
+use crate::arrays::box_corners;
 use crate::errors::os_error;
 use crate::evaluator::Certified;
 
@@ -106,11 +106,7 @@ impl PyStepModel {
     /// ``(lo, hi)``: float64 (3,) corners of a box containing the model.
     #[getter]
     fn bounding_box<'py>(&self, py: Python<'py>) -> (Bound<'py, PyAny>, Bound<'py, PyAny>) {
-        let (lo, hi) = self.model.bounding_box();
-        (
-            array1(py, lo.to_vec()).into_any(),
-            array1(py, hi.to_vec()).into_any(),
-        )
+        box_corners(py, self.model.bounding_box())
     }
 
     fn __repr__(&self) -> String {
