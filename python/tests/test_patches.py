@@ -84,13 +84,14 @@ def test_load_gives_a_patch_set_and_exact_integers_for_a_closed_one(cube_bpt):
     assert wn.method == "exact" and wn.face_count == 6 and wn.boundary_edge_count == 0
     q = lattice(-0.5, 1.5, 9, [0.0, 1.0])
     inside = np.all((q > 0) & (q < 1), axis=1).astype(np.float64)
-    # Integers up to the rounding of the interface integrals between patches (docs/patches.md,
-    # "The formula without a rounded integer"), certified: no warning.
+    # A closed set: exact integers off the surface, certified (no warning), on every ray.
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        np.testing.assert_allclose(wn(q), inside, rtol=0, atol=1e-12)
-        np.testing.assert_allclose(wn(q), gwn.WindingNumber(CUBE_V, CUBE_F)(q), rtol=0, atol=1e-12)
-    assert abs(wn([0.5, 0.5, 0.5]) - 1.0) < 1e-12
+        np.testing.assert_array_equal(wn(q), inside)
+        np.testing.assert_array_equal(wn(q), gwn.WindingNumber(CUBE_V, CUBE_F)(q))
+        for ray in ["-x", "+y", "-z"]:
+            np.testing.assert_array_equal(gwn.WindingNumber(patches, ray=ray)(q), inside)
+    assert wn([0.5, 0.5, 0.5]) == 1.0
 
 
 @pytest.mark.parametrize("method", ["exact", "direct"])
@@ -118,8 +119,7 @@ def test_the_rational_sphere_is_exact_inside_and_outside(tmp_path):
     wn = gwn.WindingNumber(patches)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        inside = (np.linalg.norm(q, axis=1) < 1).astype(np.float64)
-        np.testing.assert_allclose(wn(q), inside, rtol=0, atol=1e-12)
+        np.testing.assert_array_equal(wn(q), (np.linalg.norm(q, axis=1) < 1).astype(np.float64))
 
 
 def test_uncertified_values_warn_and_are_flagged(cube_bpt):

@@ -82,6 +82,10 @@ pub const MAX_EVALUATIONS: usize = 200_000;
 const CURVE_SPLIT_RATIO: f64 = 1.0;
 /// Halving depth limit of a boundary curve (`2^-60` of it: a query on the curve itself).
 const CURVE_MAX_DEPTH: u32 = 60;
+/// A certified value of a closed set is rounded to the integer it approximates when its error
+/// estimate is below this (any value below ½ identifies the integer; a quarter leaves the
+/// estimate a factor of two of slack).
+const CLOSED_ROUNDING_LIMIT: f64 = 0.25;
 
 /// Options of the patch evaluator.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -142,6 +146,9 @@ pub struct PatchWindingNumber {
     edges: Vec<[Vec<usize>; 4]>,
     /// World bounding box of each patch's control points.
     boxes: Vec<([f64; 3], [f64; 3])>,
+    /// No edge is a surface boundary (every one is paired with a reversed twin, bit for bit,
+    /// or collapsed): the set bounds a solid, and `w` off the surface is an integer.
+    closed: bool,
     /// Precomputed quadrature samples of the surface-boundary edges (`links` = `Boundary`), in
     /// the ray frame of `options.ray`: the query-independent part of their integrals.
     samples: Vec<[Option<CurveSamples>; 4]>,
@@ -214,6 +221,7 @@ impl PatchWindingNumber {
                 })
             })
             .collect();
+        let closed = links.iter().flatten().all(|l| *l != EdgeLink::Boundary);
         PatchWindingNumber {
             set: set.clone(),
             scaled,
@@ -221,6 +229,7 @@ impl PatchWindingNumber {
             links,
             edges,
             boxes,
+            closed,
             samples,
             options,
         }
@@ -409,13 +418,21 @@ impl PatchWindingNumber {
         }
         acc.leaf_edges(leaf_edges);
         let q_frame = ray.to_frame(q);
-        acc.finish(self.options.tolerance, |task, acc, tol, budget| {
+        let mut out = acc.finish(self.options.tolerance, |task, acc, tol, budget| {
             let (p, e, form) = task;
             match &self.samples[p][e] {
                 Some(s) => acc.integrate_sampled(s, || edge_ctrl(p, e), form, q_frame, tol, budget),
                 None => acc.integrate_curve(edge_ctrl(p, e), form, tol, budget),
             }
-        })
+        });
+        // A closed set's `w` is an integer off the surface (its boundary is empty), and a
+        // certified value is within its estimate of it: that integer, exactly, as the mesh and
+        // STEP evaluators give (the sum itself is an integer only up to the rounding of its
+        // interface terms). Values on the surface are not certified and stay the principal value.
+        if self.closed && out.certified && out.error_estimate < CLOSED_ROUNDING_LIMIT {
+            out.value = out.value.round() + 0.0; // `+ 0.0`: −0 is 0
+        }
+        out
     }
 
     /// `(min, max, scale)` of the frame `z` of patch `p`'s control points relative to `q`, from
