@@ -8,6 +8,7 @@ mod common;
 #[path = "../common/patch_points.rs"]
 mod patch_points;
 
+mod fuzz_corpus_curved;
 mod patches;
 mod patches_props;
 mod patches_seams;
