@@ -112,7 +112,7 @@ class WindingNumber:
     def eval_with_status(
         self, Q: _Floats, threads: Optional[int] = None
     ) -> Tuple[_F64, _F64, npt.NDArray[np.bool_]]:
-        """STEP models: ``(w, error_estimate, uncertified)`` at the rows of ``Q``, no warning."""
+        """STEP models and patch sets (exact): ``(w, error_estimate, uncertified)`` at the rows of ``Q``, no warning."""
     @property
     def method(self) -> _Method:
         """The evaluation method."""

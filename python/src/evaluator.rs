@@ -180,6 +180,12 @@ impl Evaluator {
         }
     }
 
+    /// Whether [`Evaluator::certified_batch`] answers (STEP models and the exact method on
+    /// patches).
+    pub fn certifies(&self) -> bool {
+        matches!(self, Evaluator::Step(_) | Evaluator::Patches(_))
+    }
+
     /// Evaluations with their certificates (STEP models and the exact method on patches), in
     /// parallel on the current rayon pool.
     pub fn certified_batch(&self, points: &[[f64; 3]]) -> Option<Vec<Certified>> {

@@ -52,7 +52,8 @@ enum Source {
     Patches(Py<PyPatchSet>),
 }
 
-/// Winding-number evaluator of one mesh or oriented point cloud, built once.
+/// Winding-number evaluator of one mesh, oriented point cloud, STEP model or patch set, built
+/// once.
 ///
 /// ``WindingNumber(V, F, method="exact", beta=None, order=None, precision=None, ray=None,
 /// tolerance=None)`` (``None``: the default)
@@ -74,6 +75,12 @@ enum Source {
 /// evaluator chooses a ray per query) and must be left at their defaults. Values that could not
 /// be certified (query on or within the margins of the surface or an edge) raise a
 /// ``RuntimeWarning``; :meth:`WindingNumber.eval_with_status` returns the flags.
+///
+/// ``WindingNumber(patches, method="exact", ray=None, tolerance=1e-10)`` with a :class:`PatchSet`
+/// (``gwn.load("teapot.bpt")``) evaluates the Bézier patches as ``gwn eval teapot.bpt`` does:
+/// the exact method (``ray`` and ``tolerance`` apply; a closed set gives exact integers off the
+/// surface, uncertified values warn as for STEP models) or ``method="direct"`` (the surface
+/// quadrature, ``tolerance`` only).
 ///
 /// Calls release the GIL; one object can be queried from several Python threads at once.
 /// Objects pickle by their arrays and are rebuilt on unpickling.
@@ -150,7 +157,7 @@ impl PyWindingNumber {
 
     /// Builds the evaluator of a STEP model or patch set `v` (`None` when `v` is neither): the
     /// library's rules and messages for the options (`EvaluatorSpec::check` on its input
-    /// kind), plus `F`, which only Python can pass.
+    /// kind), plus `F` (given and not `None`), which only Python can pass.
     fn from_curved(
         py: Python<'_>,
         v: &Bound<'_, PyAny>,
@@ -164,7 +171,7 @@ impl PyWindingNumber {
         } else {
             return Ok(None);
         };
-        if f.is_some_and(|f| !f.is_none()) {
+        if f.is_some() {
             return Err(value_error(format!(
                 "F does not apply to {kind} (pass it alone)"
             )));
@@ -198,7 +205,7 @@ impl PyWindingNumber {
         q: &Bound<'_, PyAny>,
         threads: Option<Threads>,
     ) -> PyResult<Option<Vec<Certified>>> {
-        if self.evaluator.certified_batch(&[]).is_none() {
+        if !self.evaluator.certifies() {
             return Ok(None);
         }
         with_points(q, "Q", |q| {
@@ -241,17 +248,15 @@ impl PyWindingNumber {
             ray,
             tolerance,
         };
-        let Some(F) = F.filter(|f| !f.is_none()) else {
-            return match Self::from_curved(py, V, None, args)? {
-                Some(curved) => Ok(curved),
-                None => Err(value_error(
-                    "F (the triangles) is required unless V is a gwn.StepModel or gwn.PatchSet",
-                )),
-            };
-        };
-        if let Some(curved) = Self::from_curved(py, V, Some(F), args)? {
+        let F = F.filter(|f| !f.is_none());
+        if let Some(curved) = Self::from_curved(py, V, F, args)? {
             return Ok(curved);
         }
+        let Some(F) = F else {
+            return Err(value_error(
+                "F (the triangles) is required unless V is a gwn.StepModel or gwn.PatchSet",
+            ));
+        };
         Self::from_mesh_arrays(py, V, F, args)
     }
 
@@ -340,11 +345,12 @@ impl PyWindingNumber {
         values_out(py, values, single)
     }
 
-    /// STEP models: ``(w, error, uncertified)`` at the rows of ``Q`` (n, 3): float64 (n,)
-    /// values (as ``self(Q)``, without the warning), float64 (n,) error estimates of the
-    /// boundary integral, bool (n,) flags of the values that could not be certified (query on
-    /// or within the margins of the surface or an edge, or the work cap reached; see
-    /// docs/patches.md). ``ValueError`` for the mesh and point-cloud evaluators.
+    /// STEP models and patch sets (exact method): ``(w, error, uncertified)`` at the rows of
+    /// ``Q`` (n, 3): float64 (n,) values (as ``self(Q)``, without the warning), float64 (n,)
+    /// error estimates of the boundary integral, bool (n,) flags of the values that could not
+    /// be certified (query on or within the margins of the surface or an edge, or the work cap
+    /// reached; see docs/patches.md). ``ValueError`` for the mesh, point-cloud and direct
+    /// evaluators.
     #[pyo3(signature = (Q, threads = None))]
     #[allow(non_snake_case)]
     fn eval_with_status<'py>(
