@@ -32,6 +32,14 @@ pub(in crate::patch) struct PatchHit {
 /// Subdivision depth of a patch before Newton's method starts from the piece's centre.
 const HIT_DEPTH: u32 = 12;
 
+/// Most pieces [`patch_hits`] examines on one patch. Four children per split and
+/// [`HIT_DEPTH`] levels allow `4^12` pieces where the hull tests cannot cull (a surface whose
+/// control points overflow in the ray frame, radius 1e308 in a fuzzed STEP file: minutes per
+/// query); real queries examine a few per level near each hit. Past it the whole line is
+/// reported unresolved, so no ray counts through the patch and the caller tries another ray or
+/// flags the value (a bounded, certified refusal instead of a hang).
+const MAX_HIT_PIECES: usize = 1 << 14;
+
 /// A ray frame: `e1`, `e2`, `d` right-handed.
 #[derive(Clone, Copy)]
 pub(in crate::patch) struct RayFrame {
@@ -117,7 +125,13 @@ pub(in crate::patch) fn patch_hits(
         },
         0u32,
     )];
+    let mut examined = 0;
     while let Some((piece, depth)) = stack.pop() {
+        examined += 1;
+        if examined > MAX_HIT_PIECES {
+            unresolved.push([f64::NEG_INFINITY, f64::INFINITY]);
+            return;
+        }
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
         for p in &piece.h {
@@ -175,11 +189,11 @@ pub(in crate::patch) fn patch_hits(
                 }
                 Ok(hit) if depth >= HIT_DEPTH => {
                     out.extend(hit);
-                    unresolved.push([lo[2], hi[2]]);
+                    unresolved.push(span_along_ray(lo[2], hi[2]));
                     continue;
                 }
                 Err(()) if depth >= HIT_DEPTH => {
-                    unresolved.push([lo[2], hi[2]]);
+                    unresolved.push(span_along_ray(lo[2], hi[2]));
                     continue;
                 }
                 _ => {}
@@ -189,6 +203,17 @@ pub(in crate::patch) fn patch_hits(
             stack.push((a, depth + 1));
             stack.push((b, depth + 1));
         }
+    }
+}
+
+/// The unresolved span `[lo, hi]` along the ray, or the whole line when rounding made it NaN
+/// (an overflowing net): the callers' tests (`hi ≥ −margin`) must reject the ray then, which
+/// a NaN bound would not.
+fn span_along_ray(lo: f64, hi: f64) -> [f64; 2] {
+    if lo <= hi {
+        [lo, hi]
+    } else {
+        [f64::NEG_INFINITY, f64::INFINITY]
     }
 }
 

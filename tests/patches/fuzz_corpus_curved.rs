@@ -62,3 +62,92 @@ fn prefixes_and_byte_corruptions_of_the_curved_seeds_are_handled() {
     }
     assert!(cases > 3_000, "{cases}");
 }
+
+/// Each number of each seed (every `stride`-th; all of them took 83 s in release and found the
+/// hang below) replaced by extreme values one at a time: a model that evaluates or a one-line
+/// error, never a panic or a hang (degrees, counts and multiplicities of 10⁹, knots, radii and
+/// weights of ±1e308 or 1e-320, out-of-range spellings).
+#[test]
+fn numbers_replaced_by_extreme_values_are_handled() {
+    let stride = 37;
+    let extremes = [
+        "0",
+        "-1",
+        "1000000000",
+        "1.E308",
+        "-1.E308",
+        "1.E-320",
+        "1.E999",
+        "2.5",
+    ];
+    let mut cases = 0;
+    for (name, input) in corpus() {
+        let Ok(text) = std::str::from_utf8(&input[1..]) else {
+            continue;
+        };
+        // Numbers: maximal runs of digits, signs, dots and exponents that start with a digit
+        // (or a sign/dot before one), outside `#id` references.
+        let bytes = text.as_bytes();
+        let mut spans = Vec::new();
+        let mut i = 0;
+        while i < bytes.len() {
+            let starts = bytes[i].is_ascii_digit()
+                && (i == 0 || !(bytes[i - 1].is_ascii_alphanumeric() || bytes[i - 1] == b'#'));
+            if starts {
+                let mut j = i;
+                while j < bytes.len() && (bytes[j].is_ascii_digit() || b".Ee+-".contains(&bytes[j]))
+                {
+                    j += 1;
+                }
+                spans.push((i, j));
+                i = j;
+            } else {
+                i += 1;
+            }
+        }
+        for &(a, b) in spans.iter().step_by(stride) {
+            for value in extremes {
+                let mut data = vec![input[0]];
+                data.extend_from_slice(text[..a].as_bytes());
+                data.extend_from_slice(value.as_bytes());
+                data.extend_from_slice(text[b..].as_bytes());
+                let t0 = std::time::Instant::now();
+                eprintln!("START {name} at {a} `{}` -> {value}", &text[a..b]);
+                check_load_curved(&data);
+                if t0.elapsed().as_secs_f64() > 0.5 {
+                    eprintln!(
+                        "SLOW {name} at {a} `{}` -> {value}: {:?}",
+                        &text[a..b],
+                        t0.elapsed()
+                    );
+                }
+                cases += 1;
+            }
+        }
+        assert!(!spans.is_empty(), "{name}: no numbers");
+    }
+    assert!(cases > 200, "{cases}");
+}
+
+/// The hang the extreme numbers found: the capped cylinder with a radius of 1e308. Its
+/// rational patches overflow in the ray frame, the hull tests cull nothing, and the ray-hit
+/// search split every patch to its depth limit, `4^12` pieces per patch and ray: minutes per
+/// query. The search now stops at its piece cap and refuses the ray, so the query ends in well
+/// under a second, flagged uncertified.
+#[test]
+fn a_cylinder_of_radius_1e308_evaluates_in_bounded_work() {
+    use gwn::patch::step::{StepWindingNumber, parse_step};
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/step");
+    let text = std::fs::read_to_string(dir.join("capped_cylinder.step")).unwrap();
+    let hostile = text.replace(
+        "CYLINDRICAL_SURFACE('',#10,1.)",
+        "CYLINDRICAL_SURFACE('',#10,1.E308)",
+    );
+    assert_ne!(hostile, text);
+    let model = parse_step(&hostile).unwrap();
+    let wn = StepWindingNumber::new(&model);
+    for q in [[0.0, 0.0, 1.0], [0.3, -0.2, 0.5], [5.0, 5.0, 5.0]] {
+        let e = wn.evaluate(q);
+        assert!(e.value.is_finite(), "{q:?}: {e:?}");
+    }
+}

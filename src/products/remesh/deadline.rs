@@ -4,7 +4,8 @@
 //! costs hundreds of microseconds, and a single batch (the coarse grid, a round of placement)
 //! runs for minutes: a limit checked only between phases and rounds was overrun tenfold
 //! (docs/benchmarks.md, "A time limit that holds"). [`Deadlined`] hands the batches to the
-//! evaluator [`CHUNK`] points at a time and reads the clock between chunks; past the deadline it
+//! evaluator in chunks of about [`CHUNK_SECONDS`] of work ([`MIN_CHUNK`] … [`CHUNK`] points)
+//! and reads the clock between chunks; past the deadline it
 //! answers NaN without evaluating. The remesher reads the clock at the end of every phase and
 //! before it returns, so a value answered past the deadline never reaches a surface: a run
 //! either ends in time with the surface it would have had, or returns
@@ -16,12 +17,23 @@ use std::time::Instant;
 
 use crate::eval::{Evaluator, NoGradient, SurfaceCrossing};
 
-/// Points per chunk: 4096 evaluations are ~5 ms at a microsecond each (the clock's read is
-/// ~25 ns) and ~0.2 s at the slowest measured (~100 µs on 2 threads), which bounds the overrun
-/// of one batch; each chunk is still thousands of points, enough for the evaluator's own
-/// parallel split and for its rays shared along columns (a column cut by a chunk's end is two
-/// columns: the same values).
+/// Most points per chunk: 4096 evaluations are ~5 ms at a microsecond each (the clock's read
+/// is ~25 ns) and ~0.2 s at the slowest ordinary input measured (~100 µs on 2 threads); each
+/// chunk is then thousands of points, enough for the evaluator's own parallel split and for
+/// its rays shared along columns (a column cut by a chunk's end is two columns: the same
+/// values).
 pub const CHUNK: usize = 4096;
+
+/// Fewest points per chunk, and the first chunk's size: evaluations can be far slower than
+/// the ordinary ones above (a fuzzed STEP model with a radius of 1e308 took up to a second per
+/// point, each ray search refused at its work cap), and 4096 of those would overrun a limit by
+/// half an hour. The chunks then grow towards [`CHUNK_SECONDS`] of work each.
+pub const MIN_CHUNK: usize = 8;
+
+/// The time each chunk aims at: the next chunk's size is the last one's rate times this,
+/// within [`MIN_CHUNK`] … [`CHUNK`] (so the overrun past a deadline is about this, or
+/// [`MIN_CHUNK`] evaluations when each takes longer).
+const CHUNK_SECONDS: f64 = 0.02;
 
 /// An evaluator that stops evaluating at `deadline` (see the module documentation); without a
 /// deadline it forwards every call unchanged.
@@ -51,12 +63,18 @@ impl<'a, E: Evaluator + ?Sized> Deadlined<'a, E> {
             return batch(points);
         }
         let mut out = Vec::with_capacity(points.len());
-        for chunk in points.chunks(CHUNK) {
+        let mut size = MIN_CHUNK;
+        while out.len() < points.len() {
             if self.past() {
                 out.resize(points.len(), missing);
                 break;
             }
+            let chunk = &points[out.len()..(out.len() + size).min(points.len())];
+            let start = Instant::now();
             out.extend(batch(chunk));
+            let seconds = start.elapsed().as_secs_f64();
+            let rate = chunk.len() as f64 / seconds.max(1e-9);
+            size = (rate * CHUNK_SECONDS).clamp(MIN_CHUNK as f64, CHUNK as f64) as usize;
         }
         out
     }
@@ -138,13 +156,13 @@ mod tests {
         );
         let evaluated = slow.0.load(Ordering::Relaxed);
         assert!(
-            evaluated >= CHUNK && evaluated < points.len(),
+            evaluated >= MIN_CHUNK && evaluated < points.len(),
             "{evaluated}"
         );
+        let first_nan = w.iter().position(|x| x.is_nan()).unwrap();
+        assert_eq!(first_nan, evaluated);
         assert_eq!(w.len(), points.len());
         // The values before the deadline are the evaluator's, every later one NaN.
-        let first_nan = w.iter().position(|x| x.is_nan()).unwrap();
-        assert_eq!(first_nan % CHUNK, 0);
         assert!(w[..first_nan].iter().zip(&points).all(|(x, p)| *x == p[0]));
         assert!(w[first_nan..].iter().all(|x| x.is_nan()));
         assert!(stopped.eval([1.0, 0.0, 0.0]).is_nan());
@@ -165,5 +183,33 @@ mod tests {
             let w = Deadlined::new(&slow, deadline).eval_batch_within(&points, 0.1);
             assert!(w.iter().zip(&points).all(|(x, p)| *x == (p[0], 0.0)));
         }
+    }
+
+    /// Evaluations of a second each (a hostile curved input at its work caps): the first chunk
+    /// is [`MIN_CHUNK`] points, so a limit of 0.1 s is overrun by one chunk of them, not by
+    /// [`CHUNK`] seconds.
+    #[test]
+    fn very_slow_evaluations_overrun_by_a_small_chunk() {
+        struct VerySlow(AtomicUsize);
+        impl Evaluator for VerySlow {
+            fn eval(&self, q: [f64; 3]) -> f64 {
+                self.0.fetch_add(1, Ordering::Relaxed);
+                std::thread::sleep(Duration::from_millis(200));
+                q[0]
+            }
+        }
+        let slow = VerySlow(AtomicUsize::new(0));
+        let points: Vec<[f64; 3]> = (0..CHUNK).map(|i| [i as f64, 0.0, 0.0]).collect();
+        let start = Instant::now();
+        let w = Deadlined::new(&slow, Some(start + Duration::from_millis(100))).eval_batch(&points);
+        let evaluated = slow.0.load(Ordering::Relaxed);
+        assert_eq!(evaluated, MIN_CHUNK);
+        assert!(w[MIN_CHUNK..].iter().all(|x| x.is_nan()));
+        // 8 points of 0.2 s on at least one thread: 1.6 s at most (before: 4096 of them).
+        assert!(
+            start.elapsed() < Duration::from_secs(3),
+            "{:?}",
+            start.elapsed()
+        );
     }
 }
