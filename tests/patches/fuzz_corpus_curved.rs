@@ -108,9 +108,9 @@ fn numbers_replaced_by_extreme_values_are_handled() {
         for &(a, b) in spans.iter().step_by(stride) {
             for value in extremes {
                 let mut data = vec![input[0]];
-                data.extend_from_slice(text[..a].as_bytes());
+                data.extend_from_slice(&text.as_bytes()[..a]);
                 data.extend_from_slice(value.as_bytes());
-                data.extend_from_slice(text[b..].as_bytes());
+                data.extend_from_slice(&text.as_bytes()[b..]);
                 let t0 = std::time::Instant::now();
                 eprintln!("START {name} at {a} `{}` -> {value}", &text[a..b]);
                 check_load_curved(&data);
