@@ -12,7 +12,7 @@ use pyo3::types::{PyDict, PyTuple};
 use crate::arrays::box_corners;
 use crate::errors::os_error;
 use crate::evaluator::Curved;
-use crate::step::PyStepModel;
+use crate::step::{PyStepModel, reduce_by_path};
 
 /// A patch file that cannot be read is an `OSError` (`FileNotFoundError` when missing,
 /// `PermissionError` when not readable); one that is read but is not a valid patch set (or is
@@ -112,8 +112,6 @@ impl PyPatchSet {
         &self,
         py: Python<'py>,
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
-        let load = py.import("gwn")?.getattr("load")?;
-        let args = (self.path.clone(),).into_pyobject(py)?;
-        Ok((load, args))
+        reduce_by_path(py, &self.path)
     }
 }

@@ -125,10 +125,18 @@ impl PyStepModel {
         &self,
         py: Python<'py>,
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
-        let load = py.import("gwn")?.getattr("load")?;
-        let args = (self.path.clone(),).into_pyobject(py)?;
-        Ok((load, args))
+        reduce_by_path(py, &self.path)
     }
+}
+
+/// `__reduce__` of a model read from a file: `gwn.load(path)` reads it again on unpickling.
+pub fn reduce_by_path<'py>(
+    py: Python<'py>,
+    path: &std::path::Path,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+    let load = py.import("gwn")?.getattr("load")?;
+    let args = (path.to_path_buf(),).into_pyobject(py)?;
+    Ok((load, args))
 }
 
 /// Warns (``RuntimeWarning``) when some values are uncertified, with the CLI's text (`near`:
