@@ -181,8 +181,8 @@ def fast_winding_number(
     with libigl's positional ``expansion_order, beta`` (default 2, 2.0) after the arrays."""
 
 def voxelize(
-    V: _Floats,
-    F: _Indices,
+    V: Union[_Floats, _Curved],
+    F: Optional[_Indices] = None,
     res: int = 64,
     *,
     dims: Optional[Tuple[int, int, int]] = None,
@@ -194,7 +194,7 @@ def voxelize(
     tolerance: Optional[float] = None,
     threads: Optional[int] = None,
 ) -> _Grid:
-    """Winding numbers (exact by default) on a voxel grid: (values (D, H, W) indexed [z, y, x], origin, spacing)."""
+    """Winding numbers (exact by default) on a voxel grid: (values (D, H, W) indexed [z, y, x], origin, spacing); voxelize(model, res=...) of a StepModel or PatchSet takes no F."""
 
 @overload
 def remesh(

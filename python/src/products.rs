@@ -75,7 +75,7 @@ const MAX_SLICE_RES: usize = 1 << 15;
 /// allocation) by the library's size check, the CLI's, when its `bytes_per_cell` exceed the
 /// available memory.
 fn grid_spec(
-    mesh: &Mesh,
+    input_box: Option<BoundingBox>,
     res: usize,
     dims: Option<[usize; 3]>,
     bounds: Option<[f64; 6]>,
@@ -93,7 +93,7 @@ fn grid_spec(
                     "margin must be a non-negative number, got {margin}"
                 )));
             }
-            mesh.bounding_box()
+            input_box
                 .ok_or_else(|| PyValueError::new_err("the mesh has no triangles"))?
                 .enlarged(margin)
         }
@@ -139,14 +139,16 @@ fn grid_result<'py>(
 /// ``(x0, y0, z0, x1, y1, z1)`` or the mesh's bounding box grown by ``margin`` times its largest
 /// extent, with ``dims`` (W, H, D) cells or ``res`` cells along the longest side. ``tolerance``
 /// is the exact method's boundary tolerance (``gwn voxelize --tolerance``; see
-/// :class:`WindingNumber`).
+/// :class:`WindingNumber`). ``voxelize(model, res=...)`` of a :class:`StepModel` or
+/// :class:`PatchSet` takes no ``F`` and evaluates the model with its own evaluator (the options
+/// :class:`WindingNumber` takes for it), as ``gwn voxelize part.step`` does.
 #[pyfunction]
-#[pyo3(signature = (V, F, res = 64, *, dims = None, bounds = None, margin = 0.05, method = "exact", beta = None, order = None, tolerance = None, threads = None))]
+#[pyo3(signature = (V, F = None, res = 64, *, dims = None, bounds = None, margin = 0.05, method = "exact", beta = None, order = None, tolerance = None, threads = None))]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub fn voxelize<'py>(
     py: Python<'py>,
     V: &Bound<'py, PyAny>,
-    F: &Bound<'py, PyAny>,
+    F: Option<&Bound<'py, PyAny>>,
     res: usize,
     dims: Option<[usize; 3]>,
     bounds: Option<[f64; 6]>,
@@ -158,9 +160,42 @@ pub fn voxelize<'py>(
     threads: Option<Threads>,
 ) -> PyResult<GridArrays<'py>> {
     let method = spec_of(method, beta, order, tolerance)?;
+    if let Some(curved) = crate::patches::curved_of(V) {
+        // A STEP model or patch set: its own evaluator, as `gwn voxelize part.step`.
+        if F.is_some_and(|f| !f.is_none()) {
+            return Err(PyValueError::new_err(format!(
+                "voxelize(model): {} takes no F (pass res= by name)",
+                curved.kind()
+            )));
+        }
+        let bytes = gwn::grid::EVALUATE_BYTES_PER_CELL;
+        let grid = grid_spec(
+            Some(curved.bounding_box()),
+            res,
+            dims,
+            bounds,
+            margin,
+            bytes,
+        )?;
+        let values = threads::run_interruptible(py, threads, |stop| {
+            // `None` (interrupted) out, a refused option in.
+            curved
+                .with_evaluator(&method, |wn| {
+                    gwn::grid::evaluate_until(wn, &grid, |_| {}, stop)
+                })
+                .transpose()
+        })?;
+        let values = values.map_err(value_error)?;
+        return grid_result(py, &grid, values);
+    }
+    let Some(F) = F.filter(|f| !f.is_none()) else {
+        return Err(PyValueError::new_err(
+            "voxelize(V, F): F is required for a mesh (only a gwn.StepModel or gwn.PatchSet comes alone)",
+        ));
+    };
     let mesh = mesh_from(V, F, "V", "F")?;
     let grid = grid_spec(
-        &mesh,
+        mesh.bounding_box(),
         res,
         dims,
         bounds,
@@ -196,7 +231,7 @@ pub fn sdf<'py>(
     let exact = exact_options(tolerance)?;
     let mesh = mesh_from(V, F, "V", "F")?;
     let spec = grid_spec(
-        &mesh,
+        mesh.bounding_box(),
         res,
         dims,
         bounds,

@@ -199,3 +199,27 @@ def test_the_shared_teapot_loads_and_evaluates():
     # Inside the body, above the lid and beside the spout.
     values = wn(np.array([[0.0, 0.0, 1.0], [0.0, 0.0, 5.0], [5.0, 5.0, 1.0]]))
     assert abs(values[0] - 1) < 0.05 and abs(values[1]) < 0.05 and abs(values[2]) < 0.05
+
+
+def test_voxelize_takes_patch_sets_and_step_models(cube_bpt):
+    from conftest import FIXTURES
+
+    patches = gwn.load(cube_bpt)
+    W, origin, spacing = gwn.voxelize(patches, res=6, margin=0.25)
+    assert W.shape == (6, 6, 6)
+    k, j, i = np.meshgrid(*(np.arange(n) for n in W.shape), indexing="ij")
+    points = origin + np.stack([i, j, k], -1).reshape(-1, 3) * spacing
+    inside = np.all((points > 0) & (points < 1), axis=1).astype(np.float64)
+    np.testing.assert_array_equal(W.reshape(-1), inside)  # a closed set: exact integers
+    model = gwn.load(FIXTURES / "step" / "capped_cylinder.step")
+    W, origin, spacing = gwn.voxelize(model, res=8)
+    k, j, i = np.meshgrid(*(np.arange(n) for n in W.shape), indexing="ij")
+    points = origin + np.stack([i, j, k], -1).reshape(-1, 3) * spacing
+    np.testing.assert_allclose(W.reshape(-1), gwn.WindingNumber(model)(points), atol=1e-12)
+    assert W.max() == 1.0 and W.min() == 0.0
+    with pytest.raises(ValueError, match="a patch set takes no F"):
+        gwn.voxelize(patches, CUBE_F, res=6)
+    with pytest.raises(ValueError, match="precision|fast"):
+        gwn.voxelize(patches, res=6, method="fast")
+    with pytest.raises(ValueError, match="F is required for a mesh"):
+        gwn.voxelize(CUBE_V, res=6)
