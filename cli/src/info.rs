@@ -140,13 +140,9 @@ fn cloud_report(path: &std::path::Path, cloud: &gwn::mesh::PointCloud) -> String
         ),
     ];
     if let Some(b) = gwn::BoundingBox::of_points(cloud.positions()) {
-        let diagonal = (0..3)
-            .map(|k| (b.max[k] - b.min[k]).powi(2))
-            .sum::<f64>()
-            .sqrt();
         rows.push(("bbox min", format!("{:?}", b.min)));
         rows.push(("bbox max", format!("{:?}", b.max)));
-        rows.push(("diagonal", format!("{diagonal:?}")));
+        rows.push(("diagonal", format!("{:?}", b.diagonal())));
     }
     let mut out = aligned(&rows);
     out.push_str("a point cloud: w is the fast (Barnes-Hut) method's estimate\n");
