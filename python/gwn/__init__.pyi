@@ -266,8 +266,8 @@ def signed_distance(
     """Signed distance at the rows of Q, negative where w > 1/2."""
 
 def slice(
-    V: _Floats,
-    F: _Indices,
+    V: Union[_Floats, _Curved],
+    F: Optional[_Indices] = None,
     axis: Literal["x", "y", "z"] = "z",
     at: float = 0.5,
     *,
@@ -281,13 +281,13 @@ def slice(
     tolerance: Optional[float] = None,
     threads: Optional[int] = None,
 ) -> Tuple[_F64, bytes]:
-    """Winding numbers on an axis-aligned plane: (image (height, width), PNG bytes)."""
+    """Winding numbers on an axis-aligned plane: (image (height, width), PNG bytes); slice(model, axis=...) of a StepModel or PatchSet takes no F."""
 
 def classify(
     VA: _Floats,
     FA: _Indices,
-    VB: _Floats,
-    FB: _Indices,
+    VB: Union[_Floats, _Curved],
+    FB: Optional[_Indices] = None,
     *,
     method: Literal["exact", "direct", "fast"] = "exact",
     beta: Optional[float] = None,
@@ -295,7 +295,7 @@ def classify(
     tolerance: Optional[float] = None,
     threads: Optional[int] = None,
 ) -> _F64:
-    """Winding number (exact by default) of mesh B at each face centroid of mesh A."""
+    """Winding number (exact by default) of mesh B (or a StepModel or PatchSet VB, no FB) at each face centroid of mesh A."""
 
 def filter_tets(
     V: _Floats,

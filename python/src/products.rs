@@ -160,52 +160,24 @@ pub fn voxelize<'py>(
     threads: Option<Threads>,
 ) -> PyResult<GridArrays<'py>> {
     let method = spec_of(method, beta, order, tolerance)?;
-    if let Some(curved) = crate::patches::curved_of(V) {
-        // A STEP model or patch set: its own evaluator, as `gwn voxelize part.step`.
-        if F.is_some_and(|f| !f.is_none()) {
-            return Err(PyValueError::new_err(format!(
-                "voxelize(model): {} takes no F (pass res= by name)",
-                curved.kind()
-            )));
-        }
-        let bytes = gwn::grid::EVALUATE_BYTES_PER_CELL;
-        let grid = grid_spec(
-            Some(curved.bounding_box()),
-            res,
-            dims,
-            bounds,
-            margin,
-            bytes,
-        )?;
-        let values = threads::run_interruptible(py, threads, |stop| {
-            // `None` (interrupted) out, a refused option in.
-            curved
-                .with_evaluator(&method, |wn| {
-                    gwn::grid::evaluate_until(wn, &grid, |_| {}, stop)
-                })
-                .transpose()
-        })?;
-        let values = values.map_err(value_error)?;
-        return grid_result(py, &grid, values);
-    }
-    let Some(F) = F.filter(|f| !f.is_none()) else {
-        return Err(PyValueError::new_err(
-            "voxelize(V, F): F is required for a mesh (only a gwn.StepModel or gwn.PatchSet comes alone)",
-        ));
-    };
-    let mesh = mesh_from(V, F, "V", "F")?;
+    let source = Source::of(V, F, "voxelize")?;
     let grid = grid_spec(
-        mesh.bounding_box(),
+        source.bounding_box(),
         res,
         dims,
         bounds,
         margin,
         gwn::grid::EVALUATE_BYTES_PER_CELL,
     )?;
-    let wn = threads::run(py, threads, || evaluator_for(&mesh, &method))?.map_err(value_error)?;
     let values = threads::run_interruptible(py, threads, |stop| {
-        gwn::grid::evaluate_until(&wn, &grid, |_| {}, stop)
+        // `None` (interrupted) out, a refused option in.
+        source
+            .with_evaluator(&method, |wn| {
+                gwn::grid::evaluate_until(wn, &grid, |_| {}, stop)
+            })
+            .transpose()
     })?;
+    let values = values.map_err(value_error)?;
     grid_result(py, &grid, values)
 }
 
@@ -282,20 +254,22 @@ fn axis_index(axis: &str) -> PyResult<usize> {
 
 /// A slice of the exact winding number on an axis-aligned plane, as ``gwn slice`` renders it.
 ///
-/// The plane is normal to ``axis`` at ``at`` (fraction of the mesh's bounding box along the axis,
+/// The plane is normal to ``axis`` at ``at`` (fraction of the input's bounding box along the axis,
 /// 0 = min, 1 = max) or at the absolute coordinate ``at_coord``; it covers the box grown by
 /// ``margin``, with ``res`` pixels along its longer side. Returns ``(image, png)``: ``image``
 /// float64 (height, width), row 0 at the top (x-slice: y right, z up; y-slice: x right, z up;
 /// z-slice: x right, y up), and ``png`` the bytes of the coloured picture with its colour bar
 /// (and the mesh's cross-section in black when ``outline``). ``tolerance`` is the exact method's
-/// boundary tolerance (``gwn slice --tolerance``).
+/// boundary tolerance (``gwn slice --tolerance``). ``slice(model, axis=...)`` of a
+/// :class:`StepModel` or :class:`PatchSet` takes no ``F`` and evaluates the model with its own
+/// evaluator, as ``gwn slice part.step`` does (``outline`` needs a triangle mesh).
 #[pyfunction]
-#[pyo3(signature = (V, F, axis = "z", at = 0.5, *, at_coord = None, res = 1024, margin = 0.1, outline = false, method = "exact", beta = None, order = None, tolerance = None, threads = None))]
+#[pyo3(signature = (V, F = None, axis = "z", at = 0.5, *, at_coord = None, res = 1024, margin = 0.1, outline = false, method = "exact", beta = None, order = None, tolerance = None, threads = None))]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub fn slice<'py>(
     py: Python<'py>,
     V: &Bound<'py, PyAny>,
-    F: &Bound<'py, PyAny>,
+    F: Option<&Bound<'py, PyAny>>,
     axis: &str,
     at: f64,
     at_coord: Option<f64>,
@@ -320,8 +294,14 @@ pub fn slice<'py>(
             "margin must be a non-negative number, got {margin}"
         )));
     }
-    let mesh = mesh_from(V, F, "V", "F")?;
-    let bbox = mesh
+    let source = Source::of(V, F, "slice")?;
+    if outline && let Source::Curved(curved) = &source {
+        return Err(PyValueError::new_err(format!(
+            "slice(model, outline=True): the outline needs a triangle mesh, not {}",
+            curved.kind()
+        )));
+    }
+    let bbox = source
         .bounding_box()
         .ok_or_else(|| PyValueError::new_err("the mesh has no triangles"))?;
     let coord = match at_coord {
@@ -340,17 +320,18 @@ pub fn slice<'py>(
     };
     let slice = Slice::new(&bbox.enlarged(margin), axis, coord, res);
     let (values, png) = threads::run(py, threads, || {
-        // A ray in the plane: one ray serves a whole image column or row (exact method).
+        // A ray in the plane: one ray serves a whole image column or row (the exact method on
+        // meshes and patch sets; the STEP evaluator picks its own rays), as `gwn slice`.
         let mut spec = spec;
-        if spec.method_for(InputKind::Mesh) == Method::Exact {
+        let kind = source.kind();
+        if spec.method_for(kind) == Method::Exact && kind != InputKind::Step {
             spec.ray = Some(slice.ray());
         }
-        let wn = evaluator_for(&mesh, &spec)?;
-        let values = slice.evaluate(&wn);
+        let values = source.with_evaluator(&spec, |wn| slice.evaluate(wn))?;
         let mut png = Vec::new();
         // Writing into a Vec cannot fail for I/O reasons; an encoder error is still reported.
         let written = slice
-            .render(&values, outline.then_some(&mesh))
+            .render(&values, outline.then(|| source.mesh()).flatten())
             .write_png(&mut png);
         Ok::<_, Box<dyn std::error::Error + Send + Sync>>((values, written.map(|()| png)))
     })?
@@ -362,19 +343,88 @@ pub fn slice<'py>(
     ))
 }
 
+/// What a product evaluates: a mesh `(V, F)`, or a STEP model or patch set that comes alone.
+enum Source {
+    Mesh(Mesh),
+    Curved(crate::evaluator::Curved),
+}
+
+impl Source {
+    /// `(V, F)` as a mesh, or `V` a `StepModel`/`PatchSet` with no `F`; `what` names the call in
+    /// the messages.
+    fn of(v: &Bound<'_, PyAny>, f: Option<&Bound<'_, PyAny>>, what: &str) -> PyResult<Source> {
+        Self::named(v, f, what, ["V", "F"])
+    }
+
+    /// [`Source::of`] with the arguments' names (`classify`'s `VB`, `FB`).
+    fn named(
+        v: &Bound<'_, PyAny>,
+        f: Option<&Bound<'_, PyAny>>,
+        what: &str,
+        [v_name, f_name]: [&str; 2],
+    ) -> PyResult<Source> {
+        match (crate::patches::curved_of(v), f.filter(|f| !f.is_none())) {
+            (Some(curved), None) => Ok(Source::Curved(curved)),
+            (Some(curved), Some(_)) => Err(PyValueError::new_err(format!(
+                "{what}: {} takes no {f_name} (pass the other arguments by name)",
+                curved.kind()
+            ))),
+            (None, Some(f)) => Ok(Source::Mesh(mesh_from(v, f, v_name, f_name)?)),
+            (None, None) => Err(PyValueError::new_err(format!(
+                "{what}: {f_name} is required for a mesh (only a gwn.StepModel or gwn.PatchSet comes alone)"
+            ))),
+        }
+    }
+
+    fn kind(&self) -> InputKind {
+        match self {
+            Source::Mesh(_) => InputKind::Mesh,
+            Source::Curved(curved) => curved.kind(),
+        }
+    }
+
+    fn mesh(&self) -> Option<&Mesh> {
+        match self {
+            Source::Mesh(mesh) => Some(mesh),
+            Source::Curved(_) => None,
+        }
+    }
+
+    /// A box containing the input (none for a mesh without triangles).
+    fn bounding_box(&self) -> Option<BoundingBox> {
+        match self {
+            Source::Mesh(mesh) => mesh.bounding_box(),
+            Source::Curved(curved) => Some(curved.bounding_box()),
+        }
+    }
+
+    /// Runs `f` with the evaluator `spec` describes for this input.
+    fn with_evaluator<R>(
+        &self,
+        spec: &EvaluatorSpec,
+        f: impl FnOnce(&dyn Evaluator) -> R,
+    ) -> Result<R, Box<dyn std::error::Error + Send + Sync>> {
+        match self {
+            Source::Mesh(mesh) => Ok(f(evaluator_for(mesh, spec)?.as_ref())),
+            Source::Curved(curved) => Ok(curved.with_evaluator(spec, f)?),
+        }
+    }
+}
+
 /// Classifies each face of mesh A by the exact winding number of mesh B at its centroid
 /// (the building block of mesh booleans; ``gwn classify``). Returns float64 (faces of A,);
 /// ``w > 0.5`` means inside B. ``tolerance`` is the exact method's boundary tolerance
-/// (``gwn classify --tolerance``).
+/// (``gwn classify --tolerance``). ``VB`` may be a :class:`StepModel` or :class:`PatchSet`
+/// (no ``FB``), evaluated with its own evaluator, as ``gwn classify a.obj part.step``.
 #[pyfunction]
-#[pyo3(signature = (VA, FA, VB, FB, *, method = "exact", beta = None, order = None, tolerance = None, threads = None))]
+#[pyo3(signature = (VA, FA, VB, FB = None, *, method = "exact", beta = None, order = None, tolerance = None, threads = None))]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub fn classify<'py>(
     py: Python<'py>,
     VA: &Bound<'py, PyAny>,
     FA: &Bound<'py, PyAny>,
     VB: &Bound<'py, PyAny>,
-    FB: &Bound<'py, PyAny>,
+    FB: Option<&Bound<'py, PyAny>>,
     method: &str,
     beta: Option<f64>,
     order: Option<u8>,
@@ -383,9 +433,9 @@ pub fn classify<'py>(
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let spec = spec_of(method, beta, order, tolerance)?;
     let a = mesh_from(VA, FA, "VA", "FA")?;
-    let b = mesh_from(VB, FB, "VB", "FB")?;
+    let b = Source::named(VB, FB, "classify", ["VB", "FB"])?;
     let values = threads::run(py, threads, || {
-        evaluator_for(&b, &spec).map(|wn| classify_faces(&a, &wn))
+        b.with_evaluator(&spec, |wn| classify_faces(&a, wn))
     })?
     .map_err(value_error)?;
     Ok(array1(py, values))

@@ -223,3 +223,43 @@ def test_voxelize_takes_patch_sets_and_step_models(cube_bpt):
         gwn.voxelize(patches, res=6, method="fast")
     with pytest.raises(ValueError, match="F is required for a mesh"):
         gwn.voxelize(CUBE_V, res=6)
+
+
+@pytest.mark.parametrize("kind", ["patches", "step"])
+def test_slice_of_a_model_is_the_cli_s(tmp_path, cli, cube_bpt, kind):
+    from conftest import FIXTURES
+
+    path = cube_bpt if kind == "patches" else FIXTURES / "step" / "capped_cylinder.step"
+    model = gwn.load(path)
+    image, png = gwn.slice(model, axis="x", at=0.4, res=48)
+    subprocess.run([str(cli), "slice", str(path), "--axis", "x", "--at", "0.4", "--res", "48",
+                    "--out", str(tmp_path / "s.png")], check=True, capture_output=True)
+    assert png == (tmp_path / "s.png").read_bytes()
+    # A closed solid cut across its middle: 1 inside the section, 0 around it.
+    assert image.max() == 1.0 and image.min() == 0.0
+    # Of the box grown by 10 % on each side: the unit square; the cylinder's rectangle at
+    # x = -0.2, y within sqrt(0.96) of the axis, z in [0, 2].
+    section = 1.0 / 1.2**2 if kind == "patches" else 2 * math.sqrt(0.96) * 2 / 2.4**2
+    assert abs(np.mean(image > 0.5) - section) < 0.03, np.mean(image > 0.5)
+    with pytest.raises(ValueError, match="outline needs a triangle mesh"):
+        gwn.slice(model, outline=True)
+    with pytest.raises(ValueError, match="takes no F"):
+        gwn.slice(model, "x")
+
+
+@pytest.mark.parametrize("kind", ["patches", "step"])
+def test_classify_against_a_model(cube_bpt, kind):
+    from conftest import FIXTURES
+
+    path = cube_bpt if kind == "patches" else FIXTURES / "step" / "capped_cylinder.step"
+    model = gwn.load(path)
+    # A mesh half in and half out of the model: the cube shifted by half its side.
+    VA = np.asarray(CUBE_V, dtype=np.float64) * 0.8 + 0.5
+    values = gwn.classify(VA, CUBE_F, model)
+    centroids = VA[np.asarray(CUBE_F)].mean(axis=1)
+    np.testing.assert_array_equal(values, gwn.WindingNumber(model)(centroids))
+    assert 0 < np.sum(values > 0.5) < len(CUBE_F)
+    with pytest.raises(ValueError, match="takes no FB"):
+        gwn.classify(VA, CUBE_F, model, CUBE_F)
+    with pytest.raises(ValueError, match="FB is required for a mesh"):
+        gwn.classify(VA, CUBE_F, VA)
