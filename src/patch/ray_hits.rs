@@ -412,3 +412,47 @@ fn newton(
         tau: r[2],
     }))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A net whose homogeneous points overflow in the ray frame (coordinates `±1e308` with
+    /// weight 4) turns NaN when halved, so no hull test culls a piece: without
+    /// [`MAX_HIT_PIECES`] the search would split all `4^12` pieces of [`HIT_DEPTH`] levels
+    /// (minutes). With it, the whole line is reported unresolved after the cap.
+    #[test]
+    fn a_net_that_overflows_in_the_ray_frame_is_refused_after_the_piece_cap() {
+        let big = 1e308;
+        let points = vec![
+            [-big, -big, 0.0],
+            [-big, big, 0.0],
+            [big, -big, 0.0],
+            [big, big, 0.0],
+        ];
+        let patch = Patch::rational(1, 1, points, vec![4.0; 4]).unwrap();
+        let fp = BoxedPatch {
+            patch: &patch,
+            lo: [-big, -big, 0.0],
+            hi: [big, big, 0.0],
+        };
+        let frame = RayFrame::new([0.0, 0.6, 0.8]);
+        let (mut hits, mut unresolved) = (Vec::new(), Vec::new());
+        patch_hits(
+            fp,
+            SurfaceEdges::NONE,
+            [0.1, 0.2, -1.0],
+            &frame,
+            f64::INFINITY,
+            &mut hits,
+            &mut unresolved,
+        );
+        // Work counted, not timed: each examined piece reports at most one span.
+        assert!(
+            unresolved.len() <= MAX_HIT_PIECES + 1,
+            "{}",
+            unresolved.len()
+        );
+        assert_eq!(unresolved.last(), Some(&[f64::NEG_INFINITY, f64::INFINITY]));
+    }
+}

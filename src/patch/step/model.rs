@@ -37,6 +37,15 @@ pub const EDGE_MATCH: f64 = 1e-6;
 /// lie off their faces by the modelling tolerance, tight enough to catch a pcurve in the wrong
 /// unit, on the wrong side of a seam's surface copy or of another edge.
 pub const PCURVE_TOLERANCE: f64 = 1e-3;
+/// A face is refused when an edge of its loops lies farther than this (relative to the model's
+/// diagonal) from the face's surface, at a point of the edge's trimming polygon: its loop would
+/// not bound a piece of that surface, so the model is not closed there whatever the file says.
+/// Ten times [`PCURVE_TOLERANCE`], for CAD files whose edges lie off their faces by the
+/// modelling tolerance. Such files are corrupt rather than sloppy (a cylinder's radius of
+/// `1e308`, `1e9` or `1e-320` around edges of radius 1, found by the structure-aware fuzz
+/// test), and they cost the ray-hit search its piece cap on every ray: up to a second per
+/// query, every value flagged, instead of this one-line error at load time.
+pub const EDGE_OFF_SURFACE_LIMIT: f64 = 1e-2;
 
 /// One patch of a face with its parameter rectangle and control-point box.
 #[derive(Clone, Debug)]
@@ -243,7 +252,19 @@ impl StepModel {
                         info.pcurves_rejected += 1;
                     }
                     for c in &geom {
-                        let pts = sample(c, &f.surface, &mut hint, chord);
+                        let (pts, off) = sample(c, &f.surface, &mut hint, chord);
+                        if !(off <= EDGE_OFF_SURFACE_LIMIT * diag) {
+                            return Err(StepError::Geometry {
+                                id: f.id,
+                                entity: "ADVANCED_FACE".into(),
+                                message: format!(
+                                    "edge #{} lies {off:.3e} from the face's surface, more than \
+                                     {} of the model's size {diag:.3e} (edge and surface geometry \
+                                     disagree)",
+                                    u.edge, EDGE_OFF_SURFACE_LIMIT
+                                ),
+                            });
+                        }
                         append_to_loop(&mut poly, &mut real, pts, seam);
                     }
                 }
@@ -373,15 +394,24 @@ impl StepModel {
 
 /// Samples a Bézier piece into `(u, v)` points (start and end included): bisection until the
 /// curve's midpoint is within `chord` of the chord in 3D and the inverted midpoint within
-/// `chord` (to first order, scaled by the chord's 3D/uv length ratio) of the uv chord.
+/// `chord` (to first order, scaled by the chord's 3D/uv length ratio) of the uv chord. Also
+/// returns the largest distance from a sampled edge point to the surface at its `(u, v)`
+/// ([`EDGE_OFF_SURFACE_LIMIT`]).
 fn sample(
     c: &[Homogeneous],
     surface: &Surface,
     hint: &mut Option<[f64; 2]>,
     chord: f64,
-) -> Vec<[f64; 2]> {
+) -> (Vec<[f64; 2]>, f64) {
+    // The largest distance between a polygon point's edge point and its image on the surface
+    // (infinite where either is not finite).
+    let off = |uv: [f64; 2], p: [f64; 3]| {
+        let d = surface.point(uv).map_or(f64::INFINITY, |s| norm(sub(s, p)));
+        if d.is_nan() { f64::INFINITY } else { d }
+    };
     let p0 = point_at(c, 0.0);
     let uv0 = surface.invert(p0, *hint);
+    let mut largest_off = off(uv0, p0);
     let mut out = vec![uv0];
     // Explicit stack of intervals (t0, t1, depth) in order; points carried with their uv.
     let p1 = point_at(c, 1.0);
@@ -416,12 +446,13 @@ fn sample(
             stack.push((t1, q1, w1, depth + 1));
             stack.push((tm, qm, wm, depth + 1));
         } else {
+            largest_off = largest_off.max(off(w1, q1));
             out.push(w1);
             cur = (t1, q1, w1);
         }
     }
     *hint = out.last().copied();
-    out
+    (out, largest_off)
 }
 
 /// Appends an edge piece's polygon `pts` to a loop's points, with the `real` flag of each new
