@@ -253,7 +253,7 @@ impl StepModel {
                     }
                     for c in &geom {
                         let (pts, off) = sample(c, &f.surface, &mut hint, chord);
-                        if !(off <= EDGE_OFF_SURFACE_LIMIT * diag) {
+                        if off > EDGE_OFF_SURFACE_LIMIT * diag {
                             return Err(StepError::Geometry {
                                 id: f.id,
                                 entity: "ADVANCED_FACE".into(),
