@@ -5,8 +5,8 @@
 //! query's value to the bit. Run: `cargo fuzz run --sanitizer none kernel_grazing -- -max_total_time=60`.
 #![no_main]
 
-use gwn::eval::antipodal::{Options, WindingNumber};
 use gwn::RayAxis;
+use gwn::eval::antipodal::{Options, WindingNumber};
 use gwn::testing::{on_surface, soup_from_bytes};
 use libfuzzer_sys::fuzz_target;
 

@@ -3,6 +3,7 @@
 //! that evaluates or a one-line error, never a panic.
 
 include!("../../fuzz/fuzz_targets/load_curved_check.rs");
+include!("../../fuzz/fuzz_targets/curved_numbers_edit.rs");
 
 fn corpus() -> Vec<(String, Vec<u8>)> {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus/load_curved");
@@ -150,4 +151,39 @@ fn a_cylinder_whose_radius_disagrees_with_its_edges_is_refused() {
         "CYLINDRICAL_SURFACE('',#10,1.001)",
     );
     assert!(parse_step(&close).is_ok());
+}
+
+/// The `curved_numbers` fuzz target's inputs, drawn at random on stable: each seed with one to
+/// eight of its numbers replaced by arbitrary integers, floats and odd spellings, through the
+/// same check (every input handled: a model that evaluates, or a one-line error).
+#[test]
+fn seeds_with_random_numbers_are_handled() {
+    let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+    let mut next = || {
+        // splitmix64
+        state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    };
+    let mut edited = 0;
+    for case in 0..120 {
+        let mut data = vec![(case % CURVED_SEEDS.len()) as u8];
+        for _ in 0..1 + next() % 8 {
+            data.extend_from_slice(&next().to_le_bytes()[..3]);
+            // Half the values near the seeds' scale, half anywhere in `f64`.
+            let value = if next() % 2 == 0 {
+                ((next() % 2001) as f64 / 100.0 - 10.0).to_bits()
+            } else {
+                next()
+            };
+            data.extend_from_slice(&value.to_le_bytes());
+        }
+        if let Some(input) = edit_curved_seed(&data) {
+            check_load_curved(&input);
+            edited += 1;
+        }
+    }
+    assert_eq!(edited, 120);
 }
