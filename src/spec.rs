@@ -41,6 +41,7 @@ use crate::eval::Evaluator;
 use crate::eval::antipodal::{BoundaryBy, BuildError, DEFAULT_TOLERANCE, Options, WindingNumber};
 use crate::eval::direct::DirectWindingNumber;
 use crate::eval::fast::{Admissibility, FastParams, FastWindingNumber, PointCloudWindingNumber};
+use crate::eval::parity::CrossingParity;
 use crate::input::{Input, InputKind};
 use crate::kernel::frame::RayAxis;
 use crate::kernel::quantize::Precision;
@@ -59,18 +60,22 @@ pub enum Method {
     /// Barnes–Hut (meshes and point clouds; the default for point clouds), options `beta` and
     /// `order`.
     Fast,
+    /// Closed meshes of any orientation: 1 where a ray crosses the surface an odd number of
+    /// times, else 0 ([`CrossingParity`]; the even-odd rule, exact). Options `ray`, `precision`.
+    Parity,
 }
 
 impl Method {
     /// Every method, in the order of the messages.
-    pub const ALL: [Method; 3] = [Method::Exact, Method::Direct, Method::Fast];
+    pub const ALL: [Method; 4] = [Method::Exact, Method::Direct, Method::Fast, Method::Parity];
 
-    /// The name [`FromStr`] accepts: `"exact"`, `"direct"`, `"fast"`.
+    /// The name [`FromStr`] accepts: `"exact"`, `"direct"`, `"fast"`, `"parity"`.
     pub fn name(self) -> &'static str {
         match self {
             Method::Exact => "exact",
             Method::Direct => "direct",
             Method::Fast => "fast",
+            Method::Parity => "parity",
         }
     }
 
@@ -127,7 +132,7 @@ impl SpecOption {
     /// What the option accepts, completing "`name` must be ...".
     fn expected(self) -> &'static str {
         match self {
-            SpecOption::Method => "\"exact\", \"direct\" or \"fast\"",
+            SpecOption::Method => "\"exact\", \"direct\", \"fast\" or \"parity\"",
             SpecOption::Ray => "one of +x -x +y -y +z -z",
             SpecOption::Precision => "30 or 60",
             SpecOption::Tolerance => "a finite number >= 0",
@@ -142,7 +147,7 @@ impl SpecOption {
     /// Which methods use the option, completing "it is an option of ...".
     fn owner(self) -> &'static str {
         match self {
-            SpecOption::Ray | SpecOption::Precision => "the exact method",
+            SpecOption::Ray | SpecOption::Precision => "the exact and parity methods",
             SpecOption::Tolerance => "the exact method, and of the direct method on patch sets",
             SpecOption::Beta | SpecOption::Order | SpecOption::Rule => "the fast method",
             SpecOption::Method => "every method",
@@ -181,7 +186,7 @@ impl std::error::Error for ParseError {}
 
 impl FromStr for Method {
     type Err = ParseError;
-    /// `"exact"`, `"direct"` or `"fast"`.
+    /// `"exact"`, `"direct"`, `"fast"` or `"parity"`.
     fn from_str(s: &str) -> Result<Self, ParseError> {
         Method::ALL
             .into_iter()
@@ -474,8 +479,10 @@ impl EvaluatorSpec {
     fn check_method_options(&self, method: Method) -> Result<(), SpecError> {
         for option in self.given() {
             let used = match option {
-                SpecOption::Ray | SpecOption::Precision => method == Method::Exact,
-                SpecOption::Tolerance => method != Method::Fast,
+                SpecOption::Ray | SpecOption::Precision => {
+                    matches!(method, Method::Exact | Method::Parity)
+                }
+                SpecOption::Tolerance => matches!(method, Method::Exact | Method::Direct),
                 SpecOption::Beta | SpecOption::Order | SpecOption::Rule => method == Method::Fast,
                 SpecOption::Method => true,
             };
@@ -605,6 +612,7 @@ impl EvaluatorSpec {
             Method::Exact => Box::new(WindingNumber::with_options(mesh, self.exact_options())?),
             Method::Direct => Box::new(DirectWindingNumber::new(mesh)),
             Method::Fast => Box::new(FastWindingNumber::with_params(mesh, self.fast_params())),
+            Method::Parity => Box::new(CrossingParity::with_options(mesh, self.exact_options())?),
         })
     }
 }
@@ -630,7 +638,7 @@ mod tests {
         assert_eq!(Precision::try_from(60), Ok(Precision::Bits60));
         assert_eq!(
             "approx".parse::<Method>().unwrap_err().to_string(),
-            "method must be \"exact\", \"direct\" or \"fast\", got \"approx\""
+            "method must be \"exact\", \"direct\", \"fast\" or \"parity\", got \"approx\""
         );
         assert_eq!(
             "+w".parse::<RayAxis>().unwrap_err().to_string(),

@@ -27,9 +27,10 @@ where
 #[derive(ClapArgs, Debug, Clone, Default)]
 pub struct MethodArgs {
     /// Evaluation method: exact (Antipodal method, integer predicates; O(boundary + log faces)
-    /// per query), direct (solid-angle sum over all faces, O(faces); the reference) or fast
-    /// (Barnes-Hut; the method for point clouds) [default: exact for meshes, fast for point
-    /// clouds].
+    /// per query), direct (solid-angle sum over all faces, O(faces); the reference), fast
+    /// (Barnes-Hut; the method for point clouds) or parity (closed meshes of any orientation:
+    /// 1 where a ray crosses the surface an odd number of times, else 0; exact, O(log faces))
+    /// [default: exact for meshes, fast for point clouds].
     #[arg(long, value_parser = parse_option::<Method>)]
     pub method: Option<Method>,
     /// Accuracy of the fast method: a tree node is approximated when its distance exceeds

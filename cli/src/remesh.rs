@@ -14,6 +14,8 @@ use gwn::products::remesh::{DEFAULT_BISECTION_STEPS, RemeshOptions, remesh_guide
 
 use crate::common::{CliError, outln};
 use crate::method::{MethodArgs, ToleranceArgs};
+use gwn::eval::parity::EdgeCensus;
+use gwn::spec::Method;
 
 /// Remesh at w = 1/2: a closed, edge- and vertex-manifold, consistently oriented surface of the
 /// solid where the winding number (exact by default) is above 1/2.
@@ -339,6 +341,17 @@ pub fn run(args: Args) -> Result<(), CliError> {
             100.0 * a,
             args.samples
         )?;
+    }
+    if let (Some(mesh), Method::Exact) = (input.mesh(), method.method_for(input.kind())) {
+        let census = EdgeCensus::of(mesh, method.boundary);
+        if census.closed_but_not_oriented() && args.thicken.is_none() {
+            outln!(
+                "the input is closed but not consistently oriented ({} signed boundary edges): \
+                 w is fractional near its flipped faces; --method parity remeshes the solid it \
+                 encloses",
+                census.signed_boundary_edges
+            )?;
+        }
     }
     if let Some(path) = &args.report {
         std::fs::write(path, report.to_json() + "\n")

@@ -15,7 +15,7 @@ _Indices = npt.ArrayLike
 """int32/int64/uint32/uint64 array-like of shape (m, 3) (tets: (t, 4))."""
 _F64 = npt.NDArray[np.float64]
 _I64 = npt.NDArray[np.int64]
-_Method = Literal["exact", "direct", "fast"]
+_Method = Literal["exact", "direct", "fast", "parity"]
 _Ray = Literal["+x", "-x", "+y", "-y", "+z", "-z"]
 _Rule = Literal["radius", "box-diagonal", "box-corner", "radius-or-box-corner"]
 _Grid = Tuple[_F64, _F64, _F64]
@@ -188,7 +188,7 @@ def voxelize(
     dims: Optional[Tuple[int, int, int]] = None,
     bounds: Optional[Tuple[float, float, float, float, float, float]] = None,
     margin: float = 0.05,
-    method: Literal["exact", "direct", "fast"] = "exact",
+    method: Literal["exact", "direct", "fast", "parity"] = "exact",
     beta: Optional[float] = None,
     order: Optional[int] = None,
     tolerance: Optional[float] = None,
@@ -204,7 +204,7 @@ def remesh(
     *,
     bisect: int = 8,
     simplify: bool = True,
-    method: Literal["exact", "direct", "fast"] = "exact",
+    method: Literal["exact", "direct", "fast", "parity"] = "exact",
     beta: Optional[float] = None,
     order: Optional[int] = None,
     tolerance: Optional[float] = None,
@@ -227,7 +227,7 @@ def remesh(
     *,
     bisect: int = 8,
     simplify: bool = True,
-    method: Literal["exact", "direct", "fast"] = "exact",
+    method: Literal["exact", "direct", "fast", "parity"] = "exact",
     beta: Optional[float] = None,
     order: Optional[int] = None,
     tolerance: Optional[float] = None,
@@ -275,7 +275,7 @@ def slice(
     res: int = 1024,
     margin: float = 0.1,
     outline: bool = False,
-    method: Literal["exact", "direct", "fast"] = "exact",
+    method: Literal["exact", "direct", "fast", "parity"] = "exact",
     beta: Optional[float] = None,
     order: Optional[int] = None,
     tolerance: Optional[float] = None,
@@ -289,7 +289,7 @@ def classify(
     VB: Union[_Floats, _Curved],
     FB: Optional[_Indices] = None,
     *,
-    method: Literal["exact", "direct", "fast"] = "exact",
+    method: Literal["exact", "direct", "fast", "parity"] = "exact",
     beta: Optional[float] = None,
     order: Optional[int] = None,
     tolerance: Optional[float] = None,
@@ -304,7 +304,7 @@ def filter_tets(
     tets: _Indices,
     threshold: float = 0.5,
     *,
-    method: Literal["exact", "direct", "fast"] = "exact",
+    method: Literal["exact", "direct", "fast", "parity"] = "exact",
     beta: Optional[float] = None,
     order: Optional[int] = None,
     tolerance: Optional[float] = None,

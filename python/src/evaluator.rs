@@ -7,6 +7,7 @@ use gwn::Mesh;
 use gwn::eval::antipodal::{DEFAULT_TOLERANCE, WindingNumber};
 use gwn::eval::direct::{winding_number_direct_batch, winding_number_gradient_direct};
 use gwn::eval::fast::{Admissibility, FastWindingNumber, PointCloudWindingNumber};
+use gwn::eval::parity::CrossingParity;
 use gwn::input::InputKind;
 use gwn::patch::step::{StepModel, StepWindingNumber};
 use gwn::patch::surface_quadrature::SurfaceQuadrature;
@@ -89,6 +90,8 @@ pub enum Evaluator {
     FastSoup(FastWindingNumber),
     /// Barnes–Hut over an oriented point cloud.
     FastCloud(PointCloudWindingNumber),
+    /// The crossing parity of a closed mesh (boxed like the exact evaluator it holds).
+    Parity(Box<CrossingParity>),
     /// A trimmed B-rep (STEP) model: crossings of the trimmed faces plus the surface-boundary
     /// integral (boxed: the model is large).
     Step(Box<StepWindingNumber>),
@@ -128,6 +131,10 @@ impl Evaluator {
             Method::Fast => {
                 Evaluator::FastSoup(FastWindingNumber::with_params(mesh, spec.fast_params()))
             }
+            Method::Parity => Evaluator::Parity(Box::new(CrossingParity::with_options(
+                mesh,
+                spec.exact_options(),
+            )?)),
         })
     }
 
@@ -159,6 +166,7 @@ impl Evaluator {
             Evaluator::Direct(_) => "direct",
             Evaluator::FastSoup(_) => "fast",
             Evaluator::FastCloud(_) => "fast point-cloud",
+            Evaluator::Parity(_) => "parity",
             Evaluator::Step(_) => "trimmed B-rep (STEP)",
             Evaluator::Patches(_) => "exact (patches)",
             Evaluator::PatchesDirect { .. } => "direct (patches)",
@@ -172,6 +180,7 @@ impl Evaluator {
             Evaluator::Direct(mesh) => winding_number_direct_batch(mesh, points),
             Evaluator::FastSoup(f) => f.eval_batch(points),
             Evaluator::FastCloud(f) => f.eval_batch(points),
+            Evaluator::Parity(p) => p.eval_batch(points),
             Evaluator::Step(s) => s.eval_batch(points),
             Evaluator::Patches(p) => p.eval_batch(points),
             Evaluator::PatchesDirect { set, tolerance } => {

@@ -143,6 +143,15 @@ impl PyWindingNumber {
                 None,
             ),
             Method::Direct => ("direct", None, None, None, None, None, None),
+            Method::Parity => (
+                "parity",
+                None,
+                None,
+                Some(exact.precision.bits()),
+                Some(exact.ray.to_string()),
+                None,
+                None,
+            ),
             Method::Fast => (
                 "fast",
                 Some(fast.beta),

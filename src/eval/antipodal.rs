@@ -81,6 +81,12 @@ pub enum BuildError {
     CoordinateRange,
     /// [`Options::tolerance`] is NaN, infinite or negative (the value as written).
     Tolerance(String),
+    /// The parity method's mesh is not closed: `odd_edges` edges (by position, or by index with
+    /// [`BoundaryBy::Index`]) have an odd number of faces ([`super::parity::CrossingParity`]).
+    NotClosed {
+        /// How many.
+        odd_edges: usize,
+    },
 }
 
 impl std::fmt::Display for BuildError {
@@ -95,6 +101,11 @@ impl std::fmt::Display for BuildError {
             BuildError::Tolerance(t) => {
                 write!(f, "tolerance must be a finite number >= 0, got {t}")
             }
+            BuildError::NotClosed { odd_edges } => write!(
+                f,
+                "the parity method needs a closed mesh, but {odd_edges} edges have an odd \
+                 number of faces (use the exact method: w > 1/2)"
+            ),
         }
     }
 }
@@ -149,8 +160,8 @@ impl WindingNumber {
         }
         let start = Instant::now();
         let core = match options.precision {
-            Precision::Bits30 => Dispatch::Narrow(exact_index(mesh, options)?),
-            Precision::Bits60 => Dispatch::Wide(exact_index(mesh, options)?),
+            Precision::Bits30 => Dispatch::Narrow(exact_index(mesh, options, true)?),
+            Precision::Bits60 => Dispatch::Wide(exact_index(mesh, options, true)?),
         };
         let boundary = match &core {
             Dispatch::Narrow(c) => c.boundary_len(),
@@ -160,6 +171,25 @@ impl WindingNumber {
             core,
             faces: mesh.triangles().len(),
             boundary,
+            precompute: start.elapsed(),
+            options,
+        })
+    }
+
+    /// The index of `mesh`'s triangles without its boundary: [`WindingNumber::eval`] is then the
+    /// signed crossing count χ of the ray alone, an exact integer (what
+    /// [`super::parity::CrossingParity`] reduces mod 2). Not a winding number unless the mesh is
+    /// closed and consistently oriented.
+    pub(crate) fn crossings_only(mesh: &Mesh, options: Options) -> Result<Self, BuildError> {
+        let start = Instant::now();
+        let core = match options.precision {
+            Precision::Bits30 => Dispatch::Narrow(exact_index(mesh, options, false)?),
+            Precision::Bits60 => Dispatch::Wide(exact_index(mesh, options, false)?),
+        };
+        Ok(WindingNumber {
+            core,
+            faces: mesh.triangles().len(),
+            boundary: 0,
             precompute: start.elapsed(),
             options,
         })
@@ -407,14 +437,20 @@ impl WindingNumber {
     }
 }
 
-/// Quantizes `mesh` on the `W` grid, finds its signed boundary, and indexes it in the ray frame.
-fn exact_index<W: Width>(mesh: &Mesh, options: Options) -> Result<ExactIndex<W>, BuildError> {
+/// Quantizes `mesh` on the `W` grid, finds its signed boundary (unless `with_boundary` is
+/// false), and indexes it in the ray frame.
+fn exact_index<W: Width>(
+    mesh: &Mesh,
+    options: Options,
+    with_boundary: bool,
+) -> Result<ExactIndex<W>, BuildError> {
     let Some(bbox) = mesh.bounding_box() else {
         return Ok(ExactIndex::empty(options.ray)?);
     };
     let vertices = QuantizedVertices::new(&bbox, mesh.positions(), W::PRECISION, options.ray)?;
     let tris = mesh.triangles();
     let boundary = match options.boundary {
+        _ if !with_boundary => Vec::new(),
         // The 60-bit evaluator computes on the input values, so it welds equal input positions
         // (`+ 0.0` identifies −0 with 0); the 30-bit one on the snapped mesh.
         BoundaryBy::Position if W::PRECISION == Precision::Bits60 => {

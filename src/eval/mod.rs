@@ -10,6 +10,7 @@ pub mod direct;
 mod evaluator;
 pub mod fast;
 pub mod fossil;
+pub mod parity;
 
 pub use evaluator::{Evaluator, NoGradient, SurfaceCrossing};
 

@@ -15,4 +15,5 @@ mod exactness;
 mod gradient;
 mod grid;
 mod input_bits;
+mod parity;
 mod testing_kit;
