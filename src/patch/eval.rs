@@ -470,6 +470,21 @@ struct Accumulator {
 }
 
 impl Accumulator {
+    /// Adds one integral (or azimuth) term and its error. A term that is not finite (rounding
+    /// gone past `f64`'s range: a fuzzed unit cube with one control point at `1.2·10^155`,
+    /// queried at a corner, whose pieces shrink below the smallest normal number after the
+    /// set's scaling) is left out of the sum and flags the value with an infinite estimate:
+    /// the value stays finite and is not certified.
+    fn add_term(&mut self, value: f64, error: f64) {
+        if value.is_finite() {
+            self.sum.add(value);
+            self.out.error_estimate += error;
+        } else {
+            self.out.uncertified_pieces += 1;
+            self.out.error_estimate = f64::INFINITY;
+        }
+    }
+
     fn integrate(&mut self, ctrl: Vec<Homogeneous>, form: Form) {
         self.tasks.push(Task::Curve(ctrl, form));
     }
@@ -562,8 +577,7 @@ impl Accumulator {
                     tol * 0.5f64.powi(level as i32),
                     budget,
                 );
-                self.sum.add(r.value);
-                self.out.error_estimate += r.error;
+                self.add_term(r.value, r.error);
                 self.out.evaluations += r.evaluations;
                 self.out.capped |= r.capped > 0;
             } else {
@@ -626,8 +640,7 @@ impl Accumulator {
                 tol * share,
                 budget,
             );
-            self.sum.add(r.value);
-            self.out.error_estimate += r.error;
+            self.add_term(r.value, r.error);
             self.out.evaluations += r.evaluations;
             self.out.capped |= r.capped > 0;
         }
@@ -697,7 +710,7 @@ impl Accumulator {
             Form::Down => -2.0,
         };
         match azimuth_change(ctrl) {
-            Some(a) => self.sum.add(sign * a),
+            Some(a) => self.add_term(sign * a, 0.0),
             None => {
                 // Unreachable when the classification holds (the edge then avoids the ray's
                 // line); kept so that a violated assumption costs time, not correctness.

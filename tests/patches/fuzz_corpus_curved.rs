@@ -187,3 +187,30 @@ fn seeds_with_random_numbers_are_handled() {
     }
     assert_eq!(edited, 120);
 }
+
+/// The `curved_numbers` fuzzer's corpus (`fuzz/corpus/curved_numbers/`), replayed on stable.
+/// `nan_at_a_corner` is its first find: the cube patch set with one control point moved to
+/// `1.2·10^155`, whose exact evaluation at the corner `(0, 0, 0)` was NaN (now finite,
+/// uncertified, with an infinite error estimate).
+#[test]
+fn curved_numbers_corpus_is_handled() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus/curved_numbers");
+    let mut replayed = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let data = std::fs::read(entry.unwrap().path()).unwrap();
+        if let Some(input) = edit_curved_seed(&data) {
+            check_load_curved(&input);
+            replayed += 1;
+        }
+    }
+    assert!(replayed >= 1, "{replayed}");
+    let corner = edit_curved_seed(&std::fs::read(dir.join("nan_at_a_corner")).unwrap()).unwrap();
+    let text = std::str::from_utf8(&corner[1..]).unwrap();
+    assert!(text.contains("1.1937922535104073e155 0.0 1.0"), "{text}");
+    let set = gwn::patch::io::parse_patches(text, gwn::patch::io::PatchFormat::Bpt).unwrap();
+    let e = gwn::patch::PatchWindingNumber::new(&set).evaluate([0.0, 0.0, 0.0]);
+    assert!(
+        e.value.is_finite() && !e.certified && e.error_estimate == f64::INFINITY,
+        "{e:?}"
+    );
+}
