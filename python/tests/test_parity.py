@@ -1,0 +1,51 @@
+"""The parity method from Python: ``method="parity"`` gives 1 where a ray crosses a closed mesh
+an odd number of times, whatever its faces' orientations, in ``WindingNumber``, the grid products
+and ``remesh``; open meshes are refused with the number of odd edges."""
+
+import numpy as np
+import pytest
+
+import gwn
+
+from conftest import CUBE_F, CUBE_V, OPEN_BOX_F
+
+# The unit cube with every other face flipped: closed, not oriented (w is fractional inside).
+FLIPPED_F = np.array([f[::-1] if k % 2 else f for k, f in enumerate(CUBE_F)], dtype=np.int64)
+
+
+def grid_points(n=7):
+    t = (np.arange(n) + 0.5) / n * 1.6 - 0.3  # -0.3 .. 1.3, off the cube's planes
+    return np.stack(np.meshgrid(t, t, t, indexing="ij"), -1).reshape(-1, 3)
+
+
+def test_parity_is_the_enclosed_solid_where_w_is_not():
+    q = grid_points()
+    inside = np.all((q > 0) & (q < 1), axis=1).astype(np.float64)
+    for ray in ["+x", "-y", "+z"]:
+        p = gwn.WindingNumber(CUBE_V, FLIPPED_F, method="parity", ray=ray)(q)
+        np.testing.assert_array_equal(p, inside)
+    w = gwn.WindingNumber(CUBE_V, FLIPPED_F)(q)
+    assert np.any(np.abs(w[inside == 1] - 1) > 0.1)  # w alone is not the solid here
+    W, origin, spacing = gwn.voxelize(CUBE_V, FLIPPED_F, res=8, margin=0.5, method="parity")
+    k, j, i = np.meshgrid(*(np.arange(n) for n in W.shape), indexing="ij")
+    centres = origin + np.stack([i, j, k], -1).reshape(-1, 3) * spacing
+    expected = np.all((centres > 0) & (centres < 1), axis=1).astype(np.float64)
+    np.testing.assert_array_equal(W.reshape(-1), expected)
+    assert 0 < expected.sum() < len(expected)
+
+
+def test_remesh_with_parity_encloses_the_cube():
+    V, F, report = gwn.remesh(CUBE_V, FLIPPED_F, res=16, method="parity", report=True)
+    assert report["closed"] and report["oriented"] and report["components"] == 1
+    # Volume by the divergence theorem: the unit cube's, within the placement's precision.
+    a, b, c = (V[F[:, k]] for k in range(3))
+    volume = np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6
+    assert abs(volume - 1) < 1e-3, volume
+    assert report["hausdorff_cells"] < 1
+
+
+def test_open_meshes_and_options_are_refused():
+    with pytest.raises(ValueError, match="parity method needs a closed mesh, but 4 edges"):
+        gwn.WindingNumber(CUBE_V, OPEN_BOX_F, method="parity")
+    with pytest.raises(ValueError, match="tolerance does not apply to the parity method"):
+        gwn.WindingNumber(CUBE_V, CUBE_F, method="parity", tolerance=1e-6)
