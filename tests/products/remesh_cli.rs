@@ -426,3 +426,73 @@ fn remesh_reports_the_plate_refinement_and_can_turn_it_off() {
     assert!(report_number(&json, "occupancy_agreement") < 0.98, "{json}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A closed cube with half its faces flipped: the exact method's `w` is fractional inside, and
+/// the remesh says so and names `--method parity`, whose output is the cube (one component
+/// within a cell of the input, which it bounds everywhere); an open box is refused by parity.
+#[test]
+fn remesh_points_closed_unoriented_inputs_to_the_parity_method() {
+    let dir = std::env::temp_dir().join(format!("gwn-cli-parity-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cube = gwn::testing::unit_cube(false);
+    let flipped: Vec<[u32; 3]> = cube
+        .triangles()
+        .iter()
+        .enumerate()
+        .map(|(f, &[a, b, c])| if f % 2 == 1 { [a, c, b] } else { [a, b, c] })
+        .collect();
+    let flipped = gwn::Mesh::new(cube.positions().to_vec(), flipped).unwrap();
+    let input = dir.join("flipped.obj");
+    gwn::mesh::write_obj(std::fs::File::create(&input).unwrap(), &flipped).unwrap();
+    let out = dir.join("out.ply");
+    let run = |also: &[&str]| {
+        let mut args = vec![
+            "remesh",
+            input.to_str().unwrap(),
+            "--res",
+            "16",
+            "--samples",
+            "2000",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(also);
+        gwn(&args)
+    };
+    let (ok, stdout, stderr) = run(&[]);
+    assert!(ok, "{stderr}");
+    assert!(
+        stdout.contains("the input is closed but not consistently oriented")
+            && stdout.contains("--method parity"),
+        "{stdout}"
+    );
+    let (ok, stdout, stderr) = run(&["--method", "parity"]);
+    assert!(ok, "{stderr}");
+    assert!(!stdout.contains("not consistently oriented"), "{stdout}");
+    assert!(
+        stdout.contains("Euler characteristic 2; 1 component(s)")
+            && stdout.contains("w > 1/2 on one side only: 100.0 % of its samples"),
+        "{stdout}"
+    );
+    let open = dir.join("open.obj");
+    gwn::mesh::write_obj(
+        std::fs::File::create(&open).unwrap(),
+        &gwn::testing::unit_cube(true),
+    )
+    .unwrap();
+    let (ok, _, stderr) = gwn(&[
+        "remesh",
+        open.to_str().unwrap(),
+        "--method",
+        "parity",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!ok);
+    assert!(
+        stderr.contains("the parity method needs a closed mesh, but 4 edges have an odd number")
+            && stderr.trim().lines().count() == 1,
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
