@@ -32,7 +32,7 @@
 
 use super::Evaluator;
 use super::antipodal::{BoundaryBy, BuildError, Options, WindingNumber};
-use crate::mesh::{Mesh, boundary_edges, boundary_welded_by};
+use crate::mesh::{Mesh, boundary_edges, geometric_boundary_edges};
 
 /// The crossing parity of a closed mesh: 1 inside, 0 outside, NaN for a non-finite query.
 #[derive(Clone, Debug)]
@@ -99,14 +99,7 @@ impl EdgeCensus {
     /// evaluator's default) or by index.
     pub fn of(mesh: &Mesh, by: BoundaryBy) -> EdgeCensus {
         let boundary = match by {
-            BoundaryBy::Position => {
-                let keys: Vec<[u64; 3]> = mesh
-                    .positions()
-                    .iter()
-                    .map(|p| p.map(|c| (c + 0.0).to_bits()))
-                    .collect();
-                boundary_welded_by(mesh.triangles(), &keys)
-            }
+            BoundaryBy::Position => geometric_boundary_edges(mesh),
             BoundaryBy::Index => boundary_edges(mesh),
         };
         EdgeCensus {

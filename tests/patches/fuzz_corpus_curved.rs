@@ -86,26 +86,7 @@ fn numbers_replaced_by_extreme_values_are_handled() {
         let Ok(text) = std::str::from_utf8(&input[1..]) else {
             continue;
         };
-        // Numbers: maximal runs of digits, signs, dots and exponents that start with a digit
-        // (or a sign/dot before one), outside `#id` references.
-        let bytes = text.as_bytes();
-        let mut spans = Vec::new();
-        let mut i = 0;
-        while i < bytes.len() {
-            let starts = bytes[i].is_ascii_digit()
-                && (i == 0 || !(bytes[i - 1].is_ascii_alphanumeric() || bytes[i - 1] == b'#'));
-            if starts {
-                let mut j = i;
-                while j < bytes.len() && (bytes[j].is_ascii_digit() || b".Ee+-".contains(&bytes[j]))
-                {
-                    j += 1;
-                }
-                spans.push((i, j));
-                i = j;
-            } else {
-                i += 1;
-            }
-        }
+        let spans = number_spans(text.as_bytes());
         for &(a, b) in spans.iter().step_by(stride) {
             for value in extremes {
                 let mut data = vec![input[0]];
