@@ -121,7 +121,7 @@ fn cli_methods_apply_to_every_product_and_misuse_is_an_error() {
         "eval", mesh, "--points", queries, "--method", "fast", "--ray", "-x",
     ]);
     assert!(
-        err.contains("ray does not apply to the fast method (it is an option of the exact method)"),
+        err.contains("ray does not apply to the fast method (it is an option of the exact and parity methods)"),
         "{err}"
     );
     let err = one_line_error(&["slice", cloud, "--outline", "--out", &d("o.png")]);
