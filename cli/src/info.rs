@@ -231,6 +231,13 @@ fn report(path: &std::path::Path, l: &gwn::io::LoadedMesh, s: &MeshStats) -> Str
         );
     } else {
         out.push_str("signed boundary is not empty: w varies continuously near the boundary\n");
+        let census = gwn::eval::parity::EdgeCensus::of(&l.mesh, Default::default());
+        if census.closed_but_not_oriented() {
+            out.push_str(
+                "closed but not consistently oriented (every edge has an even number of faces): \
+                 --method parity gives the solid it encloses\n",
+            );
+        }
     }
     out
 }

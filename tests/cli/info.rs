@@ -157,3 +157,39 @@ fn cli_info_on_point_clouds_and_faceless_ply() {
     assert_eq!(message, String::from_utf8_lossy(&eval.stderr));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A closed tetrahedron with one face flipped: `gwn info` says the parity method applies; an
+/// open mesh (one triangle), whose signed boundary is not empty either, does not get the line.
+#[test]
+fn cli_info_names_the_parity_method_for_closed_unoriented_meshes() {
+    let exe = env!("CARGO_BIN_EXE_gwn");
+    let dir = std::env::temp_dir().join(format!("gwn-info-parity-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let flipped = dir.join("flipped_tet.off");
+    std::fs::write(
+        &flipped,
+        "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 1 3\n3 1 2 3\n3 2 0 3\n",
+    )
+    .unwrap();
+    let open = dir.join("triangle.off");
+    std::fs::write(&open, "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n").unwrap();
+    let line = "--method parity gives the solid it encloses";
+    let out = Command::new(exe)
+        .args(["info"])
+        .arg(&flipped)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    assert!(stdout.contains(line), "{stdout}");
+    let out = Command::new(exe)
+        .args(["info"])
+        .arg(&open)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        stdout.contains("signed boundary is not empty") && !stdout.contains(line),
+        "{stdout}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
