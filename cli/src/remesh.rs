@@ -342,9 +342,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
             args.samples
         )?;
     }
-    if let (Some(mesh), Method::Exact) = (input.mesh(), method.method_for(input.kind())) {
+    if let (Some(mesh), Method::Exact, None) =
+        (input.mesh(), method.method_for(input.kind()), args.thicken)
+    {
         let census = EdgeCensus::of(mesh, method.boundary);
-        if census.closed_but_not_oriented() && args.thicken.is_none() {
+        if census.closed_but_not_oriented() {
             outln!(
                 "the input is closed but not consistently oriented ({} signed boundary edges): \
                  w is fractional near its flipped faces; --method parity remeshes the solid it \

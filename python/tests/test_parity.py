@@ -44,6 +44,18 @@ def test_remesh_with_parity_encloses_the_cube():
     assert report["hausdorff_cells"] < 1
 
 
+def test_the_parity_evaluator_pickles_with_its_ray_and_has_no_gradient():
+    import pickle
+
+    wn = gwn.WindingNumber(CUBE_V, FLIPPED_F, method="parity", ray="-y")
+    back = pickle.loads(pickle.dumps(wn))
+    assert back.method == "parity"
+    q = grid_points()
+    np.testing.assert_array_equal(back(q), wn(q))
+    with pytest.raises(ValueError, match="gradient is not available with the parity method"):
+        wn.gradient(q[:1])
+
+
 def test_open_meshes_and_options_are_refused():
     with pytest.raises(ValueError, match="parity method needs a closed mesh, but 4 edges"):
         gwn.WindingNumber(CUBE_V, OPEN_BOX_F, method="parity")

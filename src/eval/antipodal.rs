@@ -158,10 +158,23 @@ impl WindingNumber {
         if !(options.tolerance.is_finite() && options.tolerance >= 0.0) {
             return Err(BuildError::Tolerance(options.tolerance.to_string()));
         }
+        Self::build(mesh, options, true)
+    }
+
+    /// The index of `mesh`'s triangles without its boundary: [`WindingNumber::eval`] is then the
+    /// signed crossing count χ of the ray alone, an exact integer (what
+    /// [`super::parity::CrossingParity`] reduces mod 2). Not a winding number unless the mesh is
+    /// closed and consistently oriented.
+    pub(crate) fn crossings_only(mesh: &Mesh, options: Options) -> Result<Self, BuildError> {
+        Self::build(mesh, options, false)
+    }
+
+    /// Quantizes and indexes `mesh`, with its signed boundary unless `with_boundary` is false.
+    fn build(mesh: &Mesh, options: Options, with_boundary: bool) -> Result<Self, BuildError> {
         let start = Instant::now();
         let core = match options.precision {
-            Precision::Bits30 => Dispatch::Narrow(exact_index(mesh, options, true)?),
-            Precision::Bits60 => Dispatch::Wide(exact_index(mesh, options, true)?),
+            Precision::Bits30 => Dispatch::Narrow(exact_index(mesh, options, with_boundary)?),
+            Precision::Bits60 => Dispatch::Wide(exact_index(mesh, options, with_boundary)?),
         };
         let boundary = match &core {
             Dispatch::Narrow(c) => c.boundary_len(),
@@ -171,25 +184,6 @@ impl WindingNumber {
             core,
             faces: mesh.triangles().len(),
             boundary,
-            precompute: start.elapsed(),
-            options,
-        })
-    }
-
-    /// The index of `mesh`'s triangles without its boundary: [`WindingNumber::eval`] is then the
-    /// signed crossing count χ of the ray alone, an exact integer (what
-    /// [`super::parity::CrossingParity`] reduces mod 2). Not a winding number unless the mesh is
-    /// closed and consistently oriented.
-    pub(crate) fn crossings_only(mesh: &Mesh, options: Options) -> Result<Self, BuildError> {
-        let start = Instant::now();
-        let core = match options.precision {
-            Precision::Bits30 => Dispatch::Narrow(exact_index(mesh, options, false)?),
-            Precision::Bits60 => Dispatch::Wide(exact_index(mesh, options, false)?),
-        };
-        Ok(WindingNumber {
-            core,
-            faces: mesh.triangles().len(),
-            boundary: 0,
             precompute: start.elapsed(),
             options,
         })
