@@ -20,7 +20,9 @@ use super::angle_sum::AngleSum;
 #[cfg(target_arch = "x86_64")]
 use super::angle_sum::AngleSumAvx2;
 use super::double_double::DoubleDouble;
-use super::input_predicates::{InputPoint, LatticeFrame, input_inside_segment, input_orient2d};
+use super::input_predicates::{
+    InputPoint, LatticeFrame, exact_edge_moment, input_inside_segment, input_orient2d,
+};
 #[cfg(target_arch = "x86_64")]
 use super::lanes::Avx2;
 use super::lanes::{Portable, edge_term, horizontal_sq, projected_dot, vertex_factors};
@@ -846,7 +848,10 @@ impl BoundaryEdges {
         let ra = exact_offsets(pa, q, z_exact, qz_units);
         let rb = exact_offsets(pb, q, z_exact, qz_units);
         if accurate {
-            antipodal_edge_area_accurate(ra, rb, signs)
+            // The exact moment only where the query's residual and the ray coordinate are the
+            // input's (a clamped query is far from every segment).
+            let moment = || z_exact.then(|| exact_edge_moment(q, pa, pb, &self.lattice))?;
+            antipodal_edge_area_accurate(ra, rb, signs, moment)
         } else {
             // `hi` is the offset rounded once (normalized pairs).
             antipodal_edge_area(ra.map(|x| x.hi), rb.map(|x| x.hi), signs)

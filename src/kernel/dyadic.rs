@@ -52,6 +52,36 @@ impl Dyadic {
         }
     }
 
+    /// `⌊log2 |self|⌋`, or `None` for zero.
+    pub(crate) fn exponent(&self) -> Option<i64> {
+        (self.m.sign() != Sign::NoSign).then(|| self.e + self.m.bits() as i64 - 1)
+    }
+
+    /// `self · 2^-k` rounded to `f64` (relative error `≤ 2^-52`), for `|self · 2^-k| < 2^1000`;
+    /// values below `2^-1000` come out as subnormals or zero. For a direction given by exact
+    /// components: `k` the largest [`Dyadic::exponent`] brings it to unit size without ever
+    /// overflowing, whatever the components' range.
+    pub(crate) fn to_f64_scaled(&self, k: i64) -> f64 {
+        let bits = self.m.bits() as i64;
+        // The leading 63 bits of the significand fit an `i64` exactly; dropping the rest rounds
+        // by at most one unit in the 63rd bit, then the conversion to `f64` by half an ulp.
+        let drop = (bits - 63).max(0);
+        let top = i64::try_from(&self.m >> drop as usize).unwrap_or(0);
+        let e = self.e + drop - k;
+        if e < -1100 - 63 {
+            return 0.0;
+        }
+        super::boundary_sum::scaled_by_power_of_two(top as f64, e.min(1100))
+    }
+
+    /// `self · 2^-k` as a double-double (leading and trailing parts each rounded once: within
+    /// `2^-104` relative), under the same range conditions as [`Dyadic::to_f64_scaled`].
+    pub(crate) fn to_double_double_scaled(&self, k: i64) -> (f64, f64) {
+        let hi = self.to_f64_scaled(k);
+        let rest = self - &Dyadic::from_f64(hi).scaled(k);
+        (hi, rest.to_f64_scaled(k))
+    }
+
     /// Both significands over the smaller exponent.
     fn aligned(a: &Dyadic, b: &Dyadic) -> (BigInt, BigInt, i64) {
         if a.m.sign() == Sign::NoSign {
@@ -110,5 +140,32 @@ mod tests {
         let big = Dyadic::from_f64(f64::MAX).scaled(5000);
         assert_eq!((&big - &Dyadic::from_f64(f64::MAX)).sign(), 1);
         assert_eq!(Dyadic::from_f64(-0.0).sign(), 0);
+    }
+
+    #[test]
+    fn scaled_conversion_keeps_the_leading_bits_at_any_exponent() {
+        assert_eq!(Dyadic::from_f64(0.0).exponent(), None);
+        assert_eq!(Dyadic::from_f64(1.0).exponent(), Some(0));
+        assert_eq!(Dyadic::from_f64(-3.0).exponent(), Some(1));
+        assert_eq!(Dyadic::from_f64(f64::from_bits(1)).exponent(), Some(-1074));
+        // A subnormal times a normal number, exactly, then back to unit size.
+        let tiny = Dyadic::from_f64(3.0 * f64::from_bits(1));
+        let p = &tiny * &Dyadic::from_f64(0.7);
+        let k = p.exponent().unwrap();
+        let x = p.to_f64_scaled(k);
+        assert!((1.0..2.0).contains(&x));
+        assert!((x - 2.1 / 2.0).abs() < 1e-15, "{x}");
+        // More than 63 significant bits, negative: rounded to within 2^-52.
+        let wide = &(&Dyadic::from_int(-(1 << 100)) - &Dyadic::from_int(12345)) * &tiny;
+        let k = wide.exponent().unwrap();
+        assert!((wide.to_f64_scaled(k) + 1.5).abs() < 1e-15);
+        // Double-double: the trailing part holds the bits past the leading 53.
+        let (hi, lo) = wide.to_double_double_scaled(k);
+        let exact = &Dyadic::from_f64(hi).scaled(k) + &Dyadic::from_f64(lo).scaled(k);
+        let err = (&wide - &exact).to_f64_scaled(k);
+        assert!(lo != 0.0 && err.abs() < 1e-30, "{lo:e} {err:e}");
+        // Far below the unit: zero, not a panic.
+        assert_eq!(tiny.to_f64_scaled(2000), 0.0);
+        assert_eq!(Dyadic::from_f64(0.0).to_f64_scaled(0), 0.0);
     }
 }

@@ -24,6 +24,7 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
+use super::double_double::DoubleDouble;
 use super::dyadic::Dyadic;
 use super::predicates::Orient2d;
 
@@ -417,6 +418,39 @@ pub fn input_inside_segment(
     }
     let dot = &(&(&ra[0] * &rb[0]) + &(&ra[1] * &rb[1])) + &(&ra[2] * &rb[2]);
     dot.sign() < 0
+}
+
+/// `(a − q) × (b − q)` on the exact inputs as `(v, k)` with the vector `v·2^k`: `v`'s largest
+/// component in `[1, 2)`, each a double-double within `2^-104` (components `2^-1000` below the
+/// largest come out as zero), or `None` when it is zero (`q` on the line `a b`).
+///
+/// For the edge term of a query within a tiny angle of the segment's interior
+/// ([`super::spherical::antipodal_edge_area_accurate`]): there both offsets are nearly
+/// antiparallel, every product in the cross product cancels to that angle, and the offsets' own
+/// roundings (even in double-double) would decide its direction.
+#[cold]
+pub fn exact_edge_moment(
+    q: &InputPoint,
+    a: &InputPoint,
+    b: &InputPoint,
+    lattice: &LatticeFrame,
+) -> Option<([DoubleDouble; 3], i64)> {
+    let q = lattice.point(q);
+    let offsets = |p: &InputPoint| -> [Dyadic; 3] {
+        let p = lattice.point(p);
+        std::array::from_fn(|k| &p[k] - &q[k])
+    };
+    let (ra, rb) = (offsets(a), offsets(b));
+    let m: [Dyadic; 3] = std::array::from_fn(|k| {
+        let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+        &(&ra[i] * &rb[j]) - &(&ra[j] * &rb[i])
+    });
+    let top = m.iter().filter_map(Dyadic::exponent).max()?;
+    let m = m.map(|c| {
+        let (hi, lo) = c.to_double_double_scaled(top);
+        DoubleDouble { hi, lo }
+    });
+    Some((m, top))
 }
 
 #[cfg(test)]

@@ -10,6 +10,7 @@
 
 use super::double_double::{DoubleDouble, dot3};
 
+use super::boundary_sum::scaled_by_power_of_two;
 use super::quantize::decompose;
 use crate::base::vec3::{cross, dot, norm};
 
@@ -346,15 +347,24 @@ pub fn antipodal_edge_area(ra: [f64; 3], rb: [f64; 3], signs: EdgeSigns) -> f64 
 /// arguments cancel (`|n|, den ≈ |a−q||b−q|·θ` with `θ ≈ distance/length`, so `f64` loses
 /// `log2(1/θ)` bits; double-double keeps ~106 − log2(1/θ)). The degenerate limits (exact zero
 /// components) are directions only and take the `f64` formulas.
+///
+/// A query within [`NEAR_SEGMENT_ANGLE`] of the segment's interior loses every bit even there
+/// (a query `1e-30` from an edge of a unit triangle erred by `1e-4`; `1e-300` from it, by
+/// `0.125`, and differently on every ray). `exact_moment` then gives the exact direction of
+/// `ra × rb` ([`super::input_predicates::exact_edge_moment`]; `None` when the query is on the
+/// edge's line, or not computable) and the term is its limit along the query's own
+/// perpendicular offset (see [`near_segment_area`]).
 pub fn antipodal_edge_area_accurate(
     ra: [DoubleDouble; 3],
     rb: [DoubleDouble; 3],
     signs: EdgeSigns,
+    exact_moment: impl FnOnce() -> Option<([DoubleDouble; 3], i64)>,
 ) -> f64 {
     // The term depends on the directions of `ra` and `rb` only (numerator and denominator are
     // both homogeneous of degree 1 in each): scaled by powers of two to unit size, offsets of
     // `1e-300` (a query next to a boundary vertex) neither underflow their squares nor lose the
     // formula's bits (issue 21: the open box returned 0.875 for 0.5 below ~1e-172).
+    let offsets = (ra, rb);
     let (ra, rb) = (unit_scaled(ra), unit_scaled(rb));
     let hi = |r: &[DoubleDouble; 3]| r.map(|c| c.hi);
     let (fa, fb) = (hi(&ra), hi(&rb));
@@ -376,9 +386,125 @@ pub fn antipodal_edge_area_accurate(
             len - r[2]
         }
     };
-    let n = ra[0] * rb[1] - ra[1] * rb[0];
-    let den = len_minus_z(&ra, la) * len_minus_z(&rb, lb) + ra[0] * rb[0] + ra[1] * rb[1];
-    signed_double_atan2(signs.numerator, n.value().abs(), den.value())
+    let (n0, n1) = (ra[0] * rb[1], ra[1] * rb[0]);
+    let lengths = len_minus_z(&ra, la) * len_minus_z(&rb, lb);
+    let (d0, d1) = (ra[0] * rb[0], ra[1] * rb[1]);
+    let (n, den) = ((n0 - n1).value(), (lengths + d0 + d1).value());
+    // Both arguments are sums of products of the (exact, unit-scaled) offsets, each rounded by
+    // far less than DD_TERM_ROUNDING; where they cancel (the query near the segment's interior)
+    // the result can be worse than the expansion of `near_segment_area`, which is then taken.
+    let error = DD_TERM_ROUNDING
+        * (n0.hi.abs() + n1.hi.abs() + lengths.hi.abs() + d0.hi.abs() + d1.hi.abs())
+        + f64::MIN_POSITIVE;
+    if error > WELL_CONDITIONED * n.hypot(den)
+        && let Some(near) = near_segment_area((&ra, &rb), (&offsets.0, &offsets.1), exact_moment)
+        && near.error * n.hypot(den) < error * near.numerator.hypot(near.denominator)
+    {
+        return signed_double_atan2(signs.numerator, near.numerator, near.denominator);
+    }
+    signed_double_atan2(signs.numerator, n.abs(), den)
+}
+
+/// A bound on the relative rounding of one double-double product or sum of the edge term's
+/// offsets (`2^-104` each, a few of them in a row), with margin: `2^-100`.
+const DD_TERM_ROUNDING: f64 = 1.0 / (1u128 << 100) as f64;
+
+/// The relative error of the double-double edge term above which the near-segment expansion is
+/// tried (`2^-50`: below it the term is as good as `f64` can hold).
+const WELL_CONDITIONED: f64 = 1.0 / (1u64 << 50) as f64;
+
+/// The `atan2` arguments of [`near_segment_area`] (magnitude of the numerator, denominator) and
+/// a bound on the error of the denominator, in the same units.
+struct NearSegmentTerm {
+    numerator: f64,
+    denominator: f64,
+    error: f64,
+}
+
+/// The angle (radians, `2^-56`) between a query and the segment it projects inside of, below
+/// which an edge term may come from [`near_segment_area`]. Above it the double-double formula
+/// keeps at least `106 − 60` bits (its offsets are unit-scaled, so `|ra × rb| ≥ sin θ`, and it
+/// loses `log2(1/θ)` bits to cancellation); below it the expansion errs by `O(θ²)`.
+pub const NEAR_SEGMENT_ANGLE: f64 = 1.0 / (1u64 << 56) as f64;
+
+/// The term of a query within [`NEAR_SEGMENT_ANGLE`] of the interior of the segment (`scaled`:
+/// the unit-scaled offsets, nearly antiparallel; `offsets`: the same unscaled, cells) as `atan2`
+/// arguments with an error bound, or `None` when it is farther (or `exact_moment` has no answer).
+///
+/// With `u` the segment's direction, `p` the unit offset of the query from the segment's line and
+/// `d` its distance, `ra = α·u − d·p`, `rb = β·u − d·p` (`α < 0 < β`), so `m = ra × rb = (β − α)·
+/// d·(u × p)` exactly and `p = (m × u)/|m|`. Expanding `|ra|`, `|rb|` in `d` and dividing both
+/// `atan2` arguments by `(β − α)·d`:
+///
+/// `Area = 2·atan2(|m_z|/|m|, p_z + d·K)`, `K = ((β − α) − u_z·(β + α)) / (2|α|β)`,
+///
+/// to `O(θ²)` (`θ ≈ d/min(|α|, β)`; `K ≤ 1/min(|α|, β)`), branch from the exact numerator sign.
+/// As `d → 0` it is the inside-segment limit of [`antipodal_edge_area`] with the query's own `p`
+/// for the perturbation's; the `d·K` term decides it where `p_z` vanishes (an offset across the
+/// ray: the plain limit gave `−0.75` for a value in `[−0.5, 0]`). Where the ray from the query
+/// also grazes the edge's line, `p_z` and `d·K` cancel, and the numerator is tiny too: both come
+/// from the exact `m` in double-double (in `f64` that case erred by `2·10⁻⁸`). Where the ray
+/// passes within `~10⁻⁴²` rad of an endpoint as well, even double-double cannot hold their
+/// difference, and the caller keeps its own formula, whose terms are then that small too.
+fn near_segment_area(
+    scaled: (&[DoubleDouble; 3], &[DoubleDouble; 3]),
+    offsets: (&[DoubleDouble; 3], &[DoubleDouble; 3]),
+    exact_moment: impl FnOnce() -> Option<([DoubleDouble; 3], i64)>,
+) -> Option<NearSegmentTerm> {
+    let (ra, rb) = scaled;
+    let (fa, fb) = (ra.map(|c| c.hi), rb.map(|c| c.hi));
+    if dot(fa, fb) >= 0.0 {
+        return None;
+    }
+    // A cheap screen in `f64` (its cross product errs by ~2^-50 here), then double-double.
+    let largest = |m: [f64; 3]| m[0].abs().max(m[1].abs()).max(m[2].abs());
+    if largest(cross(fa, fb)) > 1e-12 {
+        return None;
+    }
+    if largest(cross_dd(ra, rb).map(|c| c.hi)) > NEAR_SEGMENT_ANGLE {
+        return None;
+    }
+    let (m, exponent) = exact_moment()?;
+    let (oa, ob) = offsets;
+    let e: [DoubleDouble; 3] = std::array::from_fn(|k| ob[k] - oa[k]);
+    let le = dot3(&e, &e).sqrt();
+    let u = e.map(|c| c / le);
+    let (alpha, beta) = (dot3(oa, &u), dot3(ob, &u));
+    if !(alpha.hi < 0.0 && beta.hi > 0.0) {
+        return None;
+    }
+    let lm = dot3(&m, &m).sqrt();
+    let pz = cross_dd(&m, &u)[2] / lm;
+    let k =
+        ((beta - alpha) - u[2] * (beta + alpha)) / (DoubleDouble::from_f64(2.0) * -alpha * beta);
+    // d·K, with d = |m|/(β − α) and |m| = lm·2^exponent (cells).
+    let dk = lm * k / (beta - alpha);
+    let dk = DoubleDouble {
+        hi: scaled_by_power_of_two(dk.hi, exponent),
+        lo: scaled_by_power_of_two(dk.lo, exponent),
+    };
+    if !dk.hi.is_finite() {
+        return None;
+    }
+    let n = (m[2] / lm).hi.abs();
+    let theta = scaled_by_power_of_two(lm.hi / le.hi, exponent) / (-alpha.hi).min(beta.hi);
+    let denominator = (pz + dk).value();
+    let (pz, dk) = (pz.hi, dk.hi);
+    Some(NearSegmentTerm {
+        numerator: n,
+        denominator,
+        error: DD_TERM_ROUNDING * (pz.abs() + dk.abs())
+            + 4.0 * theta * theta * (pz.abs() + 2.0 * theta),
+    })
+}
+
+/// `a × b` in double-double.
+fn cross_dd(a: &[DoubleDouble; 3], b: &[DoubleDouble; 3]) -> [DoubleDouble; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 
 /// `∇_q` of the solid-angle contribution of the directed segment from `q + ra` to `q + rb`:

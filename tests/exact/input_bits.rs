@@ -968,3 +968,129 @@ fn parts_smaller_than_a_lattice_cell_get_the_oracles_value() {
         }
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// Queries a tiny angle from a boundary edge's interior: next to an edge that lies on coordinate
+// planes, a query's coordinates near 0 put it as close as the subnormals (`5e-324`) to an edge of
+// length 1. The double-double edge term cancels to that angle and lost every bit below about
+// `2^-100` (`1e-30` from an edge of a unit triangle: `1e-4` off; `1e-100` and closer: off by
+// `0.125`, differently on every ray); the term is now the limit along the query's own offset,
+// from the exact cross product of the offsets.
+
+/// `w` next to the interior of an edge of a flat sheet whose normal is `+n` and whose interior
+/// lies towards `+s` from the edge, at `y` along `s` and `z` along `n`: the angle `φ = atan2(z,
+/// y)` around the edge sees a wedge of `2(π − |φ|)` steradians, negative on the front.
+fn sheet_edge_limit(y: f64, z: f64) -> f64 {
+    let phi = z.atan2(y);
+    let wedge = (std::f64::consts::PI - phi.abs()) / std::f64::consts::TAU;
+    if phi > 0.0 { -wedge } else { wedge }
+}
+
+/// `x·2^e` for `e ≥ −1074` (two exact steps, then one rounding into the subnormals).
+fn times_power_of_two(x: f64, e: i32) -> f64 {
+    x * 2f64.powi(e / 2) * 2f64.powi(e - e / 2)
+}
+
+/// The unit right triangle `(0,0,0), (1,0,0), (0,1,0)` with its axes rotated by `k` (normal
+/// `+z`, `+x` or `+y`), and that rotation.
+fn rotated_triangle(k: usize) -> (Mesh, impl Fn([f64; 3]) -> [f64; 3]) {
+    let rot = move |p: [f64; 3]| std::array::from_fn(|a| p[(a + 3 - k) % 3]);
+    let p = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]].map(rot);
+    (Mesh::from_slices(&p, &[[0, 1, 2]]).unwrap(), rot)
+}
+
+#[test]
+fn queries_a_tiny_angle_from_a_boundary_edge_get_its_limit() {
+    let tau = std::f64::consts::TAU;
+    let mut checked = 0;
+    for k in 0..3 {
+        let (tri, rot) = rotated_triangle(k);
+        let rays = all_rays(&tri);
+        for rho in [
+            1e-25, 1e-30, 1e-60, 1e-100, 1e-200, 1e-300, 1e-310, 1e-320, 4e-323,
+        ] {
+            for j in 0..12 {
+                let phi = (j as f64 + 0.37) * tau / 12.0 - std::f64::consts::PI;
+                let (s, n) = (rho * phi.cos(), rho * phi.sin());
+                if s == 0.0 || n == 0.0 {
+                    continue;
+                }
+                // Next to the edge on the x axis (interior towards +y), on the y axis
+                // (interior towards +x; seen from there the normal's side is reversed), and
+                // exactly above and below the diagonal x + y = 1 (interior towards −x−y).
+                let cases = [
+                    ([0.3, s, n], sheet_edge_limit(s, n)),
+                    ([s, 0.6875, n], sheet_edge_limit(s, n)),
+                    ([0.75, 0.25, n], sheet_edge_limit(0.0, n)),
+                ];
+                for (q, want) in cases {
+                    for (ray, wn) in &rays {
+                        let w = wn.eval(rot(q));
+                        assert!(
+                            (w - want).abs() <= 1e-12,
+                            "normal axis {k}, {ray:?}, q {q:?}: {w} vs {want}"
+                        );
+                        checked += 1;
+                    }
+                }
+            }
+        }
+    }
+    assert!(checked > 1500, "{checked}");
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
+
+    /// Any offset of any magnitude down to the subnormals from the edge on the x axis, at any
+    /// point along it: every ray gives the limit (the distance is at most `2^-70` of the edge,
+    /// so the limit is the value to far below `1e-12`).
+    #[test]
+    fn any_tiny_offset_from_an_edge_gives_the_limit_on_every_ray(
+        k in 0usize..3,
+        along in 0.01f64..0.99,
+        ys in -1.0f64..1.0,
+        zs in -1.0f64..1.0,
+        ey in -1074i32..-70,
+        ez in -1074i32..-70,
+    ) {
+        let (tri, rot) = rotated_triangle(k);
+        let y = times_power_of_two(ys, ey);
+        let z = times_power_of_two(zs, ez);
+        prop_assume!(y != 0.0 && z != 0.0);
+        let want = sheet_edge_limit(y, z);
+        for (ray, wn) in all_rays(&tri) {
+            let w = wn.eval(rot([along, y, z]));
+            prop_assert!((w - want).abs() <= 1e-12, "{ray:?}: {w} vs {want}");
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 300, ..ProptestConfig::default() })]
+
+    /// Points on any edge of the full-precision bipyramid (open or closed; coordinates of mixed
+    /// magnitudes, zeros among them, so many edges lie on coordinate planes) moved by offsets of
+    /// any magnitude down to the subnormals: off the surface, the six rays give one value.
+    #[test]
+    fn tiny_offsets_from_any_edge_do_not_depend_on_the_ray(
+        c in prop::collection::vec(coordinate(), 15),
+        open in prop::bool::ANY,
+        ends in (0usize..5, 1usize..5),
+        t in 0.0f64..1.0,
+        offsets in prop::collection::vec((-1.0f64..1.0, -1074i32..-40), 3),
+    ) {
+        let mesh = full_precision_mesh(&c, open);
+        let p = mesh.positions();
+        let (a, b) = (p[ends.0], p[(ends.0 + ends.1) % 5]);
+        let q: [f64; 3] = std::array::from_fn(|k| {
+            a[k] + t * (b[k] - a[k]) + times_power_of_two(offsets[k].0, offsets[k].1)
+        });
+        prop_assume!(!on_surface_near(&mesh, q));
+        let values: Vec<f64> = all_rays(&mesh).iter().map(|(_, wn)| wn.eval(q)).collect();
+        let (lo, hi) = values
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &w| (lo.min(w), hi.max(w)));
+        prop_assert!(hi - lo <= 1e-9, "q {q:?}: {values:?}");
+    }
+}
