@@ -222,6 +222,33 @@ fn mesh(positions: Vec<[f64; 3]>, triangles: Vec<[u32; 3]>) -> Mesh {
     Mesh::new(positions, triangles).expect("generated meshes are valid by construction")
 }
 
+/// The `kernel_tiny_offsets` fuzz decoder: the first six bytes move every query of a
+/// [`soup_from_bytes`] case (decoded from the rest) by `±2^-e`, `e` in `30..=1074`, along each
+/// axis. Next to 0 that is as close to the grid's faces and edges as the subnormals get (edges on
+/// coordinate planes are common on the grid −4..4); elsewhere the move rounds away. `None` for
+/// fewer than six bytes.
+pub fn soup_with_tiny_offsets_from_bytes(data: &[u8]) -> Option<Case> {
+    if data.len() < 6 {
+        return None;
+    }
+    let (moves, rest) = data.split_at(6);
+    let offset = |k: usize| {
+        let e = 30 + (i32::from(moves[k]) * 256 + i32::from(moves[(k + 3) % 6])) % 1045;
+        // 2^-e in two exact steps (2^-1074 is below the normal range).
+        let magnitude = 2f64.powi(-(e / 2)) * 2f64.powi(-(e - e / 2));
+        if moves[k] & 1 == 0 {
+            magnitude
+        } else {
+            -magnitude
+        }
+    };
+    let mut case = soup_from_bytes(rest);
+    for q in &mut case.queries {
+        *q = std::array::from_fn(|k| q[k] + offset(k));
+    }
+    Some(case)
+}
+
 /// The `kernel_grazing` decoder, byte for byte (do not change: the fuzz corpus depends on it).
 fn gen_soup(src: &mut Source<'_>) -> Case {
     let mut next = || src.byte();

@@ -32,11 +32,12 @@ pub mod strategies;
 pub use generators::{
     Aabb, Case, Kind, boxes, boxes_from_bytes, fan, fan_from_bytes, inconsistent,
     inconsistent_from_bytes, open, open_from_bytes, polycube, polycube_from_bytes, queries, soup,
-    soup_from_bytes, t_junction, t_junction_from_bytes, tets, tets_from_bytes,
+    soup_from_bytes, soup_with_tiny_offsets_from_bytes, t_junction, t_junction_from_bytes, tets,
+    tets_from_bytes,
 };
 pub use oracle::{
     Certified, Decision, Oracle, direct_at_perturbed, exact_winding_number_integer,
-    exact_winding_number_rational, on_surface,
+    exact_winding_number_rational, on_surface, ray_disagreements,
 };
 pub use source::{Source, SplitMix64};
 

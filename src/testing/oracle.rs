@@ -340,6 +340,41 @@ pub fn on_surface(mesh: &Mesh, q: [f64; 3]) -> bool {
     })
 }
 
+/// The queries off the surface of `mesh` ([`on_surface`] decides exactly) at which the exact
+/// evaluator's six ray directions spread by more than `tolerance`, with their values in
+/// [`RayAxis::ALL`] order: off the surface `w` does not depend on the ray, so any entry is a
+/// kernel error (the check of the `kernel_tiny_offsets` fuzz target and its stable replay).
+pub fn ray_disagreements(
+    mesh: &Mesh,
+    queries: &[[f64; 3]],
+    tolerance: f64,
+) -> Vec<([f64; 3], [f64; 6])> {
+    let rays: Vec<crate::eval::antipodal::WindingNumber> = RayAxis::ALL
+        .iter()
+        .map(|&ray| {
+            let options = crate::eval::antipodal::Options {
+                ray,
+                ..Default::default()
+            };
+            crate::eval::antipodal::WindingNumber::with_options(mesh, options)
+                .expect("a valid mesh builds on every ray")
+        })
+        .collect();
+    queries
+        .iter()
+        .filter(|&&q| !on_surface(mesh, q))
+        .filter_map(|&q| {
+            let w: [f64; 6] = std::array::from_fn(|k| rays[k].eval(q));
+            let (lo, hi) = w
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| {
+                    (lo.min(x), hi.max(x))
+                });
+            (!(hi - lo <= tolerance)).then_some((q, w))
+        })
+        .collect()
+}
+
 fn point_on_triangle(q: &[BigInt; 3], p: &[[BigInt; 3]; 3]) -> bool {
     let n = cross(&sub(&p[1], &p[0]), &sub(&p[2], &p[0]));
     if is_zero(&n) {

@@ -1094,3 +1094,27 @@ proptest! {
         prop_assert!(hi - lo <= 1e-9, "q {q:?}: {values:?}");
     }
 }
+
+/// The `kernel_tiny_offsets` fuzz target on stable: its committed corpus (the input it found
+/// with the near-segment expansion switched off) and 3,000 pseudo-random inputs, through the
+/// same decoder and check.
+#[test]
+fn tiny_offsets_fuzz_corpus_and_random_inputs_agree_on_every_ray() {
+    let dir =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus/kernel_tiny_offsets");
+    let mut inputs: Vec<Vec<u8>> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("fuzz corpus {}: {e}", dir.display()))
+        .map(|e| std::fs::read(e.unwrap().path()).unwrap())
+        .collect();
+    assert!(!inputs.is_empty());
+    let mut rng = gwn::testing::SplitMix64(26);
+    inputs.extend((0..3000).map(|_| {
+        let len = 6 + (rng.next_u64() % 40) as usize;
+        (0..len).map(|_| rng.next_u64() as u8).collect::<Vec<u8>>()
+    }));
+    for bytes in &inputs {
+        let case = gwn::testing::soup_with_tiny_offsets_from_bytes(bytes).unwrap();
+        let bad = gwn::testing::ray_disagreements(&case.mesh, &case.queries, 1e-10);
+        assert!(bad.is_empty(), "{bytes:?}: {bad:?}");
+    }
+}
