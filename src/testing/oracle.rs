@@ -370,7 +370,9 @@ pub fn ray_disagreements(
                 .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| {
                     (lo.min(x), hi.max(x))
                 });
-            (!(hi - lo <= tolerance)).then_some((q, w))
+            // A non-finite value is a disagreement too (min and max would skip a NaN).
+            let agree = w.iter().all(|x| x.is_finite()) && hi - lo <= tolerance;
+            (!agree).then_some((q, w))
         })
         .collect()
 }
