@@ -1060,8 +1060,13 @@ proptest! {
         prop_assume!(y != 0.0 && z != 0.0);
         let want = sheet_edge_limit(y, z);
         for (ray, wn) in all_rays(&tri) {
-            let w = wn.eval(rot([along, y, z]));
+            let q = rot([along, y, z]);
+            let w = wn.eval(q);
             prop_assert!((w - want).abs() <= 1e-12, "{ray:?}: {w} vs {want}");
+            // A column through the query (grids' ray reuse) gives its value to the bit.
+            let axis = ray.map()[2].0;
+            let column = wn.eval_column(q, &[q[axis] - 1.5, q[axis], q[axis] + 0.25]);
+            prop_assert_eq!(column[1].to_bits(), w.to_bits(), "{:?}: column", ray);
         }
     }
 }
