@@ -999,6 +999,31 @@ fn rotated_triangle(k: usize) -> (Mesh, impl Fn([f64; 3]) -> [f64; 3]) {
     (Mesh::from_slices(&p, &[[0, 1, 2]]).unwrap(), rot)
 }
 
+/// The unit square `[0, 1]²` at `z = 0` as an `n × n` grid of triangle pairs (normal `+z`): its
+/// `4n` boundary edges take the boundary hierarchy's leaves, not the plain loop.
+fn grid_sheet(n: u32) -> Mesh {
+    let p: Vec<[f64; 3]> = (0..=n)
+        .flat_map(|j| {
+            (0..=n).map(move |i| {
+                [
+                    f64::from(i) / f64::from(n),
+                    f64::from(j) / f64::from(n),
+                    0.0,
+                ]
+            })
+        })
+        .collect();
+    let t: Vec<[u32; 3]> = (0..n)
+        .flat_map(|j| {
+            (0..n).flat_map(move |i| {
+                let a = j * (n + 1) + i;
+                [[a, a + 1, a + n + 2], [a, a + n + 2, a + n + 1]]
+            })
+        })
+        .collect();
+    Mesh::from_slices(&p, &t).unwrap()
+}
+
 #[test]
 fn queries_a_tiny_angle_from_a_boundary_edge_get_its_limit() {
     let tau = std::f64::consts::TAU;
@@ -1037,6 +1062,26 @@ fn queries_a_tiny_angle_from_a_boundary_edge_get_its_limit() {
         }
     }
     assert!(checked > 1500, "{checked}");
+    // The same next to the edges on the axes of a sheet with 128 boundary edges.
+    let sheet = grid_sheet(32);
+    for (ray, wn) in all_rays(&sheet) {
+        for rho in [1e-30, 1e-200, 1e-310, 4e-323] {
+            for j in 0..12 {
+                let phi = (j as f64 + 0.37) * tau / 12.0 - std::f64::consts::PI;
+                let (s, n) = (rho * phi.cos(), rho * phi.sin());
+                if s == 0.0 || n == 0.0 {
+                    continue;
+                }
+                for q in [[0.3, s, n], [s, 0.6875, n]] {
+                    let (w, want) = (wn.eval(q), sheet_edge_limit(s, n));
+                    assert!(
+                        (w - want).abs() <= 1e-12,
+                        "sheet, {ray:?}, q {q:?}: {w} vs {want}"
+                    );
+                }
+            }
+        }
+    }
 }
 
 proptest! {
