@@ -350,10 +350,11 @@ pub fn antipodal_edge_area(ra: [f64; 3], rb: [f64; 3], signs: EdgeSigns) -> f64 
 ///
 /// A query within [`NEAR_SEGMENT_ANGLE`] of the segment's interior loses every bit even there
 /// (a query `1e-30` from an edge of a unit triangle erred by `1e-4`; `1e-300` from it, by
-/// `0.125`, and differently on every ray). `exact_moment` then gives the exact direction of
-/// `ra × rb` ([`super::input_predicates::exact_edge_moment`]; `None` when the query is on the
-/// edge's line, or not computable) and the term is its limit along the query's own
-/// perpendicular offset (see [`near_segment_area`]).
+/// `0.125`, and differently on every ray). Where this formula's own error bound says so, the
+/// term comes from the expansion in that angle ([`near_segment_area`]) instead, with
+/// `exact_moment` giving `ra × rb` exactly ([`super::input_predicates::exact_edge_moment`];
+/// `None` when the query is on the edge's line, or when it cannot be computed), whichever of the
+/// two has the smaller error bound.
 pub fn antipodal_edge_area_accurate(
     ra: [DoubleDouble; 3],
     rb: [DoubleDouble; 3],
