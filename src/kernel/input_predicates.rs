@@ -93,6 +93,21 @@ impl LatticeFrame {
     fn point(&self, p: &InputPoint) -> [Dyadic; 3] {
         std::array::from_fn(|k| self.coordinate(p, k))
     }
+
+    /// `a − q` and `b − q`, exactly.
+    fn offsets(
+        &self,
+        q: &InputPoint,
+        a: &InputPoint,
+        b: &InputPoint,
+    ) -> ([Dyadic; 3], [Dyadic; 3]) {
+        let q = self.point(q);
+        let from_q = |p: &InputPoint| -> [Dyadic; 3] {
+            let p = self.point(p);
+            std::array::from_fn(|k| &p[k] - &q[k])
+        };
+        (from_q(a), from_q(b))
+    }
 }
 
 const U: f64 = f64::EPSILON * 0.5;
@@ -394,15 +409,7 @@ pub fn input_inside_segment(
     lattice: &LatticeFrame,
 ) -> bool {
     count_fallback();
-    let q = lattice.point(q);
-    let ra: [Dyadic; 3] = {
-        let a = lattice.point(a);
-        std::array::from_fn(|k| &a[k] - &q[k])
-    };
-    let rb: [Dyadic; 3] = {
-        let b = lattice.point(b);
-        std::array::from_fn(|k| &b[k] - &q[k])
-    };
+    let (ra, rb) = lattice.offsets(q, a, b);
     let zero = |r: &[Dyadic; 3]| r.iter().all(|c| c.sign() == 0);
     let along_pos_x = |r: &[Dyadic; 3]| r[0].sign() > 0 && r[1].sign() == 0 && r[2].sign() == 0;
     if zero(&ra) {
@@ -411,13 +418,19 @@ pub fn input_inside_segment(
     if zero(&rb) {
         return along_pos_x(&ra);
     }
-    for (i, j) in [(1, 2), (2, 0), (0, 1)] {
-        if (&(&ra[i] * &rb[j]) - &(&ra[j] * &rb[i])).sign() != 0 {
-            return false;
-        }
+    if cross(&ra, &rb).iter().any(|c| c.sign() != 0) {
+        return false;
     }
     let dot = &(&(&ra[0] * &rb[0]) + &(&ra[1] * &rb[1])) + &(&ra[2] * &rb[2]);
     dot.sign() < 0
+}
+
+/// `a × b`, exactly.
+fn cross(a: &[Dyadic; 3], b: &[Dyadic; 3]) -> [Dyadic; 3] {
+    std::array::from_fn(|k| {
+        let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+        &(&a[i] * &b[j]) - &(&a[j] * &b[i])
+    })
 }
 
 /// `(a − q) × (b − q)` on the exact inputs as `(v, k)` with the vector `v·2^k`: `v`'s largest
@@ -435,16 +448,8 @@ pub fn exact_edge_moment(
     b: &InputPoint,
     lattice: &LatticeFrame,
 ) -> Option<([DoubleDouble; 3], i64)> {
-    let q = lattice.point(q);
-    let offsets = |p: &InputPoint| -> [Dyadic; 3] {
-        let p = lattice.point(p);
-        std::array::from_fn(|k| &p[k] - &q[k])
-    };
-    let (ra, rb) = (offsets(a), offsets(b));
-    let m: [Dyadic; 3] = std::array::from_fn(|k| {
-        let (i, j) = ((k + 1) % 3, (k + 2) % 3);
-        &(&ra[i] * &rb[j]) - &(&ra[j] * &rb[i])
-    });
+    let (ra, rb) = lattice.offsets(q, a, b);
+    let m = cross(&ra, &rb);
     let top = m.iter().filter_map(Dyadic::exponent).max()?;
     let m = m.map(|c| {
         let (hi, lo) = c.to_double_double_scaled(top);
