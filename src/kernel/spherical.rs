@@ -397,9 +397,14 @@ pub fn antipodal_edge_area_accurate(
     let error = DD_TERM_ROUNDING
         * (n0.hi.abs() + n1.hi.abs() + lengths.hi.abs() + d0.hi.abs() + d1.hi.abs())
         + f64::MIN_POSITIVE;
+    // Relative errors compared as quotients: both sides of the cross-multiplied form underflowed
+    // to 0 for a query 2^-409 from a unit edge 2^-326 off the ray (the near term erred by 1e-55
+    // of itself, the double-double one by 4e-7; `0 < 0` kept the latter, 1.2e-9 off in w).
+    let relative =
+        |error: f64, numerator: f64, denominator: f64| error / numerator.hypot(denominator);
     if error > WELL_CONDITIONED * n.hypot(den)
         && let Some(near) = near_segment_area((&ra, &rb), (&offsets.0, &offsets.1), exact_moment)
-        && near.error * n.hypot(den) < error * near.numerator.hypot(near.denominator)
+        && relative(near.error, near.numerator, near.denominator) < relative(error, n, den)
     {
         return signed_double_atan2(signs.numerator, near.numerator, near.denominator);
     }

@@ -1145,6 +1145,41 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 2000, ..ProptestConfig::default() })]
+
+    /// The doubly degenerate case of the near-segment expansion: a boundary edge `2^-slope` off
+    /// vertical, queried near its line (along it, beside it, or straight above an endpoint, so
+    /// that the vertical rays graze that endpoint by about the query's offset), with offsets far
+    /// below the slope. Off the surface, the six rays give one value. Fails with the expansion
+    /// switched off (`NEAR_SEGMENT_ANGLE = 0`), and failed at once (+z 1.2e-9 off, the committed
+    /// regression) while the two formulas' error bounds were compared cross-multiplied: at a
+    /// query `2^-409` from an edge `2^-326` off vertical both products underflowed to 0.
+    #[test]
+    fn queries_near_a_nearly_vertical_edge_do_not_depend_on_the_ray(
+        slope in 30i32..430,
+        t in -1.0f64..2.0,
+        at in 0usize..3,
+        x in (1.0f64..2.0, prop::bool::ANY, -4i32..600),
+        y in (prop::bool::ANY, 0i32..600),
+        third in (prop::bool::ANY, prop::bool::ANY, prop::bool::ANY),
+    ) {
+        let e = times_power_of_two(1.0, -slope);
+        let (cy, cz, flip) = (if third.0 { 0.0 } else { 0.37 }, if third.1 { 0.5 } else { 2.0 }, third.2);
+        let p = [[0.0, 0.0, 0.0], [e, 0.0, 1.0], [1.0, cy, cz]];
+        let f = if flip { [0, 2, 1] } else { [0, 1, 2] };
+        let mesh = Mesh::from_slices(&p, &[f]).unwrap();
+        let sign = |s: bool| if s { 1.0 } else { -1.0 };
+        let dx = sign(x.1) * times_power_of_two(x.0, -(slope + x.2).min(1074));
+        let dy = sign(y.0) * times_power_of_two(1.0, -(slope + y.1).min(1074));
+        // On the line at height t, or straight above the lower or the upper endpoint.
+        let base = [t * e, 0.0, e][at];
+        let q = [base + dx, dy, t];
+        let disagreements = gwn::testing::ray_disagreements(&mesh, &[q], 1e-9);
+        prop_assert!(disagreements.is_empty(), "{disagreements:?}");
+    }
+}
+
 /// The `kernel_tiny_offsets` fuzz target on stable: its committed corpus (the input it found
 /// with the near-segment expansion switched off) and 3,000 pseudo-random inputs, through the
 /// same decoder and check.
