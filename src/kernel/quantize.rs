@@ -117,6 +117,16 @@ impl Grid {
         let half_extent = (0..3)
             .map(|k| 0.5 * bbox.max[k] - 0.5 * bbox.min[k])
             .fold(0.0_f64, f64::max);
+        // The bound `|c| ≤ 2^53·E` below holds per axis only where that axis's coordinates
+        // differ; an axis where all are equal (a flat mesh on a plane `y = 3`) may sit any
+        // distance from 0, and `origin / cell` overflowed `i128` for a mesh smaller than
+        // `2^-53` of that distance (a `1e-32` triangle on `y = 3` failed to build). Such a box
+        // is taken as wide as its centre needs: only the lattice gets coarser, and every vertex
+        // keeps its exact residual.
+        let centre_magnitude = (0..3)
+            .map(|k| (0.5 * bbox.max[k] + 0.5 * bbox.min[k]).abs())
+            .fold(0.0_f64, f64::max);
+        let half_extent = half_extent.max(centre_magnitude * pow2(-54));
         let half_extent = if half_extent > 0.0 {
             half_extent
         } else {
@@ -590,6 +600,18 @@ mod tests {
                 let g = Grid::new(&b, p).unwrap();
                 let v = g.snap_vertex([hi; 3]);
                 assert!(v.iter().all(|c| c.abs() <= g.limit()), "{lo} {hi} {p:?}");
+            }
+        }
+        // A flat box far from 0 along its flat axis, far smaller than that distance.
+        for (x, y) in [(7.3e-33, 3.0), (1e-300, -1e300), (5e-324, f64::MAX)] {
+            let b = BoundingBox {
+                min: [0.0, y, 0.0],
+                max: [x, y, x],
+            };
+            for p in [Precision::Bits30, Precision::Bits60] {
+                let g = Grid::new(&b, p).unwrap();
+                let v = g.snap_vertex([x, y, x]);
+                assert!(v.iter().all(|c| c.abs() <= g.limit()), "{x} {y} {p:?}");
             }
         }
         let nan = BoundingBox {

@@ -366,7 +366,7 @@ pub fn antipodal_edge_area_accurate(
     // `1e-300` (a query next to a boundary vertex) neither underflow their squares nor lose the
     // formula's bits (issue 21: the open box returned 0.875 for 0.5 below ~1e-172).
     let offsets = (ra, rb);
-    let (ra, rb) = (unit_scaled(ra), unit_scaled(rb));
+    let (ra, rb) = unit_scaled(ra, rb);
     let hi = |r: &[DoubleDouble; 3]| r.map(|c| c.hi);
     let (fa, fb) = (hi(&ra), hi(&rb));
     let degenerate = signs.numerator == 0
@@ -534,37 +534,75 @@ pub fn segment_gradient(ra: [f64; 3], rb: [f64; 3]) -> [f64; 3] {
     [c[0] * f, c[1] * f, c[2] * f]
 }
 
-/// `r` times the power of two that brings its largest component into `[1, 2)` (exact; `r`
-/// unchanged when zero).
+/// `ra` and `rb`, each times the power of two that brings its largest component into `[1, 2)`
+/// (exact; unchanged when zero or not finite): the edge term depends on their directions only.
 ///
-/// A vertex seen almost exactly along the ray (`|r_xy| ≪ |r|`) is a second case: the term then
-/// depends on the azimuth of `r_xy` (the on-ray limit of §3 of docs/robustness.md, with the
-/// actual direction instead of the perturbation's), and its products would underflow below
-/// `2^-1022`. Its `r_xy` is scaled out to `NEAR_RAY_FLOOR·|r|` along its own azimuth instead,
-/// which changes the term by less than that angle, `2^-500` radians.
-fn unit_scaled(r: [DoubleDouble; 3]) -> [DoubleDouble; 3] {
-    let m = r.iter().fold(0.0_f64, |m, c| m.max(c.hi.abs()));
-    if m == 0.0 || !m.is_finite() {
-        return r;
-    }
-    let h = r[0].hi.abs().max(r[1].hi.abs());
-    let down = -binary_exponent(m);
-    let across = if h > 0.0 {
-        down.max(NEAR_RAY_FLOOR_EXPONENT - binary_exponent(h))
-    } else {
-        down
-    };
-    let scale = |c: DoubleDouble, k: i32| {
-        // `2^k` in two representable steps (`|k|` may exceed 1022 for subnormal parts).
-        let (k1, k2) = (k / 2, k - k / 2);
-        let f1 = f64::from_bits(((k1 + 1023) as u64) << 52);
-        let f2 = f64::from_bits(((k2 + 1023) as u64) << 52);
-        DoubleDouble {
-            hi: c.hi * f1 * f2,
-            lo: c.lo * f1 * f2,
+/// Their transverse parts `r_xy` are scaled up further where their products would underflow
+/// below `2^-1022` (a vertex seen almost exactly along the ray):
+/// - **One offset near the ray** (`|r_xy| ≪ |r|`, the other not): the term depends on the
+///   azimuth of its `r_xy` (the on-ray limit of §3 of docs/robustness.md, with the actual
+///   direction instead of the perturbation's), so its `r_xy` is scaled out to `2^-500·|r|`
+///   ([`NEAR_RAY_FLOOR_EXPONENT`]) along its own azimuth: the term moves by about that angle
+///   over the other's angle from the ray, `2^-400` at most (below).
+/// - **Both near the ray line**, not both below the query (an edge nearly along the ray,
+///   passing near the query): then the term depends on how their transverse parts compare, not
+///   on their azimuths alone, and scaling each out to the floor on its own replaced their ratio
+///   by 1 (a query `3e-260` beside an edge `6e-153` off vertical got `−0.133` for `−0.25`).
+///   Both are scaled by one power of two until the larger is `2^-100·|r|`
+///   ([`NEAR_RAY_COMMON_EXPONENT`]): with one offset up, the numerator and both terms of the
+///   denominator are homogeneous of degree 2 in the transverse parts (`|r| − r_z =
+///   |r_xy|²/(|r| + r_z)` for the one up, `≈ 2|r_z|` for one down), so the term changes by
+///   `O(2^-200)` relative; the smaller then takes the floor only if it is below `2^-400` of
+///   the larger.
+/// - Both below the query (near the antipode): the term is the area of a triangle of size
+///   `|r_xy|/|r|` at most, below `2^-1000`; the floors stand.
+///
+/// Each component is scaled once, from its own exponent: a transverse part of `5e-324` scaled
+/// down with its offset first would underflow to 0 and lose its azimuth.
+fn unit_scaled(
+    ra: [DoubleDouble; 3],
+    rb: [DoubleDouble; 3],
+) -> ([DoubleDouble; 3], [DoubleDouble; 3]) {
+    // Per offset: the isotropic exponent, and the transverse part's exponent after it.
+    let exponents = |r: &[DoubleDouble; 3]| {
+        let m = r.iter().fold(0.0_f64, |m, c| m.max(c.hi.abs()));
+        if m == 0.0 || !m.is_finite() {
+            return None;
         }
+        let down = -binary_exponent(m);
+        let h = r[0].hi.abs().max(r[1].hi.abs());
+        Some((down, (h > 0.0).then(|| binary_exponent(h) + down)))
     };
-    [scale(r[0], across), scale(r[1], across), scale(r[2], down)]
+    let (ea, eb) = (exponents(&ra), exponents(&rb));
+    let common = match (ea, eb) {
+        (Some((_, Some(ha))), Some((_, Some(hb))))
+            if (ra[2].hi > 0.0 || rb[2].hi > 0.0) && ha.max(hb) < NEAR_RAY_COMMON_EXPONENT =>
+        {
+            NEAR_RAY_COMMON_EXPONENT - ha.max(hb)
+        }
+        _ => 0,
+    };
+    let scaled = |r: [DoubleDouble; 3], e: Option<(i32, Option<i32>)>| {
+        let Some((down, h)) = e else { return r };
+        let across = h.map_or(0, |h| common.max(NEAR_RAY_FLOOR_EXPONENT - h).max(0));
+        [
+            times_power_of_two(r[0], down + across),
+            times_power_of_two(r[1], down + across),
+            times_power_of_two(r[2], down),
+        ]
+    };
+    (scaled(ra, ea), scaled(rb, eb))
+}
+
+/// `c·2^k`, exact (in two representable steps: `|k|` may exceed 1022 for subnormal parts).
+fn times_power_of_two(c: DoubleDouble, k: i32) -> DoubleDouble {
+    let (k1, k2) = (k / 2, k - k / 2);
+    let f1 = f64::from_bits(((k1 + 1023) as u64) << 52);
+    let f2 = f64::from_bits(((k2 + 1023) as u64) << 52);
+    DoubleDouble {
+        hi: c.hi * f1 * f2,
+        lo: c.lo * f1 * f2,
+    }
 }
 
 /// `⌊log2 |x|⌋` for finite non-zero `x` (subnormals included).
@@ -573,10 +611,15 @@ fn binary_exponent(x: f64) -> i32 {
     e + 63 - mant.unsigned_abs().leading_zeros() as i32
 }
 
-/// `log2` of `NEAR_RAY_FLOOR`, the smallest transverse size `|r_xy|/|r|` an accurate edge term
-/// computes with (see `unit_scaled`): far above the underflow of its products (squares of
-/// `2^-511`), far below any error that matters (`2^-500` radians).
+/// `log2` of the smallest transverse size `|r_xy|/|r|` an accurate edge term computes with
+/// ([`unit_scaled`]): far above the underflow of its products (squares of `2^-511`), far
+/// below any error that matters (`2^-500` radians).
 const NEAR_RAY_FLOOR_EXPONENT: i32 = -500;
+
+/// `log2` of the transverse size `|r_xy|/|r|` to which [`unit_scaled`] scales the larger
+/// of two offsets that are both near the ray line: small enough that the term's homogeneity
+/// holds to `2^-200`, large enough that the other keeps `2^-400` of it above the floor.
+const NEAR_RAY_COMMON_EXPONENT: i32 = -100;
 
 /// `|r| − r_z` without cancellation when `r` points up.
 #[inline]
