@@ -851,10 +851,22 @@ impl BoundaryEdges {
             // The exact moment only where the query's residual and the ray coordinate are the
             // input's (a clamped query is far from every segment).
             let moment = || z_exact.then(|| exact_edge_moment(q, pa, pb, &self.lattice))?;
-            antipodal_edge_area_accurate(ra, rb, signs, moment)
+            let v = antipodal_edge_area_accurate(ra, rb, signs, moment);
+            if std::env::var("GWN_DEBUG").is_ok() {
+                eprintln!("  acc term {v:e}");
+            }
+            v
         } else {
             // `hi` is the offset rounded once (normalized pairs).
-            antipodal_edge_area(ra.map(|x| x.hi), rb.map(|x| x.hi), signs)
+            let v = antipodal_edge_area(ra.map(|x| x.hi), rb.map(|x| x.hi), signs);
+            if std::env::var("GWN_DEBUG").is_ok() {
+                eprintln!(
+                    "f64 term {v:e} ra {:?} rb {:?} {signs:?}",
+                    ra.map(|x| x.hi),
+                    rb.map(|x| x.hi)
+                );
+            }
+            v
         }
     }
 

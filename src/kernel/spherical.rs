@@ -367,6 +367,15 @@ pub fn antipodal_edge_area_accurate(
     // formula's bits (issue 21: the open box returned 0.875 for 0.5 below ~1e-172).
     let offsets = (ra, rb);
     let (ra, rb) = unit_scaled(ra, rb);
+    if std::env::var("GWN_DEBUG").is_ok() {
+        eprintln!(
+            "acc off {:?} {:?}\n    scaled {:?} {:?} {signs:?}",
+            offsets.0.map(|c| c.hi),
+            offsets.1.map(|c| c.hi),
+            ra.map(|c| c.hi),
+            rb.map(|c| c.hi)
+        );
+    }
     let hi = |r: &[DoubleDouble; 3]| r.map(|c| c.hi);
     let (fa, fb) = (hi(&ra), hi(&rb));
     let degenerate = signs.numerator == 0
@@ -471,8 +480,18 @@ fn near_segment_area(
         return None;
     }
     let (m, exponent) = exact_moment()?;
-    let (oa, ob) = offsets;
-    let e: [DoubleDouble; 3] = std::array::from_fn(|k| ob[k] - oa[k]);
+    // Lengths in units of the edge's largest component (a power of two `2^-s` cells, so `|m|`
+    // is `2^(exponent + 2s)` of them): an edge can be `1e-166` cells long, whose `|e|²`
+    // underflowed to 0 and dropped the expansion (`−π` for a term near 0).
+    let e: [DoubleDouble; 3] = std::array::from_fn(|k| offsets.1[k] - offsets.0[k]);
+    let extent = largest(e.map(|c| c.hi));
+    if !(extent > 0.0 && extent.is_finite()) {
+        return None;
+    }
+    let s = -binary_exponent(extent);
+    let unit = |r: &[DoubleDouble; 3]| r.map(|c| times_power_of_two(c, s));
+    let (oa, ob, e) = (&unit(offsets.0), &unit(offsets.1), unit(&e));
+    let exponent = exponent + 2 * i64::from(s);
     let le = dot3(&e, &e).sqrt();
     let u = e.map(|c| c / le);
     let (alpha, beta) = (dot3(oa, &u), dot3(ob, &u));
@@ -483,15 +502,11 @@ fn near_segment_area(
     let pz = cross_dd(&m, &u)[2] / lm;
     let k =
         ((beta - alpha) - u[2] * (beta + alpha)) / (DoubleDouble::from_f64(2.0) * -alpha * beta);
-    // d·K, with d = |m|/(β − α) and |m| = lm·2^exponent (cells).
-    let dk = lm * k / (beta - alpha);
-    let dk = DoubleDouble {
-        hi: scaled_by_power_of_two(dk.hi, exponent),
-        lo: scaled_by_power_of_two(dk.lo, exponent),
-    };
-    if !dk.hi.is_finite() {
-        return None;
-    }
+    // d·K, with d = |m|/(β − α) and |m| = lm·2^exponent (cells), from the factors' mantissas:
+    // next to an edge `1e-183` long (`1e-166` cells) K is `~1e166` and `lm·K/(β − α)` overflowed
+    // before the scaling by `2^exponent` (`|m| ~ 1e-450`), which dropped the expansion (`−π` for
+    // a term near 0).
+    let dk = scaled_product(lm / (beta - alpha), k, exponent)?;
     let n = (m[2] / lm).hi.abs();
     let theta = scaled_by_power_of_two(lm.hi / le.hi, exponent) / (-alpha.hi).min(beta.hi);
     let denominator = (pz + dk).value();
@@ -501,6 +516,22 @@ fn near_segment_area(
         denominator,
         error: DD_TERM_ROUNDING * (pz.abs() + dk.abs())
             + 4.0 * theta * theta * (pz.abs() + 2.0 * theta),
+    })
+}
+
+/// `x·y·2^e` for positive finite double-doubles `x`, `y`, without intermediate overflow or
+/// underflow (the product of their mantissas, then one scaling); `None` otherwise.
+fn scaled_product(x: DoubleDouble, y: DoubleDouble, e: i64) -> Option<DoubleDouble> {
+    let usable = |v: DoubleDouble| v.hi > 0.0 && v.hi.is_finite();
+    if !usable(x) || !usable(y) {
+        return None;
+    }
+    let (ex, ey) = (binary_exponent(x.hi), binary_exponent(y.hi));
+    let p = times_power_of_two(x, -ex) * times_power_of_two(y, -ey);
+    let total = e + i64::from(ex) + i64::from(ey);
+    Some(DoubleDouble {
+        hi: scaled_by_power_of_two(p.hi, total),
+        lo: scaled_by_power_of_two(p.lo, total),
     })
 }
 
