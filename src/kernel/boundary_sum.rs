@@ -851,22 +851,10 @@ impl BoundaryEdges {
             // The exact moment only where the query's residual and the ray coordinate are the
             // input's (a clamped query is far from every segment).
             let moment = || z_exact.then(|| exact_edge_moment(q, pa, pb, &self.lattice))?;
-            let v = antipodal_edge_area_accurate(ra, rb, signs, moment);
-            if std::env::var("GWN_DEBUG").is_ok() {
-                eprintln!("  acc term {v:e}");
-            }
-            v
+            antipodal_edge_area_accurate(ra, rb, signs, moment)
         } else {
             // `hi` is the offset rounded once (normalized pairs).
-            let v = antipodal_edge_area(ra.map(|x| x.hi), rb.map(|x| x.hi), signs);
-            if std::env::var("GWN_DEBUG").is_ok() {
-                eprintln!(
-                    "f64 term {v:e} ra {:?} rb {:?} {signs:?}",
-                    ra.map(|x| x.hi),
-                    rb.map(|x| x.hi)
-                );
-            }
-            v
+            antipodal_edge_area(ra.map(|x| x.hi), rb.map(|x| x.hi), signs)
         }
     }
 

@@ -367,15 +367,6 @@ pub fn antipodal_edge_area_accurate(
     // formula's bits (issue 21: the open box returned 0.875 for 0.5 below ~1e-172).
     let offsets = (ra, rb);
     let (ra, rb) = unit_scaled(ra, rb);
-    if std::env::var("GWN_DEBUG").is_ok() {
-        eprintln!(
-            "acc off {:?} {:?}\n    scaled {:?} {:?} {signs:?}",
-            offsets.0.map(|c| c.hi),
-            offsets.1.map(|c| c.hi),
-            ra.map(|c| c.hi),
-            rb.map(|c| c.hi)
-        );
-    }
     let hi = |r: &[DoubleDouble; 3]| r.map(|c| c.hi);
     let (fa, fb) = (hi(&ra), hi(&rb));
     let degenerate = signs.numerator == 0
@@ -500,15 +491,28 @@ fn near_segment_area(
     }
     let lm = dot3(&m, &m).sqrt();
     let pz = cross_dd(&m, &u)[2] / lm;
-    let k =
-        ((beta - alpha) - u[2] * (beta + alpha)) / (DoubleDouble::from_f64(2.0) * -alpha * beta);
-    // d·K, with d = |m|/(β − α) and |m| = lm·2^exponent (cells), from the factors' mantissas:
-    // next to an edge `1e-183` long (`1e-166` cells) K is `~1e166` and `lm·K/(β − α)` overflowed
-    // before the scaling by `2^exponent` (`|m| ~ 1e-450`), which dropped the expansion (`−π` for
-    // a term near 0).
-    let dk = scaled_product(lm / (beta - alpha), k, exponent)?;
+    // `(β − α) − u_z·(β + α) = β·(1 − u_z) + |α|·(1 + u_z)`: two terms ≥ 0, no cancellation
+    // (`1 ∓ u_z` from `u_x² + u_y²` where it is small: an edge along the ray).
+    let across = u[0] * u[0] + u[1] * u[1];
+    let one = DoubleDouble::from_f64(1.0);
+    let (below, above) = if u[2].hi > 0.0 {
+        (across / (one + u[2]), one + u[2])
+    } else {
+        (one - u[2], across / (one - u[2]))
+    };
+    let near_end = if -alpha.hi < beta.hi { -alpha } else { beta };
+    let two = DoubleDouble::from_f64(2.0);
+    // d·K = |m|·(β(1 − u_z) + |α|(1 + u_z)) / ((β − α)·2|α|β) and θ = |m|/(|e|·min(|α|, β)),
+    // `|m| = lm·2^exponent`, formed from the factors' mantissas and scaled once: next to an
+    // endpoint `|α|` can be `2^-1000` of the edge and `|m|` `2^-1100`, where double-double
+    // overflowed to NaN (`K ~ 1e300`) and the expansion was dropped (`0` for a term of `2π`).
+    let dk = scaled_ratio(
+        &[lm, beta * below + (-alpha) * above],
+        &[beta - alpha, two * -alpha * beta],
+        exponent,
+    )?;
+    let theta = scaled_ratio(&[lm], &[le, near_end], exponent).map_or(f64::INFINITY, |t| t.hi);
     let n = (m[2] / lm).hi.abs();
-    let theta = scaled_by_power_of_two(lm.hi / le.hi, exponent) / (-alpha.hi).min(beta.hi);
     let denominator = (pz + dk).value();
     let (pz, dk) = (pz.hi, dk.hi);
     Some(NearSegmentTerm {
@@ -519,19 +523,34 @@ fn near_segment_area(
     })
 }
 
-/// `x·y·2^e` for positive finite double-doubles `x`, `y`, without intermediate overflow or
-/// underflow (the product of their mantissas, then one scaling); `None` otherwise.
-fn scaled_product(x: DoubleDouble, y: DoubleDouble, e: i64) -> Option<DoubleDouble> {
-    let usable = |v: DoubleDouble| v.hi > 0.0 && v.hi.is_finite();
-    if !usable(x) || !usable(y) {
-        return None;
+/// `Π numerators / Π denominators · 2^e` for positive finite double-doubles, from their
+/// mantissas (each in `[1, 2)`) and one scaling at the end, so no partial product overflows or
+/// underflows; `None` when a factor is not positive and finite. Where `2^e` takes the result
+/// into the subnormals it is rounded there (an error bound of `2^-1074` absolute).
+fn scaled_ratio(
+    numerators: &[DoubleDouble],
+    denominators: &[DoubleDouble],
+    e: i64,
+) -> Option<DoubleDouble> {
+    let mut total = e;
+    let mut mantissa = |v: &DoubleDouble, sign: i64| {
+        let usable = v.hi > 0.0 && v.hi.is_finite();
+        usable.then(|| {
+            let k = binary_exponent(v.hi);
+            total += sign * i64::from(k);
+            times_power_of_two(*v, -k)
+        })
+    };
+    let mut product = DoubleDouble::from_f64(1.0);
+    for v in numerators {
+        product = product * mantissa(v, 1)?;
     }
-    let (ex, ey) = (binary_exponent(x.hi), binary_exponent(y.hi));
-    let p = times_power_of_two(x, -ex) * times_power_of_two(y, -ey);
-    let total = e + i64::from(ex) + i64::from(ey);
+    for v in denominators {
+        product = product / mantissa(v, -1)?;
+    }
     Some(DoubleDouble {
-        hi: scaled_by_power_of_two(p.hi, total),
-        lo: scaled_by_power_of_two(p.lo, total),
+        hi: scaled_by_power_of_two(product.hi, total),
+        lo: scaled_by_power_of_two(product.lo, total),
     })
 }
 

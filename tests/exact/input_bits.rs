@@ -1180,6 +1180,187 @@ proptest! {
     }
 }
 
+/// Soups whose coordinates mix magnitudes down to `1e-300` with `O(1)` ones (the zeros of a
+/// rotation that are not quite zero), queried at points on their edges moved by offsets down to
+/// the subnormals: every ray gives the rational oracle's value. Each case was off on one or two
+/// rays (by 0.12 to 0.5) before the fixes of 2026-12-06: the first two where both ends of an
+/// edge were seen near the ray line and their transverse parts were each scaled to a floor on
+/// their own; the others where the near-segment expansion of an edge `1e-166` cells long
+/// overflowed (`|e|²` to 0, `|m|·K` to ∞) and was dropped.
+#[test]
+fn mixed_magnitude_soups_get_the_oracle_value_on_every_ray() {
+    type Case = (&'static [[f64; 3]], &'static [[u32; 3]], [f64; 3]);
+    let cases: [Case; 8] = [
+        (
+            &[
+                [-0.0, 0.0, -6.20260064581006e-265],
+                [9.248342506688256e-153, 0.0, 0.0],
+                [0.0, 0.0, 3.0],
+                [-6.984919309616089e-10, 0.0, 1.0625],
+            ],
+            &[[0, 1, 2]],
+            [-1.8e-322, -2.8454554514666566e-260, 1.5],
+        ),
+        (
+            &[
+                [-2.0, 0.0, -1.7295793500612577e-82],
+                [0.0, 1.6913182200647337e-251, -1.0753375999518608e-148],
+                [0.0, 0.0, 1.0],
+                [9.819305883557646e-191, 8.607837561916492e-282, -2.0],
+            ],
+            &[[0, 1, 2], [0, 2, 3]],
+            [-4.264287943994416e-266, 8.456591100323669e-252, 0.5],
+        ),
+        (
+            &[
+                [-1.0, 0.0, 1.7918661475261802e-298],
+                [-1.0, 1.9407238137370536e-172, 0.0],
+                [1.0, 0.0, 0.0],
+                [-1.25, 1.1875, -3.0],
+            ],
+            &[[0, 1, 2], [0, 2, 3]],
+            [-1.0, 1.6399116226078103e-172, 2.7773925286655807e-299],
+        ),
+        (
+            &[
+                [0.0, -3.0604216617913035e-226, -1.4265981485363138e-264],
+                [1.1756283188242405e-138, -3.0, 0.0],
+                [1.4375, 1.0, -1.9375],
+                [0.0, 5.288655398041493e-279, -4.682663633682572e-280],
+            ],
+            &[[0, 1, 2], [0, 2, 3]],
+            [0.0, -8.048908970511129e-227, -3.751953130650509e-265],
+        ),
+        (
+            &[
+                [0.0, -2.2357654998513085e-183, 0.0],
+                [-0.0, 3.443135024766597e-281, 0.0],
+                [0.0, 0.0, 7.779655623197771e-162],
+                [-3.0, -1.0, -1.0],
+            ],
+            &[[0, 1, 2], [0, 2, 3]],
+            [
+                -1.5165533800677307e-301,
+                -1.1178827499256543e-183,
+                6.956e-321,
+            ],
+        ),
+        (
+            &[
+                [2.0, 0.0, 2.0],
+                [0.0, -0.0, 8.237030788925873e-184],
+                [0.0, -1.821692753161181e-169, 0.0],
+                [0.0, 1.0, -1.8125],
+            ],
+            &[[0, 1, 2], [0, 2, 3]],
+            [
+                -1.7560488431795618e-224,
+                -9.108463765805905e-170,
+                4.1185153944629367e-184,
+            ],
+        ),
+        (
+            &[
+                [-3.1796818964267885e-168, 0.0, 0.0],
+                [0.0, 0.0, 0.0],
+                [-1.75, 4.937705530339428e-98, 3.0],
+                [0.0, 1.0, 0.0],
+            ],
+            &[[0, 1, 2]],
+            [-1.4435755809777619e-168, 0.0, -8.051435961996417e-232],
+        ),
+        (
+            &[
+                [1.3125, 0.0, 1.0],
+                [0.0, 2.410194517336618e-281, 0.0],
+                [0.0, 0.0, 8.08994095340934e-185],
+                [0.0, 0.0, -6.635360333912158e-195],
+            ],
+            &[[0, 1, 2]],
+            [
+                -1.240520129162012e-265,
+                1.1038690889401708e-281,
+                4.384747996747863e-185,
+            ],
+        ),
+    ];
+    for (k, (p, t, q)) in cases.iter().enumerate() {
+        let mesh = Mesh::from_slices(p, t).unwrap();
+        for (ray, wn) in all_rays(&mesh) {
+            let want = exact_winding_number_rational(&mesh, *q, ray);
+            let w = wn.eval(*q);
+            assert!(
+                want.contains(w, 1e-9),
+                "case {k}, {ray:?}: {w} not in [{}, {}]",
+                want.lo,
+                want.hi
+            );
+        }
+    }
+}
+
+/// A coordinate of [`mixed_magnitude_soups_do_not_depend_on_the_ray`]: 0, `O(1)`, or `O(1)`
+/// times any power of two down to `2^-999`.
+fn mixed_magnitude() -> impl Strategy<Value = f64> {
+    prop_oneof![
+        Just(0.0),
+        (-4.0f64..4.0),
+        ((-2.0f64..2.0), 1i32..1000).prop_map(|(m, e)| times_power_of_two(m, -e)),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 3000, ..ProptestConfig::default() })]
+
+    /// One or two triangles over coordinates of [`mixed_magnitude`], queried on an edge (at an
+    /// end, the middle, any point, or beyond an end) moved along each axis by nothing or by any
+    /// power of two down to the subnormals: off the surface, the six rays give one value. The
+    /// search that found the cases of `mixed_magnitude_soups_get_the_oracle_value_on_every_ray`
+    /// (142 of 200,000 before the fixes, 0 of 800,000 after).
+    #[test]
+    fn mixed_magnitude_soups_do_not_depend_on_the_ray(
+        c in prop::collection::vec(mixed_magnitude(), 12),
+        two in prop::bool::ANY,
+        ends in (0usize..4, 1usize..4),
+        t in prop_oneof![Just(0.0), Just(0.5), Just(-0.5), 0.0f64..1.0],
+        offsets in prop::collection::vec(prop_oneof![Just(0.0), ((-2.0f64..2.0), 0i32..1075).prop_map(|(m, e)| times_power_of_two(m, -e))], 3),
+    ) {
+        let p: Vec<[f64; 3]> = c.chunks(3).map(|v| [v[0], v[1], v[2]]).collect();
+        let t_faces: &[[u32; 3]] = if two { &[[0, 1, 2], [0, 2, 3]] } else { &[[0, 1, 2]] };
+        let mesh = Mesh::from_slices(&p, t_faces).unwrap();
+        let (a, b) = (p[ends.0], p[(ends.0 + ends.1) % 4]);
+        let q: [f64; 3] = std::array::from_fn(|k| a[k] + t * (b[k] - a[k]) + offsets[k]);
+        let disagreements = gwn::testing::ray_disagreements(&mesh, &[q], 1e-9);
+        prop_assert!(disagreements.is_empty(), "{disagreements:?}");
+    }
+}
+
+/// A mesh far smaller than its distance from 0 along an axis where all its points agree (a
+/// `1e-32` triangle on the plane `y = 3`) builds, on every ray, and its values off the plane
+/// agree with the rational oracle: the grid's origin overflowed before (`CoordinateRange`).
+#[test]
+fn a_tiny_flat_mesh_far_along_its_flat_axis_builds() {
+    let p = [[0.0, 3.0, 0.0], [1e-32, 3.0, 0.0], [0.0, 3.0, 1e-32]];
+    let mesh = Mesh::from_slices(&p, &[[0, 1, 2]]).unwrap();
+    let above = 3.0f64.next_up();
+    for q in [
+        [2e-33, above, 2e-33],
+        [0.0, above, 0.0],
+        [1e-30, 3.0f64.next_down(), -1e-30],
+    ] {
+        for (ray, wn) in all_rays(&mesh) {
+            let want = exact_winding_number_rational(&mesh, q, ray);
+            let w = wn.eval(q);
+            assert!(
+                want.contains(w, 1e-9),
+                "{ray:?} q={q:?}: {w} not in [{}, {}]",
+                want.lo,
+                want.hi
+            );
+        }
+    }
+}
+
 /// The `kernel_tiny_offsets` fuzz target on stable: its committed corpus (the input it found
 /// with the near-segment expansion switched off) and 3,000 pseudo-random inputs, through the
 /// same decoder and check.
