@@ -704,6 +704,104 @@ fn bad_options_are_errors() {
     );
 }
 
+/// The unit ball's indicator, counting its evaluations.
+struct CountingBall(std::sync::atomic::AtomicUsize);
+
+impl Evaluator for CountingBall {
+    fn eval(&self, q: [f64; 3]) -> f64 {
+        self.0.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        if q[0] * q[0] + q[1] * q[1] + q[2] * q[2] < 1.0 {
+            1.0
+        } else {
+            0.0
+        }
+    }
+}
+
+/// A resolution whose surface cannot fit the budget is refused levels before the budget is
+/// spent: every cell split above the resolution's level leaves one to split on each level
+/// below it, so those are counted as soon as the cell is split. Before, the refusal came only
+/// when the classified points themselves reached the budget (`cgal-bunny00 --res 65536`: 172 s
+/// and 6.1 GB to refuse on this machine, 38 s and 1.6 GB with the bound).
+#[test]
+fn an_absurd_resolution_is_refused_early() {
+    let ball = CountingBall(std::sync::atomic::AtomicUsize::new(0));
+    let bb = gwn::BoundingBox {
+        min: [-1.2; 3],
+        max: [1.2; 3],
+    };
+    let max_points = 4_000_000;
+    let options = RemeshOptions {
+        max_classified_points: Some(max_points),
+        ..RemeshOptions::with_resolution(1 << 16)
+    };
+    assert_eq!(
+        remesh(&ball, bb, &options),
+        Err(RemeshError::OutOfMemory { max_points })
+    );
+    // 971,519 evaluations with the bound; 3,115,537 without it.
+    let evaluations = ball.0.load(std::sync::atomic::Ordering::Relaxed);
+    assert!(evaluations < max_points / 3, "{evaluations}");
+}
+
+/// The early refusal's bound never refuses a run that fits: a budget of exactly the points a
+/// run classifies is enough, on a sphere, a noise field (every labelling, sub-levels) and a
+/// guided run with plates refined.
+#[test]
+fn a_budget_of_the_points_a_run_classifies_is_enough() {
+    let mesh = sphere([0.1, -0.2, 0.3], 1.0, 24, false);
+    let wn = WindingNumber::new(&mesh).unwrap();
+    let bb = mesh.bounding_box().unwrap();
+    let noise_box = gwn::BoundingBox {
+        min: [0.0; 3],
+        max: [1.0; 3],
+    };
+    let guide = SegmentBvh::of_mesh(&mesh);
+    for res in [16, 64, 160] {
+        let runs: [(
+            &dyn Evaluator,
+            gwn::BoundingBox,
+            Option<&SegmentBvh>,
+            RemeshOptions,
+        ); 3] = [
+            (&wn, bb, None, raw(res)),
+            (
+                &Noise(f64::from(res as u32) / 3.0),
+                noise_box,
+                None,
+                raw(res.min(64)),
+            ),
+            (
+                &wn,
+                bb,
+                Some(&guide),
+                RemeshOptions {
+                    sub_cell_levels: 1,
+                    ..raw(res)
+                },
+            ),
+        ];
+        for (k, (evaluator, bounds, guide, options)) in runs.into_iter().enumerate() {
+            let run =
+                |options: &RemeshOptions| remesh_guided(evaluator, guide, bounds, options, &|_| {});
+            let used = run(&options).unwrap().stats.classified_points;
+            let exact_budget = RemeshOptions {
+                max_classified_points: Some(used),
+                ..options
+            };
+            assert!(
+                run(&exact_budget).is_ok(),
+                "res {res}, run {k}: {used} points"
+            );
+            let short = RemeshOptions {
+                max_classified_points: Some(used - 1),
+                ..options
+            };
+            assert!(run(&short).is_err(), "res {res}, run {k}: {used} points");
+        }
+    }
+}
+
 #[test]
 fn oriented_point_cloud_remeshes_with_the_fast_evaluator() {
     use gwn::eval::fast::PointCloudWindingNumber;
