@@ -721,8 +721,7 @@ impl Evaluator for CountingBall {
 /// A resolution whose surface cannot fit the budget is refused levels before the budget is
 /// spent: every cell split above the resolution's level leaves one to split on each level
 /// below it, so those are counted as soon as the cell is split. Before, the refusal came only
-/// when the classified points themselves reached the budget (`cgal-bunny00 --res 65536`: 172 s
-/// and 6.1 GB to refuse on this machine, 38 s and 1.6 GB with the bound).
+/// when the classified points themselves reached the budget.
 #[test]
 fn an_absurd_resolution_is_refused_early() {
     let ball = CountingBall(std::sync::atomic::AtomicUsize::new(0));

@@ -934,6 +934,21 @@ impl Classified {
             queue.dedup();
             queue.retain(|&(level, m)| level > 0 && !out.split.contains(&(level, pack(m))));
             let cells = std::mem::take(&mut queue);
+            // A lower bound on the points this round and the later ones add: each cell split
+            // now adds its centre, a point no other cell has, and a cell split above the
+            // regular level leaves a cell to split on every level down to it (its children
+            // share the new centre, so a mixed closed box has a mixed child; a triangle meeting
+            // a box meets a child; a contradicted leaf is mixed), each adding its centre too.
+            // Checked before this round's new points are gathered (tens of millions at an
+            // absurd `--res`), and again with them below: refusing on it is as certain as
+            // refusing at the end, and can come levels earlier.
+            let to_come: usize = cells
+                .iter()
+                .map(|&(level, _)| level.saturating_sub(regular + 1) as usize)
+                .sum();
+            if out.labels.len() + cells.len() + to_come > max_points {
+                return Err(Stop::TooManyPoints);
+            }
             // The new corners of the children of every cell split in this round.
             let labels = &out.labels;
             let mut new_points: Vec<Corner> = cells
@@ -951,16 +966,6 @@ impl Classified {
             for &(level, m) in &cells {
                 out.split.insert((level, pack(m)));
             }
-            // A lower bound on the points still to come: a cell split above the regular level
-            // leaves a cell to split on every level down to it (its children share the new
-            // centre, so a mixed closed box has a mixed child; a triangle meeting a box meets
-            // a child; a contradicted leaf is mixed), and each split adds its centre, a point
-            // no other cell has. Refusing on it is as certain as refusing at the end, and comes
-            // levels earlier (`cgal-bunny00` at `--res 65536` took 172 s and 6.1 GB to refuse).
-            let to_come: usize = cells
-                .iter()
-                .map(|&(level, _)| level.saturating_sub(regular + 1) as usize)
-                .sum();
             if out.labels.len() + new_points.len() + to_come > max_points {
                 return Err(Stop::TooManyPoints);
             }
