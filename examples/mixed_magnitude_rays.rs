@@ -11,19 +11,7 @@
 //! ```
 
 use gwn::Mesh;
-
-/// SplitMix64 (the example's own: seeded, reproducible across platforms).
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-}
+use gwn::testing::SplitMix64;
 
 /// `2^-e` for `0 ≤ e ≤ 1074` (two exact steps into the subnormals).
 fn power_of_two(e: u64) -> f64 {
