@@ -480,7 +480,7 @@ fn near_segment_area(
         return None;
     }
     let s = -binary_exponent(extent);
-    let unit = |r: &[DoubleDouble; 3]| r.map(|c| times_power_of_two(c, s));
+    let unit = |r: &[DoubleDouble; 3]| r.map(|c| times_power_of_two(c, i64::from(s)));
     let (oa, ob, e) = (&unit(offsets.0), &unit(offsets.1), unit(&e));
     let exponent = exponent + 2 * i64::from(s);
     let le = dot3(&e, &e).sqrt();
@@ -538,7 +538,7 @@ fn scaled_ratio(
         usable.then(|| {
             let k = binary_exponent(v.hi);
             total += sign * i64::from(k);
-            times_power_of_two(*v, -k)
+            times_power_of_two(*v, -i64::from(k))
         })
     };
     let mut product = DoubleDouble::from_f64(1.0);
@@ -548,10 +548,7 @@ fn scaled_ratio(
     for v in denominators {
         product = product / mantissa(v, -1)?;
     }
-    Some(DoubleDouble {
-        hi: scaled_by_power_of_two(product.hi, total),
-        lo: scaled_by_power_of_two(product.lo, total),
-    })
+    Some(times_power_of_two(product, total))
 }
 
 /// `a × b` in double-double.
@@ -636,22 +633,20 @@ fn unit_scaled(
         let Some((down, h)) = e else { return r };
         let across = h.map_or(0, |h| common.max(NEAR_RAY_FLOOR_EXPONENT - h).max(0));
         [
-            times_power_of_two(r[0], down + across),
-            times_power_of_two(r[1], down + across),
-            times_power_of_two(r[2], down),
+            times_power_of_two(r[0], i64::from(down + across)),
+            times_power_of_two(r[1], i64::from(down + across)),
+            times_power_of_two(r[2], i64::from(down)),
         ]
     };
     (scaled(ra, ea), scaled(rb, eb))
 }
 
-/// `c·2^k`, exact (in two representable steps: `|k|` may exceed 1022 for subnormal parts).
-fn times_power_of_two(c: DoubleDouble, k: i32) -> DoubleDouble {
-    let (k1, k2) = (k / 2, k - k / 2);
-    let f1 = f64::from_bits(((k1 + 1023) as u64) << 52);
-    let f2 = f64::from_bits(((k2 + 1023) as u64) << 52);
+/// `c·2^k` for a double-double: [`scaled_by_power_of_two`] on both parts (exact unless the
+/// result is subnormal; `|k|` may exceed 1022 for subnormal parts).
+fn times_power_of_two(c: DoubleDouble, k: i64) -> DoubleDouble {
     DoubleDouble {
-        hi: c.hi * f1 * f2,
-        lo: c.lo * f1 * f2,
+        hi: scaled_by_power_of_two(c.hi, k),
+        lo: scaled_by_power_of_two(c.lo, k),
     }
 }
 
