@@ -21,7 +21,8 @@ use super::angle_sum::AngleSum;
 use super::angle_sum::AngleSumAvx2;
 use super::double_double::DoubleDouble;
 use super::input_predicates::{
-    InputPoint, LatticeFrame, exact_edge_moment, input_inside_segment, input_orient2d,
+    InputPoint, LatticeFrame, exact_edge_moment, input_flat_denominator_sign, input_inside_segment,
+    input_orient2d,
 };
 #[cfg(target_arch = "x86_64")]
 use super::lanes::Avx2;
@@ -822,7 +823,8 @@ impl BoundaryEdges {
         qz_units: f64,
         accurate: bool,
     ) -> f64 {
-        let signs = if pa.on_lattice() && pb.on_lattice() && q.residual_exact() {
+        let (o, query_inside_segment) = if pa.on_lattice() && pb.on_lattice() && q.residual_exact()
+        {
             let (qi, r, a, b) = (q.n, q.r, pa.n, pb.n);
             let o = perturbed_orient2d_at::<W>(
                 [qi[0], qi[1]],
@@ -830,20 +832,22 @@ impl BoundaryEdges {
                 [a[0], a[1]],
                 [b[0], b[1]],
             );
-            EdgeSigns {
-                numerator: -o.sign,
-                query_inside_segment: o.degenerate
-                    && z_exact
-                    && query_inside_segment_at(qi, r, a, b),
-            }
+            let inside = o.degenerate && z_exact && query_inside_segment_at(qi, r, a, b);
+            (o, inside)
         } else {
             let o = input_orient2d(q, pa, pb, &self.lattice);
-            EdgeSigns {
-                numerator: -o.sign,
-                query_inside_segment: o.degenerate
-                    && z_exact
-                    && input_inside_segment(q, pa, pb, &self.lattice),
-            }
+            let inside = o.degenerate && z_exact && input_inside_segment(q, pa, pb, &self.lattice);
+            (o, inside)
+        };
+        let signs = EdgeSigns {
+            numerator: -o.sign,
+            query_inside_segment,
+            // Exactly collinear seen along the ray: the denominator's sign is a predicate too.
+            flat_denominator: if o.degenerate && o.sign != 0 && !query_inside_segment {
+                input_flat_denominator_sign(q, pa, pb, &self.lattice)
+            } else {
+                0
+            },
         };
         let ra = exact_offsets(pa, q, z_exact, qz_units);
         let rb = exact_offsets(pb, q, z_exact, qz_units);

@@ -425,6 +425,78 @@ pub fn input_inside_segment(
     dot.sign() < 0
 }
 
+/// After a degenerate orientation (`q`, `a`, `b` collinear seen along the ray) with `q_ε` not
+/// inside the segment: the exact sign of the edge term's denominator
+/// `(|ra| − ra_z)(|rb| − rb_z) + ra_x rb_x + ra_y rb_y`, or `0` when it is not decided here
+/// (an end at `q` or on its vertical line: the limit formulas take those).
+///
+/// Both ends then lie in one vertical plane through `q`, at signed horizontal positions `s_a`,
+/// `s_b` along it. On one side (`s_a s_b > 0`) every term of the denominator is `≥ 0` and the
+/// planar product `> 0`: `+1`. On both sides the segment crosses `q`'s vertical line at height
+/// `z* = (z_b s_a − z_a s_b)/(s_a − s_b)` above `q`, and the arc from `A` to `B` passes over
+/// the ray's direction exactly when `z* > 0`, where the denominator is negative (its two terms
+/// are `|ra_xy||rb_xy|·(tan(θa/2)·tan(θb/2) − 1)`, `θ` the angles from `+z`, and
+/// `θa + θb < π` there). `z* = 0` puts `q` on the segment, the inside-segment limit: `0`.
+///
+/// The side of each end along the line and the crossing height's sign do not depend on the
+/// horizontal axis they are read on (both carry the line direction's component on it), so the
+/// `f64` filter takes any axis on which both offsets are certainly non-zero.
+#[inline]
+pub fn input_flat_denominator_sign(
+    q: &InputPoint,
+    a: &InputPoint,
+    b: &InputPoint,
+    lattice: &LatticeFrame,
+) -> i32 {
+    let (u, eu) = offset(a, q);
+    let (v, ev) = offset(b, q);
+    let certain = |x: f64, e: f64| x.abs() > e;
+    if let Some(k) = (0..2).find(|&k| certain(u[k], eu[k]) && certain(v[k], ev[k])) {
+        let (sa, sb) = (u[k].signum(), v[k].signum());
+        if sa == sb {
+            return 1;
+        }
+        let (p1, p2) = (v[2] * u[k], u[2] * v[k]);
+        let height = p1 - p2;
+        let bound = INPUT_FILTER_SAFETY
+            * (product_error(v[2], ev[2], u[k], eu[k])
+                + product_error(u[2], eu[2], v[k], ev[k])
+                + PRODUCT_DIFFERENCE * (p1.abs() + p2.abs()));
+        if height.abs() > bound {
+            return if height.signum() == sa { -1 } else { 1 };
+        }
+    }
+    exact_flat_denominator_sign(q, a, b, lattice)
+}
+
+#[cold]
+fn exact_flat_denominator_sign(
+    q: &InputPoint,
+    a: &InputPoint,
+    b: &InputPoint,
+    lattice: &LatticeFrame,
+) -> i32 {
+    count_fallback();
+    let (ra, rb) = lattice.offsets(q, a, b);
+    let on_vertical_line = |r: &[Dyadic; 3]| r[0].sign() == 0 && r[1].sign() == 0;
+    if on_vertical_line(&ra) || on_vertical_line(&rb) {
+        return 0;
+    }
+    // The common horizontal line through q: along x unless it is the y axis.
+    let k = if ra[0].sign() != 0 || rb[0].sign() != 0 {
+        0
+    } else {
+        1
+    };
+    let (sa, sb) = (ra[k].sign(), rb[k].sign());
+    if sa == sb {
+        return 1;
+    }
+    // sign(z*) = sign(z_b s_a − z_a s_b)·sign(s_a − s_b), and sign(s_a − s_b) = sign(s_a).
+    let height = &(&rb[2] * &ra[k]) - &(&ra[2] * &rb[k]);
+    -height.sign() * sa
+}
+
 /// `a × b`, exactly.
 fn cross(a: &[Dyadic; 3], b: &[Dyadic; 3]) -> [Dyadic; 3] {
     std::array::from_fn(|k| {
@@ -507,6 +579,60 @@ mod tests {
             assert_eq!(
                 input_inside_segment(&ip(q), &ip(a), &ip(b), &l),
                 query_inside_segment(q, a, b)
+            );
+        }
+    }
+
+    #[test]
+    fn flat_denominators_take_the_side_the_segment_passes_the_ray_line() {
+        let l = LatticeFrame::default();
+        let ip = InputPoint::lattice;
+        let q = ip([0, 0, 0]);
+        // Ends on both sides of q's vertical line: the segment crosses it above q (the arc
+        // passes over the ray: negative), below (positive); on one side: positive.
+        for (a, b, want) in [
+            ([2, 0, 1], [-2, 0, 1], -1),
+            ([2, 0, -1], [-2, 0, -1], 1),
+            ([2, 0, 1], [-1, 0, -3], 1),
+            ([0, 3, 5], [0, -1, -1], -1),
+            ([2, 2, 1], [4, 4, -7], 1),
+            // Crossing 2^-59 above / below q: beyond the filter's reach on the lattice too.
+            ([1 << 58, 0, 1], [-(1 << 58) - 1, 0, -1], -1),
+            ([1 << 58, 0, 1], [-(1 << 58) + 1, 0, -1], 1),
+        ] {
+            let s = input_flat_denominator_sign(&q, &ip(a), &ip(b), &l);
+            assert_eq!(s, want, "{a:?} {b:?}");
+            assert_eq!(exact_flat_denominator_sign(&q, &ip(a), &ip(b), &l), want);
+        }
+        // Residuals below the filter: the segment from (-1, 0, 2^-60) to (1, 0, -2^-60 + r)
+        // crosses q's line at height r/2 (cells), decided exactly.
+        for (r, want) in [(2f64.powi(-80), -1), (-(2f64.powi(-80)), 1)] {
+            let a = at([-1, 0, 0], [0.0, 0.0, 2f64.powi(-60)]);
+            let b = at([1, 0, 0], [0.0, 0.0, -(2f64.powi(-60)) + r]);
+            assert_eq!(input_flat_denominator_sign(&q, &a, &b, &l), want);
+        }
+        // An end on q's vertical line is left to the limit formulas.
+        assert_eq!(
+            input_flat_denominator_sign(&q, &ip([0, 0, 4]), &ip([1, 0, 1]), &l),
+            0
+        );
+        // The filter agrees with the exact evaluation on random collinear configurations.
+        let mut rng = TestRng::new(5);
+        for _ in 0..4000 {
+            let mut c = |m: u64| rng.below(m) as i64 - (m / 2) as i64;
+            let d = [c(5), c(5)];
+            if d == [0, 0] {
+                continue;
+            }
+            let (la, lb) = (c(9), c(9));
+            let (a, b) = (
+                ip([la * d[0], la * d[1], c(9)]),
+                ip([lb * d[0], lb * d[1], c(9)]),
+            );
+            assert_eq!(
+                input_flat_denominator_sign(&q, &a, &b, &l),
+                exact_flat_denominator_sign(&q, &a, &b, &l),
+                "{a:?} {b:?}"
             );
         }
     }

@@ -281,6 +281,13 @@ pub struct EdgeSigns {
     /// `q_ε` lies strictly inside the segment to first order (exact collinearity), so `A` and
     /// `B` are antipodal and the area is a limit.
     pub query_inside_segment: bool,
+    /// When `A`, `B` and `x1` lie on one great circle — `q`, `a`, `b` collinear seen along the
+    /// ray, neither end at `q` or on its vertical line, `q_ε` not inside the segment — the exact
+    /// sign of the denominator, which alone decides the term: `0` when it is positive, `±2π`
+    /// when negative (the numerator is `0⁺` with the perturbation's sign). `0` otherwise. A
+    /// rounded denominator decided it before, and lost its sign where the segment passes the
+    /// ray line within `2^-104` of its length from `q` (`w` off by `0.5` on one ray).
+    pub flat_denominator: i32,
 }
 
 /// The Antipodal method's term for one boundary edge (before the weight and the `1/4π`):
@@ -302,6 +309,9 @@ pub fn antipodal_edge_area(ra: [f64; 3], rb: [f64; 3], signs: EdgeSigns) -> f64 
         // Edge parallel to the ray: A, B and x1 lie on one great half-circle; area 0.
         return 0.0;
     }
+    if signs.flat_denominator != 0 {
+        return signed_double_atan2(s, 0.0, f64::from(signs.flat_denominator));
+    }
     if signs.query_inside_segment {
         let u = normalized([rb[0] - ra[0], rb[1] - ra[1], rb[2] - ra[2]]);
         // Dominant perpendicular part of (ε1, ε2, ε3): e1 − (u·e1)u, or e2 when u = ±e1.
@@ -322,6 +332,10 @@ pub fn antipodal_edge_area(ra: [f64; 3], rb: [f64; 3], signs: EdgeSigns) -> f64 
     }
     if b_on_ray {
         return signed_double_atan2(s, a_dir[1].abs(), -a_dir[0]);
+    }
+    if let Some(other) = other_end_of_edge_at_query(&ra, &rb) {
+        let (n, den) = edge_at_query_arguments(if other == 0 { ra } else { rb });
+        return signed_double_atan2(s, n, den);
     }
     // Generic case, with unit A, B and x1 = −z:
     //   n = −(A × B)_z,   den = 1 + A·B − A_z − B_z = (1 − A_z)(1 − B_z) + A_x B_x + A_y B_y,
@@ -365,6 +379,9 @@ pub fn antipodal_edge_area_accurate(
     // both homogeneous of degree 1 in each): scaled by powers of two to unit size, offsets of
     // `1e-300` (a query next to a boundary vertex) neither underflow their squares nor lose the
     // formula's bits (issue 21: the open box returned 0.875 for 0.5 below ~1e-172).
+    if signs.numerator != 0 && signs.flat_denominator != 0 {
+        return signed_double_atan2(signs.numerator, 0.0, f64::from(signs.flat_denominator));
+    }
     let offsets = (ra, rb);
     let (ra, rb) = unit_scaled(ra, rb);
     let hi = |r: &[DoubleDouble; 3]| r.map(|c| c.hi);
@@ -375,6 +392,14 @@ pub fn antipodal_edge_area_accurate(
         || fb == [0.0; 3]
         || (fa[0] == 0.0 && fa[1] == 0.0)
         || (fb[0] == 0.0 && fb[1] == 0.0);
+    if signs.numerator != 0
+        && !signs.query_inside_segment
+        && let Some(other) = other_end_of_edge_at_query(&fa, &fb)
+    {
+        let r = if other == 0 { &ra } else { &rb };
+        let (n, den) = edge_at_query_arguments_dd(r);
+        return signed_double_atan2(signs.numerator, n, den);
+    }
     if degenerate {
         return antipodal_edge_area(fa, fb, signs);
     }
@@ -471,26 +496,24 @@ fn near_segment_area(
         return None;
     }
     let (m, exponent) = exact_moment()?;
-    // Lengths in units of the edge's largest component (a power of two `2^-s` cells, so `|m|`
-    // is `2^(exponent + 2s)` of them): an edge can be `1e-166` cells long, whose `|e|²`
-    // underflowed to 0 and dropped the expansion (`−π` for a term near 0).
+    // Every length carries its own power of two (`Wide`): the edge can be `1e-166` cells long
+    // (its `|e|²` underflowed to 0 and dropped the expansion: `−π` for a term near 0), and one
+    // end can be `2^-1100` of the edge from the query (in the edge's units that end's `β`
+    // underflowed to 0 and dropped it: `0.225` for `0` in `w`, an edge `1e15` long with the
+    // query `5e-324` from its end). Only sums align their terms, where a part that underflows
+    // is below the other's rounding.
     let e: [DoubleDouble; 3] = std::array::from_fn(|k| offsets.1[k] - offsets.0[k]);
-    let extent = largest(e.map(|c| c.hi));
-    if !(extent > 0.0 && extent.is_finite()) {
+    let (u, le) = Wide::split(&e)?;
+    let (alpha, beta) = (Wide::along(offsets.0, &u)?, Wide::along(offsets.1, &u)?);
+    if !(alpha.mantissa.hi < 0.0 && beta.mantissa.hi > 0.0) {
         return None;
     }
-    let s = -binary_exponent(extent);
-    let unit = |r: &[DoubleDouble; 3]| r.map(|c| times_power_of_two(c, i64::from(s)));
-    let (oa, ob, e) = (&unit(offsets.0), &unit(offsets.1), unit(&e));
-    let exponent = exponent + 2 * i64::from(s);
-    let le = dot3(&e, &e).sqrt();
-    let u = e.map(|c| c / le);
-    let (alpha, beta) = (dot3(oa, &u), dot3(ob, &u));
-    if !(alpha.hi < 0.0 && beta.hi > 0.0) {
-        return None;
-    }
-    let lm = dot3(&m, &m).sqrt();
-    let pz = cross_dd(&m, &u)[2] / lm;
+    let alpha = alpha.negated();
+    let lm = Wide {
+        mantissa: dot3(&m, &m).sqrt(),
+        exponent,
+    };
+    let pz = cross_dd(&m, &u)[2] / lm.mantissa;
     // `(β − α) − u_z·(β + α) = β·(1 − u_z) + |α|·(1 + u_z)`: two terms ≥ 0, no cancellation
     // (`1 ∓ u_z` from `u_x² + u_y²` where it is small: an edge along the ray).
     let across = u[0] * u[0] + u[1] * u[1];
@@ -500,18 +523,26 @@ fn near_segment_area(
     } else {
         (one - u[2], across / (one - u[2]))
     };
-    let near_end = if -alpha.hi < beta.hi { -alpha } else { beta };
-    let two = DoubleDouble::from_f64(2.0);
-    // d·K = |m|·(β(1 − u_z) + |α|(1 + u_z)) / ((β − α)·2|α|β) and θ = |m|/(|e|·min(|α|, β)),
-    // `|m| = lm·2^exponent`, formed from the factors' mantissas and scaled once: next to an
-    // endpoint `|α|` can be `2^-1000` of the edge and `|m|` `2^-1100`, where double-double
-    // overflowed to NaN (`K ~ 1e300`) and the expansion was dropped (`0` for a term of `2π`).
-    let dk = scaled_ratio(
-        &[lm, beta * below + (-alpha) * above],
-        &[beta - alpha, two * -alpha * beta],
-        exponent,
-    )?;
-    let theta = scaled_ratio(&[lm], &[le, near_end], exponent).map_or(f64::INFINITY, |t| t.hi);
+    let near_end = alpha.min(beta);
+    // d·K = |m|·(β(1 − u_z) + |α|(1 + u_z)) / ((β + |α|)·2|α|β) and θ = |m|/(|e|·min(|α|, β)),
+    // scaled once at the end: next to an endpoint `|α|` can be `2^-1000` of the edge and `|m|`
+    // `2^-1100`, where double-double overflowed to NaN (`K ~ 1e300`) and the expansion was
+    // dropped (`0` for a term of `2π`).
+    let weighted = beta.times(below).plus(alpha.times(above));
+    let dk = lm
+        .product(weighted)
+        .quotient(
+            beta.plus(alpha)
+                .product(alpha)
+                .product(beta)
+                .times(DoubleDouble::from_f64(2.0)),
+        )
+        .value()?;
+    let theta = lm
+        .quotient(le.product(near_end))
+        .value()
+        .map_or(f64::INFINITY, |t| t.hi);
+    let lm = lm.mantissa;
     let n = (m[2] / lm).hi.abs();
     let denominator = (pz + dk).value();
     let (pz, dk) = (pz.hi, dk.hi);
@@ -523,32 +554,105 @@ fn near_segment_area(
     })
 }
 
-/// `Π numerators / Π denominators · 2^e` for positive finite double-doubles, from their
-/// mantissas (each in `[1, 2)`) and one scaling at the end, so no partial product overflows or
-/// underflows; `None` when a factor is not positive and finite. Where `2^e` takes the result
-/// into the subnormals it is rounded there (an error bound of `2^-1074` absolute).
-fn scaled_ratio(
-    numerators: &[DoubleDouble],
-    denominators: &[DoubleDouble],
-    e: i64,
-) -> Option<DoubleDouble> {
-    let mut total = e;
-    let mut mantissa = |v: &DoubleDouble, sign: i64| {
-        let usable = v.hi > 0.0 && v.hi.is_finite();
-        usable.then(|| {
-            let k = binary_exponent(v.hi);
-            total += sign * i64::from(k);
-            times_power_of_two(*v, -i64::from(k))
-        })
+/// A double-double with its own power of two, `mantissa·2^exponent`, for the lengths of
+/// [`near_segment_area`]: their ratios span more than the `f64` exponent range (an end
+/// `2^-1100` of its edge from the query), so products and quotients keep mantissas in `[1, 2)`
+/// and add exponents, and only the final value is scaled (rounded into the subnormals there).
+#[derive(Clone, Copy, Debug)]
+struct Wide {
+    mantissa: DoubleDouble,
+    exponent: i64,
+}
+
+impl Wide {
+    /// Zero, with an exponent below every other so that a sum aligns to the other term.
+    const ZERO: Wide = Wide {
+        mantissa: DoubleDouble { hi: 0.0, lo: 0.0 },
+        exponent: i64::MIN / 4,
     };
-    let mut product = DoubleDouble::from_f64(1.0);
-    for v in numerators {
-        product = product * mantissa(v, 1)?;
+
+    /// `v·2^e` with the mantissa brought to `[1, 2)`; `None` for zero or a non-finite `v`.
+    fn normalized(v: DoubleDouble, e: i64) -> Option<Wide> {
+        if v.hi == 0.0 || !v.hi.is_finite() {
+            return None;
+        }
+        let k = i64::from(binary_exponent(v.hi));
+        Some(Wide {
+            mantissa: times_power_of_two(v, -k),
+            exponent: e + k,
+        })
     }
-    for v in denominators {
-        product = product / mantissa(v, -1)?;
+
+    /// A vector's direction and its length; `None` for a zero or non-finite vector.
+    fn split(v: &[DoubleDouble; 3]) -> Option<([DoubleDouble; 3], Wide)> {
+        let top = v.iter().fold(0.0_f64, |m, c| m.max(c.hi.abs()));
+        if top == 0.0 || !top.is_finite() {
+            return None;
+        }
+        let k = i64::from(binary_exponent(top));
+        let v = v.map(|c| times_power_of_two(c, -k));
+        let length = dot3(&v, &v).sqrt();
+        Some((v.map(|c| c / length), Wide::normalized(length, k)?))
     }
-    Some(times_power_of_two(product, total))
+
+    /// `v·u` for the unit vector `u`, `v` scaled to unit size first (its own power of two).
+    fn along(v: &[DoubleDouble; 3], u: &[DoubleDouble; 3]) -> Option<Wide> {
+        let top = v.iter().fold(0.0_f64, |m, c| m.max(c.hi.abs()));
+        if top == 0.0 || !top.is_finite() {
+            return None;
+        }
+        let k = i64::from(binary_exponent(top));
+        Wide::normalized(dot3(&v.map(|c| times_power_of_two(c, -k)), u), k)
+    }
+
+    fn negated(self) -> Wide {
+        Wide {
+            mantissa: -self.mantissa,
+            exponent: self.exponent,
+        }
+    }
+
+    fn product(self, o: Wide) -> Wide {
+        let p = self.mantissa * o.mantissa;
+        Wide::normalized(p, self.exponent + o.exponent).unwrap_or(Wide::ZERO)
+    }
+
+    fn quotient(self, o: Wide) -> Wide {
+        let q = self.mantissa / o.mantissa;
+        Wide::normalized(q, self.exponent - o.exponent).unwrap_or(Wide::ZERO)
+    }
+
+    /// `self·f` for a double-double factor `f ≥ 0` of moderate size (zero stays zero).
+    fn times(self, f: DoubleDouble) -> Wide {
+        let p = self.mantissa * f;
+        Wide::normalized(p, self.exponent).unwrap_or(Wide::ZERO)
+    }
+
+    /// The sum of two values `≥ 0`, aligned to the larger exponent (the smaller term's bits
+    /// below its rounding may underflow).
+    fn plus(self, o: Wide) -> Wide {
+        let e = self.exponent.max(o.exponent);
+        let sum = times_power_of_two(self.mantissa, self.exponent - e)
+            + times_power_of_two(o.mantissa, o.exponent - e);
+        Wide::normalized(sum, e).unwrap_or(Wide::ZERO)
+    }
+
+    /// The smaller of two positive values.
+    fn min(self, o: Wide) -> Wide {
+        let smaller = if self.exponent != o.exponent {
+            self.exponent < o.exponent
+        } else {
+            self.mantissa.hi < o.mantissa.hi
+        };
+        if smaller { self } else { o }
+    }
+
+    /// The value as a double-double (rounded into the subnormals or to 0 below them); `None`
+    /// when it overflows.
+    fn value(self) -> Option<DoubleDouble> {
+        let v = times_power_of_two(self.mantissa, self.exponent);
+        v.hi.is_finite().then_some(v)
+    }
 }
 
 /// `a × b` in double-double.
@@ -666,6 +770,52 @@ const NEAR_RAY_FLOOR_EXPONENT: i32 = -500;
 /// holds to `2^-200`, large enough that the other keeps `2^-400` of it above the floor.
 const NEAR_RAY_COMMON_EXPONENT: i32 = -100;
 
+/// Which end (`0` for `a`, `1` for `b`) is the other one of an edge with exactly one end at the
+/// query, that end off the ray line (an end on it takes the on-ray lune).
+#[inline]
+fn other_end_of_edge_at_query(ra: &[f64; 3], rb: &[f64; 3]) -> Option<usize> {
+    let off_ray = |r: &[f64; 3]| r[0] != 0.0 || r[1] != 0.0;
+    match (*ra == [0.0; 3], *rb == [0.0; 3]) {
+        (false, true) if off_ray(ra) => Some(0),
+        (true, false) if off_ray(rb) => Some(1),
+        _ => None,
+    }
+}
+
+/// The `atan2` arguments `(|n|, den)` of an edge with one end at the query and the other at
+/// offset `r`. The end at the query is seen from `q_ε` in the direction `−x̂`, so the generic
+/// formula's `|n| = |r_y|` and `den = |r| − r_x − r_z` (up to the common factor `|r|`). That
+/// difference cancels where the edge leaves the query almost along `x̂` (the first perturbation
+/// direction, along which `q_ε` approaches the vertex): there the term is decided by `r`'s
+/// transverse parts, and `|r| − r_x` in `f64` loses them (an edge of length `1e15` whose far end
+/// is `O(1)` off the `x̂` line erred by `3·10⁻⁴` in `w`). Rationalized,
+/// `|r| − (r_x + r_z) = (r_y² − 2 r_x r_z) / (|r| + r_x + r_z)` where `r_x + r_z > 0`: no
+/// cancellation unless `r_x, r_z > 0` and `r_y² ≈ 2 r_x r_z`, and there `|n| = |r_y|` is the
+/// larger argument by far, so the angle keeps its relative accuracy.
+#[inline]
+fn edge_at_query_arguments(r: [f64; 3]) -> (f64, f64) {
+    let len = norm(r);
+    let along = r[0] + r[2];
+    let den = if along > 0.0 {
+        (r[1] * r[1] - 2.0 * r[0] * r[2]) / (len + along)
+    } else {
+        len - along
+    };
+    (r[1].abs(), den)
+}
+
+/// [`edge_at_query_arguments`] in double-double (the offset exact, unit-scaled).
+fn edge_at_query_arguments_dd(r: &[DoubleDouble; 3]) -> (f64, f64) {
+    let len = dot3(r, r).sqrt();
+    let along = r[0] + r[2];
+    let den = if along.hi > 0.0 {
+        (r[1] * r[1] - DoubleDouble::from_f64(2.0) * r[0] * r[2]) / (len + along)
+    } else {
+        len - along
+    };
+    (r[1].hi.abs(), den.value())
+}
+
 /// `|r| − r_z` without cancellation when `r` points up.
 #[inline]
 fn len_minus_z(r: [f64; 3], len: f64) -> f64 {
@@ -760,6 +910,7 @@ mod tests {
             EdgeSigns {
                 numerator: s,
                 query_inside_segment: false,
+                flat_denominator: 0,
             },
         );
         assert!((paper - ours).abs() < 1e-14, "{paper} vs {ours}");

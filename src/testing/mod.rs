@@ -36,8 +36,9 @@ pub use generators::{
     tets_from_bytes,
 };
 pub use oracle::{
-    Certified, Decision, Oracle, direct_at_perturbed, exact_winding_number_integer,
-    exact_winding_number_rational, on_surface, ray_disagreements,
+    Certified, Decision, NARROW_PER_TERM, Oracle, direct_at_perturbed,
+    exact_winding_number_integer, exact_winding_number_rational, on_surface, oracle_disagreements,
+    ray_disagreements,
 };
 pub use source::{Source, SplitMix64};
 

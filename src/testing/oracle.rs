@@ -51,7 +51,16 @@ pub struct Certified {
     /// Number of edges of the signed boundary (by exact position) that contributed a non-zero
     /// area. Zero means `lo == hi == χ`.
     pub boundary_terms: usize,
+    /// Those edges' multiplicities summed (an edge of `k` coincident boundary edges counts
+    /// `k`): what the interval's width grows with.
+    pub boundary_weight: u64,
 }
+
+/// The width of `w` that one boundary term may add to a [`Certified`] interval: each half-area
+/// is enclosed to `2^-60` before its `atan2`, whose corners are widened by 4 ulp of `π`
+/// (`2.8e-15`) on each side, which is `≈ 9e-16` of `w` per term after `2/4π`; `1e-14` leaves
+/// a margin of ten.
+pub const NARROW_PER_TERM: f64 = 1e-14;
 
 /// The answer of [`Certified::decide`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -85,6 +94,20 @@ impl Certified {
     /// True when `w` lies in `[lo − tol, hi + tol]`.
     pub fn contains(&self, w: f64, tol: f64) -> bool {
         self.lo - tol <= w && w <= self.hi + tol
+    }
+
+    /// `hi − lo`: 0 when the value is exact.
+    pub fn width(&self) -> f64 {
+        self.hi - self.lo
+    }
+
+    /// Whether the interval is as narrow as the oracle promises: at most [`NARROW_PER_TERM`]
+    /// per boundary term and unit of its multiplicity. A test should assert it next to [`Certified::contains`], which a wide
+    /// interval passes for any value (before the oracle's denominators were evaluated in big
+    /// fixed point, about 7 % of the intervals at queries one ulp from a vertex were wider
+    /// than `1e-9`, some `[0, π]` per edge).
+    pub fn is_narrow(&self) -> bool {
+        self.width() <= NARROW_PER_TERM * (self.boundary_weight as f64 + 1.0)
     }
 
     /// The midpoint of the interval.
@@ -246,6 +269,7 @@ impl Oracle {
                 hi: f64::NAN,
                 crossings: 0,
                 boundary_terms: 0,
+                boundary_weight: 0,
             };
         }
         let qs = q.iter().map(|&c| needed_scale(c)).max().unwrap_or(0);
@@ -283,6 +307,7 @@ impl Oracle {
         }
         let mut sum = Iv::point(0.0);
         let mut terms = 0;
+        let mut weight = 0u64;
         for &(a, b, k) in &self.boundary {
             let (a, b) = (&self.verts[a], &self.verts[b]);
             // Sign of the numerator x1·(A×B) = −(A×B)_z at q_t.
@@ -299,6 +324,7 @@ impl Oracle {
             let signed = area * Iv::point(f64::from(2 * s) * k as f64);
             sum = sum + signed;
             terms += 1;
+            weight += k.unsigned_abs();
         }
         if terms == 0 {
             return Certified {
@@ -306,6 +332,7 @@ impl Oracle {
                 hi: chi as f64,
                 crossings: chi,
                 boundary_terms: 0,
+                boundary_weight: 0,
             };
         }
         let inv_4pi = Iv::point(1.0) / (pi() * Iv::point(4.0));
@@ -315,6 +342,7 @@ impl Oracle {
             hi: w.hi,
             crossings: chi,
             boundary_terms: terms,
+            boundary_weight: weight,
         }
     }
 }
@@ -349,17 +377,7 @@ pub fn ray_disagreements(
     queries: &[[f64; 3]],
     tolerance: f64,
 ) -> Vec<([f64; 3], [f64; 6])> {
-    let rays: Vec<crate::eval::antipodal::WindingNumber> = RayAxis::ALL
-        .iter()
-        .map(|&ray| {
-            let options = crate::eval::antipodal::Options {
-                ray,
-                ..Default::default()
-            };
-            crate::eval::antipodal::WindingNumber::with_options(mesh, options)
-                .expect("a valid mesh builds on every ray")
-        })
-        .collect();
+    let rays = six_rays(mesh);
     queries
         .iter()
         .filter(|&&q| !on_surface(mesh, q))
@@ -373,6 +391,49 @@ pub fn ray_disagreements(
             // A non-finite value is a disagreement too (min and max would skip a NaN).
             let agree = w.iter().all(|x| x.is_finite()) && hi - lo <= tolerance;
             (!agree).then_some((q, w))
+        })
+        .collect()
+}
+
+/// The queries at which the exact evaluator on some ray of [`RayAxis::ALL`] leaves the
+/// oracle's interval for that ray (widened by `tolerance`), or that interval is not
+/// [narrow](Certified::is_narrow), with the six values: on the surface too, where each ray
+/// defines its own perturbed point (the check of the `kernel_grazing` and
+/// `kernel_tiny_offsets` fuzz targets).
+pub fn oracle_disagreements(
+    mesh: &Mesh,
+    queries: &[[f64; 3]],
+    tolerance: f64,
+) -> Vec<([f64; 3], [f64; 6])> {
+    let rays = six_rays(mesh);
+    let oracles: Vec<Oracle> = RayAxis::ALL
+        .iter()
+        .map(|&ray| Oracle::new(mesh, ray))
+        .collect();
+    queries
+        .iter()
+        .filter_map(|&q| {
+            let w: [f64; 6] = std::array::from_fn(|k| rays[k].eval(q));
+            let agree = (0..6).all(|k| {
+                let c = oracles[k].eval(q);
+                c.is_narrow() && c.contains(w[k], tolerance)
+            });
+            (!agree).then_some((q, w))
+        })
+        .collect()
+}
+
+/// The exact evaluator of `mesh` on each ray of [`RayAxis::ALL`], in that order.
+fn six_rays(mesh: &Mesh) -> Vec<crate::eval::antipodal::WindingNumber> {
+    RayAxis::ALL
+        .iter()
+        .map(|&ray| {
+            let options = crate::eval::antipodal::Options {
+                ray,
+                ..Default::default()
+            };
+            crate::eval::antipodal::WindingNumber::with_options(mesh, options)
+                .expect("a valid mesh builds on every ray")
         })
         .collect()
 }
@@ -443,29 +504,84 @@ fn edge_area_magnitude(ra: &[BigInt; 3], rb: &[BigInt; 3]) -> Iv {
                 -(&v[0] * &v[2]),
             ]
         };
-        // Scaled by |v|·|P|: N = −(v×P)_z, D = P_z·|v|.
+        // Scaled by |v|·|P|: N = −(v×P)_z, D = P_z·|v|, each of degree one in v and in P, so
+        // each factor takes its own shift (P = e2 has none: scaling it like |v|² underflowed
+        // N to 0 and gave [0, π] for an edge 2^1124 long).
         let n = -(&v[0] * &p[1] - &v[1] * &p[0]);
-        let s = shift(&v);
-        let len = big(&dot(&v, &v), 2 * s).sqrt();
-        let d = big(&p[2], 2 * s) * len;
-        return atan2_hull(big(&n, 3 * s).abs(), d);
+        let (sv, sp) = (shift(&v), shift(&p));
+        let len = big(&dot(&v, &v), 2 * sv).sqrt();
+        let d = big(&p[2], sp) * len;
+        return atan2_hull(big(&n, sv + sp).abs(), d);
     }
     // Generic: N·|ra||rb| = −(ra×rb)_z, D·|ra||rb| = (|ra| − ra_z)(|rb| − rb_z) + ra_x rb_x + ra_y rb_y.
-    let (sa, sb) = (shift(&ra), shift(&rb));
-    let n = big(&c[2], sa + sb).abs();
-    let d = len_minus_z(&ra, sa) * len_minus_z(&rb, sb)
-        + big(&(&ra[0] * &rb[0] + &ra[1] * &rb[1]), sa + sb);
-    atan2_hull(n, d)
+    generic_half_area(&c[2], &ra, &rb)
 }
 
-/// `(|r| − r_z)·2^-s`, without cancellation when `r_z > 0`.
-fn len_minus_z(r: &[BigInt; 3], s: i64) -> Iv {
-    let len = big(&dot(r, r), 2 * s).sqrt();
+/// Fractional bits beyond the operands' own at which [`generic_half_area`] starts: with
+/// `N ≥ 1` (an integer) the first pass already meets [`HALF_AREA_RELATIVE_WIDTH_BITS`].
+const HALF_AREA_EXTRA_BITS: u64 = 64;
+
+/// The widest the enclosure of `D` may be, relative to `max(N, |D|)`, before it goes to `f64`:
+/// `2^-60`, below the `f64` rounding that follows.
+const HALF_AREA_RELATIVE_WIDTH_BITS: u64 = 60;
+
+/// Past this many fractional bits the enclosure is returned as it is (still an enclosure). Not
+/// reached: `D ≠ 0` whenever `N = 0` outside the lune and segment limits (`N = 0` puts both ends
+/// in one vertical half-plane pair; `D = 0` there needs them antiparallel or one straight up).
+const HALF_AREA_MAX_BITS: u64 = 1 << 16;
+
+/// `atan2(|N|, D)` for the generic edge, `N = (ra×rb)_z`, enclosed to a few ulp of `π`.
+///
+/// `D` cancels (a sum of two terms of opposite sign and up to `|ra||rb|` each) exactly where the
+/// ray passes close to the edge, the configurations the oracle exists to check, so `D` is
+/// evaluated in big fixed point with `p` fractional bits — `|r|·2^p` by an integer square root,
+/// bracketed — and `p` doubles until `D`'s bracket is `2^-60` of `max(|N|, |D|)`. Only then
+/// are `N` and `D` scaled by one power of two (`atan2` is homogeneous of degree 0) and rounded
+/// to `f64`. A plain `f64` evaluation of `D` gave `[0, π]` for whole terms at queries one ulp
+/// from a vertex.
+fn generic_half_area(cz: &BigInt, ra: &[BigInt; 3], rb: &[BigInt; 3]) -> Iv {
+    let n = BigInt::from(cz.magnitude().clone());
+    let planar_dot = &ra[0] * &rb[0] + &ra[1] * &rb[1];
+    let operand_bits = ra.iter().chain(rb).map(BigInt::bits).max().unwrap_or(0);
+    let mut p = operand_bits + HALF_AREA_EXTRA_BITS;
+    loop {
+        let (a_lo, a_hi) = len_minus_z_fixed(ra, p);
+        let (b_lo, b_hi) = len_minus_z_fixed(rb, p);
+        let planar = &planar_dot << (2 * p);
+        // Both factors are ≥ 0, so their product's bracket is the products of the ends.
+        let d_lo = &a_lo * &b_lo + &planar;
+        let d_hi = &a_hi * &b_hi + &planar;
+        let n_p = &n << (2 * p);
+        let size = n_p.bits().max(d_lo.bits()).max(d_hi.bits());
+        let width = (&d_hi - &d_lo).bits();
+        if width + HALF_AREA_RELATIVE_WIDTH_BITS <= size || p >= HALF_AREA_MAX_BITS {
+            let s = size as i64 - 60;
+            let d = Iv {
+                lo: big(&d_lo, s).lo,
+                hi: big(&d_hi, s).hi,
+            };
+            return atan2_hull(big(&n_p, s), d);
+        }
+        p *= 2;
+    }
+}
+
+/// Integers `[lo, hi]` enclosing `(|r| − r_z)·2^p`, without cancellation when `r_z > 0`
+/// (there `|r| − r_z = (r_x² + r_y²) / (|r| + r_z)`).
+fn len_minus_z_fixed(r: &[BigInt; 3], p: u64) -> (BigInt, BigInt) {
+    let planar = &r[0] * &r[0] + &r[1] * &r[1];
+    let len_sq = &planar + &r[2] * &r[2];
+    // len ≤ |r|·2^p < len + 1.
+    let len = (len_sq << (2 * p)).sqrt();
+    let z = &r[2] << p;
     if r[2].sign() == Sign::Plus {
-        let h = &r[0] * &r[0] + &r[1] * &r[1];
-        big(&h, 2 * s) / (len + big(&r[2], s))
+        let num = planar << (2 * p);
+        let lo = &num / (&len + 1u32 + &z);
+        let den = &len + &z;
+        let hi = (&num + &den - 1u32) / den;
+        (lo, hi)
     } else {
-        len + big(&-&r[2], s)
+        (&len - &z, &len + 1u32 - &z)
     }
 }
 
@@ -710,6 +826,55 @@ mod tests {
             assert!(c.contains(5.0 / 6.0, 0.0), "{ray:?} {c:?}");
             assert!(c.hi - c.lo < 1e-14);
         }
+    }
+
+    fn big3(v: [i128; 3]) -> [BigInt; 3] {
+        v.map(BigInt::from)
+    }
+
+    #[test]
+    fn edge_terms_stay_narrow_where_the_denominator_cancels() {
+        // The far end almost along +x from a query at the other end (seen along −x): D is
+        // |r| − r_x − r_z, a difference of 2^50-sized terms worth 9.4; in f64 it was [0, π].
+        let far = big3([1 << 50, 6, -9]);
+        let at_q = big3([-1, 0, 0]);
+        let a = edge_area_magnitude(&far, &at_q);
+        let want = 6f64.atan2(9.0 + 117.0 / (2.0 * (1u64 << 50) as f64));
+        assert!(
+            a.hi - a.lo < 1e-14 && a.lo <= want && want <= a.hi,
+            "{a:?} vs {want}"
+        );
+        // N = 0, ends on both sides of q's vertical line, the segment crossing it 2^-100/3
+        // above q (D < 0 by ~2^-100 of its terms): the half-area is π, certainly.
+        for (up, down, half) in [
+            (
+                [1 << 100, 0, 1],
+                [-(1 << 101) - 1, 0, -2],
+                std::f64::consts::PI,
+            ),
+            ([1 << 100, 0, 1], [-(1 << 101) + 1, 0, -2], 0.0),
+        ] {
+            let a = edge_area_magnitude(&big3(up), &big3(down));
+            assert!(a.hi - a.lo < 1e-14 && a.lo <= half && half <= a.hi, "{a:?}");
+        }
+    }
+
+    #[test]
+    fn a_long_edge_through_the_query_is_a_quarter_turn() {
+        // q inside a segment along x, 2^1124 long: the lune's half-area is π/2 (P = e2); N was
+        // shifted like |v|³ and underflowed to 0, which gave [0, π].
+        let a = big3([1, 0, 0]);
+        let b = [
+            -(BigInt::from(1) << 1123u32),
+            BigInt::from(0),
+            BigInt::from(0),
+        ];
+        let area = edge_area_magnitude(&a, &b);
+        let quarter = std::f64::consts::FRAC_PI_2;
+        assert!(
+            area.hi - area.lo < 1e-14 && area.lo <= quarter && quarter <= area.hi,
+            "{area:?}"
+        );
     }
 
     #[test]

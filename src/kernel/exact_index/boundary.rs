@@ -58,6 +58,7 @@ impl<W: Width> ExactIndex<W> {
             let signs = EdgeSigns {
                 numerator: far_query_numerator_sign(ra, rb),
                 query_inside_segment: false,
+                flat_denominator: 0,
             };
             antipodal_edge_area(ra, rb, signs)
         };
