@@ -6,8 +6,13 @@
 //! whose six values spread by more than `1e-9` is a kernel error; each is printed as
 //! `case|positions|triangles|query|values` (for an independent check, e.g. mpmath).
 //!
+//! With `oracle`, every query — on the surface too, where each ray has its own perturbed point
+//! and agreement checks nothing — is also compared, ray by ray, with the rational oracle's
+//! narrow interval (`gwn::testing::oracle_disagreements`, tolerance `1e-10`); those lines start
+//! with `oracle|`.
+//!
 //! ```text
-//! cargo run --release --features examples --example mixed_magnitude_rays -- [CASES] [SEED]
+//! cargo run --release --features examples --example mixed_magnitude_rays -- [CASES] [SEED] [oracle]
 //! ```
 
 use gwn::Mesh;
@@ -34,6 +39,8 @@ fn main() {
     let mut args = std::env::args().skip(1);
     let cases: u64 = args.next().map_or(200_000, |s| s.parse().expect("CASES"));
     let seed: u64 = args.next().map_or(1, |s| s.parse().expect("SEED"));
+    let with_oracle = args.next().is_some_and(|s| s == "oracle");
+    let mut oracle_disagreements = 0u64;
     let mut rng = SplitMix64(seed);
     let (mut checked, mut disagreements) = (0u64, 0u64);
     for case in 0..cases {
@@ -68,6 +75,15 @@ fn main() {
             disagreements += 1;
             println!("{case}|{p:?}|{faces:?}|{q:?}|{w:?}");
         }
+        if with_oracle {
+            for (q, w) in gwn::testing::oracle_disagreements(&mesh, &[q], 1e-10) {
+                oracle_disagreements += 1;
+                println!("oracle|{case}|{p:?}|{faces:?}|{q:?}|{w:?}");
+            }
+        }
     }
     eprintln!("seed {seed}: {checked} queries, {disagreements} off the surface depend on the ray");
+    if with_oracle {
+        eprintln!("seed {seed}: {oracle_disagreements} leave the oracle's interval on some ray");
+    }
 }

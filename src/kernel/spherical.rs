@@ -314,11 +314,15 @@ pub fn antipodal_edge_area(ra: [f64; 3], rb: [f64; 3], signs: EdgeSigns) -> f64 
     }
     if signs.query_inside_segment {
         let u = normalized([rb[0] - ra[0], rb[1] - ra[1], rb[2] - ra[2]]);
-        // Dominant perpendicular part of (ε1, ε2, ε3): e1 − (u·e1)u, or e2 when u = ±e1.
-        let p = if u[1] == 0.0 && u[2] == 0.0 {
+        // Dominant perpendicular part of (ε1, ε2, ε3): e1 − (u·e1)u = (u_y² + u_z², −u_x u_y,
+        // −u_x u_z), or e2 when u = ±e1. Divided by h = max(|u_y|, |u_z|) before normalizing:
+        // for an edge 2^-700 off the x axis its squares underflowed, |p| was 0 and the term NaN.
+        let h = u[1].abs().max(u[2].abs());
+        let p = if h == 0.0 {
             [0.0, 1.0, 0.0]
         } else {
-            normalized([1.0 - u[0] * u[0], -u[0] * u[1], -u[0] * u[2]])
+            let (y, z) = (u[1] / h, u[2] / h);
+            normalized([h * (y * y + z * z), -u[0] * y, -u[0] * z])
         };
         let n = -(u[0] * p[1] - u[1] * p[0]);
         return signed_double_atan2(s, n.abs(), p[2]);

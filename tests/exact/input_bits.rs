@@ -1478,9 +1478,12 @@ proptest! {
 
     /// One or two triangles over coordinates of [`mixed_magnitude`], queried on an edge (at an
     /// end, the middle, any point, or beyond an end) moved along each axis by nothing or by any
-    /// power of two down to the subnormals: off the surface, the six rays give one value. The
-    /// search that found the cases of `mixed_magnitude_soups_get_the_exact_value_on_every_ray`
-    /// (as a seeded loop: 876 of 200,000 inputs before 2026-12-06, 0 of 1.1 million after).
+    /// power of two down to the subnormals: off the surface, the six rays give one value; on
+    /// and off it, each ray's value lies in the rational oracle's narrow interval. The search
+    /// that found the cases of `mixed_magnitude_soups_get_the_exact_value_on_every_ray` (as a
+    /// seeded loop: 876 of 200,000 inputs before 2026-12-06, 0 of 1.1 million after), and with
+    /// the oracle a NaN on two rays at 63 of 100,000 on-surface queries (an edge `1e-234` off
+    /// an axis through the query: the perturbation's direction underflowed; 0 after).
     #[test]
     fn mixed_magnitude_soups_do_not_depend_on_the_ray(
         c in prop::collection::vec(mixed_magnitude(), 12),
@@ -1496,6 +1499,34 @@ proptest! {
         let q: [f64; 3] = std::array::from_fn(|k| a[k] + t * (b[k] - a[k]) + offsets[k]);
         let disagreements = gwn::testing::ray_disagreements(&mesh, &[q], 1e-9);
         prop_assert!(disagreements.is_empty(), "{disagreements:?}");
+        let disagreements = gwn::testing::oracle_disagreements(&mesh, &[q], 1e-10);
+        prop_assert!(disagreements.is_empty(), "the oracle: {disagreements:?}");
+    }
+}
+
+/// A query inside a boundary edge that is `1e-234` off the ray frame's `x` axis (seen along
+/// `±y`): the direction of the perturbation perpendicular to the edge came from squares that
+/// underflowed, and the term was NaN on those two rays (found by `mixed_magnitude_rays ...
+/// oracle`, 63 of 100,000 queries). Every ray's value is the oracle's.
+#[test]
+fn a_query_inside_an_edge_barely_off_an_axis_is_finite_on_every_ray() {
+    let p = [
+        [0.0, -5.436400950371662e-241, -4.0],
+        [0.0, 9.367506770274758e-17, 0.0],
+        [-2.0, 0.0, 1.1558636723074572e-208],
+        [2.830582955389365e-234, 0.0, -3.0],
+    ];
+    let mesh = Mesh::from_slices(&p, &[[0, 1, 2], [0, 2, 3]]).unwrap();
+    let q = [1.4152914776946826e-234, -2.718200475185831e-241, -3.5];
+    for (ray, wn) in all_rays(&mesh) {
+        let want = exact_winding_number_rational(&mesh, q, ray);
+        let w = wn.eval(q);
+        assert!(
+            want.is_narrow() && want.contains(w, 1e-12),
+            "{ray:?}: {w} not in [{}, {}]",
+            want.lo,
+            want.hi
+        );
     }
 }
 
@@ -1530,7 +1561,8 @@ proptest! {
 
     /// The bipyramid (open or closed) over coordinates of [`mixed_magnitude`], queried on an
     /// edge moved by any power of two per axis: off the surface, the six rays give one value
-    /// (400,000 cases in release, none failing).
+    /// (400,000 cases in release, none failing); on and off it, each ray's value lies in the
+    /// rational oracle's narrow interval.
     #[test]
     fn mixed_magnitude_bipyramids_do_not_depend_on_the_ray(
         c in prop::collection::vec(mixed_magnitude(), 15),
@@ -1545,6 +1577,8 @@ proptest! {
         let q: [f64; 3] = std::array::from_fn(|k| a[k] + t * (b[k] - a[k]) + offsets[k]);
         let d = gwn::testing::ray_disagreements(&mesh, &[q], 1e-9);
         prop_assert!(d.is_empty(), "{d:?}");
+        let d = gwn::testing::oracle_disagreements(&mesh, &[q], 1e-10);
+        prop_assert!(d.is_empty(), "the oracle: {d:?}");
     }
 }
 
