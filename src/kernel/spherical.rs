@@ -316,7 +316,7 @@ pub fn antipodal_edge_area(ra: [f64; 3], rb: [f64; 3], signs: EdgeSigns) -> f64 
         let u = normalized([rb[0] - ra[0], rb[1] - ra[1], rb[2] - ra[2]]);
         // Dominant perpendicular part of (ε1, ε2, ε3): e1 − (u·e1)u = (u_y² + u_z², −u_x u_y,
         // −u_x u_z), or e2 when u = ±e1. Divided by h = max(|u_y|, |u_z|) before normalizing:
-        // for an edge 2^-700 off the x axis its squares underflowed, |p| was 0 and the term NaN.
+        // for an edge 1e-234 off the x axis its squares underflowed, |p| was 0 and the term NaN.
         let h = u[1].abs().max(u[2].abs());
         let p = if h == 0.0 {
             [0.0, 1.0, 0.0]
@@ -587,26 +587,28 @@ impl Wide {
         })
     }
 
-    /// A vector's direction and its length; `None` for a zero or non-finite vector.
-    fn split(v: &[DoubleDouble; 3]) -> Option<([DoubleDouble; 3], Wide)> {
+    /// `v` as `w·2^k` with `w`'s largest component in `[1, 2)`; `None` for a zero or
+    /// non-finite vector.
+    fn scaled_to_unit(v: &[DoubleDouble; 3]) -> Option<([DoubleDouble; 3], i64)> {
         let top = v.iter().fold(0.0_f64, |m, c| m.max(c.hi.abs()));
         if top == 0.0 || !top.is_finite() {
             return None;
         }
         let k = i64::from(binary_exponent(top));
-        let v = v.map(|c| times_power_of_two(c, -k));
+        Some((v.map(|c| times_power_of_two(c, -k)), k))
+    }
+
+    /// A vector's direction and its length.
+    fn split(v: &[DoubleDouble; 3]) -> Option<([DoubleDouble; 3], Wide)> {
+        let (v, k) = Wide::scaled_to_unit(v)?;
         let length = dot3(&v, &v).sqrt();
         Some((v.map(|c| c / length), Wide::normalized(length, k)?))
     }
 
-    /// `v·u` for the unit vector `u`, `v` scaled to unit size first (its own power of two).
+    /// `v·u` for the unit vector `u`.
     fn along(v: &[DoubleDouble; 3], u: &[DoubleDouble; 3]) -> Option<Wide> {
-        let top = v.iter().fold(0.0_f64, |m, c| m.max(c.hi.abs()));
-        if top == 0.0 || !top.is_finite() {
-            return None;
-        }
-        let k = i64::from(binary_exponent(top));
-        Wide::normalized(dot3(&v.map(|c| times_power_of_two(c, -k)), u), k)
+        let (v, k) = Wide::scaled_to_unit(v)?;
+        Wide::normalized(dot3(&v, u), k)
     }
 
     fn negated(self) -> Wide {
