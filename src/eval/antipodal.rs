@@ -387,8 +387,9 @@ impl WindingNumber {
     /// Gradient `∇w(q)`: the integer part is locally constant, so only the boundary contributes:
     /// the Biot–Savart sum over the signed boundary edges
     /// (the kernel's `segment_gradient`; better conditioned than the antipodal
-    /// paper's Supp. Alg. 3, see there). Not finite on the boundary curve; NaN for a non-finite
-    /// query.
+    /// paper's Supp. Alg. 3, see there). Not finite on the boundary curve (or within the
+    /// rounding of its offsets, about `1e-16` of an edge's length, from it); `±∞` where the
+    /// gradient overflows; NaN for a non-finite query.
     pub fn gradient(&self, q: [f64; 3]) -> [f64; 3] {
         match &self.core {
             Dispatch::Narrow(c) => c.gradient(q),
