@@ -338,7 +338,8 @@ pub fn antipodal_edge_area(ra: [f64; 3], rb: [f64; 3], signs: EdgeSigns) -> f64 
         return signed_double_atan2(s, a_dir[1].abs(), -a_dir[0]);
     }
     if let Some(other) = other_end_of_edge_at_query(&ra, &rb) {
-        let (n, den) = edge_at_query_arguments(if other == 0 { ra } else { rb });
+        let r = if other == 0 { ra } else { rb };
+        let (n, den) = edge_at_query_arguments(&r.map(DoubleDouble::from_f64));
         return signed_double_atan2(s, n, den);
     }
     // Generic case, with unit A, B and x1 = −z:
@@ -383,7 +384,7 @@ pub fn antipodal_edge_area_accurate(
     // both homogeneous of degree 1 in each): scaled by powers of two to unit size, offsets of
     // `1e-300` (a query next to a boundary vertex) neither underflow their squares nor lose the
     // formula's bits (issue 21: the open box returned 0.875 for 0.5 below ~1e-172).
-    if signs.numerator != 0 && signs.flat_denominator != 0 {
+    if signs.flat_denominator != 0 {
         return signed_double_atan2(signs.numerator, 0.0, f64::from(signs.flat_denominator));
     }
     let offsets = (ra, rb);
@@ -401,7 +402,7 @@ pub fn antipodal_edge_area_accurate(
         && let Some(other) = other_end_of_edge_at_query(&fa, &fb)
     {
         let r = if other == 0 { &ra } else { &rb };
-        let (n, den) = edge_at_query_arguments_dd(r);
+        let (n, den) = edge_at_query_arguments(r);
         return signed_double_atan2(signs.numerator, n, den);
     }
     if degenerate {
@@ -848,20 +849,11 @@ fn other_end_of_edge_at_query(ra: &[f64; 3], rb: &[f64; 3]) -> Option<usize> {
 /// `|r| − (r_x + r_z) = (r_y² − 2 r_x r_z) / (|r| + r_x + r_z)` where `r_x + r_z > 0`: no
 /// cancellation unless `r_x, r_z > 0` and `r_y² ≈ 2 r_x r_z`, and there `|n| = |r_y|` is the
 /// larger argument by far, so the angle keeps its relative accuracy.
-#[inline]
-fn edge_at_query_arguments(r: [f64; 3]) -> (f64, f64) {
-    let len = norm(r);
-    let along = r[0] + r[2];
-    let den = if along > 0.0 {
-        (r[1] * r[1] - 2.0 * r[0] * r[2]) / (len + along)
-    } else {
-        len - along
-    };
-    (r[1].abs(), den)
-}
-
-/// [`edge_at_query_arguments`] in double-double (the offset exact, unit-scaled).
-fn edge_at_query_arguments_dd(r: &[DoubleDouble; 3]) -> (f64, f64) {
+///
+/// In double-double: the accurate path passes the exact, unit-scaled offset; the `f64` path
+/// (which meets an end at the query only where the accurate path would have been taken) its
+/// rounded offset, exactly converted.
+fn edge_at_query_arguments(r: &[DoubleDouble; 3]) -> (f64, f64) {
     let len = dot3(r, r).sqrt();
     let along = r[0] + r[2];
     let den = if along.hi > 0.0 {
