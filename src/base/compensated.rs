@@ -27,16 +27,40 @@ impl NeumaierSum {
         self.sum = t;
     }
 
-    /// The compensated total.
+    /// The compensated total; `±∞` when the plain sum overflowed or took an infinite term (the
+    /// compensation is then `∞ − ∞`, NaN, and means nothing).
     #[inline]
     pub fn value(&self) -> f64 {
-        self.sum + self.compensation
+        if self.sum.is_finite() {
+            self.sum + self.compensation
+        } else {
+            self.sum
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn infinite_terms_and_overflow_give_infinity() {
+        for terms in [
+            &[1.0, f64::INFINITY, -3.0][..],
+            &[f64::MAX, f64::MAX, 1.0],
+            &[2.0, f64::NEG_INFINITY],
+        ] {
+            let mut s = NeumaierSum::new();
+            terms.iter().for_each(|&t| s.add(t));
+            let naive: f64 = terms.iter().sum();
+            assert_eq!(s.value(), naive, "{terms:?}");
+        }
+        let mut s = NeumaierSum::new();
+        [f64::INFINITY, f64::NEG_INFINITY]
+            .iter()
+            .for_each(|&t| s.add(t));
+        assert!(s.value().is_nan());
+    }
 
     #[test]
     fn recovers_what_naive_summation_loses() {

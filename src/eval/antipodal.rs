@@ -387,9 +387,11 @@ impl WindingNumber {
     /// Gradient `∇w(q)`: the integer part is locally constant, so only the boundary contributes:
     /// the Biot–Savart sum over the signed boundary edges
     /// (the kernel's `segment_gradient`; better conditioned than the antipodal
-    /// paper's Supp. Alg. 3, see there). Not finite on the boundary curve (or within the
-    /// rounding of its offsets, about `1e-16` of an edge's length, from it); `±∞` where the
-    /// gradient overflows; NaN for a non-finite query.
+    /// paper's Supp. Alg. 3, see there), within a few `1e-9` relative. Next to an edge's
+    /// interior each term takes the cross product of the exact inputs' offsets, so the gradient
+    /// is finite at any distance from the boundary curve that `f64` can express, but not on
+    /// it; `±∞` where the gradient overflows (NaN where two edges' terms overflow with
+    /// opposite signs); NaN for a non-finite query.
     pub fn gradient(&self, q: [f64; 3]) -> [f64; 3] {
         match &self.core {
             Dispatch::Narrow(c) => c.gradient(q),

@@ -807,6 +807,13 @@ impl BoundaryEdges {
         }
     }
 
+    /// `(a − q) × (b − q)` of edge `i` on the exact inputs, in cells squared, as
+    /// [`exact_edge_moment`] gives it; for the gradient next to the edge's interior.
+    pub(crate) fn edge_moment(&self, i: usize, q: &InputPoint) -> Option<([DoubleDouble; 3], i64)> {
+        let (pa, pb) = self.edge_points(i);
+        exact_edge_moment(q, &pa, &pb, &self.lattice)
+    }
+
     /// The term `Area(A, B, x1)` of the segment `pa → pb` between exact points at the exact
     /// query `q` (a residual that underflowed included), through the exact predicates and the
     /// limit formulas: the lattice ones (the `_at` forms for a query off the lattice) when both

@@ -682,20 +682,54 @@ fn cross_dd(a: &[DoubleDouble; 3], b: &[DoubleDouble; 3]) -> [DoubleDouble; 3] {
 /// mesh, along the ray, its x and y components were off by 2e-3 (relative) at 100 mesh sizes
 /// (`tests/exact/gradient.rs`), and garbage from ~1e6 (−19.6 where the true value is 7.6e-27, bundled
 /// lion head), while this form stays accurate to ~1e-9 relative.
-/// Not finite when `q` is on the segment.
+/// Not finite when `q` is on the segment; within [`NEAR_SEGMENT_GRADIENT`] of its interior the
+/// offsets' rounding decides `ra × rb` (see [`segment_gradient_with_moment`]), and
+/// `|ra||rb| + ra·rb` cancels from [`TEXTBOOK_GRADIENT_MIN`] on (see
+/// [`segment_gradient_careful`]).
 #[inline]
 pub fn segment_gradient(ra: [f64; 3], rb: [f64; 3]) -> [f64; 3] {
+    segment_gradient_with_moment(ra, rb, || None)
+}
+
+/// Below this `1 + cos∠(ra, rb)` the textbook form's denominator `|ra||rb| + ra·rb =
+/// |ra||rb|(1 + cos)` has cancelled by more than 24 bits: its rounding (`≲ 5u·|ra||rb|`, `u =
+/// 2^-53`) is then above `6e-10` of it, so the term takes `|ra × rb|²/(|ra||rb| − ra·rb)`
+/// instead. Measured: 3.5e-5 relative error at `1 + cos = 4e-12`, a query `1e-9` from a
+/// boundary edge of cgal-blobby-shuffled (docs/benchmarks.md).
+const TEXTBOOK_GRADIENT_MIN: f64 = 1.0 / (1u64 << 24) as f64;
+
+/// Below this `1 + cos∠(ra, rb)` (`≈ sin²/2`: the query within `2^-20` radians of the
+/// segment's interior, seen from its ends) the cross product of offsets rounded once has lost
+/// more than `2^-32` of its relative accuracy (its error is `~2u` against `sin`), so
+/// [`segment_gradient_with_moment`] takes the exact one.
+pub const NEAR_SEGMENT_GRADIENT: f64 = 1.0 / (1u64 << 41) as f64;
+
+/// [`segment_gradient`] with `exact_moment` giving `ra × rb` exactly as `(m, k)`, the vector
+/// `m·2^k` in the units of `ra` and `rb` (`m`'s largest component in `[1, 2)`; `None` when the
+/// query is on the segment's line, or when it cannot be computed), called only where the query
+/// is within [`NEAR_SEGMENT_GRADIENT`] of the segment's interior. There both offsets are nearly
+/// antiparallel and every product of `ra × rb` cancels to the angle: from offsets rounded once
+/// the term was NaN within `~1e-16` of an edge's length (the rounded offsets exactly
+/// antiparallel) and pointed the wrong way a little farther. With `|ra||rb| + ra·rb =
+/// |ra × rb|²/(|ra||rb| − ra·rb)` the term is `(ra × rb)/|ra × rb|² · (|ra| + |rb|)(1 − â·b̂)`,
+/// whose only cancelling factor is the exact moment.
+#[inline]
+pub fn segment_gradient_with_moment(
+    ra: [f64; 3],
+    rb: [f64; 3],
+    exact_moment: impl FnOnce() -> Option<([DoubleDouble; 3], i64)>,
+) -> [f64; 3] {
     let la = norm(ra);
     let lb = norm(rb);
     let c = cross(ra, rb);
     let p = la * lb;
     let den = p * (p + dot(ra, rb));
     // Past the range of normal f64 (an offset below ~1e-77 or above ~1e77 of the other's
-    // scale, or the sum cancelled to nothing next to the segment): the careful form. The
-    // branch costs 5–9 % of the gradient of a mesh whose every edge is a boundary edge
-    // (docs/benchmarks.md).
-    if !(f64::MIN_POSITIVE..f64::INFINITY).contains(&den) {
-        return segment_gradient_careful(ra, rb);
+    // scale), or `1 + cos` cancelled (the query near the segment's interior): the careful
+    // forms. The range branch costs 5–9 % of the gradient of a mesh whose every edge is a
+    // boundary edge (docs/benchmarks.md).
+    if !(f64::MIN_POSITIVE..f64::INFINITY).contains(&den) || den < p * p * TEXTBOOK_GRADIENT_MIN {
+        return segment_gradient_careful(ra, rb, exact_moment);
     }
     let f = (la + lb) / den;
     [c[0] * f, c[1] * f, c[2] * f]
@@ -705,16 +739,33 @@ pub fn segment_gradient(ra: [f64; 3], rb: [f64; 3]) -> [f64; 3] {
 /// length by its own power of two, where the textbook form fails: a query `1e-268` from a vertex
 /// of an edge of length 1 made `|ra||rb|(|ra||rb| + ra·rb)` underflow to 0, and the gradient
 /// was NaN (a third of the off-surface queries next to mixed-magnitude edges); `1 + â·b̂` is
-/// `|â×b̂|²/(1 − â·b̂)` where `â·b̂ < 0`, as in the textbook form. Overflows to `±∞`
-/// only where the gradient does; NaN only with an end at the query or `â`, `b̂` antiparallel in
-/// `f64` (the query on the boundary curve, or within rounding of it).
+/// `|â×b̂|²/(1 − â·b̂)` where `â·b̂ < 0`, as in the textbook form, and `â × b̂` the exact moment's
+/// direction next to the segment's interior ([`segment_gradient_with_moment`]). Overflows to
+/// `±∞` only where the gradient does; NaN only with an end at the query, or on the segment (or
+/// within rounding of it when no exact moment is given).
 #[cold]
-fn segment_gradient_careful(ra: [f64; 3], rb: [f64; 3]) -> [f64; 3] {
+fn segment_gradient_careful(
+    ra: [f64; 3],
+    rb: [f64; 3],
+    exact_moment: impl FnOnce() -> Option<([DoubleDouble; 3], i64)>,
+) -> [f64; 3] {
     let (Some((a, la)), Some((b, lb))) = (direction_and_length(ra), direction_and_length(rb))
     else {
         return [f64::NAN; 3];
     };
     let d = dot(a, b);
+    // A zero component stays zero when the scale overflows (not 0·∞).
+    let times = |v: [f64; 3], s: f64| v.map(|x| if x == 0.0 { 0.0 } else { x * s });
+    if 1.0 + d < NEAR_SEGMENT_GRADIENT
+        && let Some((m, k)) = exact_moment()
+    {
+        let m = m.map(|x| x.hi);
+        let lm = norm(m);
+        // `|ra × rb| = lm·2^k`; the factor before the power of two is within `[2^-2, 2^3]`
+        // of the lengths' sum, so only the power of two can overflow (where the gradient does).
+        let f = (la + lb) * (1.0 - d) / (lm * lm);
+        return m.map(|x| scaled_by_power_of_two(x * f, -k));
+    }
     let c = cross(a, b);
     let (direction, magnitude) = if d >= 0.0 {
         (c, 1.0 / (1.0 + d))
@@ -724,9 +775,7 @@ fn segment_gradient_careful(ra: [f64; 3], rb: [f64; 3]) -> [f64; 3] {
             None => return [f64::NAN; 3],
         }
     };
-    let scale = magnitude * (1.0 / la + 1.0 / lb);
-    // A zero component stays zero when the scale overflows (not 0·∞).
-    direction.map(|x| if x == 0.0 { 0.0 } else { x * scale })
+    times(direction, magnitude * (1.0 / la + 1.0 / lb))
 }
 
 /// `(v/|v|, |v|)`, `v` scaled by a power of two before its norm (no under- or overflow of the
@@ -812,7 +861,7 @@ fn times_power_of_two(c: DoubleDouble, k: i64) -> DoubleDouble {
 }
 
 /// `⌊log2 |x|⌋` for finite non-zero `x` (subnormals included).
-fn binary_exponent(x: f64) -> i32 {
+pub(crate) fn binary_exponent(x: f64) -> i32 {
     let (mant, e) = decompose(x);
     e + 63 - mant.unsigned_abs().leading_zeros() as i32
 }

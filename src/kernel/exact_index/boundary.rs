@@ -9,7 +9,10 @@ use crate::kernel::boundary_sum::{LoopFrame, scaled_by_power_of_two};
 use crate::kernel::boundary_tree::{BoundaryTree, TreeQuery};
 use crate::kernel::input_predicates::InputPoint;
 use crate::kernel::predicates::{Width, far_query_numerator_sign};
-use crate::kernel::spherical::{EdgeSigns, INV_4PI, antipodal_edge_area, segment_gradient};
+use crate::kernel::quantize::Snap;
+use crate::kernel::spherical::{
+    EdgeSigns, INV_4PI, antipodal_edge_area, binary_exponent, segment_gradient_with_moment,
+};
 
 impl<W: Width> ExactIndex<W> {
     /// `Σ k·Area(A, B, x1)` with exact branch signs at the query `qi + r` (lattice point and
@@ -102,7 +105,8 @@ impl<W: Width> ExactIndex<W> {
     }
 
     /// Gradient `∇w` at a world query: the integer part is locally constant, so only the boundary
-    /// contributes (the Biot–Savart sum of [`segment_gradient`]). NaN for a non-finite query.
+    /// contributes (the Biot–Savart sum of
+    /// [`crate::kernel::spherical::segment_gradient`]). NaN for a non-finite query.
     pub fn gradient(&self, q: [f64; 3]) -> [f64; 3] {
         if q.iter().any(|c| !c.is_finite()) {
             return [f64::NAN; 3];
@@ -137,6 +141,12 @@ impl<W: Width> ExactIndex<W> {
             }
             LoopFrame::Lattice => None,
         };
+        // Next to an edge's interior the term takes `(a − q) × (b − q)` on the exact inputs
+        // (cells squared; the offsets are cells times `cell·scale`, a power of two): the exact
+        // query, where it snaps inside the grid (a query outside is far from every edge).
+        let exact_query = unshifted_query.and(self.query_point(qg, q));
+        let moment_exponent =
+            2 * (i64::from(binary_exponent(self.cell)) + i64::from(binary_exponent(scale)));
         let mut g = [NeumaierSum::new(); 3];
         for i in 0..self.boundary.len() {
             let (a, b, weight) = self.boundary.edge(i);
@@ -153,13 +163,31 @@ impl<W: Width> ExactIndex<W> {
                     self.rel_f64(b, qf).map(|v| v * scale),
                 ),
             };
-            let e = segment_gradient(ra, rb);
+            let e = segment_gradient_with_moment(ra, rb, || {
+                let (m, k) = self.boundary.edge_moment(i, exact_query.as_ref()?)?;
+                Some((m, k + moment_exponent))
+            });
             for k in 0..3 {
                 g[k].add(weight * e[k]);
             }
         }
         let g = self.ray.to_world(g.map(|s| s.value() * scale * INV_4PI));
         self.grid.gradient_to_world(g)
+    }
+
+    /// The world query `world` (grid space `qg`) as an exact point of the frame, when it snaps
+    /// inside the grid on every axis.
+    fn query_point(&self, qg: [f64; 3], world: [f64; 3]) -> Option<InputPoint> {
+        let snapped = self.snap_frame(qg, world);
+        let [Snap::In(x), Snap::In(y), Snap::In(z)] = snapped.snap else {
+            return None;
+        };
+        Some(InputPoint {
+            n: [x, y, z],
+            r: snapped.residual,
+            world: self.ray.to_frame(world),
+            exact: snapped.exact,
+        })
     }
 
     /// The boundary sums of a column's points (one lattice `x, y`) whose sum is the flat loop,
