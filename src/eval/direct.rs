@@ -3,9 +3,12 @@
 //! and the `beta <= 0` path of the FOSSIL-style API.
 //!
 //! Accuracy: each triangle's offsets are exact (double-double), its solid angle is evaluated on
-//! unit vectors (any magnitude, 1e-300 to 1e300) and in double-double where `f64` is
-//! ill-conditioned (query near an edge), so the sum is accurate to ~1e-14 down to distances of
-//! ~1e-14 of the edge lengths (it erred by ≈ 2e-17·E/d before, 0.44 at 1e-17 from an edge).
+//! unit vectors (any magnitude, 1e-300 to 1e300), in double-double where `f64` is
+//! ill-conditioned (query near an edge), and with the edge's exact moment within `2^-40` of its
+//! length from its interior; the sign of a triple product within rounding of zero is decided on
+//! the exact offsets. So the sum is accurate to ~1e-14 at any distance from the edges (it erred
+//! by ≈ 2e-17·E/d before 2026-11, 0.44 at 1e-17 from an edge; and by a sign or more below
+//! ~1e-30·E until 2026-12-06).
 //!
 //! On-surface semantics: a triangle whose plane contains the query exactly contributes 0 (the
 //! principal value), so the direct sum returns the local solid-angle fraction: 1/2 on a face of

@@ -521,13 +521,33 @@ pub fn exact_edge_moment(
     lattice: &LatticeFrame,
 ) -> Option<([DoubleDouble; 3], i64)> {
     let (ra, rb) = lattice.offsets(q, a, b);
-    let m = cross(&ra, &rb);
+    scaled_to_double_double(cross(&ra, &rb))
+}
+
+/// An exact vector as `(v, k)`, `v·2^k` with `v`'s largest component in `[1, 2)` in
+/// double-double; `None` for zero.
+fn scaled_to_double_double(m: [Dyadic; 3]) -> Option<([DoubleDouble; 3], i64)> {
     let top = m.iter().filter_map(Dyadic::exponent).max()?;
     let m = m.map(|c| {
         let (hi, lo) = c.to_double_double_scaled(top);
         DoubleDouble { hi, lo }
     });
     Some((m, top))
+}
+
+/// `(a − q) × (b − q)` of `f64` points exactly, as [`exact_edge_moment`] gives it (`m·2^k`, `m`'s
+/// largest component in `[1, 2)`; `None` when `q` is on the line `a b`): for the direct sum's
+/// solid angle next to an edge ([`super::spherical::triangle_solid_angle_at`]).
+#[cold]
+pub fn exact_moment_of_points(
+    q: [f64; 3],
+    a: [f64; 3],
+    b: [f64; 3],
+) -> Option<([DoubleDouble; 3], i64)> {
+    let offset = |p: [f64; 3]| -> [Dyadic; 3] {
+        std::array::from_fn(|k| &Dyadic::from_f64(p[k]) - &Dyadic::from_f64(q[k]))
+    };
+    scaled_to_double_double(cross(&offset(a), &offset(b)))
 }
 
 #[cfg(test)]

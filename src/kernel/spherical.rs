@@ -11,6 +11,7 @@
 use super::double_double::{DoubleDouble, dot3};
 
 use super::boundary_sum::scaled_by_power_of_two;
+use super::input_predicates::exact_moment_of_points;
 use super::quantize::decompose;
 use crate::base::vec3::{cross, dot, norm};
 
@@ -69,7 +70,9 @@ pub fn triangle_solid_angle(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
 /// The common case in the textbook form (no normalization, as fast as before the magnitude
 /// fixes): when every `|r|²` is a normal `f64` far from over- and underflow, and
 /// `√(det² + den²) ≥ condition·|a||b||c|`. `None` sends the triangle to the careful path
-/// ([`solid_angle_parts`], double-double).
+/// ([`solid_angle_parts`], double-double). With `condition > 0` the offsets are rounded ones
+/// ([`triangle_solid_angle_at`]): a triple product within [`ZERO_AREA_SUSPECT`] of zero may
+/// have its sign (or its zero) from their rounding, and goes to the careful path too.
 #[inline]
 fn solid_angle_moderate(a: [f64; 3], b: [f64; 3], c: [f64; 3], condition: f64) -> Option<f64> {
     let (la2, lb2, lc2) = (dot(a, a), dot(b, b), dot(c, c));
@@ -78,13 +81,16 @@ fn solid_angle_moderate(a: [f64; 3], b: [f64; 3], c: [f64; 3], condition: f64) -
         return None;
     }
     let det = dot(a, cross(b, c));
-    if det == 0.0 {
+    if det == 0.0 && condition == 0.0 {
         return Some(0.0);
     }
     let (la, lb, lc) = (la2.sqrt(), lb2.sqrt(), lc2.sqrt());
     let labc = la * lb * lc;
     let den = labc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
     if det.abs() <= ZERO_AREA_SUSPECT * labc {
+        if condition > 0.0 {
+            return None;
+        }
         // See the zero-area test of `solid_angle_parts`.
         let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
         let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
@@ -101,7 +107,7 @@ fn solid_angle_moderate(a: [f64; 3], b: [f64; 3], c: [f64; 3], condition: f64) -
 /// `(sign, â·(b̂×ĉ), 1 + â·b̂ + b̂·ĉ + ĉ·â)`, or `None` when the triangle subtends nothing
 /// (coplanar query, zero-area triangle). `sign` is the exact sign of `a·(b×c)`, which the `f64`
 /// triple product may have lost to underflow (a query `5e-324` off a face).
-#[inline]
+#[cfg(test)]
 fn solid_angle_parts(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> Option<(i32, f64, f64)> {
     // The exact-zero test on the raw offsets (brought to magnitude ~1 by one common power of
     // two, so that it neither underflows nor overflows), before normalizing rounds it away.
@@ -144,25 +150,35 @@ fn solid_angle_parts(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> Option<(i32, f64,
     Some((sign, det, den))
 }
 
-/// Exact sign of `a·(b×c)` for any finite `f64` vectors (every `f64` is `m·2^e`: scaled to
-/// integers, big-integer arithmetic). The rare path of an underflowed `f64` triple product.
-#[cold]
+/// Exact sign of `a·(b×c)` for any finite `f64` vectors. The rare path of an underflowed `f64`
+/// triple product.
+#[cfg(test)]
 fn exact_triple_product_sign(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> i32 {
+    exact_orientation_sign([0.0; 3], [a, b, c])
+}
+
+/// Below this `|â·(b̂×ĉ)|` the double-double triple product of the unit offsets (each within
+/// `~2^-104`) may have the wrong sign: [`triangle_solid_angle_at`] decides it exactly.
+const DD_TRIPLE_PRODUCT_ROUNDING: f64 = 1.0 / (1u128 << 96) as f64;
+
+/// Exact sign of `(a − q)·((b − q)×(c − q))` for finite `f64` points `[a, b, c]` (every `f64` is
+/// `m·2^e`: scaled to integers, big-integer arithmetic).
+#[cold]
+fn exact_orientation_sign(q: [f64; 3], [a, b, c]: [[f64; 3]; 3]) -> i32 {
     use num_bigint::BigInt;
-    let min_exp = [a, b, c]
+    let min_exp = [q, a, b, c]
         .iter()
         .flatten()
         .filter(|x| **x != 0.0)
         .map(|&x| decompose(x).1)
         .min()
         .unwrap_or(0);
-    let big = |v: [f64; 3]| -> [BigInt; 3] {
-        v.map(|x| {
-            let (m, e) = decompose(x);
-            BigInt::from(m) << (e - min_exp) as usize
-        })
+    let big = |x: f64| -> BigInt {
+        let (m, e) = decompose(x);
+        BigInt::from(m) << (e - min_exp) as usize
     };
-    let (a, b, c) = (big(a), big(b), big(c));
+    let offset = |v: [f64; 3]| -> [BigInt; 3] { std::array::from_fn(|k| big(v[k]) - big(q[k])) };
+    let (a, b, c) = (offset(a), offset(b), offset(c));
     let cx = &b[1] * &c[2] - &b[2] * &c[1];
     let cy = &b[2] * &c[0] - &b[0] * &c[2];
     let cz = &b[0] * &c[1] - &b[1] * &c[0];
@@ -180,9 +196,12 @@ fn exact_triple_product_sign(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> i32 {
 pub const SOLID_ANGLE_CONDITION: f64 = 1.0 / 64.0;
 
 /// [`triangle_solid_angle`] of the triangle with corners `p` seen from `q` (world coordinates),
-/// accurate to `~1e-15` down to distances `~1e-14` of the triangle's size from its edges: the
-/// offsets `p − q` are exact double-doubles (no loss when `|p| ≫ |p − q|`), and ill-conditioned
-/// triangles ([`SOLID_ANGLE_CONDITION`]) are evaluated in double-double.
+/// accurate to `~1e-15` at any distance from its edges, with the exact sign: the offsets `p − q`
+/// are exact double-doubles (no loss when `|p| ≫ |p − q|`), ill-conditioned triangles
+/// ([`SOLID_ANGLE_CONDITION`]) are evaluated in double-double, and next to an edge's interior
+/// with its exact moment ([`solid_angle_next_to_edge`]). Where the triple product is within
+/// rounding of zero its sign is decided on the exact offsets: `0` (the principal value) only
+/// with `q` exactly in the triangle's plane, or a triangle of exactly zero area.
 #[inline]
 pub fn triangle_solid_angle_at(p: [[f64; 3]; 3], q: [f64; 3]) -> f64 {
     // The rounded offsets are the leading parts of the exact ones: the fast path needs no more.
@@ -192,22 +211,123 @@ pub fn triangle_solid_angle_at(p: [[f64; 3]; 3], q: [f64; 3]) -> f64 {
     }
     let r: [[DoubleDouble; 3]; 3] =
         p.map(|v| std::array::from_fn(|k| DoubleDouble::diff(v[k], q[k])));
-    let f = r.map(|v| v.map(|c| c.hi));
-    let Some((sign, det, den)) = solid_angle_parts(f[0], f[1], f[2]) else {
+    if r.iter().any(|v| v.iter().all(|c| c.hi == 0.0))
+        || (0..3).any(|k| r.iter().all(|v| v[k].hi == 0.0))
+    {
+        // `q` at a corner, or in the triangle's axis-aligned plane (a zero column of the triple
+        // product; a box's faces sampled at their own coordinate): exactly in its plane,
+        // without the exact sign's big integers.
         return 0.0;
-    };
-    if det * det + den * den >= SOLID_ANGLE_CONDITION * SOLID_ANGLE_CONDITION {
-        return signed_double_atan2(sign, det.abs(), den);
     }
-    let [a, b, c] = r.map(unit_dd);
-    let cross_bc = [
-        b[1] * c[2] - b[2] * c[1],
-        b[2] * c[0] - b[0] * c[2],
-        b[0] * c[1] - b[1] * c[0],
-    ];
-    let det = dot3(&a, &cross_bc);
-    let den = DoubleDouble::from_f64(1.0) + dot3(&a, &b) + dot3(&b, &c) + dot3(&c, &a);
-    signed_double_atan2(sign, det.value().abs(), den.value())
+    // Unit vectors in `f64` (offsets of any magnitude) where that is well conditioned and the
+    // triple product's sign is far above its rounding (`≲ 1.1e-15`, see [`ZERO_AREA_SUSPECT`]).
+    let [ua, ub, uc] = r.map(|v| unit(v.map(|c| c.hi)));
+    let det = dot(ua, cross(ub, uc));
+    let den = 1.0 + dot(ua, ub) + dot(ub, uc) + dot(uc, ua);
+    if det.abs() > ZERO_AREA_SUSPECT
+        && det * det + den * den >= SOLID_ANGLE_CONDITION * SOLID_ANGLE_CONDITION
+    {
+        return 2.0 * det.atan2(den);
+    }
+    let units = r.map(unit_dd);
+    let [a, b, c] = &units;
+    let det = dot3(a, &cross_dd(b, c)).value();
+    let den = (DoubleDouble::from_f64(1.0) + dot3(a, b) + dot3(b, c) + dot3(c, a)).value();
+    let sign = if det.abs() > DD_TRIPLE_PRODUCT_ROUNDING {
+        if det > 0.0 { 1 } else { -1 }
+    } else {
+        exact_orientation_sign(q, p)
+    };
+    if sign == 0 {
+        return 0.0;
+    }
+    if det * det + den * den < NEAR_EDGE_SOLID_ANGLE * NEAR_EDGE_SOLID_ANGLE {
+        // The edge the query is next to: the pair of corners seen most nearly opposite. Its
+        // corners in cyclic order, so the triple product keeps its sign.
+        let [i, j, k] = [[0, 1, 2], [1, 2, 0], [2, 0, 1]]
+            .into_iter()
+            .min_by(|x, y| {
+                let opposite = |[i, j, _]: [usize; 3]| dot3(&units[i], &units[j]).value();
+                opposite(*x).total_cmp(&opposite(*y))
+            })
+            .unwrap_or([0, 1, 2]);
+        if let Some((det, den)) = solid_angle_next_to_edge(p[i], p[j], p[k], q) {
+            return signed_double_atan2(sign, det.abs(), den);
+        }
+    }
+    signed_double_atan2(sign, det.abs(), den)
+}
+
+/// Below this `√(det² + den²)` (unit vectors, double-double) the query is within `~2^-40` of an
+/// edge's length from its interior: double-double keeps `~106 − 40` bits there, and fewer
+/// closer in (a query `1e-300` from an edge of the unit cube got `w = −0.25` for `0`), so the
+/// triangle takes [`solid_angle_next_to_edge`].
+const NEAR_EDGE_SOLID_ANGLE: f64 = 1.0 / (1u64 << 40) as f64;
+
+/// `(det, den)` of `tan(Ω/2) = det/den` for the triangle `pa pb pc` seen from `q` next to the
+/// interior of its edge `pa pb` (world points), both divided by one positive factor; `None` when
+/// `q` is on the edge's line.
+///
+/// Van Oosterom–Strackee on the offsets `a, b, c` from `q`: `det = a·(b×c) = c·m` with the exact
+/// moment `m = a × b`, and `den = |a||b||c| + (a·b)|c| + (b·c)|a| + (c·a)|b|`, where
+/// `|a||b| + a·b` and `|a| b + |b| a` cancel to the query's angle from the edge. With `e = b − a`,
+/// `t = −(a·e)/|e|²` and `a⊥ = a + t e = (e × m)/|e|²` (the offset across the edge):
+/// `|a||b| + a·b = |m|²/(|a||b| − a·b)`, and `|a| b + |b| a = X e + (|a| + |b|) a⊥` with
+/// `X = |a|(1 − t) − |b| t = |a⊥|²(1 − 2t)/(|a|(1 − t) + |b| t)`, `|a⊥|² = |m|²/|e|²`. So
+/// `den = (c·(e × m))(|a| + |b|)/|e|² + |m|²(|c|/(|a||b| − a·b) + (c·e)(1 − 2t)/(|e|²(|a|(1 − t) +
+/// |b| t)))`: no cancelling difference is left (`a`, `b` nearly opposite make `0 < t < 1`), and
+/// the first-order term and `det` carry the exact moment's relative accuracy at any distance.
+#[cold]
+fn solid_angle_next_to_edge(
+    pa: [f64; 3],
+    pb: [f64; 3],
+    pc: [f64; 3],
+    q: [f64; 3],
+) -> Option<(f64, f64)> {
+    let (m, mk) = exact_moment_of_points(q, pa, pb)?;
+    let diff = |p: [f64; 3], o: [f64; 3]| -> [DoubleDouble; 3] {
+        std::array::from_fn(|k| DoubleDouble::diff(p[k], o[k]))
+    };
+    let (a, b, c, e) = (diff(pa, q), diff(pb, q), diff(pc, q), diff(pb, pa));
+    // `det` and `den` are of degree 2 in `(a, b, e, m^½)` jointly and 1 in `c`: each group is
+    // brought to unit size by its own power of two (exact), `m` by twice the first.
+    let largest = |vs: &[&[DoubleDouble; 3]]| {
+        vs.iter()
+            .flat_map(|v| v.iter())
+            .fold(0.0_f64, |x, c| x.max(c.hi.abs()))
+    };
+    let s1 = -i64::from(binary_exponent(largest(&[&a, &b, &e])));
+    let s2 = -i64::from(binary_exponent(largest(&[&c])));
+    let scaled = |v: [DoubleDouble; 3], s: i64| v.map(|x| times_power_of_two(x, s));
+    let (a, b, e, c) = (scaled(a, s1), scaled(b, s1), scaled(e, s1), scaled(c, s2));
+    // `|m| = |m̃|·2^k` in the scaled units: the second-order terms carry one more `2^k`.
+    let k = mk + 2 * s1;
+    let (la, lb, lc) = (length_dd(&a), length_dd(&b), length_dd(&c));
+    let one = DoubleDouble::from_f64(1.0);
+    let ee = dot3(&e, &e);
+    let t = DoubleDouble::from_f64(0.0) - dot3(&a, &e) / ee;
+    let mm = dot3(&m, &m);
+    let first = dot3(&c, &cross_dd(&e, &m)) * (la + lb) / ee;
+    let second = mm
+        * (lc / (la * lb - dot3(&a, &b))
+            + dot3(&c, &e) * (one - t - t) / (ee * (la * (one - t) + lb * t)));
+    let den = first.value() + scaled_by_power_of_two(second.value(), k);
+    Some((dot3(&c, &m).value(), den))
+}
+
+/// `|v|` in double-double, `v` scaled by a power of two first (no under- or overflow of the
+/// squares).
+fn length_dd(v: &[DoubleDouble; 3]) -> DoubleDouble {
+    let s = power_of_two_scale(v[0].hi.abs().max(v[1].hi.abs()).max(v[2].hi.abs()));
+    let w = v.map(|c| DoubleDouble {
+        hi: c.hi * s[0] * s[1],
+        lo: c.lo * s[0] * s[1],
+    });
+    let len = dot3(&w, &w).sqrt();
+    DoubleDouble {
+        hi: len.hi / s[0] / s[1],
+        lo: len.lo / s[0] / s[1],
+    }
 }
 
 /// `v/|v|`, scaled by a power of two first when needed so that `|v|²` neither overflows nor

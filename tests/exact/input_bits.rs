@@ -331,6 +331,53 @@ fn direct_sum_is_accurate_next_to_any_edge() {
     }
 }
 
+/// The direct sum from `1e-20` down to `1e-300` of an edge's length from its interior: the unit
+/// cube moved so that its edge `x` (`y = z = 0`) and its bottom face's diagonals run through the
+/// origin, where such queries exist in `f64`, gets the exact 0 or 1; an open triangle with an
+/// edge through the origin gets the exact evaluator's value. In double-double alone the
+/// triangles' arguments cancelled to noise there (`−0.25` for 0 at `1e-300`).
+#[test]
+fn direct_sum_is_exact_next_to_edges_at_any_distance() {
+    let moved = |m: &Mesh, by: [f64; 3]| {
+        let p: Vec<[f64; 3]> = m
+            .positions()
+            .iter()
+            .map(|v| std::array::from_fn(|k| v[k] - by[k]))
+            .collect();
+        Mesh::from_slices(&p, m.triangles()).unwrap()
+    };
+    let cube = common::unit_cube();
+    let along_x_edge = moved(&cube, [0.5, 0.0, 0.0]);
+    let across_bottom = moved(&cube, [0.5, 0.5, 0.0]);
+    let triangle = Mesh::from_slices(
+        &[[0.6, 0.35, -0.2], [-1.2, -0.7, 0.4], [0.1, 0.9, 0.3]],
+        &[[0, 1, 2]],
+    )
+    .unwrap();
+    let exact = WindingNumber::new(&triangle).unwrap();
+    for d in [1e-20, 1e-40, 1e-100, 1e-200, 1e-300] {
+        for sy in [-1.0, 1.0] {
+            for sz in [-1.0, 1.0] {
+                let q = [0.3 * d, sy * 0.7 * d, sz * 0.4 * d];
+                let w = direct::winding_number_direct(&along_x_edge, q);
+                let want = if sy > 0.0 && sz > 0.0 { 1.0 } else { 0.0 };
+                assert!((w - want).abs() <= 1e-12, "x edge, d = {d:e}, {q:?}: {w}");
+                let w = direct::winding_number_direct(&across_bottom, q);
+                let want = if sz > 0.0 { 1.0 } else { 0.0 };
+                assert!((w - want).abs() <= 1e-12, "diagonal, d = {d:e}, {q:?}: {w}");
+            }
+        }
+        for n in [[0.3, -0.5, 0.2], [-0.1, 0.2, 0.9], [0.5, 0.1, -0.7]] {
+            let q = n.map(|c| c * d);
+            let (w, want) = (direct::winding_number_direct(&triangle, q), exact.eval(q));
+            assert!(
+                (w - want).abs() <= 1e-12,
+                "triangle, d = {d:e}, {q:?}: {w} vs {want}"
+            );
+        }
+    }
+}
+
 /// Section 4: direct and fast at extreme magnitudes (they returned NaN for a cube at ≥ 1e103 and
 /// for fast queries ≥ 1e19 away, 0 for a cube at ≤ 1e-110, 1.4036 at 1e-300 inside the cube).
 #[test]
