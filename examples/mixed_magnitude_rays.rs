@@ -9,10 +9,12 @@
 //! With `oracle`, every query — on the surface too, where each ray has its own perturbed point
 //! and agreement checks nothing — is also compared, ray by ray, with the rational oracle's
 //! narrow interval (`gwn::testing::oracle_disagreements`, tolerance `1e-10`); those lines start
-//! with `oracle|`.
+//! with `oracle|`. With `direct`, the direct sum (`--method direct`) is compared with the
+//! oracle instead, off the surface (on it the direct sum returns the principal value, not a
+//! ray's perturbed limit); those lines start with `direct|`.
 //!
 //! ```text
-//! cargo run --release --features examples --example mixed_magnitude_rays -- [CASES] [SEED] [oracle]
+//! cargo run --release --features examples --example mixed_magnitude_rays -- [CASES] [SEED] [oracle|direct]
 //! ```
 
 use gwn::Mesh;
@@ -39,7 +41,8 @@ fn main() {
     let mut args = std::env::args().skip(1);
     let cases: u64 = args.next().map_or(200_000, |s| s.parse().expect("CASES"));
     let seed: u64 = args.next().map_or(1, |s| s.parse().expect("SEED"));
-    let with_oracle = args.next().is_some_and(|s| s == "oracle");
+    let mode = args.next().unwrap_or_default();
+    let (with_oracle, direct) = (mode == "oracle", mode == "direct");
     let mut oracle_disagreements = 0u64;
     let mut rng = SplitMix64(seed);
     let (mut checked, mut disagreements) = (0u64, 0u64);
@@ -71,6 +74,18 @@ fn main() {
             continue;
         }
         checked += 1;
+        if direct {
+            if !gwn::testing::on_surface(&mesh, q) {
+                let w = gwn::eval::direct::winding_number_direct(&mesh, q);
+                let oracle =
+                    gwn::testing::exact_winding_number_rational(&mesh, q, gwn::RayAxis::PosZ);
+                if !oracle.contains(w, 1e-10) {
+                    oracle_disagreements += 1;
+                    println!("direct|{case}|{p:?}|{faces:?}|{q:?}|{w:?}|{oracle:?}");
+                }
+            }
+            continue;
+        }
         for (q, w) in gwn::testing::ray_disagreements(&mesh, &[q], 1e-9) {
             disagreements += 1;
             println!("{case}|{p:?}|{faces:?}|{q:?}|{w:?}");
@@ -81,6 +96,12 @@ fn main() {
                 println!("oracle|{case}|{p:?}|{faces:?}|{q:?}|{w:?}");
             }
         }
+    }
+    if direct {
+        eprintln!(
+            "seed {seed}: {checked} queries, {oracle_disagreements} direct sums off the surface leave the oracle's interval"
+        );
+        return;
     }
     eprintln!("seed {seed}: {checked} queries, {disagreements} off the surface depend on the ray");
     if with_oracle {

@@ -1,6 +1,6 @@
 //! The direct solid-angle sum `w(q) = (1/4π) Σ_f Ω_f(q)` (Van Oosterom–Strackee per triangle,
-//! Neumaier-compensated accumulation): the ground truth the other evaluators are tested against,
-//! and the `beta <= 0` path of the FOSSIL-style API.
+//! Neumaier-compensated accumulation): the floating-point reference the other evaluators are
+//! compared with (libigl's `winding_number`), `--method direct`.
 //!
 //! Accuracy: each triangle's offsets are exact (double-double), its solid angle is evaluated on
 //! unit vectors (any magnitude, 1e-300 to 1e300), in double-double where `f64` is
@@ -8,7 +8,9 @@
 //! length from its interior; the sign of a triple product within rounding of zero is decided on
 //! the exact offsets. So the sum is accurate to ~1e-14 at any distance from the edges (it erred
 //! by ≈ 2e-17·E/d before 2026-11, 0.44 at 1e-17 from an edge; and by a sign or more below
-//! ~1e-30·E until 2026-12-06).
+//! ~1e-30·E until 2026-12-06). Not an oracle for slivers: a triangle whose three corners are
+//! within a tiny angle of one line, seen from near that line, can cancel beyond double-double
+//! (docs/robustness.md; the rational oracle is `gwn::testing::exact_winding_number_rational`).
 //!
 //! On-surface semantics: a triangle whose plane contains the query exactly contributes 0 (the
 //! principal value), so the direct sum returns the local solid-angle fraction: 1/2 on a face of

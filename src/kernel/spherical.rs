@@ -271,12 +271,14 @@ const NEAR_EDGE_SOLID_ANGLE: f64 = 1.0 / (1u64 << 40) as f64;
 /// Van Oosterom–Strackee on the offsets `a, b, c` from `q`: `det = a·(b×c) = c·m` with the exact
 /// moment `m = a × b`, and `den = |a||b||c| + (a·b)|c| + (b·c)|a| + (c·a)|b|`, where
 /// `|a||b| + a·b` and `|a| b + |b| a` cancel to the query's angle from the edge. With `e = b − a`,
-/// `t = −(a·e)/|e|²` and `a⊥ = a + t e = (e × m)/|e|²` (the offset across the edge):
-/// `|a||b| + a·b = |m|²/(|a||b| − a·b)`, and `|a| b + |b| a = X e + (|a| + |b|) a⊥` with
-/// `X = |a|(1 − t) − |b| t = |a⊥|²(1 − 2t)/(|a|(1 − t) + |b| t)`, `|a⊥|² = |m|²/|e|²`. So
-/// `den = (c·(e × m))(|a| + |b|)/|e|² + |m|²(|c|/(|a||b| − a·b) + (c·e)(1 − 2t)/(|e|²(|a|(1 − t) +
-/// |b| t)))`: no cancelling difference is left (`a`, `b` nearly opposite make `0 < t < 1`), and
-/// the first-order term and `det` carry the exact moment's relative accuracy at any distance.
+/// `t = −(a·e)/|e|²` (so `1 − t = (b·e)/|e|²`) and `a⊥ = a + t e = (e × m)/|e|²` (the offset
+/// across the edge): `|a||b| + a·b = |m|²/(|a||b| − a·b)`, and `|a| b + |b| a = X e + (|a| +
+/// |b|) a⊥` with `X = |a|(1 − t) − |b| t = |a⊥|²(1 − 2t)/(|a|(1 − t) + |b| t)`, `|a⊥|² =
+/// |m|²/|e|²`. So
+/// `den = (c·(e × m))(|a| + |b|)/|e|² + |m|²(|c|/(|a||b| − a·b) + (c·e)(b·e + a·e)/(|e|²(|a|(b·e) − |b|(a·e))))`:
+/// every remaining difference is of two positive terms (`a`, `b` nearly opposite make
+/// `a·b, a·e < 0 < b·e`), and the first-order term and `det` carry the exact moment's relative
+/// accuracy at any distance.
 #[cold]
 fn solid_angle_next_to_edge(
     pa: [f64; 3],
@@ -300,18 +302,35 @@ fn solid_angle_next_to_edge(
     let s2 = -i64::from(binary_exponent(largest(&[&c])));
     let scaled = |v: [DoubleDouble; 3], s: i64| v.map(|x| times_power_of_two(x, s));
     let (a, b, e, c) = (scaled(a, s1), scaled(b, s1), scaled(e, s1), scaled(c, s2));
-    // `|m| = |m̃|·2^k` in the scaled units: the second-order terms carry one more `2^k`.
-    let k = mk + 2 * s1;
     let (la, lb, lc) = (length_dd(&a), length_dd(&b), length_dd(&c));
-    let one = DoubleDouble::from_f64(1.0);
     let ee = dot3(&e, &e);
-    let t = DoubleDouble::from_f64(0.0) - dot3(&a, &e) / ee;
-    let mm = dot3(&m, &m);
     let first = dot3(&c, &cross_dd(&e, &m)) * (la + lb) / ee;
-    let second = mm
-        * (lc / (la * lb - dot3(&a, &b))
-            + dot3(&c, &e) * (one - t - t) / (ee * (la * (one - t) + lb * t)));
-    let den = first.value() + scaled_by_power_of_two(second.value(), k);
+    // The second-order terms divide by the nearer end's distance, which may be `2^-1000` of the
+    // edge (a query next to a vertex, beside the edge): the nearer offset and its length are
+    // brought to unit size by `2^σ` before any product, and `2^σ` joins the moment's `2^k`.
+    let (ae, be) = (dot3(&a, &e), dot3(&b, &e));
+    let a_is_nearer = la.hi <= lb.hi;
+    let sigma = -i64::from(binary_exponent(if a_is_nearer { la.hi } else { lb.hi }));
+    // `(|a||b| − a·b)·2^σ` and `(|a|(b·e) − |b|(a·e))·2^σ` (a subnormal offset's length taken
+    // after the scaling, where it has all its bits).
+    let (d1, d2) = if a_is_nearer {
+        let a_up = scaled(a, sigma);
+        let la_up = length_dd(&a_up);
+        (
+            la_up * lb - dot3(&a_up, &b),
+            la_up * be - lb * dot3(&a_up, &e),
+        )
+    } else {
+        let b_up = scaled(b, sigma);
+        let lb_up = length_dd(&b_up);
+        (
+            la * lb_up - dot3(&a, &b_up),
+            la * dot3(&b_up, &e) - lb_up * ae,
+        )
+    };
+    let second = dot3(&m, &m) * (lc / d1 + dot3(&c, &e) * (be + ae) / (ee * d2));
+    // Summed in double-double: for a sliver (`c` near the edge's line too) the two parts cancel.
+    let den = (first + times_power_of_two(second, mk + 2 * s1 + sigma)).value();
     Some((dot3(&c, &m).value(), den))
 }
 

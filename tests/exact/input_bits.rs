@@ -378,6 +378,43 @@ fn direct_sum_is_exact_next_to_edges_at_any_distance() {
     }
 }
 
+/// Mixed magnitudes beside an edge, next to one of its ends (`1e-306` and `5e-321` from it, the
+/// edge of size 1): the direct sum's near-edge form divides by the nearer end's distance, and
+/// its products overflowed to NaN until that end's offset was scaled to unit size first (found
+/// by `examples/mixed_magnitude_rays … direct`; the exact evaluator is the reference, itself
+/// checked against the rational oracle there).
+#[test]
+fn direct_sum_beside_an_edge_next_to_its_end_is_finite_and_exact() {
+    let cases: [(&[[f64; 3]], [f64; 3]); 2] = [
+        (
+            &[
+                [-3.0, -3.0, 1.125],
+                [1.3984388871000388e-154, 0.0, -1.1546610378843915e-62],
+                [0.0, 2.0, 1.4077146763006178e-147],
+                [0.0, -1.0, 0.0],
+            ],
+            [1.3984388871000388e-154, 4.743e-321, -1.1546610378843915e-62],
+        ),
+        (
+            &[
+                [0.0, 0.0, 3.912045199536573e-35],
+                [0.0, 1.25, -1.1875],
+                [0.0, 1.625, 9.940675065644505e-290],
+                [-4.0, -3.498008481983094e-209, 1.1875],
+            ],
+            [0.0, 4.2721418083338267e-306, 3.912045199536573e-35],
+        ),
+    ];
+    for (p, q) in cases {
+        for faces in [&[[0, 1, 2]][..], &[[0, 2, 3]], &[[0, 1, 2], [0, 2, 3]]] {
+            let mesh = Mesh::from_slices(p, faces).unwrap();
+            let w = direct::winding_number_direct(&mesh, q);
+            let want = WindingNumber::new(&mesh).unwrap().eval(q);
+            assert!((w - want).abs() <= 1e-12, "{faces:?}: {w} vs {want}");
+        }
+    }
+}
+
 /// Section 4: direct and fast at extreme magnitudes (they returned NaN for a cube at ≥ 1e103 and
 /// for fast queries ≥ 1e19 away, 0 for a cube at ≤ 1e-110, 1.4036 at 1e-300 inside the cube).
 #[test]
