@@ -239,47 +239,23 @@ fn gradients_beside_an_edge_are_accurate_at_any_distance() {
     }
 }
 
-/// A dyadic `±(1 + k/16)·2^j`: exact, so `−r·a` below is exact too.
-fn dyadic() -> impl proptest::strategy::Strategy<Value = f64> {
-    use proptest::prelude::*;
-    (0u32..16, -3i32..=3, any::<bool>()).prop_map(|(k, j, neg)| {
-        (1.0 + f64::from(k) / 16.0) * 2f64.powi(j) * if neg { -1.0 } else { 1.0 }
-    })
-}
-
 proptest::proptest! {
     #![proptest_config(proptest::prelude::ProptestConfig { cases: 64, ..Default::default() })]
 
-    /// Random open triangles whose edge `a → b` runs through the origin (`b = −r·a`, exact), and
-    /// queries `d·n` beside it from `1e-6` to `1e-300` (`n` away from the triangle's plane and
-    /// from the edge's direction): the gradient matches Richardson-extrapolated differences of
-    /// the exact `w` within `1e-7`, on two rays.
+    /// Random open triangles whose edge `a → b` runs through the origin, and queries `d·n`
+    /// beside it from `1e-6` to `1e-300` (`n` away from the triangle's plane and from the
+    /// edge's direction): the gradient matches Richardson-extrapolated differences of the exact
+    /// `w` within `1e-7`, on two rays.
     #[test]
     fn gradients_beside_random_edges_match_differences_of_the_exact_value(
-        a in proptest::array::uniform3(dyadic()),
-        c in proptest::array::uniform3(dyadic()),
-        n in proptest::array::uniform3(-1.0f64..1.0),
-        r in proptest::sample::select(vec![0.25, 0.5, 1.0, 1.5, 3.0]),
-        d in proptest::sample::select(vec![1e-6, 1e-12, 1e-40, 1e-150, 1e-300]),
+        case in crate::beside_edge::beside_edge(),
     ) {
-        let b = a.map(|x| -r * x);
-        let e = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-        let ca = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-        let cross = |u: [f64; 3], v: [f64; 3]| {
-            [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
-        };
-        let dot = |u: [f64; 3], v: [f64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
-        let normal = cross(e, ca);
-        let (ln, le, lnn) = (dot(normal, normal).sqrt(), dot(e, e).sqrt(), dot(n, n).sqrt());
-        proptest::prop_assume!(ln > 1e-3 * le * dot(ca, ca).sqrt() && lnn > 0.1);
-        proptest::prop_assume!(dot(n, normal).abs() > 0.1 * lnn * ln);
-        proptest::prop_assume!(dot(cross(n, e), cross(n, e)).sqrt() > 0.3 * lnn * le);
-        let mesh = Mesh::from_slices(&[a, b, c], &[[0, 1, 2]]).unwrap();
-        let q = n.map(|x| x * d);
+        proptest::prop_assume!(case.off_plane > 0.1);
+        let q = case.n.map(|x| x * case.d);
         for ray in [RayAxis::PosZ, RayAxis::NegX] {
-            let wn = with_ray(&mesh, ray);
+            let wn = with_ray(&case.mesh, ray);
             let g = wn.gradient(q);
-            let fd = richardson_gradient(&wn, q, 1e-3 * d);
+            let fd = richardson_gradient(&wn, q, 1e-3 * case.d);
             let size = fd.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
             for k in 0..3 {
                 proptest::prop_assert!(

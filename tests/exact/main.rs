@@ -8,6 +8,7 @@
 mod common;
 
 mod agreement;
+mod beside_edge;
 mod boundary_hierarchy;
 mod closed_form;
 mod evaluator;
