@@ -20,7 +20,8 @@ use crate::base::vec3::sub;
 use rayon::prelude::*;
 
 use crate::base::compensated::NeumaierSum;
-use crate::kernel::spherical::{segment_gradient, triangle_solid_angle_at};
+use crate::kernel::input_predicates::exact_moment_of_points;
+use crate::kernel::spherical::{segment_gradient_with_moment, triangle_solid_angle_at};
 use crate::mesh::Mesh;
 
 use crate::kernel::spherical::INV_4PI;
@@ -45,7 +46,8 @@ pub fn winding_number_direct_batch(mesh: &Mesh, points: &[[f64; 3]]) -> Vec<f64>
 
 /// Gradient `∇w(q)` by the Biot–Savart form: the field of a surface depends only on its boundary,
 /// so summing the closed-form segment integral over every triangle edge (interior edges cancel)
-/// gives the gradient. Not finite on the surface's edges.
+/// gives the gradient, with the exact cross product of an edge's offsets next to its interior
+/// (`kernel::spherical::segment_gradient_with_moment`). Not finite on the surface's edges.
 pub fn winding_number_gradient_direct(mesh: &Mesh, q: [f64; 3]) -> [f64; 3] {
     let p = mesh.positions();
     let mut g = [NeumaierSum::new(); 3];
@@ -54,7 +56,12 @@ pub fn winding_number_gradient_direct(mesh: &Mesh, q: [f64; 3]) -> [f64; 3] {
             if t[i] == t[j] {
                 continue;
             }
-            let s = segment_gradient(sub(p[t[i] as usize], q), sub(p[t[j] as usize], q));
+            let (a, b) = (p[t[i] as usize], p[t[j] as usize]);
+            // Next to the edge's interior, the exact cross product of its offsets (an interior
+            // edge's two directions still cancel exactly: the moment is antisymmetric).
+            let s = segment_gradient_with_moment(sub(a, q), sub(b, q), || {
+                exact_moment_of_points(q, a, b)
+            });
             for k in 0..3 {
                 g[k].add(s[k]);
             }

@@ -226,12 +226,17 @@ fn gradients_beside_an_edge_are_accurate_at_any_distance() {
             for n in [[0.3, -0.5, 0.2], [-0.1, 0.2, 0.9]] {
                 let q = n.map(|c| c * d);
                 let g = wn.gradient(q);
+                let gd = winding_number_gradient_direct(&mesh, q);
                 let fd = richardson_gradient(&wn, q, 1e-3 * d);
                 let size = fd.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
                 for k in 0..3 {
                     assert!(
                         g[k].is_finite() && (g[k] - fd[k]).abs() <= 1e-8 * size,
                         "{ray:?} d = {d:e}, {n:?}: {g:?} vs {fd:?}"
+                    );
+                    assert!(
+                        gd[k].is_finite() && (gd[k] - fd[k]).abs() <= 1e-8 * size,
+                        "direct, d = {d:e}, {n:?}: {gd:?} vs {fd:?}"
                     );
                 }
             }
