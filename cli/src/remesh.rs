@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use clap::Args as ClapArgs;
 use gwn::products::remesh::crossings::SegmentBvh;
+use gwn::products::remesh::keep_input::{InputCheck, keep_input};
 use gwn::products::remesh::report::{
     DistanceReference, PhaseClock, RemeshReport, ReportPhase, curved_surface_for_distance,
 };
@@ -140,8 +141,23 @@ pub fn run(args: Args) -> Result<(), CliError> {
             bar.inc(1);
         }
     };
-    let mut out = remesh_guided(wn, guide, bounds, &options, &announce)
-        .map_err(|e| CliError(format!("{}: {e}", args.mesh.display())))?;
+    // A mesh that already is the boundary of its `w > ½` solid is the answer as it is (exact
+    // checks, linear in the input); the exact method's field only, as asked.
+    let kept = match (input.mesh(), method.method_for(input.kind()), &thickened) {
+        (Some(mesh), Method::Exact, None) if !args.knobs.always_remesh => {
+            Some(keep_input(mesh, bounds, &options))
+        }
+        _ => None,
+    };
+    let mut out = match kept {
+        Some(Ok(out)) => out,
+        kept => {
+            let mut out = remesh_guided(wn, guide, bounds, &options, &announce)
+                .map_err(|e| CliError(format!("{}: {e}", args.mesh.display())))?;
+            out.stats.input = kept.and_then(Result::err).map(InputCheck::Remeshed);
+            out
+        }
+    };
     let secs = start.elapsed().as_secs_f64();
     let phase_seconds = clock.seconds();
     bar.inc(1);
@@ -180,7 +196,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     )
     .map_err(|e| CliError::msg(format!("--samples: {e}")))?;
     report.seconds = secs;
-    report.phase_seconds = Some(phase_seconds);
+    report.phase_seconds = (out.stats.input != Some(InputCheck::Kept)).then_some(phase_seconds);
     report.thicken = thickened.as_ref().map(|t| t.eps());
     drop(curved_surface);
     let topology = report.topology;
@@ -194,103 +210,123 @@ pub fn run(args: Args) -> Result<(), CliError> {
         let [x, y, z] = out.cell_sizes;
         format!("cells {x:.4e} x {y:.4e} x {z:.4e}")
     };
-    outln!(
-        "{}: res {} ({cells}, lattice {}x{}x{}), {:.2} s, {} points classified, {} band cells",
-        args.out.display(),
-        args.res,
-        s.lattice_cells[0],
-        s.lattice_cells[1],
-        s.lattice_cells[2],
-        secs,
-        s.classified_points,
-        s.band_cells
-    )?;
-    let phases: Vec<String> = phase_seconds
-        .named()
-        .iter()
-        .map(|(name, s)| format!("{name} {s:.2}"))
-        .collect();
-    outln!("seconds by phase: {}", phases.join(", "))?;
-    if options.sub_cell_levels > 0 {
-        outln!(
-            "sub-cell levels: {} ({} cells crossed by the input with agreeing corners refined)",
-            options.sub_cell_levels,
-            s.refined_cells
-        )?;
+    match s.input {
+        Some(InputCheck::Kept) => {
+            outln!(
+                "{}: the input as it is ({} faces, {:.2} s): closed, manifold, oriented, no \
+                 self-intersection (exact) and the boundary of w > 1/2 (--always-remesh remeshes \
+                 it at res {})",
+                args.out.display(),
+                topology.faces,
+                secs,
+                args.res
+            )?;
+            outln!("{topology}")?;
+        }
+        Some(InputCheck::Remeshed(why)) => {
+            outln!("remeshed: the input is not kept as it is: {why}")?
+        }
+        None => {}
     }
-    if options.planar_levels > 0 {
-        let f = s.flatness.flat_fraction;
-        let kept = if s.planar_levels > 0 {
-            format!(
-                "cells up to {}x the resolution's kept whole where the input is flat",
-                1u32 << s.planar_levels
-            )
-        } else {
-            "too little of the input is flat for them to pay".to_string()
-        };
+    if s.input != Some(InputCheck::Kept) {
         outln!(
-            "planar levels: {} of {} ({kept}; input area flat at 2x, 4x, 8x: {:.0} %, {:.0} %, \
-             {:.0} %)",
-            s.planar_levels,
-            options.planar_levels,
-            100.0 * f[1],
-            100.0 * f[2],
-            100.0 * f[3]
+            "{}: res {} ({cells}, lattice {}x{}x{}), {:.2} s, {} points classified, {} band cells",
+            args.out.display(),
+            args.res,
+            s.lattice_cells[0],
+            s.lattice_cells[1],
+            s.lattice_cells[2],
+            secs,
+            s.classified_points,
+            s.band_cells
         )?;
-    }
-    if s.plates.refines() {
-        let axes: Vec<String> = (0..3)
-            .filter(|&a| s.plates.refinement[a] > 1.0)
-            .map(|a| {
-                let thickness = s.plates.thickness[a].unwrap_or(f64::NAN);
-                format!(
-                    "{:.2}x along {} (plates {thickness:.4e} thick)",
-                    s.plates.refinement[a],
-                    ["x", "y", "z"][a]
-                )
-            })
+        let phases: Vec<String> = phase_seconds
+            .named()
+            .iter()
+            .map(|(name, s)| format!("{name} {s:.2}"))
             .collect();
+        outln!("seconds by phase: {}", phases.join(", "))?;
+        if options.sub_cell_levels > 0 {
+            outln!(
+                "sub-cell levels: {} ({} cells crossed by the input with agreeing corners refined)",
+                options.sub_cell_levels,
+                s.refined_cells
+            )?;
+        }
+        if options.planar_levels > 0 {
+            let f = s.flatness.flat_fraction;
+            let kept = if s.planar_levels > 0 {
+                format!(
+                    "cells up to {}x the resolution's kept whole where the input is flat",
+                    1u32 << s.planar_levels
+                )
+            } else {
+                "too little of the input is flat for them to pay".to_string()
+            };
+            outln!(
+                "planar levels: {} of {} ({kept}; input area flat at 2x, 4x, 8x: {:.0} %, {:.0} %, \
+                 {:.0} %)",
+                s.planar_levels,
+                options.planar_levels,
+                100.0 * f[1],
+                100.0 * f[2],
+                100.0 * f[3]
+            )?;
+        }
+        if s.plates.refines() {
+            let axes: Vec<String> = (0..3)
+                .filter(|&a| s.plates.refinement[a] > 1.0)
+                .map(|a| {
+                    let thickness = s.plates.thickness[a].unwrap_or(f64::NAN);
+                    format!(
+                        "{:.2}x along {} (plates {thickness:.4e} thick)",
+                        s.plates.refinement[a],
+                        ["x", "y", "z"][a]
+                    )
+                })
+                .collect();
+            outln!(
+                "cells made finer for plates of the input thinner than a cell: {}",
+                axes.join(", ")
+            )?;
+        }
+        outln!("{topology}")?;
+        if options.simplify.is_some() {
+            outln!(
+                "faces: {} marching tetrahedra, {} after {} edge collapses ({:.1} %); a dense marching \
+                 cubes would have {} ({:.1} % of it)",
+                s.extracted_faces,
+                topology.faces,
+                s.simplify.collapses,
+                100.0 * topology.faces as f64 / s.extracted_faces.max(1) as f64,
+                s.marching_cubes_faces,
+                100.0 * topology.faces as f64 / s.marching_cubes_faces.max(1) as f64
+            )?;
+            outln!(
+                "vertices on cube face and body diagonals collapsed cube by cube first: {} ({} kept)",
+                s.simplify.diagonal_collapses,
+                s.simplify.diagonals_left
+            )?;
+            outln!(
+                "vertices moved towards their quadric minimum: {} ({} moves refused by the checks)",
+                s.simplify.relocated,
+                s.simplify.relocations_refused
+            )?;
+        } else {
+            outln!(
+                "faces: {} marching tetrahedra (not simplified); a dense marching cubes would have {}",
+                s.extracted_faces,
+                s.marching_cubes_faces
+            )?;
+        }
         outln!(
-            "cells made finer for plates of the input thinner than a cell: {}",
-            axes.join(", ")
+            "marching-tetrahedra vertices placed at a verified crossing with the input: {} of {} ({} \
+             evaluations)",
+            s.guided_vertices,
+            s.extracted_vertices,
+            s.placement_evaluations
         )?;
     }
-    outln!("{topology}")?;
-    if options.simplify.is_some() {
-        outln!(
-            "faces: {} marching tetrahedra, {} after {} edge collapses ({:.1} %); a dense marching \
-             cubes would have {} ({:.1} % of it)",
-            s.extracted_faces,
-            topology.faces,
-            s.simplify.collapses,
-            100.0 * topology.faces as f64 / s.extracted_faces.max(1) as f64,
-            s.marching_cubes_faces,
-            100.0 * topology.faces as f64 / s.marching_cubes_faces.max(1) as f64
-        )?;
-        outln!(
-            "vertices on cube face and body diagonals collapsed cube by cube first: {} ({} kept)",
-            s.simplify.diagonal_collapses,
-            s.simplify.diagonals_left
-        )?;
-        outln!(
-            "vertices moved towards their quadric minimum: {} ({} moves refused by the checks)",
-            s.simplify.relocated,
-            s.simplify.relocations_refused
-        )?;
-    } else {
-        outln!(
-            "faces: {} marching tetrahedra (not simplified); a dense marching cubes would have {}",
-            s.extracted_faces,
-            s.marching_cubes_faces
-        )?;
-    }
-    outln!(
-        "marching-tetrahedra vertices placed at a verified crossing with the input: {} of {} ({} \
-         evaluations)",
-        s.guided_vertices,
-        s.extracted_vertices,
-        s.placement_evaluations
-    )?;
     match &report.self_intersections {
         Ok(r) => outln!(
             "self-intersections (exact): {} face pairs ({} pairs tested, {} degenerate faces, \
@@ -418,6 +454,11 @@ pub struct RemeshKnobs {
     /// Use all --planar-levels, whatever the flatness probe finds.
     #[arg(long)]
     pub no_flatness_probe: bool,
+    /// Remesh even an input that already is a closed, manifold, oriented surface without
+    /// self-intersections bounding w > 1/2 (by default such an input, proved so with exact
+    /// tests, is written as it is when it has at most the simplification target's faces).
+    #[arg(long)]
+    pub always_remesh: bool,
 }
 
 impl RemeshKnobs {

@@ -87,6 +87,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         load: gwn::io::LoadOptions {
             weld: if args.no_weld { Some(false) } else { None },
         },
+        keep_input: !args.knobs.always_remesh,
     };
     let (rows, secs) = args.inputs.run(&job, &args.out, "remesh")?;
     let count = |s: Status| rows.iter().filter(|r| r.status == s).count();

@@ -141,8 +141,8 @@ def label_dataset(paths, out_dir, *, root=None, uniform=50_000, near=50_000,
 
 def remesh_dataset(paths, out_dir, res=128, *, root=None, format="ply", samples=10_000,
                    thicken_cells=None, weld=None, time_limit=None, bisect=None, simplify=True,
-                   refine_plates=True, sub_cell_levels=None, planar_levels=None, threads=None,
-                   progress=None):
+                   refine_plates=True, sub_cell_levels=None, planar_levels=None,
+                   always_remesh=False, threads=None, progress=None):
     """Remeshes a dataset at w = 1/2, exactly as ``gwn remesh-dataset`` does.
 
     Per input: the closed, edge- and vertex-manifold, oriented surface ``gwn remesh`` makes at
@@ -157,13 +157,16 @@ def remesh_dataset(paths, out_dir, res=128, *, root=None, format="ply", samples=
     output is reused only when it was made with the same options from the same input, else
     redone and ``redone`` says why); broken files and FIFOs are manifest rows; two inputs with
     one output are a ``ValueError`` before anything is written. ``sub_cell_levels`` and
-    ``planar_levels`` and ``bisect``: ``None`` for ``gwn remesh``'s defaults.
+    ``planar_levels`` and ``bisect``: ``None`` for ``gwn remesh``'s defaults. A mesh that already
+    is a closed, manifold, oriented surface without self-intersections bounding ``w > 1/2``
+    (exact tests) is written as it is (the row's ``kept``) unless ``always_remesh``.
 
     ``progress`` as in ``gwn.label_dataset``. Returns the manifest rows (dicts with ``mesh``,
     ``output``, ``status`` in ``ok``/``done``/``failed``/``timeout``, ``error``, ``input`` (the
     kind: ``mesh``, ``point cloud``, ``patch set``, ``STEP model``), ``faces`` (triangles,
     patches or B-rep faces), ``vertices`` (mesh vertices or points), ``output_faces``,
-    ``output_vertices``, ``valid`` (closed, manifold, oriented, no exact self-intersection),
+    ``kept``, ``output_vertices``, ``valid`` (closed, manifold, oriented, no exact
+    self-intersection),
     ``components``, ``self_intersections``, ``hausdorff_cells``, ``occupancy_agreement``,
     ``seconds``, ``redone``), in input order. For a cluster, see ``gwn.dask.remesh_dataset``.
     """
@@ -177,7 +180,8 @@ def remesh_dataset(paths, out_dir, res=128, *, root=None, format="ply", samples=
             format=format, samples=samples, thicken_cells=thicken_cells, weld=weld,
             time_limit=time_limit,
             bisect=bisect, simplify=simplify, refine_plates=refine_plates,
-            sub_cell_levels=sub_cell_levels, planar_levels=planar_levels),
+            sub_cell_levels=sub_cell_levels, planar_levels=planar_levels,
+            always_remesh=always_remesh),
         threads=threads,
         progress=None if callback is None else (lambda line: callback(_json.loads(line))))
     return [_json.loads(r) for r in rows]

@@ -216,8 +216,9 @@ def remesh(
     report: Literal[False] = False,
     samples: int = 10000,
     time_limit: Optional[float] = None,
+    always_remesh: bool = False,
 ) -> Tuple[_F64, _I64]:
-    """A closed, manifold, oriented surface of the solid w > 1/2 as (V float64 (n, 3), F int64 (m, 3)); simplify=False: the raw marching-tetrahedra surface; refine_plates=False keeps the lattice of res alone. remesh(model, res=...) of a StepModel or PatchSet takes no F."""
+    """A closed, manifold, oriented surface of the solid w > 1/2 as (V float64 (n, 3), F int64 (m, 3)); simplify=False: the raw marching-tetrahedra surface; refine_plates=False keeps the lattice of res alone; a mesh that already is such a surface bounding w > 1/2 (exact tests) comes back as it is unless always_remesh. remesh(model, res=...) of a StepModel or PatchSet takes no F."""
 
 @overload
 def remesh(
@@ -239,6 +240,7 @@ def remesh(
     report: Literal[True],
     samples: int = 10000,
     time_limit: Optional[float] = None,
+    always_remesh: bool = False,
 ) -> Tuple[_F64, _I64, dict]:
     """(V, F, report): the report a dict of what ``gwn remesh --report`` writes (closed, edge_manifold, vertex_manifold, oriented, euler_characteristic, components, self_intersections, hausdorff_boundary_cells, occupancy_agreement, seconds, ...); samples per surface and in the box for the distance and the agreement (0: neither)."""
 
@@ -390,6 +392,7 @@ def remesh_dataset(
     refine_plates: bool = True,
     sub_cell_levels: Optional[int] = None,
     planar_levels: Optional[int] = None,
+    always_remesh: bool = False,
     threads: Optional[int] = None,
     progress: Union[None, bool, Callable[[dict], Any]] = None,
 ) -> list[dict]:

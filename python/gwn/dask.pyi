@@ -39,6 +39,7 @@ def remesh_dataset(
     refine_plates: bool = True,
     sub_cell_levels: Optional[int] = None,
     planar_levels: Optional[int] = None,
+    always_remesh: bool = False,
     threads_per_task: int = 1,
     progress: Union[None, bool, Callable[[dict], Any]] = None,
 ) -> list[dict]:

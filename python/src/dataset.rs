@@ -189,6 +189,7 @@ fn remesh_job(
     refine_plates: bool,
     sub_cell_levels: u32,
     planar_levels: u32,
+    always_remesh: bool,
 ) -> PyResult<RemeshJob> {
     let format =
         SurfaceFormat::of_path(std::path::Path::new(&format!("x.{format}"))).ok_or_else(|| {
@@ -207,6 +208,7 @@ fn remesh_job(
     job.options.refine_plates = refine_plates;
     job.options.sub_cell_levels = sub_cell_levels;
     job.options.planar_levels = planar_levels;
+    job.keep_input = !always_remesh;
     job.validate().map_err(PyValueError::new_err)?;
     Ok(job)
 }
@@ -224,8 +226,8 @@ fn remesh_job(
     bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS,
     simplify = true, refine_plates = true,
     sub_cell_levels = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS,
-    planar_levels = gwn::products::remesh::DEFAULT_PLANAR_LEVELS, threads = None,
-    progress = None))]
+    planar_levels = gwn::products::remesh::DEFAULT_PLANAR_LEVELS, always_remesh = false,
+    threads = None, progress = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn remesh_dataset(
     py: Python<'_>,
@@ -243,6 +245,7 @@ pub fn remesh_dataset(
     refine_plates: bool,
     sub_cell_levels: u32,
     planar_levels: u32,
+    always_remesh: bool,
     threads: Option<Threads>,
     progress: Option<PyObject>,
 ) -> PyResult<Vec<String>> {
@@ -258,6 +261,7 @@ pub fn remesh_dataset(
         refine_plates,
         sub_cell_levels,
         planar_levels,
+        always_remesh,
     )?;
     run_job(py, job, paths, out_dir, root, threads, progress)
 }
@@ -271,7 +275,8 @@ pub fn remesh_dataset(
     bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS,
     simplify = true, refine_plates = true,
     sub_cell_levels = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS,
-    planar_levels = gwn::products::remesh::DEFAULT_PLANAR_LEVELS, threads = None))]
+    planar_levels = gwn::products::remesh::DEFAULT_PLANAR_LEVELS, always_remesh = false,
+    threads = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn remesh_file(
     py: Python<'_>,
@@ -289,6 +294,7 @@ pub fn remesh_file(
     refine_plates: bool,
     sub_cell_levels: u32,
     planar_levels: u32,
+    always_remesh: bool,
     threads: Option<Threads>,
 ) -> PyResult<String> {
     let job = remesh_job(
@@ -303,6 +309,7 @@ pub fn remesh_file(
         refine_plates,
         sub_cell_levels,
         planar_levels,
+        always_remesh,
     )?;
     let root = std::path::absolute(&root).unwrap_or(root);
     threads::run(py, threads, move || {

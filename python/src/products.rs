@@ -516,6 +516,11 @@ pub fn filter_tets<'py>(
 /// ``res``, as ``gwn remesh --sub-cell-levels``. ``planar_levels`` (0 to 3, default 3) keeps
 /// cells up to ``2**planar_levels`` times larger whole where the input in them is flat, as many levels as a
 /// probe of the input finds pay (none on curved inputs), as ``gwn remesh --planar-levels``.
+/// With the exact method, a mesh that already is a closed, manifold, oriented surface without
+/// self-intersections bounding ``w > 1/2`` (proved with exact tests) comes back as it is, when
+/// it has at most the simplification target's faces (the report's ``input`` says ``kept``, or
+/// ``remeshed`` and ``input_not_kept`` why); ``always_remesh=True`` remeshes it anyway, as
+/// ``gwn remesh --always-remesh``.
 /// ``gwn.remesh(model, res=...)`` remeshes a :class:`StepModel` (``gwn.load("part.step")``)
 /// the way ``gwn remesh part.step`` does: no ``F``, exact method only (``tolerance=`` as in
 /// :class:`WindingNumber`), vertices placed at the model's own surface hits; ``thicken`` is
@@ -527,7 +532,7 @@ pub fn filter_tets<'py>(
 /// the distance nor the agreement). ``time_limit`` (seconds) raises ``TimeoutError`` once the
 /// remesh runs past it (checked between its phases and rounds; the report is not limited).
 #[pyfunction]
-#[pyo3(signature = (V, F = None, res = 128, *, bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS, simplify = true, method = "exact", beta = None, order = None, tolerance = None, threads = None, thicken = None, refine_plates = true, sub_cell_levels = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS, planar_levels = gwn::products::remesh::DEFAULT_PLANAR_LEVELS, report = false, samples = 10_000, time_limit = None))]
+#[pyo3(signature = (V, F = None, res = 128, *, bisect = gwn::products::remesh::DEFAULT_BISECTION_STEPS, simplify = true, method = "exact", beta = None, order = None, tolerance = None, threads = None, thicken = None, refine_plates = true, sub_cell_levels = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS, planar_levels = gwn::products::remesh::DEFAULT_PLANAR_LEVELS, report = false, samples = 10_000, time_limit = None, always_remesh = false))]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub fn remesh<'py>(
     py: Python<'py>,
@@ -548,11 +553,14 @@ pub fn remesh<'py>(
     report: bool,
     samples: usize,
     time_limit: Option<f64>,
+    always_remesh: bool,
 ) -> PyResult<Bound<'py, PyTuple>> {
     use gwn::products::remesh::report::{DistanceReference, PhaseClock, RemeshReport};
 
     use gwn::products::remesh::{
-        RemeshOptions, remesh_guided,
+        RemeshOptions,
+        keep_input::{InputCheck, keep_input},
+        remesh_guided,
         thicken::{self, ThickenedSheets},
     };
     let method = spec_of(method, beta, order, tolerance)?;
@@ -653,9 +661,20 @@ pub fn remesh<'py>(
             reference,
         } = thicken::of_mesh(&mesh, &*wn, thick.as_ref(), bounds);
         let clock = PhaseClock::start();
-        let out = remesh_guided(field, Some(&guide), bounds, &options, &|phase| {
-            clock.mark(phase)
-        })?;
+        // As `gwn remesh`: a mesh that already bounds its `w > ½` solid is kept as it is.
+        let exact = method.method_for(gwn::input::InputKind::Mesh) == gwn::spec::Method::Exact;
+        let kept = (exact && thick.is_none() && !always_remesh)
+            .then(|| keep_input(&mesh, bounds, &options));
+        let out = match kept {
+            Some(Ok(out)) => out,
+            kept => {
+                let mut out = remesh_guided(field, Some(&guide), bounds, &options, &|phase| {
+                    clock.mark(phase)
+                })?;
+                out.stats.input = kept.and_then(Result::err).map(InputCheck::Remeshed);
+                out
+            }
+        };
         let seconds = start.elapsed().as_secs_f64();
         let phase_seconds = clock.seconds();
         let request = report.then_some(ReportRequest {

@@ -544,6 +544,115 @@ fn scaled_dyadic(x: f64, shift: usize) -> BigInt {
     }
 }
 
+/// Relative bound of the `f64` filter of [`closed_surface_orientation`] on `Σ` of the faces'
+/// permanents: each face's determinant errs by `ORIENT3D_FILTER_RELATIVE·permanent`, and a running
+/// sum of `F` terms by `F·u` times the sum of their magnitudes (`u = 2^-53`), each at most its
+/// permanent; the filter takes twice `(8 + F)·u` (the permanents' own sum is rounded too).
+pub const VOLUME_FILTER_RELATIVE: f64 = 2.0 * (f64::EPSILON * 0.5);
+
+/// Exact sign of `Σ det(a − o, b − o, c − o)` over the faces `(a, b, c)`: six times the signed
+/// volume a closed, consistently oriented surface encloses (the same for every apex `o`), so `+1`
+/// when it is oriented outward and `−1` inward. Coordinates below `2^125` in magnitude. An `f64` sum with its error bound decides unless
+/// the volume is within rounding of zero; then the sum is made in integers.
+pub fn closed_surface_orientation(
+    points: &[[i128; 3]],
+    faces: impl Iterator<Item = [u32; 3]> + Clone,
+    apex: [i128; 3],
+) -> i32 {
+    let offset = |v: u32| {
+        let p = points[v as usize];
+        [p[0] - apex[0], p[1] - apex[1], p[2] - apex[2]]
+    };
+    let (mut sum, mut permanents, mut count) = (0.0f64, 0.0f64, 0.0f64);
+    for [a, b, c] in faces.clone() {
+        let [d, e1, e2] = [offset(a), offset(b), offset(c)].map(|p| p.map(|x| x as f64));
+        let m = |i: usize, j: usize| (e1[i] * e2[j], e1[j] * e2[i]);
+        let (x, y, z) = (m(1, 2), m(2, 0), m(0, 1));
+        sum += d[0] * (x.0 - x.1) + d[1] * (y.0 - y.1) + d[2] * (z.0 - z.1);
+        permanents += d[0].abs() * (x.0.abs() + x.1.abs())
+            + d[1].abs() * (y.0.abs() + y.1.abs())
+            + d[2].abs() * (z.0.abs() + z.1.abs());
+        count += 1.0;
+    }
+    let bound = (ORIENT3D_FILTER_RELATIVE + (8.0 + count) * VOLUME_FILTER_RELATIVE) * permanents;
+    if sum.abs() > bound {
+        return if sum > 0.0 { 1 } else { -1 };
+    }
+    let exact: BigInt = faces
+        .map(|[a, b, c]| {
+            let [d, e1, e2] = [offset(a), offset(b), offset(c)].map(|p| p.map(BigInt::from));
+            &d[0] * (&e1[1] * &e2[2] - &e1[2] * &e2[1])
+                + &d[1] * (&e1[2] * &e2[0] - &e1[0] * &e2[2])
+                + &d[2] * (&e1[0] * &e2[1] - &e1[1] * &e2[0])
+        })
+        .sum();
+    sign_of(&exact)
+}
+
+/// `sign(a0·b1 − a1·b0)` for integer differences below `2^126` (an input's own coordinates as
+/// integers, wider than the 60-bit grid): the [`DET2_FILTER_RELATIVE`] filter (each conversion
+/// to `f64` rounds once, as in the 60-bit test), then arbitrary precision.
+pub fn det2_sign_wide(a0: i128, a1: i128, b0: i128, b1: i128) -> i32 {
+    let p1 = a0 as f64 * b1 as f64;
+    let p2 = a1 as f64 * b0 as f64;
+    let d = p1 - p2;
+    let bound = DET2_FILTER_RELATIVE * (p1.abs() + p2.abs());
+    if d > bound {
+        return 1;
+    }
+    if d < -bound {
+        return -1;
+    }
+    let exact = BigInt::from(a0) * BigInt::from(b1) - BigInt::from(a1) * BigInt::from(b0);
+    sign_of(&exact)
+}
+
+/// `sign(d·(e1×e2))` for integer differences below `2^126`: the [`ORIENT3D_FILTER_RELATIVE`]
+/// filter, exact below `2^53` as in the 60-bit test, then arbitrary precision.
+pub fn orient3d_sign_wide(d: [i128; 3], e1: [i128; 3], e2: [i128; 3]) -> i32 {
+    let f = |v: [i128; 3]| v.map(|c| c as f64);
+    let (x, a, b) = (f(d), f(e1), f(e2));
+    let n = [
+        (a[1] * b[2], a[2] * b[1]),
+        (a[2] * b[0], a[0] * b[2]),
+        (a[0] * b[1], a[1] * b[0]),
+    ];
+    let v: f64 = (0..3).map(|k| x[k] * (n[k].0 - n[k].1)).sum();
+    let permanent: f64 = (0..3)
+        .map(|k| x[k].abs() * (n[k].0.abs() + n[k].1.abs()))
+        .sum();
+    let bound = ORIENT3D_FILTER_RELATIVE * permanent;
+    if v > bound {
+        return 1;
+    }
+    if v < -bound {
+        return -1;
+    }
+    if permanent < EXACT_F64_INTEGER {
+        return if v > 0.0 {
+            1
+        } else if v < 0.0 {
+            -1
+        } else {
+            0
+        };
+    }
+    let big = |v: [i128; 3]| v.map(BigInt::from);
+    let (x, a, b) = (big(d), big(e1), big(e2));
+    let exact = &x[0] * (&a[1] * &b[2] - &a[2] * &b[1])
+        + &x[1] * (&a[2] * &b[0] - &a[0] * &b[2])
+        + &x[2] * (&a[0] * &b[1] - &a[1] * &b[0]);
+    sign_of(&exact)
+}
+
+fn sign_of(v: &BigInt) -> i32 {
+    match v.sign() {
+        num_bigint::Sign::Plus => 1,
+        num_bigint::Sign::Minus => -1,
+        num_bigint::Sign::NoSign => 0,
+    }
+}
+
 /// Exact cross product of grid differences (< 2^61 each ⇒ components < 2^123).
 #[inline]
 pub fn cross_exact(a: [i64; 3], b: [i64; 3]) -> [i128; 3] {

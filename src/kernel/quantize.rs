@@ -427,6 +427,43 @@ pub(crate) fn decompose(x: f64) -> (i64, i32) {
     (if x.is_sign_negative() { -m } else { m }, e)
 }
 
+/// The points as integers in one fixed-point scale: `p = n · 2^e` exactly for every coordinate,
+/// with the common exponent `e` as large as the finest coordinate allows, and `|n| < 2^max_bits`;
+/// `None` when the coordinates span more bits than that (a value of `1` beside one of `1e-17`) or
+/// one is not finite. Exact predicates on `n` are then exact on the points themselves.
+pub(crate) fn common_fixed_point(points: &[[f64; 3]], max_bits: u32) -> Option<Vec<[i128; 3]>> {
+    debug_assert!(max_bits <= 126);
+    let mut finest = i32::MAX;
+    let mut top = i32::MIN;
+    for &x in points.iter().flatten() {
+        if !x.is_finite() {
+            return None;
+        }
+        if x != 0.0 {
+            let (m, e) = decompose(x);
+            let tz = m.trailing_zeros() as i32;
+            finest = finest.min(e + tz);
+            top = top.max(e + 64 - m.unsigned_abs().leading_zeros() as i32);
+        }
+    }
+    if finest == i32::MAX {
+        return Some(vec![[0; 3]; points.len()]);
+    }
+    // `|n| < 2^(top − finest)`.
+    if top - finest > max_bits as i32 {
+        return None;
+    }
+    let fixed = |x: f64| {
+        let (m, e) = decompose(x);
+        if m == 0 {
+            return 0;
+        }
+        let tz = m.trailing_zeros() as i32;
+        i128::from(m >> tz) << (e + tz - finest) as u32
+    };
+    Some(points.iter().map(|p| p.map(fixed)).collect())
+}
+
 /// `2^e` for `|e| ≤ 1022`.
 fn pow2(e: i32) -> f64 {
     debug_assert!((-1022..=1023).contains(&e));
@@ -525,6 +562,40 @@ fn round_half_away(v: f64) -> i64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every coordinate is its integer times the common power of two, exactly; the scale is
+    /// the finest coordinate's last bit; a span past the limit is refused.
+    #[test]
+    fn common_fixed_point_is_exact() {
+        let points = [
+            [1.0, -0.375, 0.0],
+            [1.0 + f64::EPSILON, 3.0e5, -2.5],
+            [-0.1, 1e-5, 7.0],
+        ];
+        let fixed = common_fixed_point(&points, 125).unwrap();
+        // The finest bit: that of 1e-5 (exponent -17, 53 bits) at 2^-69 or below.
+        let finest = points
+            .iter()
+            .flatten()
+            .filter(|x| **x != 0.0)
+            .map(|&x| {
+                let (m, e) = decompose(x);
+                e + m.trailing_zeros() as i32
+            })
+            .min()
+            .unwrap();
+        // `n` keeps the 53 bits of an `f64`, so `n as f64` is exact, and so is the power of two.
+        for (p, n) in points.iter().zip(&fixed) {
+            for k in 0..3 {
+                assert_eq!(n[k] as f64 * 2f64.powi(finest), p[k]);
+            }
+        }
+        assert_eq!(fixed[2][2], 7 << -finest);
+        assert!(common_fixed_point(&points, 60).is_none());
+        assert!(common_fixed_point(&[[1.0, 1e-300, 0.0]], 125).is_none());
+        assert!(common_fixed_point(&[[f64::NAN, 0.0, 0.0]], 125).is_none());
+        assert_eq!(common_fixed_point(&[[0.0; 3]], 8), Some(vec![[0; 3]]));
+    }
 
     #[test]
     fn fast_rounding_matches_round() {

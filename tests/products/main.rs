@@ -14,6 +14,7 @@ mod products;
 mod remesh;
 mod remesh_cli;
 mod remesh_dataset;
+mod remesh_keep;
 mod remesh_levels;
 mod remesh_planar;
 mod remesh_report;

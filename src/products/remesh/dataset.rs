@@ -33,6 +33,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use super::crossings::SegmentBvh;
+use super::keep_input::InputCheck;
 use super::report::{DistanceReference, RemeshReport};
 use super::thicken::{self, MeshField, ThickenedSheets};
 use super::write::{SurfaceFormat, write_surface};
@@ -65,6 +66,9 @@ pub struct RemeshJob {
     /// phases and rounds and every 4096 evaluations, [`RemeshOptions::deadline`]). An input
     /// past it is a `timeout` row without an output.
     pub time_limit: Option<Duration>,
+    /// Write a mesh that already is the boundary of its `w > ½` solid as it is
+    /// ([`super::keep_input`]; the row's `kept`); `false` remeshes every input.
+    pub keep_input: bool,
 }
 
 impl RemeshJob {
@@ -78,6 +82,7 @@ impl RemeshJob {
             thicken_cells: None,
             load: LoadOptions::default(),
             time_limit: None,
+            keep_input: true,
         }
     }
 }
@@ -114,6 +119,7 @@ impl MeshJob for RemeshJob {
         ("input", "null"),
         ("faces", "null"),
         ("vertices", "null"),
+        ("kept", "null"),
         ("output_faces", "null"),
         ("output_vertices", "null"),
         ("valid", "null"),
@@ -145,6 +151,7 @@ impl MeshJob for RemeshJob {
                 or_null(self.thicken_cells.map(json_number)),
             ),
             ("weld", or_null(self.load.weld.map(|w| w.to_string()))),
+            ("keep_input", self.keep_input.to_string()),
             ("bisection_steps", o.bisection_steps.to_string()),
             (
                 "max_classified_points",
@@ -289,7 +296,16 @@ impl MeshJob for RemeshJob {
             reference,
         } = thicken::of_mesh(mesh, &*wn, thick.as_ref(), bounds);
         in_time("building the evaluator")?;
-        let out = self.remesh(field, Some(&guide), bounds, deadline)?;
+        let kept = (self.keep_input && thick.is_none())
+            .then(|| super::keep_input::keep_input(mesh, bounds, &self.options));
+        let out = match kept {
+            Some(Ok(out)) => out,
+            kept => {
+                let mut out = self.remesh(field, Some(&guide), bounds, deadline)?;
+                out.stats.input = kept.and_then(Result::err).map(InputCheck::Remeshed);
+                out
+            }
+        };
         self.finish(out, field, reference, bounds, deadline, stats)
     }
 }
@@ -386,6 +402,7 @@ impl RemeshJob {
         let mut bytes = Vec::new();
         write_surface(&mut bytes, self.format, &surface)?;
         let t = report.topology;
+        stats.set("kept", out.stats.input == Some(InputCheck::Kept));
         stats.set("output_faces", t.faces);
         stats.set("output_vertices", t.vertices);
         let intersections = report.self_intersections.as_ref().ok().map(|r| r.pairs);

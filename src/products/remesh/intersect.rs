@@ -23,7 +23,8 @@
 
 use rayon::prelude::*;
 
-use crate::kernel::predicates::{W128, Width};
+use crate::kernel::predicates::{W128, Width, det2_sign_wide, orient3d_sign_wide};
+use crate::kernel::quantize::common_fixed_point;
 
 /// Largest accepted coordinate magnitude (the 60-bit predicates need differences below `2^61`).
 pub const MAX_COORDINATE: i64 = 1 << 60;
@@ -47,6 +48,9 @@ pub enum IntersectError {
         /// Vertex index.
         vertex: usize,
     },
+    /// The coordinates span more bits than the wide predicates take, in one fixed-point scale
+    /// ([`self_intersections_of_positions`]).
+    CoordinateSpan,
     /// A face refers to a vertex that does not exist.
     BadIndex {
         /// Face index.
@@ -67,6 +71,10 @@ impl std::fmt::Display for IntersectError {
             IntersectError::CoordinateTooLarge { vertex } => write!(
                 f,
                 "vertex {vertex} has a coordinate of magnitude 2^60 or more"
+            ),
+            IntersectError::CoordinateSpan => write!(
+                f,
+                "the coordinates span more than 125 bits as integers in one scale"
             ),
             IntersectError::BadIndex { face } => {
                 write!(f, "face {face} refers to a vertex that does not exist")
@@ -97,31 +105,87 @@ pub fn self_intersections(
     {
         return Err(IntersectError::CoordinateTooLarge { vertex });
     }
-    if let Some(face) = triangles
+    check_indices(points.len(), triangles)?;
+    let boxes: Vec<(P, P)> = triangles
         .iter()
-        .position(|t| t.iter().any(|&v| v as usize >= points.len()))
-    {
-        return Err(IntersectError::BadIndex { face });
-    }
-    let tri = |f: usize| triangles[f].map(|v| points[v as usize]);
-    let boxes: Vec<(P, P)> = (0..triangles.len())
-        .map(|f| {
-            let t = tri(f);
+        .map(|t| {
+            let t = t.map(|v| points[v as usize]);
             (
                 std::array::from_fn(|a| t[0][a].min(t[1][a]).min(t[2][a])),
                 std::array::from_fn(|a| t[0][a].max(t[1][a]).max(t[2][a])),
             )
         })
         .collect();
+    count_intersecting_pairs(points, triangles, &boxes, budget)
+}
+
+/// [`self_intersections`] of a surface with `f64` vertices, exact on those very coordinates
+/// (an input kept as it is, [`super::keep_input`]): they are written as integers in one scale
+/// ([`common_fixed_point`]), which the 60-bit predicates take when they fit and the wide ones
+/// otherwise; the broad phase then runs on the boxes rounded outward to 60 bits.
+pub fn self_intersections_of_positions(
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    budget: u64,
+) -> Result<SelfIntersections, IntersectError> {
+    let wide_bits = MAX_WIDE_COORDINATE.trailing_zeros();
+    let wide = common_fixed_point(positions, wide_bits).ok_or(IntersectError::CoordinateSpan)?;
+    let top = wide
+        .iter()
+        .flatten()
+        .map(|c| 128 - c.unsigned_abs().leading_zeros())
+        .max()
+        .unwrap_or(0);
+    let narrow_bits = MAX_COORDINATE.trailing_zeros();
+    if top < narrow_bits {
+        let narrow: Vec<P> = wide.iter().map(|p| p.map(|c| c as i64)).collect();
+        return self_intersections(&narrow, triangles, budget);
+    }
+    check_indices(wide.len(), triangles)?;
+    let shift = top - (narrow_bits - 1);
+    // Arithmetic shifts round towards −∞: the minimum down, the maximum (negated) up.
+    let floor = |c: i128| (c >> shift) as i64;
+    let ceil = |c: i128| -((-c) >> shift) as i64;
+    let boxes: Vec<(P, P)> = triangles
+        .iter()
+        .map(|t| {
+            let t = t.map(|v| wide[v as usize]);
+            (
+                std::array::from_fn(|a| floor(t[0][a].min(t[1][a]).min(t[2][a]))),
+                std::array::from_fn(|a| ceil(t[0][a].max(t[1][a]).max(t[2][a]))),
+            )
+        })
+        .collect();
+    count_intersecting_pairs(&wide, triangles, &boxes, budget)
+}
+
+fn check_indices(points: usize, triangles: &[[u32; 3]]) -> Result<(), IntersectError> {
+    match triangles
+        .iter()
+        .position(|t| t.iter().any(|&v| v as usize >= points))
+    {
+        Some(face) => Err(IntersectError::BadIndex { face }),
+        None => Ok(()),
+    }
+}
+
+/// The pairs of [`self_intersections`], with each face's box (exact, or rounded outward).
+fn count_intersecting_pairs<T: ExactPoint>(
+    points: &[T],
+    triangles: &[[u32; 3]],
+    boxes: &[(P, P)],
+    budget: u64,
+) -> Result<SelfIntersections, IntersectError> {
+    let tri = |f: usize| triangles[f].map(|v| points[v as usize]);
     // One grid at the largest extent; by size classes only when that is over the budget.
     // Classes have fewer candidates but cost more hash lookups per cell: on the bunny at res
     // 256 (157k faces) one grid has 34.7M candidates and checks in 0.14–0.22 s, classes 8.3M
     // and 0.46 s; cura-predator_platform at res 256 is over its budget with one grid (304M, a
     // flat bed's large faces among small ones) and checks by classes in 0.77 s.
-    let mut grids = SizeClassGrids::new(&boxes, false);
+    let mut grids = SizeClassGrids::new(boxes, false);
     let mut candidates = grids.candidates();
     if candidates > budget {
-        let classes = SizeClassGrids::new(&boxes, true);
+        let classes = SizeClassGrids::new(boxes, true);
         let c = classes.candidates();
         if c < candidates {
             (grids, candidates) = (classes, c);
@@ -138,7 +202,7 @@ pub fn self_intersections(
         .into_par_iter()
         .map(|f| {
             let t = tri(f);
-            normal(t[0], t[1], t[2]) == [0; 3]
+            T::projection_axis(t[0], t[1], t[2]).is_none()
         })
         .collect();
     // `acc`: intersecting pairs, tested pairs.
@@ -350,9 +414,70 @@ fn normal(a: P, b: P, c: P) -> [i128; 3] {
     ]
 }
 
-/// Sign of `(d − a) · ((b − a) × (c − a))`.
-fn orient(a: P, b: P, c: P, d: P) -> i32 {
-    W128::orient3d_sign(sub(d, a), sub(b, a), sub(c, a))
+/// The points the exact tests run on: the remesher's fixed point (`[i64; 3]`, below
+/// [`MAX_COORDINATE`], the kernel's 60-bit predicates) or an input's own coordinates as integers
+/// in one scale (`[i128; 3]`, below [`MAX_WIDE_COORDINATE`], the kernel's wide predicates).
+pub trait ExactPoint: Copy + PartialEq + Send + Sync {
+    /// One coordinate.
+    type Coordinate: Copy + Ord;
+    /// Coordinate `k`.
+    fn at(self, k: usize) -> Self::Coordinate;
+    /// Sign of `(d − a) · ((b − a) × (c − a))`.
+    fn orient(a: Self, b: Self, c: Self, d: Self) -> i32;
+    /// Sign of the 2D orientation of `(a, b, c)` in the plane of axes `(i, j)`.
+    fn orient2(a: Self, b: Self, c: Self, axes: (usize, usize)) -> i32;
+    /// An axis along which the triangle's normal is nonzero, `None` when its corners are
+    /// collinear (component `k` of the normal is the orientation in the plane of the other two).
+    fn projection_axis(a: Self, b: Self, c: Self) -> Option<usize> {
+        (0..3).find(|&k| Self::orient2(a, b, c, plane_axes(k)) != 0)
+    }
+}
+
+impl ExactPoint for P {
+    type Coordinate = i64;
+    #[inline]
+    fn at(self, k: usize) -> i64 {
+        self[k]
+    }
+    #[inline]
+    fn orient(a: P, b: P, c: P, d: P) -> i32 {
+        W128::orient3d_sign(sub(d, a), sub(b, a), sub(c, a))
+    }
+    #[inline]
+    fn orient2(a: P, b: P, c: P, (i, j): (usize, usize)) -> i32 {
+        W128::det2_sign(b[i] - a[i], b[j] - a[j], c[i] - a[i], c[j] - a[j])
+    }
+    #[inline]
+    fn projection_axis(a: P, b: P, c: P) -> Option<usize> {
+        let n = normal(a, b, c);
+        (0..3).find(|&k| n[k] != 0)
+    }
+}
+
+/// Largest accepted magnitude of a wide coordinate (differences stay below `2^126`).
+pub const MAX_WIDE_COORDINATE: i128 = 1 << 125;
+
+impl ExactPoint for [i128; 3] {
+    type Coordinate = i128;
+    #[inline]
+    fn at(self, k: usize) -> i128 {
+        self[k]
+    }
+    fn orient(a: Self, b: Self, c: Self, d: Self) -> i32 {
+        let sub = |p: Self, q: Self| [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
+        orient3d_sign_wide(sub(d, a), sub(b, a), sub(c, a))
+    }
+    fn orient2(a: Self, b: Self, c: Self, (i, j): (usize, usize)) -> i32 {
+        det2_sign_wide(b[i] - a[i], b[j] - a[j], c[i] - a[i], c[j] - a[j])
+    }
+}
+
+fn orient<T: ExactPoint>(a: T, b: T, c: T, d: T) -> i32 {
+    T::orient(a, b, c, d)
+}
+
+fn orient2<T: ExactPoint>(a: T, b: T, c: T, axes: (usize, usize)) -> i32 {
+    T::orient2(a, b, c, axes)
 }
 
 /// The two axes kept when projecting along `axis`.
@@ -360,18 +485,13 @@ fn plane_axes(axis: usize) -> (usize, usize) {
     ((axis + 1) % 3, (axis + 2) % 3)
 }
 
-/// Sign of the 2D orientation of `(a, b, c)` in the plane of axes `(i, j)`.
-fn orient2(a: P, b: P, c: P, (i, j): (usize, usize)) -> i32 {
-    W128::det2_sign(b[i] - a[i], b[j] - a[j], c[i] - a[i], c[j] - a[j])
-}
-
-/// An axis along which the (non-degenerate) triangle's normal is nonzero.
-fn projection_axis(n: [i128; 3]) -> usize {
-    (0..3).find(|&a| n[a] != 0).unwrap_or(2)
+/// The plane of projection of a non-degenerate triangle.
+fn projection_axes<T: ExactPoint>(a: T, b: T, c: T) -> (usize, usize) {
+    plane_axes(T::projection_axis(a, b, c).unwrap_or(2))
 }
 
 /// Whether the faces `s` and `t` (non-degenerate) meet outside what they share.
-pub fn faces_intersect(s: [P; 3], t: [P; 3]) -> bool {
+pub fn faces_intersect<T: ExactPoint>(s: [T; 3], t: [T; 3]) -> bool {
     // At most three shared corners (no allocation: this runs for every candidate pair, and for
     // every collapse the simplification tries).
     let mut shared = [(0usize, 0usize); 3];
@@ -394,7 +514,7 @@ pub fn faces_intersect(s: [P; 3], t: [P; 3]) -> bool {
             if side == [0; 3] {
                 // Coplanar (a flat region of the remesher's output: most pairs the
                 // simplification tests there, and most of them apart).
-                let axes = plane_axes(projection_axis(normal(s[0], s[1], s[2])));
+                let axes = projection_axes(s[0], s[1], s[2]);
                 return coplanar_triangles_meet(s, t, axes);
             }
             let side = s.map(|p| orient(t[0], t[1], t[2], p));
@@ -424,7 +544,7 @@ pub fn faces_intersect(s: [P; 3], t: [P; 3]) -> bool {
             if orient(u, v, a, b) != 0 {
                 return false;
             }
-            let axes = plane_axes(projection_axis(normal(u, v, a)));
+            let axes = projection_axes(u, v, a);
             orient2(u, v, a, axes) == orient2(u, v, b, axes)
         }
         _ => true,
@@ -432,18 +552,23 @@ pub fn faces_intersect(s: [P; 3], t: [P; 3]) -> bool {
 }
 
 /// Whether the closed segment `p q` meets the closed (non-degenerate) triangle `t`.
-fn segment_meets_triangle(p: P, q: P, t: [P; 3]) -> bool {
+fn segment_meets_triangle<T: ExactPoint>(p: T, q: T, t: [T; 3]) -> bool {
     let sides = (orient(t[0], t[1], t[2], p), orient(t[0], t[1], t[2], q));
     segment_meets_triangle_on_sides(p, q, t, sides)
 }
 
 /// [`segment_meets_triangle`] with the sides of `p` and `q` of `t`'s plane known.
-fn segment_meets_triangle_on_sides(p: P, q: P, t: [P; 3], (op, oq): (i32, i32)) -> bool {
+fn segment_meets_triangle_on_sides<T: ExactPoint>(
+    p: T,
+    q: T,
+    t: [T; 3],
+    (op, oq): (i32, i32),
+) -> bool {
     if op == oq && op != 0 {
         return false;
     }
     if op == 0 && oq == 0 {
-        let axes = plane_axes(projection_axis(normal(t[0], t[1], t[2])));
+        let axes = projection_axes(t[0], t[1], t[2]);
         return coplanar_segment_meets_triangle(p, q, t, axes);
     }
     // The segment meets the plane in one point; the line through it passes through the closed
@@ -458,7 +583,7 @@ fn segment_meets_triangle_on_sides(p: P, q: P, t: [P; 3], (op, oq): (i32, i32)) 
 
 /// Whether the closed triangles `s` and `t`, non-degenerate and in one plane, meet (projected on
 /// `axes`, along which their normals are nonzero).
-fn coplanar_triangles_meet(s: [P; 3], t: [P; 3], axes: (usize, usize)) -> bool {
+fn coplanar_triangles_meet<T: ExactPoint>(s: [T; 3], t: [T; 3], axes: (usize, usize)) -> bool {
     // A line that leaves one closed set strictly on one side and the other touching or on the
     // other side separates them; the lines through the edges are the first ones tried, at 3
     // orientations each, since the edge-by-edge test below takes 108 when they are apart
@@ -473,7 +598,7 @@ fn coplanar_triangles_meet(s: [P; 3], t: [P; 3], axes: (usize, usize)) -> bool {
 /// Whether every point of `points` lies strictly on the far side, from `t`, of the line through
 /// one edge of `t` (all in one plane, projected on `axes`; `t` non-degenerate there): then the
 /// convex hull of `points` and the closed triangle are apart.
-fn strictly_outside_an_edge(points: &[P], t: [P; 3], axes: (usize, usize)) -> bool {
+fn strictly_outside_an_edge<T: ExactPoint>(points: &[T], t: [T; 3], axes: (usize, usize)) -> bool {
     let inside = orient2(t[0], t[1], t[2], axes);
     (0..3).any(|k| {
         points
@@ -484,7 +609,12 @@ fn strictly_outside_an_edge(points: &[P], t: [P; 3], axes: (usize, usize)) -> bo
 
 /// Whether the closed segment `p q` meets the closed triangle `t`, all in one plane, projected on
 /// `axes` (a plane of projection along which the triangle's normal is nonzero).
-fn coplanar_segment_meets_triangle(p: P, q: P, t: [P; 3], axes: (usize, usize)) -> bool {
+fn coplanar_segment_meets_triangle<T: ExactPoint>(
+    p: T,
+    q: T,
+    t: [T; 3],
+    axes: (usize, usize),
+) -> bool {
     if strictly_outside_an_edge(&[p, q], t, axes) {
         return false;
     }
@@ -497,13 +627,13 @@ fn coplanar_segment_meets_triangle(p: P, q: P, t: [P; 3], axes: (usize, usize)) 
 
 /// [`coplanar_segment_meets_triangle`] without the separating lines: an end inside, or a
 /// crossing or touching edge.
-fn segment_meets_triangle_2d(p: P, q: P, t: [P; 3], axes: (usize, usize)) -> bool {
+fn segment_meets_triangle_2d<T: ExactPoint>(p: T, q: T, t: [T; 3], axes: (usize, usize)) -> bool {
     point_in_triangle_2d(p, t, axes)
         || point_in_triangle_2d(q, t, axes)
         || (0..3).any(|k| segments_meet_2d(p, q, t[k], t[(k + 1) % 3], axes))
 }
 
-fn point_in_triangle_2d(p: P, t: [P; 3], axes: (usize, usize)) -> bool {
+fn point_in_triangle_2d<T: ExactPoint>(p: T, t: [T; 3], axes: (usize, usize)) -> bool {
     let s = [
         orient2(t[0], t[1], p, axes),
         orient2(t[1], t[2], p, axes),
@@ -513,7 +643,7 @@ fn point_in_triangle_2d(p: P, t: [P; 3], axes: (usize, usize)) -> bool {
 }
 
 /// Whether the closed segments `a b` and `c d`, coplanar, meet (projected on `axes`).
-fn segments_meet_2d(a: P, b: P, c: P, d: P, axes: (usize, usize)) -> bool {
+fn segments_meet_2d<T: ExactPoint>(a: T, b: T, c: T, d: T, axes: (usize, usize)) -> bool {
     let d1 = orient2(c, d, a, axes);
     let d2 = orient2(c, d, b, axes);
     let d3 = orient2(a, b, c, axes);
@@ -521,8 +651,9 @@ fn segments_meet_2d(a: P, b: P, c: P, d: P, axes: (usize, usize)) -> bool {
     if d1 * d2 < 0 && d3 * d4 < 0 {
         return true;
     }
-    let within =
-        |x: P, y: P, z: P| (0..3).all(|k| x[k].min(y[k]) <= z[k] && z[k] <= x[k].max(y[k]));
+    let within = |x: T, y: T, z: T| {
+        (0..3).all(|k| x.at(k).min(y.at(k)) <= z.at(k) && z.at(k) <= x.at(k).max(y.at(k)))
+    };
     (d1 == 0 && within(c, d, a))
         || (d2 == 0 && within(c, d, b))
         || (d3 == 0 && within(a, b, c))
@@ -603,7 +734,7 @@ mod tests {
                 if ns == [0; 3] || normal(t[0], t[1], t[2]) == [0; 3] {
                     continue;
                 }
-                let axes = plane_axes(projection_axis(ns));
+                let axes = projection_axes(s[0], s[1], s[2]);
                 let by_edges = (0..3)
                     .any(|k| segment_meets_triangle_2d(s[k], s[(k + 1) % 3], t, axes))
                     || (0..3).any(|k| segment_meets_triangle_2d(t[k], t[(k + 1) % 3], s, axes));
@@ -626,6 +757,109 @@ mod tests {
             }
         }
         assert!(apart > 5_000 && meeting > 5_000 && segments > 10_000);
+    }
+
+    /// The wide predicates decide every pair of a small grid's triangles (shared corners,
+    /// coplanar, touching) as the 60-bit ones do on the grid itself, after an invertible integer
+    /// map with 61-bit entries (meeting is invariant under it): the images need ~64 bits, the
+    /// `f64` filters round them, and the degenerate cases reach the arbitrary-precision
+    /// fallbacks (each of which, broken, fails this test).
+    #[test]
+    fn wide_coordinates_decide_as_the_narrow_ones() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = |m: u64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state % m
+        };
+        let (mut meeting, mut apart) = (0, 0);
+        for round in 0..200 {
+            // A fresh map every 100 pairs; entries below 2^61, images below 2^64.
+            let m: [[i128; 3]; 3] =
+                std::array::from_fn(|_| std::array::from_fn(|_| i128::from(next(1 << 61))));
+            let big = |r: usize, c: usize| num_bigint::BigInt::from(m[r][c]);
+            let det = big(0, 0) * (big(1, 1) * big(2, 2) - big(1, 2) * big(2, 1))
+                - big(0, 1) * (big(1, 0) * big(2, 2) - big(1, 2) * big(2, 0))
+                + big(0, 2) * (big(1, 0) * big(2, 1) - big(1, 1) * big(2, 0));
+            if det == num_bigint::BigInt::from(0) {
+                continue;
+            }
+            let map = |p: P| -> [i128; 3] {
+                std::array::from_fn(|r| (0..3).map(|c| m[r][c] * i128::from(p[c])).sum())
+            };
+            for _ in 0..100 {
+                let mut point = || -> P { [0, 1, 2].map(|_| next(4) as i64) };
+                let s: [P; 3] = [point(), point(), point()];
+                let t: [P; 3] = [point(), point(), point()];
+                if P::projection_axis(s[0], s[1], s[2]).is_none()
+                    || P::projection_axis(t[0], t[1], t[2]).is_none()
+                {
+                    continue;
+                }
+                let narrow = faces_intersect(s, t);
+                assert_eq!(
+                    faces_intersect(s.map(map), t.map(map)),
+                    narrow,
+                    "round {round}: {s:?} {t:?}"
+                );
+                if narrow {
+                    meeting += 1;
+                } else {
+                    apart += 1;
+                }
+            }
+        }
+        assert!(meeting > 1_000 && apart > 1_000, "{meeting} {apart}");
+    }
+
+    /// On `f64` vertices: the octahedron at `1 + 2^-70`-fine coordinates (past the 60-bit
+    /// range) is clean, and the spike through it counts twice, as on integers.
+    #[test]
+    fn positions_beyond_sixty_bits_are_tested_exactly() {
+        let tiny = 2f64.powi(-70);
+        let p = [
+            [1.0, tiny, 0.0],
+            [-1.0, 0.0, tiny],
+            [0.0, 1.0, 0.0],
+            [tiny, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, tiny, -1.0],
+        ];
+        let f = [
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ];
+        let r = self_intersections_of_positions(&p, &f, u64::MAX).unwrap();
+        assert_eq!((r.pairs, r.degenerate_faces), (0, 0));
+        let mut p2 = p.to_vec();
+        p2.extend([[0.1, 0.1, -2.0], [0.2, 0.1, 2.0], [0.1, 0.2, 2.0]]);
+        let mut f2 = f.to_vec();
+        f2.push([6, 7, 8]);
+        assert_eq!(
+            self_intersections_of_positions(&p2, &f2, u64::MAX)
+                .unwrap()
+                .pairs,
+            2
+        );
+        // A face through a vertex `2^-70` off its plane: apart; on it: touching.
+        let q = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        for (z, pairs) in [(tiny, 0), (0.0, 1)] {
+            let mut pts = q.to_vec();
+            pts.extend([[0.25, 0.25, z], [0.3, 0.25, 1.0], [0.25, 0.3, 1.0]]);
+            let r = self_intersections_of_positions(&pts, &[[0, 1, 2], [3, 4, 5]], u64::MAX);
+            assert_eq!(r.unwrap().pairs, pairs, "z = {z}");
+        }
+        assert_eq!(
+            self_intersections_of_positions(&[[1.0, 1e-300, 0.0]], &[], 10),
+            Err(IntersectError::CoordinateSpan)
+        );
     }
 
     #[test]

@@ -55,6 +55,7 @@ mod deadline;
 pub mod extract;
 pub mod flatness;
 pub mod intersect;
+pub mod keep_input;
 pub mod lattice;
 pub mod levels;
 pub mod octree;
@@ -336,6 +337,9 @@ pub struct RemeshStats {
     /// What the plate probe found and how much finer it made the cells along each axis
     /// ([`RemeshOptions::refine_plates`]).
     pub plates: plates::PlateProbe,
+    /// Whether the input was kept as the output ([`keep_input::keep_input`]) or why not;
+    /// `None` when that was not tried (point clouds, curved inputs, `--always-remesh`).
+    pub input: Option<keep_input::InputCheck>,
 }
 
 /// The surface [`remesh`] returns.
@@ -347,9 +351,11 @@ pub struct Remeshed {
     pub triangles: Vec<[u32; 3]>,
     /// The vertices exactly, in fixed point: lattice units times `ticks_per_cell` (the exact
     /// self-intersection check, [`intersect::self_intersections`], runs on these; `positions`
-    /// are their images in world coordinates, rounded to `f64`).
+    /// are their images in world coordinates, rounded to `f64`). Empty when the input was kept
+    /// ([`keep_input`]): `positions` are then exact.
     pub fixed: Vec<[i64; 3]>,
-    /// Fixed-point units per lattice cell edge (`2^(bisection_steps + 1)`).
+    /// Fixed-point units per lattice cell edge (`2^(bisection_steps + 1)`; 0 when the input was
+    /// kept).
     pub ticks_per_cell: i64,
     /// The resolution's cell edge, `longest extent / resolution` (cells are cubes of this edge,
     /// finer along an axis on which the box is thin or across plates thinner than a cell:
@@ -575,6 +581,7 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
         marching_cubes_faces: band.marching_cubes_triangles,
         simplify: simplify::SimplifyStats::default(),
         plates,
+        input: None,
     };
     drop(classified);
     in_time(RemeshPhase::Place)?;

@@ -3,7 +3,10 @@
 //! with the run's counters — what `gwn remesh` prints and writes with `--report`, and what
 //! `gwn.remesh(..., report=True)` returns, measured once here for both.
 
-use super::super::intersect::{IntersectError, SelfIntersections, self_intersections};
+use super::super::intersect::{
+    IntersectError, SelfIntersections, self_intersections, self_intersections_of_positions,
+};
+use super::super::keep_input::InputCheck;
 use super::super::{RemeshOptions, RemeshStats, Remeshed};
 use super::{
     BoundaryHausdorff, NoSurface, TopologyReport, hausdorff_distance, hausdorff_to_solid_boundary,
@@ -189,7 +192,11 @@ impl RemeshReport {
         // budget only guards against a surprise.
         let budget = 1000 * surface.triangles().len() as u64 + 1_000_000;
         let start = std::time::Instant::now();
-        let intersections = self_intersections(&out.fixed, surface.triangles(), budget);
+        let intersections = if out.stats.input == Some(InputCheck::Kept) {
+            self_intersections_of_positions(surface.positions(), surface.triangles(), budget)
+        } else {
+            self_intersections(&out.fixed, surface.triangles(), budget)
+        };
         let self_intersection_seconds = start.elapsed().as_secs_f64();
         progress(ReportPhase::Hausdorff);
         let offset = SIDE_TEST_OFFSET_CELLS * out.cell_size;
@@ -277,6 +284,14 @@ impl RemeshReport {
             ("plate_thin_fraction", triple(s.plates.thin_fraction)),
             ("seconds", format!("{:.3}", self.seconds)),
         ];
+        match s.input {
+            Some(InputCheck::Kept) => members.push(("input", json_string("kept"))),
+            Some(InputCheck::Remeshed(why)) => {
+                members.push(("input", json_string("remeshed")));
+                members.push(("input_not_kept", json_string(&why.to_string())));
+            }
+            None => {}
+        }
         if let Some(phases) = &self.phase_seconds {
             members.push(("phase_seconds", phases.to_json()));
         }

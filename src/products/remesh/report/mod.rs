@@ -173,7 +173,7 @@ impl std::fmt::Display for TopologyReport {
     }
 }
 
-fn find(parent: &mut [u32], mut v: u32) -> u32 {
+pub(in crate::products::remesh) fn find(parent: &mut [u32], mut v: u32) -> u32 {
     while parent[v as usize] != v {
         let p = parent[parent[v as usize] as usize];
         parent[v as usize] = p;
@@ -182,7 +182,7 @@ fn find(parent: &mut [u32], mut v: u32) -> u32 {
     v
 }
 
-fn union(parent: &mut [u32], a: u32, b: u32) {
+pub(in crate::products::remesh) fn union(parent: &mut [u32], a: u32, b: u32) {
     let (ra, rb) = (find(parent, a), find(parent, b));
     if ra != rb {
         parent[ra as usize] = rb;

@@ -1,0 +1,379 @@
+//! Inputs that already are the surface a remesh aims for: kept as they are, bit for bit.
+//!
+//! A remesh returns a closed, edge- and vertex-manifold, consistently oriented surface without
+//! self-intersections that bounds `{w > ½}` with its normals pointing out of it. Many inputs
+//! already are one (clean scans, CAD exports, most printable models): for them the best answer
+//! is the input itself (Hausdorff distance 0, occupancy agreement 100 %, the input's own
+//! faces), and the test is linear in the input instead of in the surface's area in cells.
+//! [`keep_input`] keeps a mesh only when it proves all of this exactly, on the coordinates the
+//! user gave:
+//!
+//! 1. **Topology** ([`TopologyReport`]): every edge in exactly two faces, used once each way;
+//!    every vertex's faces one fan; no face that repeats a vertex; no two vertices at one
+//!    position.
+//! 2. **Embedding** ([`self_intersections_of_positions`]): the coordinates, written as integers
+//!    times one power of two (below `2^125`, else not kept: a coordinate of `1` beside one of
+//!    `1e-30`), go through the exact triangle–triangle test of the remesher's output (its
+//!    predicates widened to those integers): no collinear face, and no two faces
+//!    meeting outside the vertex or edge they share. So the components are disjoint closed
+//!    surfaces, each splitting space in two, and `w` jumps by exactly one across every face, up
+//!    against its normal.
+//! 3. **Winding**: `w` then takes one value on each region between components, and the faces are
+//!    the boundary of `{w > ½}`, oriented out of it, exactly when every face has `w = 0` in
+//!    front and `1` behind. Per component `C` that is two exact facts: the value `o` just outside
+//!    `C`, and `C`'s orientation `s` (the sign of the volume it encloses,
+//!    [`closed_surface_orientation`]); `C` is right when `(o, s)` is `(0, +1)` (a solid's outer
+//!    wall) or `(1, −1)` (a cavity's wall). `o` is the exact evaluator's value at `C`'s
+//!    lexicographically largest vertex `v`: the evaluator answers at `v + (ε1, ε2, ε3)` (docs/
+//!    robustness.md, section 4), a point lexicographically above all of `C`, hence outside its
+//!    convex hull, and infinitely close to `v`, which no other component touches.
+//! 4. **Size**: the input has at most the face count the remesh would aim for, the simplifier's
+//!    fraction of a dense marching cubes' count at this resolution, estimated from the input's
+//!    area: marching cubes puts a vertex on every lattice edge the surface crosses (the faces'
+//!    areas projected along each axis, over the cell faces across it) and a closed surface has
+//!    about twice as many faces as vertices. A finer input than that is remeshed, unless it has
+//!    at most [`ALWAYS_KEPT_FACES`] (the estimate is near 0 for parts thinner than a cell,
+//!    which a remesh would lose).
+//!
+//! What is kept is the input with bit-identical vertices merged: its referenced vertices in
+//! their order, and its faces in theirs.
+
+use rayon::slice::ParallelSliceMut;
+
+use crate::Mesh;
+use crate::base::bounding_box::BoundingBox;
+use crate::eval::antipodal::WindingNumber;
+use crate::kernel::predicates::closed_surface_orientation;
+use crate::kernel::quantize::common_fixed_point;
+
+use super::intersect::{self, IntersectError, self_intersections_of_positions};
+use super::lattice::Lattice;
+use super::report::TopologyReport;
+use super::{RemeshOptions, RemeshStats, Remeshed};
+
+/// Inputs of at most this many faces are never too fine to keep: the estimate of step 4 is
+/// near 0 for a part thinner than a cell (a needle, a sheet-thin plate), which a remesh would
+/// lose, while keeping it costs no more than this many faces.
+pub const ALWAYS_KEPT_FACES: usize = 10_000;
+
+/// Why [`keep_input`] remeshed instead of keeping the input (the first reason found, in the
+/// order of the module's steps).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NotKept {
+    /// The mesh has no faces.
+    Empty,
+    /// Edges in one face only.
+    Open {
+        /// How many.
+        boundary_edges: usize,
+    },
+    /// Edges in more than two faces, or vertices whose faces are not one fan.
+    NotManifold {
+        /// Edges in three faces or more.
+        edges: usize,
+        /// Vertices whose faces form several fans.
+        vertices: usize,
+    },
+    /// Edges used twice in the same direction.
+    Misoriented {
+        /// How many.
+        edges: usize,
+    },
+    /// Faces that repeat a vertex or whose corners are collinear.
+    DegenerateFaces {
+        /// How many.
+        faces: usize,
+    },
+    /// Distinct vertices at one position (a pinch the indices do not show).
+    CoincidentVertices {
+        /// Vertices beyond the first at their position.
+        vertices: usize,
+    },
+    /// The coordinates need more than 60 bits in one fixed-point scale (the exact test's range).
+    CoordinateRange,
+    /// Faces of too uneven sizes for the intersection test's broad phase.
+    UnevenFaces,
+    /// Faces that meet outside what they share.
+    SelfIntersecting {
+        /// Pairs of faces.
+        pairs: usize,
+    },
+    /// A component with the wrong winding number around it: nested in another of the same
+    /// orientation, or an inward-facing shell outside any solid.
+    Winding {
+        /// `w` just outside the component.
+        outside: i64,
+        /// Its orientation: `+1` outward, `−1` inward.
+        orientation: i32,
+    },
+    /// More faces than the remesh would aim for at this resolution.
+    TooManyFaces {
+        /// The input's faces.
+        faces: usize,
+        /// The remesh's target (estimated).
+        target: usize,
+    },
+}
+
+impl std::fmt::Display for NotKept {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            NotKept::Empty => write!(f, "it has no faces"),
+            NotKept::Open { boundary_edges } => {
+                write!(f, "it is open ({boundary_edges} boundary edges)")
+            }
+            NotKept::NotManifold { edges, vertices } => write!(
+                f,
+                "it is not manifold ({edges} edges in more than two faces, {vertices} vertices \
+                 with several fans)"
+            ),
+            NotKept::Misoriented { edges } => {
+                write!(f, "its faces are not consistently oriented ({edges} edges)")
+            }
+            NotKept::DegenerateFaces { faces } => write!(f, "it has {faces} degenerate faces"),
+            NotKept::CoincidentVertices { vertices } => write!(
+                f,
+                "{vertices} of its vertices repeat the position of another (not welded)"
+            ),
+            NotKept::CoordinateRange => write!(
+                f,
+                "its coordinates span more than 60 bits (the exact intersection test's range)"
+            ),
+            NotKept::UnevenFaces => write!(
+                f,
+                "its face sizes are too uneven for the intersection test's broad phase"
+            ),
+            NotKept::SelfIntersecting { pairs } => {
+                write!(f, "it self-intersects ({pairs} pairs of faces)")
+            }
+            NotKept::Winding {
+                outside,
+                orientation,
+            } => write!(
+                f,
+                "a component has w = {outside} outside it and {} inside: not the boundary of \
+                 w > 1/2",
+                outside + i64::from(orientation)
+            ),
+            NotKept::TooManyFaces { faces, target } => write!(
+                f,
+                "it has {faces} faces, more than the remesh's target of about {target} at this \
+                 resolution"
+            ),
+        }
+    }
+}
+
+/// What happened to the input before the lattice ([`RemeshStats::input`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum InputCheck {
+    /// The input is the output ([`keep_input`]).
+    Kept,
+    /// The input was remeshed, for this reason.
+    Remeshed(NotKept),
+}
+
+/// The input itself as the remesh of `mesh` (triangles whose `w > ½` solid is meant, with
+/// `bounds` and `options` as the remesh would take them), when it provably already is that
+/// surface (see the [module documentation](self)); else why not. `options.simplify` sets the
+/// face target; without simplification (a raw lattice surface was asked for) nothing is kept.
+///
+/// ```
+/// use gwn::Mesh;
+/// use gwn::products::remesh::{RemeshOptions, keep_input::{NotKept, keep_input}};
+/// // A unit cube, outward.
+/// let p = [[0.,0.,0.],[1.,0.,0.],[1.,1.,0.],[0.,1.,0.],[0.,0.,1.],[1.,0.,1.],[1.,1.,1.],[0.,1.,1.]];
+/// let t = [[0,2,1],[0,3,2],[0,1,5],[0,5,4],[1,2,6],[1,6,5],[2,3,7],[2,7,6],[3,0,4],[3,4,7],[4,5,6],[4,6,7]];
+/// let cube = Mesh::from_slices(&p, &t)?;
+/// let options = RemeshOptions::with_resolution(64);
+/// let bounds = cube.bounding_box().unwrap();
+/// let kept = keep_input(&cube, bounds, &options).unwrap();
+/// assert_eq!(kept.triangles, t);
+/// // Inward, it bounds no solid (w = -1 inside).
+/// let flipped: Vec<[u32; 3]> = t.iter().map(|&[a, b, c]| [a, c, b]).collect();
+/// let inward = Mesh::from_slices(&p, &flipped)?;
+/// assert!(matches!(
+///     keep_input(&inward, bounds, &options),
+///     Err(NotKept::Winding { outside: 0, orientation: -1 })
+/// ));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn keep_input(
+    mesh: &Mesh,
+    bounds: BoundingBox,
+    options: &RemeshOptions,
+) -> Result<Remeshed, NotKept> {
+    if mesh.triangles().is_empty() {
+        return Err(NotKept::Empty);
+    }
+    // Vertices at one position are one point of the surface (and of the exact evaluator's
+    // boundary by position), whatever the file's indices say.
+    let (mesh, _) = mesh.welded();
+    let triangles = mesh.triangles();
+    let lattice = Lattice::new(bounds, options.resolution).ok_or(NotKept::CoordinateRange)?;
+    let target = options
+        .simplify
+        .map(|s| s.target_fraction_of_marching_cubes * marching_cubes_faces(&mesh, lattice.h))
+        .unwrap_or(0.0);
+    if triangles.len() > ALWAYS_KEPT_FACES && triangles.len() as f64 > target {
+        return Err(NotKept::TooManyFaces {
+            faces: triangles.len(),
+            target: target as usize,
+        });
+    }
+    let topology = TopologyReport::of(mesh.positions(), triangles);
+    if topology.degenerate_faces > 0 {
+        return Err(NotKept::DegenerateFaces {
+            faces: topology.degenerate_faces,
+        });
+    }
+    if !topology.closed {
+        return Err(NotKept::Open {
+            boundary_edges: topology.boundary_edges,
+        });
+    }
+    if !(topology.edge_manifold && topology.vertex_manifold) {
+        return Err(NotKept::NotManifold {
+            edges: topology.nonmanifold_edges,
+            vertices: topology.nonmanifold_vertices,
+        });
+    }
+    if !topology.oriented {
+        return Err(NotKept::Misoriented {
+            edges: topology.misoriented_edges,
+        });
+    }
+    // The referenced vertices, in their order.
+    let mut used = vec![false; mesh.positions().len()];
+    for &v in triangles.iter().flatten() {
+        used[v as usize] = true;
+    }
+    let mut index = vec![u32::MAX; used.len()];
+    let mut positions = Vec::with_capacity(topology.vertices);
+    for (v, p) in mesh.positions().iter().enumerate() {
+        if used[v] {
+            index[v] = positions.len() as u32;
+            positions.push(*p);
+        }
+    }
+    let triangles: Vec<[u32; 3]> = triangles
+        .iter()
+        .map(|t| t.map(|v| index[v as usize]))
+        .collect();
+    // The input's coordinates as integers in one scale: exact for the intersection test (which
+    // makes them again, narrow or wide) and the orientations.
+    let bits = intersect::MAX_WIDE_COORDINATE.trailing_zeros();
+    let fixed = common_fixed_point(&positions, bits).ok_or(NotKept::CoordinateRange)?;
+    // Distinct vertices at one position would pass the topology (different indices) and the
+    // intersection test (coincident positions count as shared) while pinching the surface.
+    let mut sorted = fixed.clone();
+    sorted.par_sort_unstable();
+    let coincident = sorted.windows(2).filter(|w| w[0] == w[1]).count();
+    if coincident > 0 {
+        return Err(NotKept::CoincidentVertices {
+            vertices: coincident,
+        });
+    }
+    // The report's budget: linear on evenly sized faces, refused when it would not be.
+    let budget = 1000 * triangles.len() as u64 + 1_000_000;
+    let si =
+        self_intersections_of_positions(&positions, &triangles, budget).map_err(|e| match e {
+            IntersectError::TooManyCandidates { .. } => NotKept::UnevenFaces,
+            IntersectError::CoordinateTooLarge { .. }
+            | IntersectError::CoordinateSpan
+            | IntersectError::BadIndex { .. } => NotKept::CoordinateRange,
+        })?;
+    if si.degenerate_faces > 0 {
+        return Err(NotKept::DegenerateFaces {
+            faces: si.degenerate_faces,
+        });
+    }
+    if si.pairs > 0 {
+        return Err(NotKept::SelfIntersecting { pairs: si.pairs });
+    }
+    let surface =
+        Mesh::from_slices(&positions, &triangles).map_err(|_| NotKept::CoordinateRange)?;
+    check_winding(&surface, &fixed)?;
+    Ok(Remeshed {
+        positions,
+        triangles,
+        fixed: Vec::new(),
+        ticks_per_cell: 0,
+        cell_size: lattice.largest_cell(),
+        cell_sizes: lattice.h,
+        stats: RemeshStats {
+            input: Some(InputCheck::Kept),
+            ..RemeshStats::default()
+        },
+    })
+}
+
+/// Step 3 of the module documentation on a closed, manifold, oriented, embedded `surface` with
+/// its exact fixed-point vertices.
+fn check_winding(surface: &Mesh, fixed: &[[i128; 3]]) -> Result<(), NotKept> {
+    let triangles = surface.triangles();
+    let positions = surface.positions();
+    let mut parent: Vec<u32> = (0..positions.len() as u32).collect();
+    for &[a, b, c] in triangles {
+        super::report::union(&mut parent, a, b);
+        super::report::union(&mut parent, b, c);
+    }
+    let roots: Vec<u32> = (0..positions.len() as u32)
+        .map(|v| super::report::find(&mut parent, v))
+        .collect();
+    // Faces by component, and each component's lexicographically largest vertex.
+    let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
+    order.sort_unstable_by_key(|&f| roots[triangles[f as usize][0] as usize]);
+    // The evaluator's own perturbation is what step 3 relies on: build it with the defaults
+    // (ray `+z`), whatever evaluator the caller remeshes with.
+    let wn = WindingNumber::new(surface).map_err(|_| NotKept::CoordinateRange)?;
+    let lex = |v: u32| {
+        let p = positions[v as usize];
+        (p[0], p[1], p[2])
+    };
+    for faces in order.chunk_by(|&f, &g| {
+        roots[triangles[f as usize][0] as usize] == roots[triangles[g as usize][0] as usize]
+    }) {
+        let component = faces.iter().map(|&f| triangles[f as usize]);
+        let top = component
+            .clone()
+            .flatten()
+            .max_by(|&a, &b| lex(a).partial_cmp(&lex(b)).expect("finite coordinates"))
+            .expect("a component has faces");
+        let outside = wn.eval(positions[top as usize]);
+        let orientation = closed_surface_orientation(fixed, component, fixed[top as usize]);
+        // `outside` is an integer (no boundary: χ alone); compare it as one.
+        let outside = outside.round() as i64;
+        if !matches!((outside, orientation), (0, 1) | (1, -1)) {
+            return Err(NotKept::Winding {
+                outside,
+                orientation,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Triangles of a dense marching cubes on the lattice of spacing `h` around `mesh` (estimated):
+/// twice the lattice edges it crosses, `Σ_faces Σ_k |projected area along k| / (h_i h_j)`.
+fn marching_cubes_faces(mesh: &Mesh, h: [f64; 3]) -> f64 {
+    let p = mesh.positions();
+    let crossed: f64 = mesh
+        .triangles()
+        .iter()
+        .map(|&[a, b, c]| {
+            let [a, b, c] = [a, b, c].map(|v| p[v as usize]);
+            let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+            let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+            let n = [
+                e1[1] * e2[2] - e1[2] * e2[1],
+                e1[2] * e2[0] - e1[0] * e2[2],
+                e1[0] * e2[1] - e1[1] * e2[0],
+            ];
+            0.5 * (n[0].abs() / (h[1] * h[2])
+                + n[1].abs() / (h[2] * h[0])
+                + n[2].abs() / (h[0] * h[1]))
+        })
+        .sum();
+    2.0 * crossed
+}

@@ -1,0 +1,324 @@
+//! `products::remesh::keep_input`: an input that already is the boundary of its `w > ½` solid is
+//! the output as it is, and every way of not being one (open, non-manifold, misoriented,
+//! self-intersecting, winding the wrong way, too fine) is told apart from it exactly.
+
+use proptest::prelude::*;
+
+use crate::common;
+use crate::remesh::{sphere, torus, with_flipped_faces};
+
+use gwn::Mesh;
+use gwn::eval::antipodal::WindingNumber;
+use gwn::products::remesh::RemeshOptions;
+use gwn::products::remesh::keep_input::{NotKept, keep_input};
+
+fn kept(mesh: &Mesh, res: usize) -> Result<gwn::products::remesh::Remeshed, NotKept> {
+    keep_input(
+        mesh,
+        mesh.bounding_box().unwrap(),
+        &RemeshOptions::with_resolution(res),
+    )
+}
+
+fn join(parts: &[Mesh]) -> Mesh {
+    parts[1..]
+        .iter()
+        .fold(parts[0].clone(), |m, p| m.concatenated(p).unwrap())
+}
+
+/// A box from `lo` to `hi`, outward (`inward`: turned around).
+fn cuboid(lo: [f64; 3], hi: [f64; 3], inward: bool) -> Mesh {
+    let c = common::unit_cube();
+    let p: Vec<[f64; 3]> = c
+        .positions()
+        .iter()
+        .map(|p| std::array::from_fn(|k| lo[k] + p[k] * (hi[k] - lo[k])))
+        .collect();
+    let m = Mesh::new(p, c.triangles().to_vec()).unwrap();
+    if inward { m.flipped() } else { m }
+}
+
+#[test]
+fn solids_and_their_cavities_are_kept_as_they_are() {
+    let cube = common::unit_cube();
+    let out = kept(&cube, 64).unwrap();
+    assert_eq!(
+        (out.positions.as_slice(), out.triangles.as_slice()),
+        (cube.positions(), cube.triangles())
+    );
+    assert!(out.fixed.is_empty());
+    for mesh in [
+        sphere([0.0; 3], 1.0, 12, false),
+        torus(1.0, 0.3, 12),
+        // A hollow shell: the cavity's wall faces into the cavity (w = 0 there).
+        join(&[
+            sphere([0.0; 3], 1.0, 12, false),
+            sphere([0.0; 3], 0.5, 12, true),
+        ]),
+        // A solid in a cavity of a solid.
+        join(&[
+            cuboid([-3.0; 3], [3.0; 3], false),
+            cuboid([-2.0; 3], [2.0; 3], true),
+            cuboid([-1.0; 3], [1.0; 3], false),
+        ]),
+        // Disjoint solids.
+        join(&[cube.clone(), cube.translated([1.5, 0.2, 0.0])]),
+    ] {
+        let out = kept(&mesh, 64).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(out.triangles.len(), mesh.triangles().len());
+    }
+}
+
+#[test]
+fn every_way_of_not_bounding_the_solid_is_remeshed() {
+    let cube = common::unit_cube();
+    let ball = sphere([0.0; 3], 1.0, 12, false);
+    // Open: the top removed.
+    let open = Mesh::new(cube.positions().to_vec(), cube.triangles()[..10].to_vec()).unwrap();
+    assert!(matches!(kept(&open, 64), Err(NotKept::Open { .. })));
+    // A face turned around.
+    let flipped = with_flipped_faces(&ball, |f| f == 7);
+    assert!(matches!(
+        kept(&flipped, 64),
+        Err(NotKept::Misoriented { .. })
+    ));
+    // Inward: w = -1 inside.
+    assert_eq!(
+        kept(&ball.flipped(), 64).err(),
+        Some(NotKept::Winding {
+            outside: 0,
+            orientation: -1
+        })
+    );
+    // Nested with one orientation: w = 2 in the inner ball.
+    let nested = join(&[ball.clone(), sphere([0.0; 3], 0.5, 12, false)]);
+    assert_eq!(
+        kept(&nested, 64).err(),
+        Some(NotKept::Winding {
+            outside: 1,
+            orientation: 1
+        })
+    );
+    // A cavity's wall outside any solid.
+    let cavity = join(&[cube.clone(), sphere([5.0; 3], 0.5, 8, true)]);
+    assert!(matches!(
+        kept(&cavity, 64),
+        Err(NotKept::Winding {
+            outside: 0,
+            orientation: -1
+        })
+    ));
+    // Overlapping solids.
+    let overlap = join(&[cube.clone(), cube.translated([0.5, 0.5, 0.5])]);
+    assert!(matches!(
+        kept(&overlap, 64),
+        Err(NotKept::SelfIntersecting { .. })
+    ));
+    // Touching along a face: coplanar faces meet.
+    let touching = join(&[cube.clone(), cube.translated([1.0, 0.25, 0.25])]);
+    assert!(matches!(
+        kept(&touching, 64),
+        Err(NotKept::SelfIntersecting { .. })
+    ));
+    // Sharing a corner: welded into one vertex whose faces are two fans.
+    let corner = join(&[cube.clone(), cube.translated([1.0, 1.0, 1.0])]);
+    assert!(matches!(
+        kept(&corner, 64),
+        Err(NotKept::NotManifold {
+            edges: 0,
+            vertices: 1
+        })
+    ));
+    // A duplicated face: an edge in three faces.
+    let mut faces = cube.triangles().to_vec();
+    faces.push(faces[0]);
+    let doubled = Mesh::new(cube.positions().to_vec(), faces).unwrap();
+    assert!(matches!(
+        kept(&doubled, 64),
+        Err(NotKept::NotManifold { .. })
+    ));
+    // A closed surface with a flat fold: a tetrahedron whose apex lies in its base's plane.
+    let flat = Mesh::new(
+        vec![
+            [0.0; 3],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.25, 0.25, 0.0],
+        ],
+        vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]],
+    )
+    .unwrap();
+    assert!(matches!(
+        kept(&flat, 64),
+        Err(NotKept::SelfIntersecting { .. })
+    ));
+    // Finer than the remesh's face target at a coarse resolution (32,512 faces, a target of
+    // ~150), unless within the faces always kept.
+    assert!(matches!(
+        kept(&sphere([0.0; 3], 1.0, 128, false), 8),
+        Err(NotKept::TooManyFaces { .. })
+    ));
+    assert!(kept(&sphere([0.0; 3], 1.0, 40, false), 8).is_ok());
+    assert_eq!(kept(&ball, 64).map(|o| o.triangles.len()).ok(), Some(528));
+    let empty = Mesh::new(vec![[0.0; 3]], vec![]).unwrap();
+    assert_eq!(
+        keep_input(
+            &empty,
+            cube.bounding_box().unwrap(),
+            &RemeshOptions::with_resolution(8)
+        )
+        .err(),
+        Some(NotKept::Empty)
+    );
+}
+
+/// Coordinates that need more than 60 bits in one scale take the wide exact predicates: a gap
+/// of `2^-70` between two solids keeps them apart, no gap makes them touch.
+#[test]
+fn the_tests_are_exact_beyond_sixty_bits() {
+    let cube = common::unit_cube();
+    let tiny = 2f64.powi(-70);
+    let left = cuboid([-1.0, 0.0, 0.0], [0.0, 1.0, 1.0], false);
+    let apart = join(&[
+        left.clone(),
+        cuboid([tiny, 0.25, 0.25], [1.0, 0.75, 0.75], false),
+    ]);
+    kept(&apart, 64).unwrap_or_else(|e| panic!("{e}"));
+    let touching = join(&[left, cuboid([0.0, tiny, 0.25], [1.0, 0.75, 0.75], false)]);
+    assert!(matches!(
+        kept(&touching, 64),
+        Err(NotKept::SelfIntersecting { .. })
+    ));
+    // A span no integer scale below 2^125 holds: not tested, remeshed.
+    let far = cube.translated([1e-300, 0.0, 0.0]);
+    assert!(matches!(
+        kept(&join(&[far, cube.translated([3.0, 0.0, 0.0])]), 64),
+        Err(NotKept::CoordinateRange)
+    ));
+}
+
+/// A box of the grid below: its low corner and size, and whether it faces inward.
+type GridBox = ([u8; 3], [u8; 3], bool);
+
+/// Whether `keep_input` must keep these boxes, decided on the integer grid alone: every two
+/// closed boxes apart or one strictly inside the other (else they meet: touching faces, edges
+/// or corners, or crossing), and each box with `w` 0 just outside and 1 just inside (the sum of
+/// the orientations of the boxes around it, then its own).
+fn boxes_bound_a_solid(boxes: &[GridBox]) -> bool {
+    let lo = |b: &GridBox| b.0.map(i32::from);
+    let hi = |b: &GridBox| std::array::from_fn::<i32, 3, _>(|k| i32::from(b.0[k] + b.1[k]));
+    let inside =
+        |a: &GridBox, b: &GridBox| (0..3).all(|k| lo(b)[k] < lo(a)[k] && hi(a)[k] < hi(b)[k]);
+    let apart =
+        |a: &GridBox, b: &GridBox| (0..3).any(|k| hi(a)[k] < lo(b)[k] || hi(b)[k] < lo(a)[k]);
+    let sign = |b: &GridBox| if b.2 { -1 } else { 1 };
+    boxes.iter().enumerate().all(|(i, a)| {
+        let separate = boxes
+            .iter()
+            .enumerate()
+            .all(|(j, b)| i == j || apart(a, b) || inside(a, b) || inside(b, a));
+        let outside: i32 = boxes.iter().filter(|b| inside(a, b)).map(sign).sum();
+        separate && matches!((outside, sign(a)), (0, 1) | (1, -1))
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    /// Disjoint, nested, touching and crossing boxes of either orientation: kept exactly when
+    /// the grid says they bound a solid, and then with `w` 0 or 1 at every lattice point off
+    /// them. `tiny` moves grid value 1 to `2^-70` (an order-preserving map, so the boxes'
+    /// relations stay), and the coordinates need the wide predicates.
+    #[test]
+    fn boxes_are_kept_exactly_when_they_bound_a_solid(
+        drawn in prop::collection::vec(
+            (
+                ([0u8..6, 0u8..6, 0u8..6], [1u8..9, 1u8..9, 1u8..9], prop::bool::weighted(0.4)),
+                any::<bool>(),
+            ),
+            1..5,
+        ),
+        tiny in any::<bool>(),
+    ) {
+        // Half the boxes go inside the one before them when it has room (nesting is rare
+        // among free boxes), one grid step in from each of its faces.
+        let mut boxes: Vec<GridBox> = Vec::new();
+        for (b, nest) in drawn {
+            match boxes.last() {
+                Some(&(lo, size, _)) if nest && size.iter().all(|&s| s >= 3) => {
+                    boxes.push((lo.map(|c| c + 1), size.map(|s| s - 2), b.2));
+                }
+                _ => boxes.push(b),
+            }
+        }
+        let at = |g: u8| match (tiny, g) {
+            (true, 1) => 2f64.powi(-70),
+            (true, g) if g > 1 => f64::from(g - 1),
+            (_, g) => f64::from(g),
+        };
+        let parts: Vec<Mesh> = boxes
+            .iter()
+            .map(|&(lo, size, inward)| {
+                cuboid(lo.map(at), std::array::from_fn(|k| at(lo[k] + size[k])), inward)
+            })
+            .collect();
+        let mesh = join(&parts);
+        let expected = boxes_bound_a_solid(&boxes);
+        let got = kept(&mesh, 32);
+        prop_assert_eq!(got.is_ok(), expected, "{:?}", got.err());
+        if expected {
+            let wn = WindingNumber::new(&mesh).unwrap();
+            for x in 0..15u8 {
+                for y in 0..15u8 {
+                    for z in 0..15u8 {
+                        // Half-integers: off every face.
+                        let q = [x, y, z].map(|g| at(g) + 0.5);
+                        let w = wn.eval(q);
+                        prop_assert!(w == 0.0 || w == 1.0, "w = {} at {:?}", w, q);
+                    }
+                }
+            }
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+
+    /// Every generator of the testing kit (soups, boxes, polycubes, T-junctions, open,
+    /// inconsistent and duplicated meshes, fans, tets): whatever is kept has `w` exactly 0 or 1
+    /// wherever it is off the surface (the exact evaluator at seeded points and at the input's
+    /// vertices moved by a little), and is the input with its vertices welded.
+    #[test]
+    fn whatever_is_kept_bounds_its_solid(case in gwn::testing::strategies::any_case()) {
+        let mesh = &case.mesh;
+        let Some(bounds) = mesh.bounding_box() else { return Ok(()) };
+        let Ok(out) = keep_input(mesh, bounds, &RemeshOptions::with_resolution(32)) else {
+            return Ok(());
+        };
+        let (welded, _) = mesh.welded();
+        let used: Vec<[f64; 3]> = out.positions.clone();
+        prop_assert_eq!(out.triangles.len(), welded.triangles().len());
+        let wn = WindingNumber::new(mesh).unwrap();
+        let mut rng = gwn::testing::SplitMix64(7);
+        let extent: Vec<f64> = (0..3).map(|k| bounds.max[k] - bounds.min[k]).collect();
+        let mut points: Vec<[f64; 3]> = (0..400)
+            .map(|_| std::array::from_fn(|k| {
+                bounds.min[k] + (rng.unit() * 1.2 - 0.1) * extent[k].max(1e-9)
+            }))
+            .collect();
+        points.extend(&case.queries);
+        for p in &used {
+            for d in [1e-3, -1e-3] {
+                points.push([p[0] + d, p[1] + 0.7 * d, p[2] - 0.3 * d]);
+            }
+        }
+        for q in points {
+            if gwn::testing::on_surface(mesh, q) {
+                continue;
+            }
+            let w = wn.eval(q);
+            prop_assert!(w == 0.0 || w == 1.0, "w = {} at {:?} ({:?})", w, q, case.kind);
+        }
+    }
+}
