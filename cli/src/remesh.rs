@@ -4,14 +4,14 @@ use std::path::PathBuf;
 
 use clap::Args as ClapArgs;
 use gwn::products::remesh::crossings::SegmentBvh;
-use gwn::products::remesh::keep_input::{InputCheck, keep_input};
+use gwn::products::remesh::keep_input::InputCheck;
 use gwn::products::remesh::report::{
     DistanceReference, PhaseClock, RemeshReport, ReportPhase, curved_surface_for_distance,
 };
 use gwn::products::remesh::simplify::SimplifyOptions;
 use gwn::products::remesh::thicken::{self, ThickenedSheets};
 use gwn::products::remesh::write::{SurfaceFormat, write_surface};
-use gwn::products::remesh::{DEFAULT_BISECTION_STEPS, RemeshOptions, remesh_guided};
+use gwn::products::remesh::{DEFAULT_BISECTION_STEPS, RemeshOptions, remesh_guided, remesh_mesh};
 
 use crate::common::{CliError, outln};
 use crate::method::{MethodArgs, ToleranceArgs};
@@ -137,27 +137,21 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let announce = |phase: gwn::products::remesh::RemeshPhase| {
         clock.mark(phase);
         bar.set_message(phase.name());
-        if phase != gwn::products::remesh::RemeshPhase::Classify {
+        use gwn::products::remesh::RemeshPhase;
+        if !matches!(phase, RemeshPhase::Classify | RemeshPhase::KeepInput) {
             bar.inc(1);
         }
     };
     // A mesh that already is the boundary of its `w > ½` solid is the answer as it is (exact
-    // checks, linear in the input); the exact method's field only, as asked.
-    let kept = match (input.mesh(), method.method_for(input.kind()), &thickened) {
-        (Some(mesh), Method::Exact, None) if !args.knobs.always_remesh => {
-            Some(keep_input(mesh, bounds, &options))
-        }
-        _ => None,
+    // checks, linear in the input): the exact method's field of the mesh itself only.
+    let keep = matches!(method.method_for(input.kind()), Method::Exact)
+        && thickened.is_none()
+        && !args.knobs.always_remesh;
+    let out = match input.mesh() {
+        Some(mesh) => remesh_mesh(mesh, keep, wn, guide, bounds, &options, &announce),
+        None => remesh_guided(wn, guide, bounds, &options, &announce),
     };
-    let mut out = match kept {
-        Some(Ok(out)) => out,
-        kept => {
-            let mut out = remesh_guided(wn, guide, bounds, &options, &announce)
-                .map_err(|e| CliError(format!("{}: {e}", args.mesh.display())))?;
-            out.stats.input = kept.and_then(Result::err).map(InputCheck::Remeshed);
-            out
-        }
-    };
+    let mut out = out.map_err(|e| CliError(format!("{}: {e}", args.mesh.display())))?;
     let secs = start.elapsed().as_secs_f64();
     let phase_seconds = clock.seconds();
     bar.inc(1);

@@ -558,9 +558,7 @@ pub fn remesh<'py>(
     use gwn::products::remesh::report::{DistanceReference, PhaseClock, RemeshReport};
 
     use gwn::products::remesh::{
-        RemeshOptions,
-        keep_input::{InputCheck, keep_input},
-        remesh_guided,
+        RemeshOptions, remesh_guided, remesh_mesh,
         thicken::{self, ThickenedSheets},
     };
     let method = spec_of(method, beta, order, tolerance)?;
@@ -663,18 +661,16 @@ pub fn remesh<'py>(
         let clock = PhaseClock::start();
         // As `gwn remesh`: a mesh that already bounds its `w > ½` solid is kept as it is.
         let exact = method.method_for(gwn::input::InputKind::Mesh) == gwn::spec::Method::Exact;
-        let kept = (exact && thick.is_none() && !always_remesh)
-            .then(|| keep_input(&mesh, bounds, &options));
-        let out = match kept {
-            Some(Ok(out)) => out,
-            kept => {
-                let mut out = remesh_guided(field, Some(&guide), bounds, &options, &|phase| {
-                    clock.mark(phase)
-                })?;
-                out.stats.input = kept.and_then(Result::err).map(InputCheck::Remeshed);
-                out
-            }
-        };
+        let keep = exact && thick.is_none() && !always_remesh;
+        let out = remesh_mesh(
+            &mesh,
+            keep,
+            field,
+            Some(&guide),
+            bounds,
+            &options,
+            &|phase| clock.mark(phase),
+        )?;
         let seconds = start.elapsed().as_secs_f64();
         let phase_seconds = clock.seconds();
         let request = report.then_some(ReportRequest {

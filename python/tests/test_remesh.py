@@ -24,7 +24,8 @@ def volume(V, F):
 
 
 def test_cube_gives_a_closed_oriented_sphere_of_the_right_volume():
-    V, F = gwn.remesh(CUBE_V, CUBE_F, res=16)
+    # The remesher's path: the clean cube itself is kept as it is without always_remesh (below).
+    V, F = gwn.remesh(CUBE_V, CUBE_F, res=16, always_remesh=True)
     assert V.dtype == np.float64 and V.shape[1] == 3
     assert F.dtype == np.int64 and F.shape[1] == 3 and len(F) > 0
     once, twice, edges = edge_census(F)
@@ -43,7 +44,7 @@ def test_cube_gives_a_closed_oriented_sphere_of_the_right_volume():
 def test_disjoint_cubes_stay_two_solids_and_open_box_closes():
     V2 = np.concatenate([CUBE_V, CUBE_V + [2.0, 0.0, 0.0]])
     F2 = np.concatenate([CUBE_F, CUBE_F + len(CUBE_V)])
-    V, F = gwn.remesh(V2, F2, res=24, threads=1)
+    V, F = gwn.remesh(V2, F2, res=24, threads=1, always_remesh=True)
     once, twice, edges = edge_census(F)
     assert once and twice
     assert len(np.unique(F)) - edges + len(F) == 4
@@ -53,7 +54,7 @@ def test_disjoint_cubes_stay_two_solids_and_open_box_closes():
 
 
 def test_simplify_false_gives_the_raw_surface_with_more_faces():
-    V, F = gwn.remesh(CUBE_V, CUBE_F, res=16)
+    V, F = gwn.remesh(CUBE_V, CUBE_F, res=16, always_remesh=True)
     Vr, Fr = gwn.remesh(CUBE_V, CUBE_F, res=16, simplify=False)
     for V_, F_ in ((V, F), (Vr, Fr)):
         once, twice, edges = edge_census(F_)
@@ -141,7 +142,7 @@ def test_planar_levels_keep_a_box_closed_and_on_its_faces():
     # whole there; the output is as closed and its vertices as close (on the cube within a
     # tick) as with planar_levels=0, the resolution's cells everywhere.
     for levels in (0, 3):
-        Vo, Fo = gwn.remesh(CUBE_V, CUBE_F, res=64, planar_levels=levels)
+        Vo, Fo = gwn.remesh(CUBE_V, CUBE_F, res=64, planar_levels=levels, always_remesh=True)
         assert edge_census(Fo)[:2] == (True, True)
         assert abs(volume(Vo, Fo) - 1.0) < 1e-3, volume(Vo, Fo)
         # Every vertex on the cube's surface: one coordinate at 0 or 1.
@@ -195,7 +196,8 @@ def test_a_step_model_remeshes_like_the_cli(cli, tmp_path):
 
 
 def test_report_measures_the_surface_it_returns():
-    V, F, report = gwn.remesh(CUBE_V, CUBE_F, res=16, report=True, samples=4000)
+    V, F, report = gwn.remesh(CUBE_V, CUBE_F, res=16, report=True, samples=4000,
+                              always_remesh=True)
     once, twice, edges = edge_census(F)
     assert (report["faces"], report["vertices"], report["edges"]) == (len(F), len(V), edges)
     assert report["closed"] and report["edge_manifold"] and report["vertex_manifold"]
@@ -213,7 +215,7 @@ def test_report_measures_the_surface_it_returns():
     assert report["occupancy_agreement"] > 0.99 and report["occupancy_samples"] == 4000
     assert report["method"] == "exact" and report["simplified"] is True
     # The same call without a report gives the same surface.
-    V2, F2 = gwn.remesh(CUBE_V, CUBE_F, res=16)
+    V2, F2 = gwn.remesh(CUBE_V, CUBE_F, res=16, always_remesh=True)
     np.testing.assert_array_equal(V, V2)
     np.testing.assert_array_equal(F, F2)
 
@@ -248,3 +250,21 @@ def test_report_of_thickened_sheets_counts_the_whole_input():
     # The slab's faces are EPS off the sheet: the plain distance, no boundary part.
     assert "hausdorff_boundary" not in report
     assert 0.05 < report["hausdorff"] < 0.2
+
+
+def test_a_clean_solid_comes_back_as_it_is():
+    """A closed, manifold, oriented mesh without self-intersections that bounds w > 1/2 is its
+    own remesh (proved with exact tests); always_remesh=True remeshes it; the report says which
+    and why, as ``gwn remesh --report`` does."""
+    V, F, report = gwn.remesh(CUBE_V, CUBE_F, res=16, report=True, samples=2000)
+    np.testing.assert_array_equal(V, CUBE_V)
+    np.testing.assert_array_equal(F, CUBE_F)
+    assert report["input"] == "kept" and report["self_intersections"] == 0
+    assert report["hausdorff_boundary_cells"] == 0.0 and report["occupancy_agreement"] == 1.0
+    Vr, Fr, remeshed = gwn.remesh(CUBE_V, CUBE_F, res=16, report=True, samples=0,
+                                  always_remesh=True)
+    assert len(Fr) > len(F) and "input" not in remeshed
+    # Inward: w = -1 inside, so not its solid's boundary (the solid is empty).
+    Vi, Fi, inward = gwn.remesh(CUBE_V, CUBE_F[:, ::-1], res=16, report=True, samples=0)
+    assert inward["input"] == "remeshed" and len(Fi) == 0
+    assert "w = 0 outside it and -1 inside" in inward["input_not_kept"]

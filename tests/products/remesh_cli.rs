@@ -23,6 +23,8 @@ fn remesh_writes_every_format_and_a_report() {
             report.to_str().unwrap(),
             "--samples",
             "2000",
+            // The cube already is its own answer (below): the remesher's path here.
+            "--always-remesh",
         ]);
         assert!(ok, "{stderr}");
         assert!(stdout.contains("closed: yes") && stdout.contains("Euler characteristic 2"));
@@ -57,7 +59,65 @@ fn remesh_writes_every_format_and_a_report() {
             gwn::products::remesh::report::TopologyReport::of(back.positions(), back.triangles());
         assert!(r.closed && r.edge_manifold && r.oriented, "{ext}: {r}");
         assert_eq!(r.euler_characteristic, 2, "{ext}: {r}");
+        assert!(json.contains("\"input\": \"remeshed\"") || !json.contains("\"input\""));
     }
+    // Without --always-remesh the clean cube is written as it is, and the report says so.
+    let out = dir.join("kept.obj");
+    let report = dir.join("kept.json");
+    let (ok, stdout, stderr) = gwn(&[
+        "remesh",
+        input.to_str().unwrap(),
+        "--res",
+        "20",
+        "--out",
+        out.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+        "--samples",
+        "2000",
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("the input as it is (12 faces"), "{stdout}");
+    assert!(
+        stdout.contains("self-intersections (exact): 0 face pairs"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("occupancy agreement 100.000 %"), "{stdout}");
+    let json = std::fs::read_to_string(&report).unwrap();
+    assert!(json.contains("\"input\": \"kept\""), "{json}");
+    assert!(json.contains("\"hausdorff_boundary_cells\": 0.0"), "{json}");
+    let back = gwn::io::load_mesh(&out).unwrap().mesh;
+    assert_eq!(back.triangles(), cube.triangles());
+    assert_eq!(back.positions(), cube.positions());
+    // An open box is remeshed, and the report names why.
+    let open = dir.join("open.obj");
+    gwn::mesh::write_obj(
+        std::fs::File::create(&open).unwrap(),
+        &gwn::testing::unit_cube(true),
+    )
+    .unwrap();
+    let (ok, stdout, stderr) = gwn(&[
+        "remesh",
+        open.to_str().unwrap(),
+        "--res",
+        "12",
+        "--out",
+        out.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+        "--samples",
+        "0",
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(
+        stdout.contains("remeshed: the input is not kept as it is: it is open (4 boundary edges)"),
+        "{stdout}"
+    );
+    let json = std::fs::read_to_string(&report).unwrap();
+    assert!(
+        json.contains("\"input_not_kept\": \"it is open (4 boundary edges)\""),
+        "{json}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -87,6 +147,7 @@ fn no_simplify_writes_the_marching_tetrahedra_surface() {
             out.to_str().unwrap(),
             "--report",
             report.to_str().unwrap(),
+            "--always-remesh",
         ];
         args.extend_from_slice(extra);
         let (ok, _, stderr) = gwn(&args);
@@ -382,6 +443,7 @@ fn remesh_reports_the_plate_refinement_and_can_turn_it_off() {
             out.to_str().unwrap(),
             "--report",
             report.to_str().unwrap(),
+            "--always-remesh",
         ];
         args.extend_from_slice(extra);
         let (ok, stdout, stderr) = gwn(&args);

@@ -53,18 +53,21 @@ fn inputs(dir: &Path) -> Vec<PathBuf> {
 }
 
 /// The PLY bytes `gwn remesh INPUT --res RES --samples 0` writes (to a file in `scratch`).
-fn remeshed_by_the_cli(input: &Path, res: usize, scratch: &Path) -> Vec<u8> {
+fn remeshed_by_the_cli(input: &Path, res: usize, scratch: &Path, extra: &[&str]) -> Vec<u8> {
     let single = scratch.join("single.ply");
-    let (ok, _, err) = gwn(&[
+    let res = res.to_string();
+    let mut args = vec![
         "remesh",
         input.to_str().unwrap(),
         "--res",
-        &res.to_string(),
+        &res,
         "--samples",
         "0",
         "--out",
         single.to_str().unwrap(),
-    ]);
+    ];
+    args.extend_from_slice(extra);
+    let (ok, _, err) = gwn(&args);
     assert!(ok, "{err}");
     std::fs::read(&single).unwrap()
 }
@@ -75,8 +78,10 @@ fn remesh_dataset_writes_what_gwn_remesh_writes_and_resumes() {
     let dir = &scratch.0;
     let meshes = inputs(dir);
     let out = dir.join("out");
+    // The remesher's own path (the clean cubes would be kept as they are: below).
     let job = RemeshJob {
         samples: 2000,
+        keep_input: false,
         ..RemeshJob::new(32)
     };
     let rows = run_dataset(&job, &meshes, &out, None, |_| {}).unwrap();
@@ -108,7 +113,7 @@ fn remesh_dataset_writes_what_gwn_remesh_writes_and_resumes() {
     // (the job's defaults are the CLI's).
     assert_eq!(
         std::fs::read(out.join("cube.off.ply")).unwrap(),
-        remeshed_by_the_cli(&fixture("cube.off"), 32, dir)
+        remeshed_by_the_cli(&fixture("cube.off"), 32, dir, &["--always-remesh"])
     );
     assert!(out.join("sub/triangle.obj.ply").is_file());
     assert!(!out.join("broken_nan.off.ply").exists());
@@ -129,6 +134,7 @@ fn remesh_dataset_writes_what_gwn_remesh_writes_and_resumes() {
     // Another resolution redoes them, and says so.
     let coarser = RemeshJob {
         samples: 2000,
+        keep_input: false,
         ..RemeshJob::new(24)
     };
     let redone = run_dataset(&coarser, &meshes[..1], &out, None, |_| {}).unwrap();
@@ -139,7 +145,28 @@ fn remesh_dataset_writes_what_gwn_remesh_writes_and_resumes() {
     );
     assert_ne!(
         std::fs::read(out.join("cube.off.ply")).unwrap(),
-        remeshed_by_the_cli(&fixture("cube.off"), 32, dir)
+        remeshed_by_the_cli(&fixture("cube.off"), 32, dir, &["--always-remesh"])
+    );
+    // Keeping clean inputs is an option of the job: the cubes are written as they are (the
+    // bytes of `gwn remesh` without --always-remesh), the lone triangle is still remeshed.
+    let keeping = RemeshJob {
+        samples: 2000,
+        ..RemeshJob::new(24)
+    };
+    let kept = run_dataset(&keeping, &meshes, &out, None, |_| {}).unwrap();
+    assert_eq!(
+        kept[0].redone.as_deref(),
+        Some("options changed: keep_input false -> true")
+    );
+    let kept_stat = |i: usize| kept[i].stats.get("kept").unwrap().to_string();
+    assert_eq!(
+        [kept_stat(0), kept_stat(1), kept_stat(2)],
+        ["true", "true", "false"]
+    );
+    assert_eq!(kept[0].stats.get("output_faces").unwrap().to_string(), "12");
+    assert_eq!(
+        std::fs::read(out.join("cube.off.ply")).unwrap(),
+        remeshed_by_the_cli(&fixture("cube.off"), 24, dir, &[])
     );
 
     // One file twice: refused before anything is written.
@@ -514,7 +541,7 @@ fn remesh_dataset_takes_step_models_patch_sets_and_point_clouds() {
     for name in ["torus_full.step", "sphere.ply"] {
         assert_eq!(
             std::fs::read(out.join(format!("{name}.ply"))).unwrap(),
-            remeshed_by_the_cli(&input.join(name), 24, dir),
+            remeshed_by_the_cli(&input.join(name), 24, dir, &[]),
             "{name}"
         );
     }

@@ -37,7 +37,7 @@ use super::keep_input::InputCheck;
 use super::report::{DistanceReference, RemeshReport};
 use super::thicken::{self, MeshField, ThickenedSheets};
 use super::write::{SurfaceFormat, write_surface};
-use super::{RemeshOptions, Remeshed, remesh_guided};
+use super::{RemeshOptions, Remeshed, remesh_guided, remesh_mesh};
 use crate::eval::Evaluator;
 use crate::input::{Input, InputKind, load_input_with};
 use crate::io::LoadOptions;
@@ -268,7 +268,7 @@ impl MeshJob for RemeshJob {
                 .into());
             }
             in_time("building the evaluator")?;
-            let out = self.remesh(&*wn, None, bounds, deadline)?;
+            let out = self.remesh(&*wn, None, None, bounds, deadline)?;
             #[cfg(feature = "patch")]
             let curved = (self.samples > 0)
                 .then(|| super::report::curved_surface_for_distance(&input, out.cell_size))
@@ -296,16 +296,8 @@ impl MeshJob for RemeshJob {
             reference,
         } = thicken::of_mesh(mesh, &*wn, thick.as_ref(), bounds);
         in_time("building the evaluator")?;
-        let kept = (self.keep_input && thick.is_none())
-            .then(|| super::keep_input::keep_input(mesh, bounds, &self.options));
-        let out = match kept {
-            Some(Ok(out)) => out,
-            kept => {
-                let mut out = self.remesh(field, Some(&guide), bounds, deadline)?;
-                out.stats.input = kept.and_then(Result::err).map(InputCheck::Remeshed);
-                out
-            }
-        };
+        let keep = self.keep_input.then_some(mesh).filter(|_| thick.is_none());
+        let out = self.remesh(field, Some(&guide), keep, bounds, deadline)?;
         self.finish(out, field, reference, bounds, deadline, stats)
     }
 }
@@ -346,11 +338,12 @@ fn input_name(kind: InputKind) -> &'static str {
 
 impl RemeshJob {
     /// [`remesh_guided`] under the job's options and `deadline`, its time limit named as the
-    /// job's.
+    /// job's; [`super::remesh_mesh`] with `kept` (the mesh, when it may be kept as it is).
     fn remesh(
         &self,
         field: &dyn Evaluator,
         guide: Option<&SegmentBvh>,
+        kept: Option<&Mesh>,
         bounds: crate::BoundingBox,
         deadline: Option<(Instant, Duration)>,
     ) -> Result<Remeshed, RemeshJobError> {
@@ -358,7 +351,11 @@ impl RemeshJob {
             deadline: deadline.map(|(at, _)| at),
             ..self.options
         };
-        remesh_guided(field, guide, bounds, &options, &|_| {}).map_err(|e| -> RemeshJobError {
+        let out = match kept {
+            Some(mesh) => remesh_mesh(mesh, true, field, guide, bounds, &options, &|_| {}),
+            None => remesh_guided(field, guide, bounds, &options, &|_| {}),
+        };
+        out.map_err(|e| -> RemeshJobError {
             match (e, deadline) {
                 (super::RemeshError::TimeLimit { phase }, Some((_, limit))) => {
                     Box::new(TimeLimitExceeded {

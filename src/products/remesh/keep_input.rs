@@ -176,7 +176,8 @@ pub enum InputCheck {
 /// The input itself as the remesh of `mesh` (triangles whose `w > ½` solid is meant, with
 /// `bounds` and `options` as the remesh would take them), when it provably already is that
 /// surface (see the [module documentation](self)); else why not. `options.simplify` sets the
-/// face target; without simplification (a raw lattice surface was asked for) nothing is kept.
+/// face target (without it, only inputs of at most [`ALWAYS_KEPT_FACES`] are kept;
+/// [`super::remesh_mesh`] does not try then: a raw lattice surface was asked for).
 ///
 /// ```
 /// use gwn::Mesh;

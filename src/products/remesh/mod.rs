@@ -188,6 +188,53 @@ pub struct RemeshOptions {
 }
 
 impl RemeshOptions {
+    /// Checks every option's range (what [`remesh_guided`] refuses).
+    pub fn check(&self) -> Result<(), RemeshError> {
+        let options = self;
+        if options.resolution == 0 || options.resolution > MAX_RESOLUTION {
+            return Err(RemeshError::BadResolution {
+                resolution: options.resolution,
+            });
+        }
+        if options.sub_cell_levels > octree::MAX_SUB_LEVELS {
+            return Err(RemeshError::BadSubCellLevels {
+                levels: options.sub_cell_levels,
+            });
+        }
+        if options.planar_levels > octree::MAX_PLANAR_LEVELS {
+            return Err(RemeshError::BadPlanarLevels {
+                levels: options.planar_levels,
+            });
+        }
+        if options.bisection_steps > MAX_BISECTION_STEPS {
+            return Err(RemeshError::BadBisectionSteps {
+                steps: options.bisection_steps,
+            });
+        }
+        if let Some(s) = options.simplify {
+            let bad = |x: f64| !(x.is_finite() && x >= 0.0);
+            for (option, value, wrong) in [
+                ("max_distance", s.max_distance, bad(s.max_distance)),
+                ("flat_tolerance", s.flat_tolerance, bad(s.flat_tolerance)),
+                (
+                    "target_fraction_of_marching_cubes",
+                    s.target_fraction_of_marching_cubes,
+                    bad(s.target_fraction_of_marching_cubes),
+                ),
+                (
+                    "max_face_extent",
+                    f64::from(s.max_face_extent),
+                    s.max_face_extent == 0,
+                ),
+            ] {
+                if wrong {
+                    return Err(RemeshError::BadSimplification { option, value });
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// `resolution` with the default bisection steps and the default simplification.
     pub fn with_resolution(resolution: usize) -> Self {
         RemeshOptions {
@@ -383,10 +430,53 @@ pub fn remesh<E: Evaluator + ?Sized>(
     remesh_guided(evaluator, None, bounds, options, &|_| {})
 }
 
+/// [`remesh_guided`] of a mesh's own field, unless the mesh already is the surface it would aim
+/// for: with `keep` (the exact method's field of `mesh`, nothing thickened), a mesh that
+/// [`keep_input::keep_input`] proves to be the boundary of its `w > ½` solid is returned as it
+/// is (not tried without [`RemeshOptions::simplify`]: the raw lattice surface was asked for);
+/// otherwise the remesh, with [`RemeshStats::input`] saying why the input was not kept.
+/// Options are checked either way. What `gwn remesh`, `gwn remesh-dataset` and `gwn.remesh` run.
+pub fn remesh_mesh<E: Evaluator + ?Sized>(
+    mesh: &crate::Mesh,
+    keep: bool,
+    evaluator: &E,
+    guide: Option<&crossings::SegmentBvh>,
+    bounds: BoundingBox,
+    options: &RemeshOptions,
+    progress: &dyn Fn(RemeshPhase),
+) -> Result<Remeshed, RemeshError> {
+    options.check()?;
+    // Without simplification the raw lattice surface was asked for.
+    let not_kept = if keep && options.simplify.is_some() {
+        progress(RemeshPhase::KeepInput);
+        let kept = keep_input::keep_input(mesh, bounds, options);
+        // Linear in the input and not interrupted; the time limit holds after it.
+        if options
+            .deadline
+            .is_some_and(|at| std::time::Instant::now() > at)
+        {
+            return Err(RemeshError::TimeLimit {
+                phase: RemeshPhase::KeepInput,
+            });
+        }
+        match kept {
+            Ok(out) => return Ok(out),
+            Err(why) => Some(keep_input::InputCheck::Remeshed(why)),
+        }
+    } else {
+        None
+    };
+    let mut out = remesh_guided(evaluator, guide, bounds, options, progress)?;
+    out.stats.input = not_kept;
+    Ok(out)
+}
+
 /// The steps of a [`remesh`] run, announced to the progress callback of [`remesh_guided`] as
 /// each begins.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RemeshPhase {
+    /// Whether the input already is the surface ([`remesh_mesh`], [`keep_input`]).
+    KeepInput,
     /// Corner classification (coarse grid, then the octree band).
     Classify,
     /// Marching tetrahedra over the band.
@@ -401,6 +491,7 @@ impl RemeshPhase {
     /// A short name for progress messages.
     pub fn name(self) -> &'static str {
         match self {
+            RemeshPhase::KeepInput => "checking whether the input is kept as it is",
             RemeshPhase::Classify => "classifying lattice corners",
             RemeshPhase::Extract => "extracting the surface",
             RemeshPhase::Place => "placing vertices",
@@ -426,47 +517,7 @@ pub fn remesh_guided<E: Evaluator + ?Sized>(
     options: &RemeshOptions,
     progress: &dyn Fn(RemeshPhase),
 ) -> Result<Remeshed, RemeshError> {
-    if options.resolution == 0 || options.resolution > MAX_RESOLUTION {
-        return Err(RemeshError::BadResolution {
-            resolution: options.resolution,
-        });
-    }
-    if options.sub_cell_levels > octree::MAX_SUB_LEVELS {
-        return Err(RemeshError::BadSubCellLevels {
-            levels: options.sub_cell_levels,
-        });
-    }
-    if options.planar_levels > octree::MAX_PLANAR_LEVELS {
-        return Err(RemeshError::BadPlanarLevels {
-            levels: options.planar_levels,
-        });
-    }
-    if options.bisection_steps > MAX_BISECTION_STEPS {
-        return Err(RemeshError::BadBisectionSteps {
-            steps: options.bisection_steps,
-        });
-    }
-    if let Some(s) = options.simplify {
-        let bad = |x: f64| !(x.is_finite() && x >= 0.0);
-        for (option, value, wrong) in [
-            ("max_distance", s.max_distance, bad(s.max_distance)),
-            ("flat_tolerance", s.flat_tolerance, bad(s.flat_tolerance)),
-            (
-                "target_fraction_of_marching_cubes",
-                s.target_fraction_of_marching_cubes,
-                bad(s.target_fraction_of_marching_cubes),
-            ),
-            (
-                "max_face_extent",
-                f64::from(s.max_face_extent),
-                s.max_face_extent == 0,
-            ),
-        ] {
-            if wrong {
-                return Err(RemeshError::BadSimplification { option, value });
-            }
-        }
-    }
+    options.check()?;
     // Every evaluation below stops at the deadline (NaN after it). All of them are made before
     // placement ends, which checks the clock, so those values never reach a surface.
     let evaluator = &deadline::Deadlined::new(evaluator, options.deadline);

@@ -9,7 +9,8 @@ use std::time::Instant;
 /// Wall-clock seconds of each phase of one remesh.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PhaseSeconds {
-    /// Before classification: the plate and flatness probes and the lattice's set-up.
+    /// Before classification: whether the input is kept as it is
+    /// ([`RemeshPhase::KeepInput`]), the plate and flatness probes and the lattice's set-up.
     pub probes: f64,
     /// [`RemeshPhase::Classify`].
     pub classify: f64,
@@ -101,6 +102,7 @@ impl PhaseClock {
             let end = marks.get(i + 1).map_or(now, |&(_, at)| at);
             let seconds = end.duration_since(begin).as_secs_f64();
             *match phase {
+                RemeshPhase::KeepInput => &mut out.probes,
                 RemeshPhase::Classify => &mut out.classify,
                 RemeshPhase::Extract => &mut out.extract,
                 RemeshPhase::Place => &mut out.place,
