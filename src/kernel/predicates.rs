@@ -548,12 +548,14 @@ fn scaled_dyadic(x: f64, shift: usize) -> BigInt {
 /// permanents: each face's determinant errs by `ORIENT3D_FILTER_RELATIVE·permanent`, and a running
 /// sum of `F` terms by `F·u` times the sum of their magnitudes (`u = 2^-53`), each at most its
 /// permanent; the filter takes twice `(8 + F)·u` (the permanents' own sum is rounded too).
+#[cfg(feature = "products")] // The remesher's exact tests on an input's own coordinates.
 pub const VOLUME_FILTER_RELATIVE: f64 = 2.0 * (f64::EPSILON * 0.5);
 
 /// Exact sign of `Σ det(a − o, b − o, c − o)` over the faces `(a, b, c)`: six times the signed
 /// volume a closed, consistently oriented surface encloses (the same for every apex `o`), so `+1`
 /// when it is oriented outward and `−1` inward. Coordinates below `2^125` in magnitude. An `f64` sum with its error bound decides unless
 /// the volume is within rounding of zero; then the sum is made in integers.
+#[cfg(feature = "products")] // The remesher's exact tests on an input's own coordinates.
 pub fn closed_surface_orientation(
     points: &[[i128; 3]],
     faces: impl Iterator<Item = [u32; 3]> + Clone,
@@ -592,6 +594,7 @@ pub fn closed_surface_orientation(
 /// `sign(a0·b1 − a1·b0)` for integer differences below `2^126` (an input's own coordinates as
 /// integers, wider than the 60-bit grid): the [`DET2_FILTER_RELATIVE`] filter (each conversion
 /// to `f64` rounds once, as in the 60-bit test), then arbitrary precision.
+#[cfg(feature = "products")] // The remesher's exact tests on an input's own coordinates.
 pub fn det2_sign_wide(a0: i128, a1: i128, b0: i128, b1: i128) -> i32 {
     let p1 = a0 as f64 * b1 as f64;
     let p2 = a1 as f64 * b0 as f64;
@@ -609,6 +612,7 @@ pub fn det2_sign_wide(a0: i128, a1: i128, b0: i128, b1: i128) -> i32 {
 
 /// `sign(d·(e1×e2))` for integer differences below `2^126`: the [`ORIENT3D_FILTER_RELATIVE`]
 /// filter, exact below `2^53` as in the 60-bit test, then arbitrary precision.
+#[cfg(feature = "products")] // The remesher's exact tests on an input's own coordinates.
 pub fn orient3d_sign_wide(d: [i128; 3], e1: [i128; 3], e2: [i128; 3]) -> i32 {
     let f = |v: [i128; 3]| v.map(|c| c as f64);
     let (x, a, b) = (f(d), f(e1), f(e2));
@@ -645,6 +649,7 @@ pub fn orient3d_sign_wide(d: [i128; 3], e1: [i128; 3], e2: [i128; 3]) -> i32 {
     sign_of(&exact)
 }
 
+#[cfg(feature = "products")] // The remesher's exact tests on an input's own coordinates.
 fn sign_of(v: &BigInt) -> i32 {
     match v.sign() {
         num_bigint::Sign::Plus => 1,

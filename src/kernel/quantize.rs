@@ -431,6 +431,7 @@ pub(crate) fn decompose(x: f64) -> (i64, i32) {
 /// with the common exponent `e` as large as the finest coordinate allows, and `|n| < 2^max_bits`;
 /// `None` when the coordinates span more bits than that (a value of `1` beside one of `1e-17`) or
 /// one is not finite. Exact predicates on `n` are then exact on the points themselves.
+#[cfg(feature = "products")] // The remesher's exact tests on an input's own coordinates.
 pub(crate) fn common_fixed_point(points: &[[f64; 3]], max_bits: u32) -> Option<Vec<[i128; 3]>> {
     debug_assert!(max_bits <= 126);
     let mut finest = i32::MAX;
@@ -566,6 +567,7 @@ mod tests {
     /// Every coordinate is its integer times the common power of two, exactly; the scale is
     /// the finest coordinate's last bit; a span past the limit is refused.
     #[test]
+    #[cfg(feature = "products")]
     fn common_fixed_point_is_exact() {
         let points = [
             [1.0, -0.375, 0.0],
