@@ -56,17 +56,10 @@ impl Width for W128 {
     const PRECISION: Precision = Precision::Bits60;
     #[inline]
     fn det2_sign(a0: i64, a1: i64, b0: i64, b1: i64) -> i32 {
+        if let Some(sign) = det2_filtered(a0 as f64, a1 as f64, b0 as f64, b1 as f64) {
+            return sign;
+        }
         // Exact fallback: |a|,|b| < 2^61 ⇒ each product < 2^122, the difference < 2^123.
-        let p1 = a0 as f64 * b1 as f64;
-        let p2 = a1 as f64 * b0 as f64;
-        let d = p1 - p2;
-        let bound = DET2_FILTER_RELATIVE * (p1.abs() + p2.abs());
-        if d > bound {
-            return 1;
-        }
-        if d < -bound {
-            return -1;
-        }
         let d = i128::from(a0) * i128::from(b1) - i128::from(a1) * i128::from(b0);
         d.signum() as i32
     }
@@ -76,35 +69,8 @@ impl Width for W128 {
         // conversion, which was measurable: docs/benchmarks.md, "Design measurements"); see
         // ORIENT3D_FILTER_RELATIVE. Exact otherwise: i128 cross product, BigInt dot product.
         let f = |v: [i64; 3]| v.map(|c| c as f64);
-        let (x, a, b) = (f(d), f(e1), f(e2));
-        let n0a = a[1] * b[2];
-        let n0b = a[2] * b[1];
-        let n1a = a[2] * b[0];
-        let n1b = a[0] * b[2];
-        let n2a = a[0] * b[1];
-        let n2b = a[1] * b[0];
-        let v = x[0] * (n0a - n0b) + x[1] * (n1a - n1b) + x[2] * (n2a - n2b);
-        let permanent = x[0].abs() * (n0a.abs() + n0b.abs())
-            + x[1].abs() * (n1a.abs() + n1b.abs())
-            + x[2].abs() * (n2a.abs() + n2b.abs());
-        let bound = ORIENT3D_FILTER_RELATIVE * permanent;
-        if v > bound {
-            return 1;
-        }
-        if v < -bound {
-            return -1;
-        }
-        // Below 2^53 every step was exact (a nonzero integer `x_k` bounds its products by the
-        // permanent; `x_k = 0` zeroes its term whatever the rounding): `v` is the determinant.
-        // Coplanar points (v = 0) land here, and the remesher's flat regions test thousands.
-        if permanent < EXACT_F64_INTEGER {
-            return if v > 0.0 {
-                1
-            } else if v < 0.0 {
-                -1
-            } else {
-                0
-            };
+        if let Some(sign) = orient3d_filtered(f(d), f(e1), f(e2)) {
+            return sign;
         }
         exact_dot3_sign(d, cross_exact(e1, e2))
     }
@@ -114,6 +80,59 @@ impl Width for W128 {
 /// integers (relative error `≤ u = 2^-53` each), the two products and the difference bound the
 /// error of `d = p1 − p2` by `4u·(|p1| + |p2|)`; the filter tests twice that, `8u`.
 pub const DET2_FILTER_RELATIVE: f64 = 8.0 * (f64::EPSILON * 0.5);
+
+/// The `f64` filter of the `det2` tests on integer differences converted to `f64` (each rounded
+/// once): `sign(a0·b1 − a1·b0)` when it clears [`DET2_FILTER_RELATIVE`], else `None`.
+#[inline]
+fn det2_filtered(a0: f64, a1: f64, b0: f64, b1: f64) -> Option<i32> {
+    let p1 = a0 * b1;
+    let p2 = a1 * b0;
+    let d = p1 - p2;
+    let bound = DET2_FILTER_RELATIVE * (p1.abs() + p2.abs());
+    if d > bound {
+        Some(1)
+    } else if d < -bound {
+        Some(-1)
+    } else {
+        None
+    }
+}
+
+/// The `f64` filter of the `orient3d` tests, `sign(x·(a×b))`, on integer differences converted
+/// to `f64` (each rounded once; see [`ORIENT3D_FILTER_RELATIVE`]), else `None`.
+#[inline]
+fn orient3d_filtered(x: [f64; 3], a: [f64; 3], b: [f64; 3]) -> Option<i32> {
+    let n0a = a[1] * b[2];
+    let n0b = a[2] * b[1];
+    let n1a = a[2] * b[0];
+    let n1b = a[0] * b[2];
+    let n2a = a[0] * b[1];
+    let n2b = a[1] * b[0];
+    let v = x[0] * (n0a - n0b) + x[1] * (n1a - n1b) + x[2] * (n2a - n2b);
+    let permanent = x[0].abs() * (n0a.abs() + n0b.abs())
+        + x[1].abs() * (n1a.abs() + n1b.abs())
+        + x[2].abs() * (n2a.abs() + n2b.abs());
+    let bound = ORIENT3D_FILTER_RELATIVE * permanent;
+    if v > bound {
+        return Some(1);
+    }
+    if v < -bound {
+        return Some(-1);
+    }
+    // Below 2^53 every step was exact (a nonzero integer `x_k` bounds its products by the
+    // permanent; `x_k = 0` zeroes its term whatever the rounding): `v` is the determinant.
+    // Coplanar points (v = 0) land here, and the remesher's flat regions test thousands.
+    if permanent < EXACT_F64_INTEGER {
+        return Some(if v > 0.0 {
+            1
+        } else if v < 0.0 {
+            -1
+        } else {
+            0
+        });
+    }
+    None
+}
 
 /// `2^53`: integers below it, and sums and products of them that stay below it, are exact in
 /// `f64`.
@@ -596,15 +615,8 @@ pub fn closed_surface_orientation(
 /// to `f64` rounds once, as in the 60-bit test), then arbitrary precision.
 #[cfg(feature = "products")] // The remesher's exact tests on an input's own coordinates.
 pub fn det2_sign_wide(a0: i128, a1: i128, b0: i128, b1: i128) -> i32 {
-    let p1 = a0 as f64 * b1 as f64;
-    let p2 = a1 as f64 * b0 as f64;
-    let d = p1 - p2;
-    let bound = DET2_FILTER_RELATIVE * (p1.abs() + p2.abs());
-    if d > bound {
-        return 1;
-    }
-    if d < -bound {
-        return -1;
+    if let Some(sign) = det2_filtered(a0 as f64, a1 as f64, b0 as f64, b1 as f64) {
+        return sign;
     }
     let exact = BigInt::from(a0) * BigInt::from(b1) - BigInt::from(a1) * BigInt::from(b0);
     sign_of(&exact)
@@ -615,31 +627,8 @@ pub fn det2_sign_wide(a0: i128, a1: i128, b0: i128, b1: i128) -> i32 {
 #[cfg(feature = "products")] // The remesher's exact tests on an input's own coordinates.
 pub fn orient3d_sign_wide(d: [i128; 3], e1: [i128; 3], e2: [i128; 3]) -> i32 {
     let f = |v: [i128; 3]| v.map(|c| c as f64);
-    let (x, a, b) = (f(d), f(e1), f(e2));
-    let n = [
-        (a[1] * b[2], a[2] * b[1]),
-        (a[2] * b[0], a[0] * b[2]),
-        (a[0] * b[1], a[1] * b[0]),
-    ];
-    let v: f64 = (0..3).map(|k| x[k] * (n[k].0 - n[k].1)).sum();
-    let permanent: f64 = (0..3)
-        .map(|k| x[k].abs() * (n[k].0.abs() + n[k].1.abs()))
-        .sum();
-    let bound = ORIENT3D_FILTER_RELATIVE * permanent;
-    if v > bound {
-        return 1;
-    }
-    if v < -bound {
-        return -1;
-    }
-    if permanent < EXACT_F64_INTEGER {
-        return if v > 0.0 {
-            1
-        } else if v < 0.0 {
-            -1
-        } else {
-            0
-        };
+    if let Some(sign) = orient3d_filtered(f(d), f(e1), f(e2)) {
+        return sign;
     }
     let big = |v: [i128; 3]| v.map(BigInt::from);
     let (x, a, b) = (big(d), big(e1), big(e2));
