@@ -3,7 +3,8 @@
 
 /// Feeds `data` to a loader: the first byte selects the format (OBJ, STL, OFF, PLY, detect by
 /// content, query points, or glTF), the rest is the file. Must never panic; a successful load must
-/// give a valid, non-empty mesh whose statistics compute.
+/// give a valid, non-empty mesh whose statistics compute, and which the remesher's exact test of
+/// "already the surface" either keeps as a closed, manifold, oriented surface or refuses.
 pub fn check_load_mesh(data: &[u8]) {
     use gwn::io::{Format, LoadOptions, load_mesh_from_bytes_with, load_points_from_bytes};
     let Some((&selector, body)) = data.split_first() else {
@@ -30,6 +31,18 @@ pub fn check_load_mesh(data: &[u8]) {
             assert!(!l.mesh.triangles().is_empty());
             let s = gwn::mesh::stats::MeshStats::compute(&l.mesh);
             assert_eq!(s.faces, l.mesh.triangles().len());
+            if let Some(bounds) = l.mesh.bounding_box() {
+                let options = gwn::products::remesh::RemeshOptions::with_resolution(16);
+                if let Ok(kept) =
+                    gwn::products::remesh::keep_input::keep_input(&l.mesh, bounds, &options)
+                {
+                    let t = gwn::products::remesh::report::TopologyReport::of(
+                        &kept.positions,
+                        &kept.triangles,
+                    );
+                    assert!(t.closed && t.edge_manifold && t.vertex_manifold && t.oriented);
+                }
+            }
         }
         Err(e) => {
             let msg = e.to_string();
