@@ -144,8 +144,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
     };
     // A mesh that already is the boundary of its `w > ½` solid is the answer as it is (exact
     // checks, linear in the input): the exact method's field of the mesh itself only.
+    // (Its vertices merged by position, as the exact method's boundary is by default: not with
+    // --no-weld, whose boundary is by index.)
     let keep = matches!(method.method_for(input.kind()), Method::Exact)
         && thickened.is_none()
+        && !args.weld.no_weld
         && !args.knobs.always_remesh;
     let out = match input.mesh() {
         Some(mesh) => remesh_mesh(mesh, keep, wn, guide, bounds, &options, &announce),

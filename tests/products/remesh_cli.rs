@@ -89,6 +89,23 @@ fn remesh_writes_every_format_and_a_report() {
     let back = gwn::io::load_mesh(&out).unwrap().mesh;
     assert_eq!(back.triangles(), cube.triangles());
     assert_eq!(back.positions(), cube.positions());
+    // With --no-weld the exact method's boundary is by index: not tried.
+    let (ok, stdout, stderr) = gwn(&[
+        "remesh",
+        input.to_str().unwrap(),
+        "--res",
+        "12",
+        "--out",
+        out.to_str().unwrap(),
+        "--samples",
+        "0",
+        "--no-weld",
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(
+        !stdout.contains("the input as it is") && !stdout.contains("not kept"),
+        "{stdout}"
+    );
     // An open box is remeshed, and the report names why.
     let open = dir.join("open.obj");
     gwn::mesh::write_obj(

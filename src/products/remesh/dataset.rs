@@ -296,7 +296,10 @@ impl MeshJob for RemeshJob {
             reference,
         } = thicken::of_mesh(mesh, &*wn, thick.as_ref(), bounds);
         in_time("building the evaluator")?;
-        let keep = self.keep_input.then_some(mesh).filter(|_| thick.is_none());
+        // Kept with its vertices merged by position, as the field's boundary is: not when
+        // welding is off (a boundary by index).
+        let keep =
+            (self.keep_input && thick.is_none() && self.load.weld != Some(false)).then_some(mesh);
         let out = self.remesh(field, Some(&guide), keep, bounds, deadline)?;
         self.finish(out, field, reference, bounds, deadline, stats)
     }

@@ -56,8 +56,8 @@ use super::{RemeshOptions, RemeshStats, Remeshed};
 /// lose, while keeping it costs no more than this many faces.
 pub const ALWAYS_KEPT_FACES: usize = 10_000;
 
-/// Why [`keep_input`] remeshed instead of keeping the input (the first reason found, in the
-/// order of the module's steps).
+/// Why [`keep_input`] remeshed instead of keeping the input (the first reason found: the size
+/// first, as it is the cheapest, then the module's steps in order).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum NotKept {
     /// The mesh has no faces.
