@@ -666,6 +666,18 @@ mod tests {
 
     const T: [P; 3] = [[0, 0, 0], [10, 0, 0], [0, 10, 0]];
 
+    /// The octahedron's outward faces over the corners `+x, −x, +y, −y, +z, −z`.
+    const OCTAHEDRON: [[u32; 3]; 8] = [
+        [0, 2, 4],
+        [2, 1, 4],
+        [1, 3, 4],
+        [3, 0, 4],
+        [2, 0, 5],
+        [1, 2, 5],
+        [3, 1, 5],
+        [0, 3, 5],
+    ];
+
     #[test]
     fn piercing_and_separate() {
         // A vertical triangle through T's interior.
@@ -826,16 +838,7 @@ mod tests {
             [0.0, 0.0, 1.0],
             [0.0, tiny, -1.0],
         ];
-        let f = [
-            [0, 2, 4],
-            [2, 1, 4],
-            [1, 3, 4],
-            [3, 0, 4],
-            [2, 0, 5],
-            [1, 2, 5],
-            [3, 1, 5],
-            [0, 3, 5],
-        ];
+        let f = OCTAHEDRON;
         let r = self_intersections_of_positions(&p, &f, u64::MAX).unwrap();
         assert_eq!((r.pairs, r.degenerate_faces), (0, 0));
         let mut p2 = p.to_vec();
@@ -872,16 +875,7 @@ mod tests {
             [0, 0, 10],
             [0, 0, -10],
         ];
-        let f = [
-            [0, 2, 4],
-            [2, 1, 4],
-            [1, 3, 4],
-            [3, 0, 4],
-            [2, 0, 5],
-            [1, 2, 5],
-            [3, 1, 5],
-            [0, 3, 5],
-        ];
+        let f = OCTAHEDRON;
         let r = self_intersections(&p, &f, u64::MAX).unwrap();
         assert_eq!((r.pairs, r.degenerate_faces), (0, 0));
         let mut p2 = p.to_vec();
