@@ -453,7 +453,9 @@ pub struct RemeshKnobs {
     pub no_flatness_probe: bool,
     /// Remesh even an input that already is a closed, manifold, oriented surface without
     /// self-intersections bounding w > 1/2 (by default such an input, proved so with exact
-    /// tests, is written as it is when it has at most the simplification target's faces).
+    /// tests, is written as it is when it has at most the simplification target's faces, or at
+    /// most 10,000; not tried with --no-weld, --thicken, --no-simplify or a method other than
+    /// exact).
     #[arg(long)]
     pub always_remesh: bool,
 }
