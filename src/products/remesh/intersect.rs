@@ -130,6 +130,24 @@ pub fn self_intersections_of_positions(
 ) -> Result<SelfIntersections, IntersectError> {
     let wide_bits = MAX_WIDE_COORDINATE.trailing_zeros();
     let wide = common_fixed_point(positions, wide_bits).ok_or(IntersectError::CoordinateSpan)?;
+    self_intersections_wide(&wide, triangles, budget)
+}
+
+/// [`self_intersections`] of integer points below [`MAX_WIDE_COORDINATE`]: the 60-bit
+/// predicates when they fit, the wide ones otherwise (what
+/// [`self_intersections_of_positions`] runs on an input's coordinates in one scale).
+pub fn self_intersections_wide(
+    wide: &[[i128; 3]],
+    triangles: &[[u32; 3]],
+    budget: u64,
+) -> Result<SelfIntersections, IntersectError> {
+    if wide
+        .iter()
+        .flatten()
+        .any(|c| c.unsigned_abs() >= MAX_WIDE_COORDINATE as u128)
+    {
+        return Err(IntersectError::CoordinateSpan);
+    }
     let top = wide
         .iter()
         .flatten()
@@ -156,7 +174,7 @@ pub fn self_intersections_of_positions(
             )
         })
         .collect();
-    count_intersecting_pairs(&wide, triangles, &boxes, budget)
+    count_intersecting_pairs(wide, triangles, &boxes, budget)
 }
 
 fn check_indices(points: usize, triangles: &[[u32; 3]]) -> Result<(), IntersectError> {

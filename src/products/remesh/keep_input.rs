@@ -11,7 +11,7 @@
 //! 1. **Topology** ([`TopologyReport`]): every edge in exactly two faces, used once each way;
 //!    every vertex's faces one fan; no face that repeats a vertex; no two vertices at one
 //!    position.
-//! 2. **Embedding** ([`self_intersections_of_positions`]): the coordinates, written as integers
+//! 2. **Embedding** ([`self_intersections_wide`]): the coordinates, written as integers
 //!    times one power of two (below `2^125`, else not kept: a coordinate of `1` beside one of
 //!    `1e-30`), go through the exact triangle–triangle test of the remesher's output (its
 //!    predicates widened to those integers): no collinear face, and no two faces
@@ -46,7 +46,7 @@ use crate::eval::antipodal::WindingNumber;
 use crate::kernel::predicates::closed_surface_orientation;
 use crate::kernel::quantize::common_fixed_point;
 
-use super::intersect::{self, IntersectError, self_intersections_of_positions};
+use super::intersect::{self, IntersectError, self_intersections_wide};
 use super::lattice::Lattice;
 use super::report::TopologyReport;
 use super::{RemeshOptions, RemeshStats, Remeshed};
@@ -261,8 +261,8 @@ pub fn keep_input(
         .iter()
         .map(|t| t.map(|v| index[v as usize]))
         .collect();
-    // The input's coordinates as integers in one scale: exact for the intersection test (which
-    // makes them again, narrow or wide) and the orientations.
+    // The input's coordinates as integers in one scale: exact for the intersection test
+    // (narrow or wide predicates, as they fit) and the orientations.
     let bits = intersect::MAX_WIDE_COORDINATE.trailing_zeros();
     let fixed = common_fixed_point(&positions, bits).ok_or(NotKept::CoordinateRange)?;
     // Distinct vertices at one position would pass the topology (different indices) and the
@@ -277,13 +277,12 @@ pub fn keep_input(
     }
     // The report's budget: linear on evenly sized faces, refused when it would not be.
     let budget = 1000 * triangles.len() as u64 + 1_000_000;
-    let si =
-        self_intersections_of_positions(&positions, &triangles, budget).map_err(|e| match e {
-            IntersectError::TooManyCandidates { .. } => NotKept::UnevenFaces,
-            IntersectError::CoordinateTooLarge { .. }
-            | IntersectError::CoordinateSpan
-            | IntersectError::BadIndex { .. } => NotKept::CoordinateRange,
-        })?;
+    let si = self_intersections_wide(&fixed, &triangles, budget).map_err(|e| match e {
+        IntersectError::TooManyCandidates { .. } => NotKept::UnevenFaces,
+        IntersectError::CoordinateTooLarge { .. }
+        | IntersectError::CoordinateSpan
+        | IntersectError::BadIndex { .. } => NotKept::CoordinateRange,
+    })?;
     if si.degenerate_faces > 0 {
         return Err(NotKept::DegenerateFaces {
             faces: si.degenerate_faces,
