@@ -193,7 +193,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     )
     .map_err(|e| CliError::msg(format!("--samples: {e}")))?;
     report.seconds = secs;
-    report.phase_seconds = (out.stats.input != Some(InputCheck::Kept)).then_some(phase_seconds);
+    let kept = out.stats.input.is_some_and(|i| i.is_kept());
+    report.phase_seconds = (!kept).then_some(phase_seconds);
     report.thicken = thickened.as_ref().map(|t| t.eps());
     drop(curved_surface);
     let topology = report.topology;
@@ -208,9 +209,24 @@ pub fn run(args: Args) -> Result<(), CliError> {
         format!("cells {x:.4e} x {y:.4e} x {z:.4e}")
     };
     match s.input {
-        Some(InputCheck::Kept) => {
+        Some(InputCheck::Kept {
+            zero_area_faces,
+            split_faces,
+        }) => {
+            // What the kept input lost or gained: faces only, never a position.
+            let repairs = if zero_area_faces + split_faces > 0 {
+                let s = |n: usize| if n == 1 { "" } else { "s" };
+                format!(
+                    ", {zero_area_faces} zero-area face{} left out, {split_faces} face{} split at \
+                     vertices on their edges",
+                    s(zero_area_faces),
+                    s(split_faces)
+                )
+            } else {
+                String::new()
+            };
             outln!(
-                "{}: the input as it is ({} faces, {:.2} s): closed, manifold, oriented, no \
+                "{}: the input as it is ({} faces{repairs}, {:.2} s): closed, manifold, oriented, no \
                  self-intersection (exact) and the boundary of w > 1/2 (--always-remesh remeshes \
                  it at res {})",
                 args.out.display(),
@@ -225,7 +241,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         }
         None => {}
     }
-    if s.input != Some(InputCheck::Kept) {
+    if !kept {
         outln!(
             "{}: res {} ({cells}, lattice {}x{}x{}), {:.2} s, {} points classified, {} band cells",
             args.out.display(),

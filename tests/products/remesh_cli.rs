@@ -89,6 +89,44 @@ fn remesh_writes_every_format_and_a_report() {
     let back = gwn::io::load_mesh(&out).unwrap().mesh;
     assert_eq!(back.triangles(), cube.triangles());
     assert_eq!(back.positions(), cube.positions());
+    assert!(json.contains("\"input_zero_area_faces\": 0"), "{json}");
+    // A cube with a zero-area cap over a T-junction (as OpenSCAD exports write them): the cap
+    // goes, the face across the junction is split, no vertex moves.
+    let capped = dir.join("capped.obj");
+    let mut p = cube.positions().to_vec();
+    let mut t = cube.triangles().to_vec();
+    let [a, b, c] = t[1];
+    let (pa, pb) = (p[a as usize], p[b as usize]);
+    p.push(std::array::from_fn(|k| (pa[k] + pb[k]) / 2.0));
+    t[1] = [a, 8, c];
+    t.extend([[8, b, c], [a, b, 8]]);
+    let with_cap = gwn::Mesh::new(p.clone(), t).unwrap();
+    gwn::mesh::write_obj(std::fs::File::create(&capped).unwrap(), &with_cap).unwrap();
+    let (ok, stdout, stderr) = gwn(&[
+        "remesh",
+        capped.to_str().unwrap(),
+        "--res",
+        "20",
+        "--out",
+        out.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+        "--samples",
+        "2000",
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(
+        stdout.contains(
+            "the input as it is (14 faces, 1 zero-area face left out, 1 face split at vertices \
+             on their edges"
+        ),
+        "{stdout}"
+    );
+    let json = std::fs::read_to_string(&report).unwrap();
+    assert!(json.contains("\"input_zero_area_faces\": 1"), "{json}");
+    assert!(json.contains("\"input_split_faces\": 1"), "{json}");
+    let back = gwn::io::load_mesh(&out).unwrap().mesh;
+    assert_eq!(back.positions(), p.as_slice());
     // With --no-weld the exact method's boundary is by index: not tried.
     let (ok, stdout, stderr) = gwn(&[
         "remesh",

@@ -33,7 +33,6 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use super::crossings::SegmentBvh;
-use super::keep_input::InputCheck;
 use super::report::{DistanceReference, RemeshReport};
 use super::thicken::{self, MeshField, ThickenedSheets};
 use super::write::{SurfaceFormat, write_surface};
@@ -402,7 +401,7 @@ impl RemeshJob {
         let mut bytes = Vec::new();
         write_surface(&mut bytes, self.format, &surface)?;
         let t = report.topology;
-        stats.set("kept", out.stats.input == Some(InputCheck::Kept));
+        stats.set("kept", out.stats.input.is_some_and(|i| i.is_kept()));
         stats.set("output_faces", t.faces);
         stats.set("output_vertices", t.vertices);
         let intersections = report.self_intersections.as_ref().ok().map(|r| r.pairs);

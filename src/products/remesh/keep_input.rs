@@ -6,7 +6,8 @@
 //! is the input itself (Hausdorff distance 0, occupancy agreement 100 %, the input's own
 //! faces), and the test is linear in the input instead of in the surface's area in cells.
 //! [`keep_input`] keeps a mesh only when it proves all of this exactly, on the coordinates the
-//! user gave:
+//! user gave, after [`exact_repair`] (zero-area faces out, faces split at the vertices on their
+//! boundary edges: `w` unchanged off the surface, no vertex moved):
 //!
 //! 1. **Topology** ([`TopologyReport`]): every edge in exactly two faces, used once each way;
 //!    every vertex's faces one fan; no face that repeats a vertex; no two vertices at one
@@ -35,8 +36,9 @@
 //!    at most [`ALWAYS_KEPT_FACES`] (the estimate is near 0 for parts thinner than a cell,
 //!    which a remesh would lose).
 //!
-//! What is kept is the input with bit-identical vertices merged: its referenced vertices in
-//! their order, and its faces in theirs.
+//! What is kept is the input with bit-identical vertices merged and the repairs made: its
+//! referenced vertices in their order, and its faces in theirs. Where the repaired mesh fails
+//! step 1, the reason given is the input's own first problem there.
 
 use rayon::slice::ParallelSliceMut;
 
@@ -46,6 +48,7 @@ use crate::eval::antipodal::WindingNumber;
 use crate::kernel::predicates::closed_surface_orientation;
 use crate::kernel::quantize::common_fixed_point;
 
+use super::exact_repair;
 use super::intersect::{self, IntersectError, self_intersections_wide};
 use super::lattice::Lattice;
 use super::report::TopologyReport;
@@ -167,10 +170,23 @@ impl std::fmt::Display for NotKept {
 /// What happened to the input before the lattice ([`RemeshStats::input`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum InputCheck {
-    /// The input is the output ([`keep_input`]).
-    Kept,
+    /// The input is the output ([`keep_input`]), its zero-area faces left out and its faces
+    /// split at the vertices on their edges ([`exact_repair`]).
+    Kept {
+        /// Zero-area faces left out.
+        zero_area_faces: usize,
+        /// Faces split at a T-junction.
+        split_faces: usize,
+    },
     /// The input was remeshed, for this reason.
     Remeshed(NotKept),
+}
+
+impl InputCheck {
+    /// Whether the input was kept.
+    pub fn is_kept(&self) -> bool {
+        matches!(self, InputCheck::Kept { .. })
+    }
 }
 
 /// The input itself as the remesh of `mesh` (triangles whose `w > ½` solid is meant, with
@@ -222,49 +238,36 @@ pub fn keep_input(
             target: target as usize,
         });
     }
-    let topology = TopologyReport::of(mesh.positions(), triangles);
-    if topology.degenerate_faces > 0 {
-        return Err(NotKept::DegenerateFaces {
-            faces: topology.degenerate_faces,
-        });
-    }
-    if !topology.closed {
-        return Err(NotKept::Open {
-            boundary_edges: topology.boundary_edges,
-        });
-    }
-    if !(topology.edge_manifold && topology.vertex_manifold) {
-        return Err(NotKept::NotManifold {
-            edges: topology.nonmanifold_edges,
-            vertices: topology.nonmanifold_vertices,
-        });
-    }
-    if !topology.oriented {
-        return Err(NotKept::Misoriented {
-            edges: topology.misoriented_edges,
-        });
-    }
-    // The referenced vertices, in their order.
-    let mut used = vec![false; mesh.positions().len()];
-    for &v in triangles.iter().flatten() {
-        used[v as usize] = true;
-    }
-    let mut index = vec![u32::MAX; used.len()];
-    let mut positions = Vec::with_capacity(topology.vertices);
-    for (v, p) in mesh.positions().iter().enumerate() {
-        if used[v] {
-            index[v] = positions.len() as u32;
-            positions.push(*p);
-        }
-    }
-    let triangles: Vec<[u32; 3]> = triangles
-        .iter()
-        .map(|t| t.map(|v| index[v as usize]))
-        .collect();
-    // The input's coordinates as integers in one scale: exact for the intersection test
-    // (narrow or wide predicates, as they fit) and the orientations.
+    // The referenced vertices, in their order, and their coordinates as integers in one scale:
+    // exact for the repairs, the intersection test (narrow or wide predicates, as they fit)
+    // and the orientations.
+    let (positions, triangles) = referenced(mesh.positions(), triangles);
     let bits = intersect::MAX_WIDE_COORDINATE.trailing_zeros();
-    let fixed = common_fixed_point(&positions, bits).ok_or(NotKept::CoordinateRange)?;
+    let original = TopologyReport::of(&positions, &triangles);
+    let Some(fixed) = common_fixed_point(&positions, bits) else {
+        return Err(topology_problem(&original).unwrap_or(NotKept::CoordinateRange));
+    };
+    // Zero-area faces out, T-junctions split: `w` is the same everywhere off the surface.
+    let repaired = exact_repair::repair(
+        &fixed,
+        &triangles,
+        original.closed,
+        1000 * triangles.len() as u64,
+    );
+    let (positions, fixed, triangles) = if repaired.zero_area_faces + repaired.split_faces > 0 {
+        let topology = TopologyReport::of(&positions, &repaired.triangles);
+        if let Some(problem) = topology_problem(&topology) {
+            return Err(topology_problem(&original).unwrap_or(problem));
+        }
+        let (kept, triangles) = referenced(&fixed, &repaired.triangles);
+        let (positions, _) = referenced(&positions, &repaired.triangles);
+        (positions, kept, triangles)
+    } else {
+        if let Some(problem) = topology_problem(&original) {
+            return Err(problem);
+        }
+        (positions, fixed, triangles)
+    };
     // Distinct vertices at one position would pass the topology (different indices) and the
     // intersection test (coincident positions count as shared) while pinching the surface.
     let mut sorted = fixed.clone();
@@ -283,11 +286,10 @@ pub fn keep_input(
         | IntersectError::CoordinateSpan
         | IntersectError::BadIndex { .. } => NotKept::CoordinateRange,
     })?;
-    if si.degenerate_faces > 0 {
-        return Err(NotKept::DegenerateFaces {
-            faces: si.degenerate_faces,
-        });
-    }
+    debug_assert_eq!(
+        si.degenerate_faces, 0,
+        "the repair took zero-area faces out"
+    );
     if si.pairs > 0 {
         return Err(NotKept::SelfIntersecting { pairs: si.pairs });
     }
@@ -302,10 +304,60 @@ pub fn keep_input(
         cell_size: lattice.largest_cell(),
         cell_sizes: lattice.h,
         stats: RemeshStats {
-            input: Some(InputCheck::Kept),
+            input: Some(InputCheck::Kept {
+                zero_area_faces: repaired.zero_area_faces,
+                split_faces: repaired.split_faces,
+            }),
             ..RemeshStats::default()
         },
     })
+}
+
+/// The first reason of step 1 not to keep a mesh with this topology.
+fn topology_problem(topology: &TopologyReport) -> Option<NotKept> {
+    if topology.degenerate_faces > 0 {
+        return Some(NotKept::DegenerateFaces {
+            faces: topology.degenerate_faces,
+        });
+    }
+    if !topology.closed {
+        return Some(NotKept::Open {
+            boundary_edges: topology.boundary_edges,
+        });
+    }
+    if !(topology.edge_manifold && topology.vertex_manifold) {
+        return Some(NotKept::NotManifold {
+            edges: topology.nonmanifold_edges,
+            vertices: topology.nonmanifold_vertices,
+        });
+    }
+    if !topology.oriented {
+        return Some(NotKept::Misoriented {
+            edges: topology.misoriented_edges,
+        });
+    }
+    None
+}
+
+/// The `values` of the vertices `triangles` refer to, in their order, and the triangles
+/// renumbered to them.
+fn referenced<V: Copy>(values: &[V], triangles: &[[u32; 3]]) -> (Vec<V>, Vec<[u32; 3]>) {
+    let mut index = vec![u32::MAX; values.len()];
+    for &v in triangles.iter().flatten() {
+        index[v as usize] = 0;
+    }
+    let mut kept = Vec::new();
+    for (v, value) in values.iter().enumerate() {
+        if index[v] == 0 {
+            index[v] = kept.len() as u32;
+            kept.push(*value);
+        }
+    }
+    let triangles = triangles
+        .iter()
+        .map(|t| t.map(|v| index[v as usize]))
+        .collect();
+    (kept, triangles)
 }
 
 /// Step 3 of the module documentation on a closed, manifold, oriented, embedded `surface` with

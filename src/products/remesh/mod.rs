@@ -52,6 +52,7 @@
 pub mod crossings;
 pub mod dataset;
 mod deadline;
+pub mod exact_repair;
 pub mod extract;
 pub mod flatness;
 pub mod intersect;

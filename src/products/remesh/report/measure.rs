@@ -192,7 +192,7 @@ impl RemeshReport {
         // budget only guards against a surprise.
         let budget = 1000 * surface.triangles().len() as u64 + 1_000_000;
         let start = std::time::Instant::now();
-        let intersections = if out.stats.input == Some(InputCheck::Kept) {
+        let intersections = if out.stats.input.is_some_and(|i| i.is_kept()) {
             self_intersections_of_positions(surface.positions(), surface.triangles(), budget)
         } else {
             self_intersections(&out.fixed, surface.triangles(), budget)
@@ -285,7 +285,14 @@ impl RemeshReport {
             ("seconds", format!("{:.3}", self.seconds)),
         ];
         match s.input {
-            Some(InputCheck::Kept) => members.push(("input", json_string("kept"))),
+            Some(InputCheck::Kept {
+                zero_area_faces,
+                split_faces,
+            }) => members.extend([
+                ("input", json_string("kept")),
+                ("input_zero_area_faces", zero_area_faces.to_string()),
+                ("input_split_faces", split_faces.to_string()),
+            ]),
             Some(InputCheck::Remeshed(why)) => {
                 members.push(("input", json_string("remeshed")));
                 members.push(("input_not_kept", json_string(&why.to_string())));

@@ -1,0 +1,330 @@
+//! Repairs of an input that change its `w` nowhere off its surface, for [`super::keep_input`]:
+//!
+//! - **zero-area faces out**: a face that repeats a vertex, or whose corners are collinear
+//!   (exactly, on the input's own coordinates), spans no solid angle from any point off it;
+//! - **faces split at the vertices on their boundary edges** (T-junctions): when a vertex `p`
+//!   lies strictly inside the edge `a b` of face `a b c`, the faces `a p c` and `p b c` tile it
+//!   with its orientation (`p − a` is a positive multiple of `b − a`), so every solid angle sum,
+//!   hence `w`, is unchanged.
+//!
+//! What was open or degenerate only because of these (a zero-area cap over a T-junction, an
+//! export that left its junctions unsplit, a needle whose two ends were welded) comes out closed;
+//! no position moves, every vertex is one of the input's, and nothing else is decided here:
+//! [`super::keep_input`] proves the result closed, manifold, embedded and the boundary of
+//! `{w > ½}` as for any input.
+//!
+//! Only *boundary* edges (in one face) are split, and only at vertices of other boundary edges:
+//! splitting an edge that two faces share would open it, and a vertex that ends no boundary edge
+//! closes no crack.
+
+use std::collections::HashMap;
+
+use super::intersect::ExactPoint;
+
+/// The result of [`repair`].
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Repaired {
+    /// The faces: the input's in their order, zero-area ones left out, split ones replaced by
+    /// their pieces where they were.
+    pub triangles: Vec<[u32; 3]>,
+    /// Zero-area faces left out.
+    pub zero_area_faces: usize,
+    /// Faces split at vertices on their boundary edges.
+    pub split_faces: usize,
+}
+
+/// `triangles` on the exact `points` without zero-area faces and split at the vertices that lie
+/// on their boundary edges (see the [module documentation](self)). The search for those
+/// vertices tests at most about `budget` candidates; beyond it no face is split. `closed` says
+/// that `triangles` has no boundary edge (then, without zero-area faces, there is nothing to do).
+pub fn repair<T: ExactPoint>(
+    points: &[T],
+    triangles: &[[u32; 3]],
+    closed: bool,
+    budget: u64,
+) -> Repaired {
+    let zero_area = |&[a, b, c]: &[u32; 3]| {
+        a == b
+            || b == c
+            || c == a
+            || T::projection_axis(points[a as usize], points[b as usize], points[c as usize])
+                .is_none()
+    };
+    let kept: Vec<[u32; 3]> = triangles
+        .iter()
+        .filter(|t| !zero_area(t))
+        .copied()
+        .collect();
+    let zero_area_faces = triangles.len() - kept.len();
+    if closed && zero_area_faces == 0 {
+        return Repaired {
+            triangles: kept,
+            ..Repaired::default()
+        };
+    }
+    // Undirected edges in one face only.
+    let mut faces_of_edge: HashMap<(u32, u32), u32> = HashMap::new();
+    for t in &kept {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            *faces_of_edge.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    let mut boundary: Vec<(u32, u32)> = faces_of_edge
+        .into_iter()
+        .filter(|&(_, n)| n == 1)
+        .map(|(e, _)| e)
+        .collect();
+    // The hash map's order is random; the budget's cut-off must not be.
+    boundary.sort_unstable();
+    let junctions = boundary_junctions(points, &boundary, budget);
+    if junctions.is_empty() {
+        return Repaired {
+            triangles: kept,
+            zero_area_faces,
+            split_faces: 0,
+        };
+    }
+    let on_edge = |a: u32, b: u32| -> &[u32] {
+        junctions
+            .get(&(a.min(b), a.max(b)))
+            .map_or(&[][..], Vec::as_slice)
+    };
+    let mut out = Vec::with_capacity(kept.len() + 2 * junctions.len());
+    let mut split_faces = 0;
+    for &t in &kept {
+        let before = out.len();
+        split_face(t, &on_edge, &mut out);
+        split_faces += usize::from(out.len() > before + 1);
+    }
+    Repaired {
+        triangles: out,
+        zero_area_faces,
+        split_faces,
+    }
+}
+
+/// For each boundary edge (as `(min, max)` vertex indices), the boundary vertices strictly
+/// inside it, ordered from `min` to `max`; empty when the search would exceed `budget`.
+fn boundary_junctions<T: ExactPoint>(
+    points: &[T],
+    boundary: &[(u32, u32)],
+    budget: u64,
+) -> HashMap<(u32, u32), Vec<u32>> {
+    let mut ends: Vec<u32> = boundary.iter().flat_map(|&(a, b)| [a, b]).collect();
+    ends.sort_unstable();
+    ends.dedup();
+    // The ends sorted along each axis; an edge's candidates are those whose coordinate on one
+    // axis lies within the edge's range there (the axis with the fewest).
+    let by_axis: [Vec<u32>; 3] = std::array::from_fn(|k| {
+        let mut v = ends.clone();
+        v.sort_unstable_by_key(|&i| points[i as usize].at(k));
+        v
+    });
+    let mut junctions = HashMap::new();
+    let mut tested = 0u64;
+    for &(a, b) in boundary {
+        let (pa, pb) = (points[a as usize], points[b as usize]);
+        let range = |k: usize| {
+            let (lo, hi) = (pa.at(k).min(pb.at(k)), pa.at(k).max(pb.at(k)));
+            let list = &by_axis[k];
+            let start = list.partition_point(|&i| points[i as usize].at(k) < lo);
+            let end = list.partition_point(|&i| points[i as usize].at(k) <= hi);
+            &list[start..end]
+        };
+        let candidates = (0..3).map(range).min_by_key(|c| c.len()).unwrap_or(&[]);
+        tested += candidates.len() as u64;
+        if tested > budget {
+            return HashMap::new();
+        }
+        // An axis along which the edge advances: on it, order along the edge is order of the
+        // coordinate (the points are collinear with it).
+        let Some(axis) = (0..3).find(|&k| pa.at(k) != pb.at(k)) else {
+            continue;
+        };
+        let mut inside: Vec<u32> = candidates
+            .iter()
+            .copied()
+            .filter(|&p| strictly_inside(points[p as usize], pa, pb, axis))
+            .collect();
+        if inside.is_empty() {
+            continue;
+        }
+        inside.sort_unstable_by_key(|&p| points[p as usize].at(axis));
+        if pa.at(axis) > pb.at(axis) {
+            inside.reverse();
+        }
+        junctions.insert((a, b), inside);
+    }
+    junctions
+}
+
+/// Whether `p` lies strictly between `a` and `b` on their segment (`a ≠ b`, differing on
+/// `axis`): collinear, exactly, and strictly between them on `axis`.
+fn strictly_inside<T: ExactPoint>(p: T, a: T, b: T, axis: usize) -> bool {
+    let (lo, hi) = (a.at(axis).min(b.at(axis)), a.at(axis).max(b.at(axis)));
+    lo < p.at(axis) && p.at(axis) < hi && T::projection_axis(a, b, p).is_none()
+}
+
+/// Face `t` tiled by faces whose edges pass through none of the vertices `on_edge` lists
+/// (ordered from the edge's lower index to its higher one): a fan from the corner opposite the
+/// first edge that has any, then the same for the fan's two outer faces, which keep the other two
+/// edges. Every piece has two corners on one of `t`'s edges and the third off its line, so none
+/// is degenerate, and each has `t`'s orientation.
+fn split_face<'a>(t: [u32; 3], on_edge: &impl Fn(u32, u32) -> &'a [u32], out: &mut Vec<[u32; 3]>) {
+    // Work items: a face and, for each of its edges, whether it is a piece of one of `t`'s
+    // edges (only those can carry junctions; the fan's inner edges cross `t`).
+    let mut stack = vec![(t, [true; 3])];
+    while let Some((f, original)) = stack.pop() {
+        let split = (0..3).find_map(|k| {
+            let (a, b) = (f[k], f[(k + 1) % 3]);
+            if !original[k] {
+                return None;
+            }
+            // Flagged edges are whole edges of `t` (the pieces' edges along one carry none).
+            let mut inside = on_edge(a, b).to_vec();
+            if inside.is_empty() {
+                return None;
+            }
+            if a > b {
+                inside.reverse();
+            }
+            Some((k, inside))
+        });
+        let Some((k, inside)) = split else {
+            out.push(f);
+            continue;
+        };
+        let (a, b, c) = (f[k], f[(k + 1) % 3], f[(k + 2) % 3]);
+        // Edge flags of `f` in the order (a b), (b c), (c a).
+        let (bc, ca) = (original[(k + 1) % 3], original[(k + 2) % 3]);
+        let chain: Vec<u32> = std::iter::once(a)
+            .chain(inside.iter().copied())
+            .chain(std::iter::once(b))
+            .collect();
+        let last = chain.len() - 2;
+        for (i, w) in chain.windows(2).enumerate() {
+            // The piece `w0 w1 c`: its edge `w0 w1` lies on `a b` (no junction left inside it),
+            // `w1 c` is `b c` for the last piece, `c w0` is `c a` for the first.
+            let piece = [w[0], w[1], c];
+            let flags = [false, i == last && bc, i == 0 && ca];
+            if flags[1] || flags[2] {
+                stack.push((piece, flags));
+            } else {
+                out.push(piece);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    type P = [i64; 3];
+
+    /// A unit cube (outward) with its front bottom edge's cap: the face `0 1 2` of the bottom is
+    /// replaced by `0 8 2`, `8 1 2` on one side and a zero-area cap `0 1 8` fills the other.
+    fn capped_cube() -> (Vec<P>, Vec<[u32; 3]>) {
+        let s = 2;
+        let p: Vec<P> = vec![
+            [0, 0, 0],
+            [s, 0, 0],
+            [s, s, 0],
+            [0, s, 0],
+            [0, 0, s],
+            [s, 0, s],
+            [s, s, s],
+            [0, s, s],
+            [1, 0, 0],
+        ];
+        let t = vec![
+            [0, 2, 8],
+            [8, 2, 1],
+            [0, 3, 2],
+            // The front face, `0 1 5 4`, split at 8 on its bottom edge only on the other side.
+            [0, 1, 5],
+            [0, 5, 4],
+            [1, 2, 6],
+            [1, 6, 5],
+            [2, 3, 7],
+            [2, 7, 6],
+            [3, 0, 4],
+            [3, 4, 7],
+            [4, 5, 6],
+            [4, 6, 7],
+        ];
+        (p, t)
+    }
+
+    #[test]
+    fn a_t_junction_is_split_and_zero_area_faces_go() {
+        let (p, mut t) = capped_cube();
+        let plain = repair(&p, &t, false, 1000);
+        // Without the cap the front face's edge 0 1 meets 0 8 and 8 1: split there.
+        assert_eq!(plain.zero_area_faces, 0);
+        assert_eq!(plain.split_faces, 1);
+        assert_eq!(plain.triangles.len(), t.len() + 1);
+        assert!(plain.triangles.contains(&[0, 8, 5]) && plain.triangles.contains(&[8, 1, 5]));
+        // With a cap `0 8 1` closing it instead, the cap goes and the same split is made; a
+        // needle repeating a vertex goes too.
+        t.push([0, 8, 1]);
+        t.push([3, 3, 7]);
+        let capped = repair(&p, &t, false, 1000);
+        assert_eq!(capped.zero_area_faces, 2);
+        assert_eq!(capped.triangles, plain.triangles);
+        // Over budget: nothing is split.
+        assert_eq!(repair(&p, &t, false, 0).split_faces, 0);
+    }
+
+    #[test]
+    fn several_junctions_on_several_edges_give_nondegenerate_pieces_with_the_faces_area() {
+        // A triangle (doubled area 2·64·64 along z) whose three edges carry 3, 1 and 2 junctions,
+        // against a fan of slivers on the other side that ends each boundary run there.
+        let p: Vec<P> = vec![
+            [0, 0, 0],
+            [64, 0, 0],
+            [0, 64, 0],
+            [16, 0, 0],
+            [32, 0, 0],
+            [48, 0, 0],
+            [32, 32, 0],
+            [0, 48, 0],
+            [0, 16, 0],
+        ];
+        let face = [0, 1, 2];
+        // The other side's edges: 0 3 4 5 1 along the bottom, 1 6 2 along the diagonal, 2 7 8 0.
+        let chain = [0u32, 3, 4, 5, 1, 6, 2, 7, 8, 0];
+        let mut t = vec![face];
+        for w in chain.windows(2) {
+            t.push([w[1], w[0], 9]);
+        }
+        let mut p = p;
+        p.push([20, 20, -10]);
+        let r = repair(&p, &t, false, 1000);
+        assert_eq!(r.split_faces, 1);
+        let pieces: Vec<[u32; 3]> = r
+            .triangles
+            .iter()
+            .filter(|f| !f.contains(&9))
+            .copied()
+            .collect();
+        assert_eq!(pieces.len(), 1 + 6);
+        let doubled_area = |&[a, b, c]: &[u32; 3]| {
+            let (a, b, c) = (p[a as usize], p[b as usize], p[c as usize]);
+            (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+        };
+        assert!(pieces.iter().all(|f| doubled_area(f) > 0));
+        assert_eq!(pieces.iter().map(doubled_area).sum::<i64>(), 64 * 64);
+        // Every piece's edges are matched by the other side's or by another piece: closed.
+        let mut count: HashMap<(u32, u32), i32> = HashMap::new();
+        for f in &r.triangles {
+            for k in 0..3 {
+                *count.entry((f[k], f[(k + 1) % 3])).or_default() += 1;
+            }
+        }
+        for (&(a, b), &n) in &count {
+            assert_eq!(count.get(&(b, a)), Some(&n), "edge {a} {b}");
+        }
+    }
+}
