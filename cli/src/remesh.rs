@@ -236,6 +236,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
             )?;
             outln!("{topology}")?;
         }
+        Some(InputCheck::PartlyKept {
+            kept_components,
+            components,
+            kept_faces,
+            why,
+        }) => outln!(
+            "partly kept: the input is not kept as it is ({why}); {kept_components} of its \
+             {components} components ({kept_faces} faces) are, exactly, and the rest is remeshed"
+        )?,
         Some(InputCheck::Remeshed(why)) => {
             outln!("remeshed: the input is not kept as it is: {why}")?
         }

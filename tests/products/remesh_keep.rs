@@ -435,3 +435,114 @@ proptest! {
         }
     }
 }
+
+/// The default remesh of a mesh, as the CLI runs it: the exact field, the mesh as its guide, the
+/// whole input kept when it can be, else its clean components.
+fn remesh_default(mesh: &Mesh, res: usize) -> gwn::products::remesh::Remeshed {
+    use gwn::products::remesh::{crossings::SegmentBvh, remesh_mesh};
+    let wn = WindingNumber::new(mesh).unwrap();
+    let guide = SegmentBvh::of_field_mesh(mesh);
+    let bounds = mesh.bounding_box().unwrap();
+    let options = RemeshOptions::with_resolution(res);
+    remesh_mesh(mesh, true, &wn, Some(&guide), bounds, &options, &|_| {}).unwrap()
+}
+
+/// Closed, manifold, oriented and without self-intersections on its `f64` vertices.
+fn assert_valid(out: &gwn::products::remesh::Remeshed) {
+    use gwn::products::remesh::{intersect, report::TopologyReport};
+    let t = TopologyReport::of(&out.positions, &out.triangles);
+    assert!(
+        t.closed && t.edge_manifold && t.vertex_manifold && t.oriented,
+        "{t}"
+    );
+    let si = intersect::self_intersections_of_positions(&out.positions, &out.triangles, 1 << 40)
+        .unwrap();
+    assert_eq!((si.pairs, si.degenerate_faces), (0, 0));
+}
+
+#[test]
+fn clean_components_are_kept_and_only_the_rest_is_remeshed() {
+    use gwn::products::remesh::keep_input::InputCheck;
+    let cube = common::unit_cube().translated([3.0, 0.2, 0.1]);
+    let open = common::open_cube();
+    // Apart from an open box (w of the box at the cube's corners: a few hundredths).
+    let out = remesh_default(&join(&[cube.clone(), open.clone()]), 32);
+    assert_eq!(
+        out.stats.input,
+        Some(InputCheck::PartlyKept {
+            kept_components: 1,
+            components: 2,
+            kept_faces: 12,
+            why: NotKept::Open { boundary_edges: 4 }
+        })
+    );
+    assert_eq!(&out.triangles[..12], cube.triangles());
+    assert_eq!(&out.positions[..8], cube.positions());
+    assert!(out.triangles.len() > 12, "the open box's solid is remeshed");
+    assert!(out.fixed.is_empty());
+    assert_valid(&out);
+    // The output's solid: the cube, and the open box's (w > 1/2 inside it).
+    let solid = Mesh::new(out.positions.clone(), out.triangles.clone()).unwrap();
+    let w = WindingNumber::new(&solid).unwrap();
+    for (q, inside) in [
+        ([3.5, 0.7, 0.6], true),
+        ([0.5, 0.5, 0.3], true),
+        ([2.0, 0.5, 0.5], false),
+        ([3.5, 0.7, 1.5], false),
+    ] {
+        assert_eq!(w.eval(q) == 1.0, inside, "{q:?}");
+    }
+    // With an inward box beside them, which fails the winding on its own: it is remeshed
+    // with the open box (and vanishes: w = -1 in it), the cube is still kept.
+    let inward = cuboid([0.0, 3.0, 0.0], [1.0, 4.0, 1.0], true);
+    let out = remesh_default(&join(&[cube.clone(), open.clone(), inward]), 32);
+    assert_eq!(
+        out.stats.input,
+        Some(InputCheck::PartlyKept {
+            kept_components: 1,
+            components: 3,
+            kept_faces: 12,
+            why: NotKept::Open { boundary_edges: 4 }
+        })
+    );
+    assert_valid(&out);
+    // A bar through the open box's walls, its corners outside it: it meets the box's faces,
+    // so it is no part to keep (step 1; the union's proof would refuse it too, after a remesh
+    // of the rest).
+    let bar = cuboid([-0.5, 0.4, 0.4], [1.5, 0.6, 0.6], false);
+    let crossing = join(&[bar, open.clone()]);
+    let bounds = crossing.bounding_box().unwrap();
+    let options = RemeshOptions::with_resolution(24);
+    assert!(gwn::products::remesh::keep_parts::kept_parts(&crossing, bounds, &options).is_none());
+    let out = remesh_default(&crossing, 24);
+    assert_eq!(
+        out.stats.input,
+        Some(InputCheck::Remeshed(NotKept::Open { boundary_edges: 4 }))
+    );
+    assert_valid(&out);
+    // Inside the open box, where its w is about 0.9: the cube's faces are not where w crosses
+    // 1/2 (w is 1.9 inside it), so it is not kept.
+    let inner = cuboid([0.4, 0.4, 0.05], [0.6, 0.6, 0.25], false);
+    let out = remesh_default(&join(&[inner, open.clone()]), 24);
+    assert!(
+        matches!(out.stats.input, Some(InputCheck::Remeshed(_))),
+        "{:?}",
+        out.stats.input
+    );
+    assert_valid(&out);
+    // Inside an inward box with one side open (w about -0.8 there, and 0.2 inside the cube):
+    // the cube's faces are not where w crosses 1/2 (step 3), and the solid is empty.
+    let shell = cuboid([-1.0; 3], [2.0; 3], true);
+    let open_shell =
+        Mesh::new(shell.positions().to_vec(), shell.triangles()[..10].to_vec()).unwrap();
+    let out = remesh_default(&join(&[common::unit_cube(), open_shell]), 24);
+    assert!(
+        matches!(
+            out.stats.input,
+            Some(InputCheck::Remeshed(NotKept::Open { .. }))
+        ),
+        "{:?}",
+        out.stats.input
+    );
+    assert!(out.triangles.is_empty());
+}

@@ -21,6 +21,8 @@
 //! every face lies in one lattice cell) and refuses, with [`IntersectError::TooManyCandidates`],
 //! when uneven face sizes would make it quadratic beyond a budget.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use rayon::prelude::*;
 
 use crate::kernel::predicates::{W128, Width, det2_sign_wide, orient3d_sign_wide};
@@ -99,6 +101,17 @@ pub fn self_intersections(
     triangles: &[[u32; 3]],
     budget: u64,
 ) -> Result<SelfIntersections, IntersectError> {
+    narrow_intersections(points, triangles, budget, None)
+}
+
+/// [`self_intersections`], marking the faces of every intersecting pair in `marks` (one per
+/// face) when given.
+fn narrow_intersections(
+    points: &[P],
+    triangles: &[[u32; 3]],
+    budget: u64,
+    marks: Option<&[AtomicBool]>,
+) -> Result<SelfIntersections, IntersectError> {
     if let Some(vertex) = points
         .iter()
         .position(|p| p.iter().any(|c| c.unsigned_abs() >= MAX_COORDINATE as u64))
@@ -116,7 +129,7 @@ pub fn self_intersections(
             )
         })
         .collect();
-    count_intersecting_pairs(points, triangles, &boxes, budget)
+    count_intersecting_pairs(points, triangles, &boxes, budget, marks)
 }
 
 /// [`self_intersections`] of a surface with `f64` vertices, exact on those very coordinates
@@ -141,6 +154,27 @@ pub fn self_intersections_wide(
     triangles: &[[u32; 3]],
     budget: u64,
 ) -> Result<SelfIntersections, IntersectError> {
+    wide_intersections(wide, triangles, budget, None)
+}
+
+/// Which faces of [`self_intersections_wide`]'s surface meet another outside what they share.
+pub fn intersecting_faces_wide(
+    wide: &[[i128; 3]],
+    triangles: &[[u32; 3]],
+    budget: u64,
+) -> Result<Vec<bool>, IntersectError> {
+    let marks: Vec<AtomicBool> = triangles.iter().map(|_| AtomicBool::new(false)).collect();
+    wide_intersections(wide, triangles, budget, Some(&marks))?;
+    Ok(marks.into_iter().map(AtomicBool::into_inner).collect())
+}
+
+/// [`self_intersections_wide`], marking as [`narrow_intersections`] does.
+fn wide_intersections(
+    wide: &[[i128; 3]],
+    triangles: &[[u32; 3]],
+    budget: u64,
+    marks: Option<&[AtomicBool]>,
+) -> Result<SelfIntersections, IntersectError> {
     if wide
         .iter()
         .flatten()
@@ -157,7 +191,7 @@ pub fn self_intersections_wide(
     let narrow_bits = MAX_COORDINATE.trailing_zeros();
     if top < narrow_bits {
         let narrow: Vec<P> = wide.iter().map(|p| p.map(|c| c as i64)).collect();
-        return self_intersections(&narrow, triangles, budget);
+        return narrow_intersections(&narrow, triangles, budget, marks);
     }
     check_indices(wide.len(), triangles)?;
     let shift = top - (narrow_bits - 1);
@@ -174,7 +208,7 @@ pub fn self_intersections_wide(
             )
         })
         .collect();
-    count_intersecting_pairs(wide, triangles, &boxes, budget)
+    count_intersecting_pairs(wide, triangles, &boxes, budget, marks)
 }
 
 fn check_indices(points: usize, triangles: &[[u32; 3]]) -> Result<(), IntersectError> {
@@ -187,12 +221,14 @@ fn check_indices(points: usize, triangles: &[[u32; 3]]) -> Result<(), IntersectE
     }
 }
 
-/// The pairs of [`self_intersections`], with each face's box (exact, or rounded outward).
+/// The pairs of [`self_intersections`], with each face's box (exact, or rounded outward),
+/// their faces marked in `marks` when given.
 fn count_intersecting_pairs<T: ExactPoint>(
     points: &[T],
     triangles: &[[u32; 3]],
     boxes: &[(P, P)],
     budget: u64,
+    marks: Option<&[AtomicBool]>,
 ) -> Result<SelfIntersections, IntersectError> {
     let tri = |f: usize| triangles[f].map(|v| points[v as usize]);
     // One grid at the largest extent; by size classes only when that is over the budget.
@@ -231,6 +267,10 @@ fn count_intersecting_pairs<T: ExactPoint>(
         acc[1] += 1;
         if faces_intersect(tri(f), tri(g)) {
             acc[0] += 1;
+            if let Some(marks) = marks {
+                marks[f].store(true, Ordering::Relaxed);
+                marks[g].store(true, Ordering::Relaxed);
+            }
         }
     };
     let [pairs, tested_pairs] = grids.pairs_of_cells(|a, b| {

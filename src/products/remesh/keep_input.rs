@@ -178,12 +178,24 @@ pub enum InputCheck {
         /// Faces split at a T-junction.
         split_faces: usize,
     },
+    /// Some of the input's components were kept as they are and the rest remeshed
+    /// ([`super::keep_parts`]), as the whole was not kept, for `why`.
+    PartlyKept {
+        /// Components kept.
+        kept_components: usize,
+        /// The input's components.
+        components: usize,
+        /// Faces kept.
+        kept_faces: usize,
+        /// Why the whole input was not kept.
+        why: NotKept,
+    },
     /// The input was remeshed, for this reason.
     Remeshed(NotKept),
 }
 
 impl InputCheck {
-    /// Whether the input was kept.
+    /// Whether the input was kept whole.
     pub fn is_kept(&self) -> bool {
         matches!(self, InputCheck::Kept { .. })
     }
@@ -268,34 +280,7 @@ pub fn keep_input(
         }
         (positions, fixed, triangles)
     };
-    // Distinct vertices at one position would pass the topology (different indices) and the
-    // intersection test (coincident positions count as shared) while pinching the surface.
-    let mut sorted = fixed.clone();
-    sorted.par_sort_unstable();
-    let coincident = sorted.windows(2).filter(|w| w[0] == w[1]).count();
-    if coincident > 0 {
-        return Err(NotKept::CoincidentVertices {
-            vertices: coincident,
-        });
-    }
-    // The report's budget: linear on evenly sized faces, refused when it would not be.
-    let budget = 1000 * triangles.len() as u64 + 1_000_000;
-    let si = self_intersections_wide(&fixed, &triangles, budget).map_err(|e| match e {
-        IntersectError::TooManyCandidates { .. } => NotKept::UnevenFaces,
-        IntersectError::CoordinateTooLarge { .. }
-        | IntersectError::CoordinateSpan
-        | IntersectError::BadIndex { .. } => NotKept::CoordinateRange,
-    })?;
-    debug_assert_eq!(
-        si.degenerate_faces, 0,
-        "the repair took zero-area faces out"
-    );
-    if si.pairs > 0 {
-        return Err(NotKept::SelfIntersecting { pairs: si.pairs });
-    }
-    let surface =
-        Mesh::from_slices(&positions, &triangles).map_err(|_| NotKept::CoordinateRange)?;
-    check_winding(&surface, &fixed)?;
+    bounds_its_solid(&positions, &fixed, &triangles)?;
     Ok(Remeshed {
         positions,
         triangles,
@@ -313,8 +298,56 @@ pub fn keep_input(
     })
 }
 
+/// Steps 2 and 3 of the module documentation on a surface that passed step 1 (with no
+/// zero-area face), with its vertices' exact fixed-point coordinates `fixed`: no two at one
+/// position, no self-intersection, and `w = 0` in front of every face and `1` behind.
+pub(super) fn bounds_its_solid(
+    positions: &[[f64; 3]],
+    fixed: &[[i128; 3]],
+    triangles: &[[u32; 3]],
+) -> Result<(), NotKept> {
+    // Distinct vertices at one position would pass the topology (different indices) and the
+    // intersection test (coincident positions count as shared) while pinching the surface.
+    let mut sorted = fixed.to_vec();
+    sorted.par_sort_unstable();
+    let coincident = sorted.windows(2).filter(|w| w[0] == w[1]).count();
+    if coincident > 0 {
+        return Err(NotKept::CoincidentVertices {
+            vertices: coincident,
+        });
+    }
+    // The report's budget: linear on evenly sized faces, refused when it would not be.
+    let si = self_intersections_wide(fixed, triangles, intersection_budget(triangles.len()))
+        .map_err(not_kept_for)?;
+    if si.degenerate_faces > 0 {
+        return Err(NotKept::DegenerateFaces {
+            faces: si.degenerate_faces,
+        });
+    }
+    if si.pairs > 0 {
+        return Err(NotKept::SelfIntersecting { pairs: si.pairs });
+    }
+    let surface = Mesh::from_slices(positions, triangles).map_err(|_| NotKept::CoordinateRange)?;
+    check_winding(&surface, fixed)
+}
+
+/// The candidate pairs the intersection tests may take: linear on evenly sized faces.
+pub(super) fn intersection_budget(faces: usize) -> u64 {
+    1000 * faces as u64 + 1_000_000
+}
+
+/// Why an intersection test that refused keeps nothing.
+pub(super) fn not_kept_for(e: IntersectError) -> NotKept {
+    match e {
+        IntersectError::TooManyCandidates { .. } => NotKept::UnevenFaces,
+        IntersectError::CoordinateTooLarge { .. }
+        | IntersectError::CoordinateSpan
+        | IntersectError::BadIndex { .. } => NotKept::CoordinateRange,
+    }
+}
+
 /// The first reason of step 1 not to keep a mesh with this topology.
-fn topology_problem(topology: &TopologyReport) -> Option<NotKept> {
+pub(super) fn topology_problem(topology: &TopologyReport) -> Option<NotKept> {
     if topology.degenerate_faces > 0 {
         return Some(NotKept::DegenerateFaces {
             faces: topology.degenerate_faces,
@@ -341,7 +374,7 @@ fn topology_problem(topology: &TopologyReport) -> Option<NotKept> {
 
 /// The `values` of the vertices `triangles` refer to, in their order, and the triangles
 /// renumbered to them.
-fn referenced<V: Copy>(values: &[V], triangles: &[[u32; 3]]) -> (Vec<V>, Vec<[u32; 3]>) {
+pub(super) fn referenced<V: Copy>(values: &[V], triangles: &[[u32; 3]]) -> (Vec<V>, Vec<[u32; 3]>) {
     let mut index = vec![u32::MAX; values.len()];
     for &v in triangles.iter().flatten() {
         index[v as usize] = 0;
@@ -363,40 +396,12 @@ fn referenced<V: Copy>(values: &[V], triangles: &[[u32; 3]]) -> (Vec<V>, Vec<[u3
 /// Step 3 of the module documentation on a closed, manifold, oriented, embedded `surface` with
 /// its exact fixed-point vertices.
 fn check_winding(surface: &Mesh, fixed: &[[i128; 3]]) -> Result<(), NotKept> {
-    let triangles = surface.triangles();
-    let positions = surface.positions();
-    let mut parent: Vec<u32> = (0..positions.len() as u32).collect();
-    for &[a, b, c] in triangles {
-        super::report::union(&mut parent, a, b);
-        super::report::union(&mut parent, b, c);
-    }
-    let roots: Vec<u32> = (0..positions.len() as u32)
-        .map(|v| super::report::find(&mut parent, v))
-        .collect();
-    // Faces by component, and each component's lexicographically largest vertex.
-    let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
-    order.sort_unstable_by_key(|&f| roots[triangles[f as usize][0] as usize]);
     // The evaluator's own perturbation is what step 3 relies on: build it with the defaults
     // (ray `+z`), whatever evaluator the caller remeshes with.
     let wn = WindingNumber::new(surface).map_err(|_| NotKept::CoordinateRange)?;
-    let lex = |v: u32| {
-        let p = positions[v as usize];
-        (p[0], p[1], p[2])
-    };
-    for faces in order.chunk_by(|&f, &g| {
-        roots[triangles[f as usize][0] as usize] == roots[triangles[g as usize][0] as usize]
-    }) {
-        let component = faces.iter().map(|&f| triangles[f as usize]);
-        let top = component
-            .clone()
-            .flatten()
-            .max_by(|&a, &b| lex(a).partial_cmp(&lex(b)).expect("finite coordinates"))
-            .expect("a component has faces");
-        let outside = wn.eval(positions[top as usize]);
-        let orientation = closed_surface_orientation(fixed, component, fixed[top as usize]);
-        // `outside` is an integer (no boundary: χ alone); compare it as one.
-        let outside = outside.round() as i64;
-        if !matches!((outside, orientation), (0, 1) | (1, -1)) {
+    for faces in components(surface.triangles()) {
+        let (outside, orientation) = component_winding(&wn, surface, fixed, &faces);
+        if !winds_right(outside, orientation) {
             return Err(NotKept::Winding {
                 outside,
                 orientation,
@@ -406,9 +411,66 @@ fn check_winding(surface: &Mesh, fixed: &[[i128; 3]]) -> Result<(), NotKept> {
     Ok(())
 }
 
+/// The faces of each connected component (faces sharing a vertex are connected), each list in
+/// increasing order, the lists in the order of their first face.
+pub(super) fn components(triangles: &[[u32; 3]]) -> Vec<Vec<u32>> {
+    let n = triangles
+        .iter()
+        .flatten()
+        .max()
+        .map_or(0, |&v| v as usize + 1);
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    for &[a, b, c] in triangles {
+        super::report::union(&mut parent, a, b);
+        super::report::union(&mut parent, b, c);
+    }
+    let mut slot = vec![u32::MAX; n];
+    let mut lists: Vec<Vec<u32>> = Vec::new();
+    for (f, t) in triangles.iter().enumerate() {
+        let root = super::report::find(&mut parent, t[0]) as usize;
+        if slot[root] == u32::MAX {
+            slot[root] = lists.len() as u32;
+            lists.push(Vec::new());
+        }
+        lists[slot[root] as usize].push(f as u32);
+    }
+    lists
+}
+
+/// `(o, s)` of step 3 for the component of `surface` made of `faces`: `wn` is the exact
+/// evaluator of all of `surface`, `fixed` its vertices' exact coordinates.
+pub(super) fn component_winding(
+    wn: &WindingNumber,
+    surface: &Mesh,
+    fixed: &[[i128; 3]],
+    faces: &[u32],
+) -> (i64, i32) {
+    let (triangles, positions) = (surface.triangles(), surface.positions());
+    let lex = |v: u32| {
+        let p = positions[v as usize];
+        (p[0], p[1], p[2])
+    };
+    let component = faces.iter().map(|&f| triangles[f as usize]);
+    let top = component
+        .clone()
+        .flatten()
+        .max_by(|&a, &b| lex(a).partial_cmp(&lex(b)).expect("finite coordinates"))
+        .expect("a component has faces");
+    // `w` there is an integer (no boundary: χ alone); compare it as one.
+    let outside = wn.eval(positions[top as usize]).round() as i64;
+    let orientation = closed_surface_orientation(fixed, component, fixed[top as usize]);
+    (outside, orientation)
+}
+
+/// Whether a component with `w = outside` just outside it and this orientation is a wall of
+/// `{w > ½}` facing out of it: a solid's outer wall, or a cavity's.
+pub(super) fn winds_right(outside: i64, orientation: i32) -> bool {
+    matches!((outside, orientation), (0, 1) | (1, -1))
+}
+
 /// Triangles of a dense marching cubes on the lattice of spacing `h` around `mesh` (estimated):
 /// twice the lattice edges it crosses, `Σ_faces Σ_k |projected area along k| / (h_i h_j)`.
-fn marching_cubes_faces(mesh: &Mesh, h: [f64; 3]) -> f64 {
+pub(super) fn marching_cubes_faces(mesh: &Mesh, h: [f64; 3]) -> f64 {
     let p = mesh.positions();
     let crossed: f64 = mesh
         .triangles()

@@ -57,6 +57,7 @@ pub mod extract;
 pub mod flatness;
 pub mod intersect;
 pub mod keep_input;
+pub mod keep_parts;
 pub mod lattice;
 pub mod levels;
 pub mod octree;
@@ -462,7 +463,14 @@ pub fn remesh_mesh<E: Evaluator + ?Sized>(
         }
         match kept {
             Ok(out) => return Ok(out),
-            Err(why) => Some(keep_input::InputCheck::Remeshed(why)),
+            Err(why) => {
+                if let Some(out) =
+                    remesh_rest(mesh, guide.is_some(), bounds, options, why, progress)?
+                {
+                    return Ok(out);
+                }
+                Some(keep_input::InputCheck::Remeshed(why))
+            }
         }
     } else {
         None
@@ -470,6 +478,46 @@ pub fn remesh_mesh<E: Evaluator + ?Sized>(
     let mut out = remesh_guided(evaluator, guide, bounds, options, progress)?;
     out.stats.input = not_kept;
     Ok(out)
+}
+
+/// The input's clean components kept and only the rest remeshed ([`keep_parts`]), when the
+/// whole was not kept for `why` and the union is proved; `None` to remesh the whole. The rest is
+/// remeshed with its own exact evaluator (default options) and, when `guided`, itself as the
+/// guide.
+fn remesh_rest(
+    mesh: &crate::Mesh,
+    guided: bool,
+    bounds: BoundingBox,
+    options: &RemeshOptions,
+    why: keep_input::NotKept,
+    progress: &dyn Fn(RemeshPhase),
+) -> Result<Option<Remeshed>, RemeshError> {
+    use keep_input::NotKept;
+    // Too fine, or beyond the exact tests: so are the parts.
+    if matches!(
+        why,
+        NotKept::Empty
+            | NotKept::TooManyFaces { .. }
+            | NotKept::CoordinateRange
+            | NotKept::UnevenFaces
+    ) {
+        return Ok(None);
+    }
+    let Some(parts) = keep_parts::kept_parts(mesh, bounds, options) else {
+        return Ok(None);
+    };
+    let guide = guided.then(|| crossings::SegmentBvh::of_field_mesh(&parts.rest));
+    let rest = remesh_guided(&parts.rest_field, guide.as_ref(), bounds, options, progress)?;
+    let Some(mut out) = keep_parts::merge(&parts, rest) else {
+        return Ok(None);
+    };
+    out.stats.input = Some(keep_input::InputCheck::PartlyKept {
+        kept_components: parts.kept_components,
+        components: parts.components,
+        kept_faces: parts.kept_triangles.len(),
+        why,
+    });
+    Ok(Some(out))
 }
 
 /// The steps of a [`remesh`] run, announced to the progress callback of [`remesh_guided`] as

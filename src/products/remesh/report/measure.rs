@@ -192,7 +192,8 @@ impl RemeshReport {
         // budget only guards against a surprise.
         let budget = 1000 * surface.triangles().len() as u64 + 1_000_000;
         let start = std::time::Instant::now();
-        let intersections = if out.stats.input.is_some_and(|i| i.is_kept()) {
+        // Kept inputs, whole or in part, have their `f64` positions proved, not fixed-point ones.
+        let intersections = if out.fixed.is_empty() {
             self_intersections_of_positions(surface.positions(), surface.triangles(), budget)
         } else {
             self_intersections(&out.fixed, surface.triangles(), budget)
@@ -292,6 +293,18 @@ impl RemeshReport {
                 ("input", json_string("kept")),
                 ("input_zero_area_faces", zero_area_faces.to_string()),
                 ("input_split_faces", split_faces.to_string()),
+            ]),
+            Some(InputCheck::PartlyKept {
+                kept_components,
+                components,
+                kept_faces,
+                why,
+            }) => members.extend([
+                ("input", json_string("partly kept")),
+                ("input_kept_components", kept_components.to_string()),
+                ("input_components", components.to_string()),
+                ("input_kept_faces", kept_faces.to_string()),
+                ("input_not_kept", json_string(&why.to_string())),
             ]),
             Some(InputCheck::Remeshed(why)) => {
                 members.push(("input", json_string("remeshed")));
