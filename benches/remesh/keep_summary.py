@@ -1,6 +1,7 @@
 """Summary of benches/remesh/keep_sweep.sh: per kept input, the check against the remesh of
-the same input (validity, manifold3d, agreement, distance, seconds, the time goal), then the face
-target's estimate against the dense marching-cubes count the remesh reports.
+the same input (validity, manifold3d, agreement, distance, seconds, the time goal), the same for
+inputs kept in part, then the face target's estimate against the dense marching-cubes count the
+remesh reports.
 Usage: python3 benches/remesh/keep_summary.py OUT MESH_DIR"""
 import json, sys, os, glob
 import numpy as np
@@ -19,11 +20,11 @@ except ImportError:
     manifold3d = trimesh = None
 not_kept = {}
 for name, k, r in rows:
-    if k.get('input') == 'remeshed':
+    if k.get('input') in ('remeshed', 'partly kept'):
         reason = k.get('input_not_kept', '').split(' (')[0]
         not_kept[reason] = not_kept.get(reason, 0) + 1
 for reason, n in sorted(not_kept.items(), key=lambda x: -x[1]):
-    print(f"  remeshed: {n:3d}  {reason}")
+    print(f"  not kept whole: {n:3d}  {reason}")
 goal_k = goal_r = 0
 tot_k = tot_r = 0.0
 for name, k, r in rows:
@@ -45,6 +46,16 @@ for name, k, r in rows:
           f"haus {k.get('hausdorff_boundary_cells', float('nan')):.2e} / {r.get('hausdorff_boundary_cells', float('nan')) if r else None}  "
           f"out faces {k['faces']} / {r['faces'] if r else None}")
 print(f"sum seconds kept {tot_k:.2f} remesh {tot_r:.2f}; time goal met kept {goal_k} remesh {goal_r}")
+# Inputs whose clean components were kept and the rest remeshed, against --always-remesh.
+partly = [x for x in rows if x[1].get('input') == 'partly kept']
+print(f"partly kept: {len(partly)}")
+for name, k, r in partly:
+    valid = k['closed'] and k['edge_manifold'] and k['vertex_manifold'] and k['oriented'] and k['self_intersections'] == 0
+    print(f"{name:45s} components {k['input_kept_components']}/{k['input_components']} faces kept {k['input_kept_faces']:6d}  "
+          f"seconds {k['seconds']:7.2f} / {r['seconds'] if r else float('nan'):7.2f}  valid {valid}  "
+          f"agree {k.get('occupancy_agreement')} / {r.get('occupancy_agreement') if r else None}  "
+          f"haus {k.get('hausdorff_boundary_cells', float('nan')):.3f} / {r.get('hausdorff_boundary_cells', float('nan')) if r else float('nan'):.3f}  "
+          f"out faces {k['faces']} / {r['faces'] if r else None}")
 # The face estimate of keep_input against the dense marching cubes count the remesh reports.
 if trimesh is None:
     sys.exit(0)

@@ -4,7 +4,8 @@
 /// Feeds `data` to a loader: the first byte selects the format (OBJ, STL, OFF, PLY, detect by
 /// content, query points, or glTF), the rest is the file. Must never panic; a successful load must
 /// give a valid, non-empty mesh whose statistics compute, and which the remesher's exact test of
-/// "already the surface" either keeps as a closed, manifold, oriented surface or refuses.
+/// "already the surface" either keeps as a closed, manifold, oriented surface or refuses (and
+/// then the components it would keep are closed, manifold and oriented).
 pub fn check_load_mesh(data: &[u8]) {
     use gwn::io::{Format, LoadOptions, load_mesh_from_bytes_with, load_points_from_bytes};
     let Some((&selector, body)) = data.split_first() else {
@@ -33,14 +34,21 @@ pub fn check_load_mesh(data: &[u8]) {
             assert_eq!(s.faces, l.mesh.triangles().len());
             if let Some(bounds) = l.mesh.bounding_box() {
                 let options = gwn::products::remesh::RemeshOptions::with_resolution(16);
-                if let Ok(kept) =
-                    gwn::products::remesh::keep_input::keep_input(&l.mesh, bounds, &options)
-                {
-                    let t = gwn::products::remesh::report::TopologyReport::of(
-                        &kept.positions,
-                        &kept.triangles,
-                    );
-                    assert!(t.closed && t.edge_manifold && t.vertex_manifold && t.oriented);
+                use gwn::products::remesh::report::TopologyReport;
+                let valid = |p: &[[f64; 3]], t: &[[u32; 3]]| {
+                    let t = TopologyReport::of(p, t);
+                    t.closed && t.edge_manifold && t.vertex_manifold && t.oriented
+                };
+                match gwn::products::remesh::keep_input::keep_input(&l.mesh, bounds, &options) {
+                    Ok(kept) => assert!(valid(&kept.positions, &kept.triangles)),
+                    // The clean components of what is not kept whole, and the rest.
+                    Err(_) => {
+                        use gwn::products::remesh::keep_parts::kept_parts;
+                        if let Some(parts) = kept_parts(&l.mesh, bounds, &options) {
+                            assert!(valid(&parts.kept_positions, &parts.kept_triangles));
+                            assert!(!parts.rest.triangles().is_empty());
+                        }
+                    }
                 }
             }
         }

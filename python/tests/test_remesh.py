@@ -270,3 +270,18 @@ def test_a_clean_solid_comes_back_as_it_is():
     Vi, Fi, inward = gwn.remesh(CUBE_V, CUBE_F[:, ::-1], res=16, report=True, samples=0)
     assert inward["input"] == "remeshed" and len(Fi) == 0
     assert "w = 0 outside it and -1 inside" in inward["input_not_kept"]
+
+
+def test_clean_parts_are_kept_and_the_rest_remeshed():
+    """A clean cube beside an open box: the cube comes back as it is, the box's solid is
+    remeshed, and the union is proved; the report says which part was kept."""
+    far = CUBE_V + np.array([3.0, 0.2, 0.1])
+    V = np.vstack([far, CUBE_V])
+    F = np.vstack([CUBE_F, OPEN_BOX_F + 8])
+    V2, F2, report = gwn.remesh(V, F, res=24, report=True, samples=2000)
+    assert report["input"] == "partly kept"
+    assert report["input_kept_components"] == 1 and report["input_components"] == 2
+    assert report["input_kept_faces"] == 12 and "open" in report["input_not_kept"]
+    np.testing.assert_array_equal(V2[:8], far)
+    np.testing.assert_array_equal(F2[:12], CUBE_F)
+    assert report["closed"] and report["self_intersections"] == 0 and len(F2) > 12

@@ -23,7 +23,8 @@
 //!    `w = 2`, or `1` on both sides).
 //!
 //! A component that fails 2 or 3 moves to `R` (which changes `w_K` and `w_R`, so the steps run
-//! again until none moves). When 4 fails, the whole input is remeshed.
+//! again until none moves, at most [`MAX_ROUNDS`] times). When 4 fails, the whole input is
+//! remeshed.
 
 use crate::Mesh;
 use crate::base::bounding_box::BoundingBox;
@@ -43,6 +44,11 @@ use super::{RemeshOptions, Remeshed};
 /// `|w_R|` at `K`'s vertices must be below `½ −` this: over the exact evaluator's documented
 /// error on the boundary sum (`1e-10`), so the test is certain.
 pub const REST_FIELD_MARGIN: f64 = 1e-9;
+
+/// Rounds of steps 2 and 3 before giving up: each moves at least one component, and a round
+/// builds two evaluators, so nested failures (a component failing only once its container
+/// moved) are followed this deep.
+pub const MAX_ROUNDS: usize = 8;
 
 /// The split of an input into the components kept and the rest ([`kept_parts`]).
 pub struct KeptParts {
@@ -74,19 +80,25 @@ pub fn kept_parts(mesh: &Mesh, bounds: BoundingBox, options: &RemeshOptions) -> 
     let budget = intersection_budget(triangles.len());
     let triangles = exact_repair::repair(&fixed, &triangles, closed, budget).triangles;
     let parts = components(&triangles);
-    let meets_another = intersecting_faces_wide(&fixed, &triangles, budget).ok()?;
-    // Step 1, per component.
+    // Step 1, per component: the topology first (cheap, and most inputs stop there), then the
+    // intersections of the whole input.
     let faces_of =
         |c: &[u32]| -> Vec<[u32; 3]> { c.iter().map(|&f| triangles[f as usize]).collect() };
     let mut kept: Vec<bool> = parts
         .iter()
         .map(|c| {
             let (p, t) = referenced(&positions, &faces_of(c));
-            c.iter().all(|&f| !meets_another[f as usize])
-                && topology_problem(&TopologyReport::of(&p, &t)).is_none()
+            topology_problem(&TopologyReport::of(&p, &t)).is_none()
         })
         .collect();
-    loop {
+    if !kept.contains(&true) {
+        return None;
+    }
+    let meets_another = intersecting_faces_wide(&fixed, &triangles, budget).ok()?;
+    for (k, c) in kept.iter_mut().zip(&parts) {
+        *k &= c.iter().all(|&f| !meets_another[f as usize]);
+    }
+    for _ in 0..MAX_ROUNDS {
         let select = |keep: bool| -> Vec<[u32; 3]> {
             (parts.iter().zip(&kept))
                 .filter(|&(_, &k)| k == keep)
@@ -151,6 +163,7 @@ pub fn kept_parts(mesh: &Mesh, bounds: BoundingBox, options: &RemeshOptions) -> 
             rest_field,
         });
     }
+    None
 }
 
 /// `K ∪ S` (`rest` is `S`, the remesh of `parts.rest` on the lattice of a remesh of the whole
