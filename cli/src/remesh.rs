@@ -209,21 +209,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
         format!("cells {x:.4e} x {y:.4e} x {z:.4e}")
     };
     match s.input {
-        Some(InputCheck::Kept {
-            zero_area_faces,
-            split_faces,
-        }) => {
+        Some(InputCheck::Kept { repairs }) => {
             // What the kept input lost or gained: faces only, never a position.
-            let repairs = if zero_area_faces + split_faces > 0 {
-                let s = |n: usize| if n == 1 { "" } else { "s" };
-                format!(
-                    ", {zero_area_faces} zero-area face{} left out, {split_faces} face{} split at \
-                     vertices on their edges",
-                    s(zero_area_faces),
-                    s(split_faces)
-                )
-            } else {
+            let repairs = if repairs.is_empty() {
                 String::new()
+            } else {
+                format!(", {repairs}")
             };
             outln!(
                 "{}: the input as it is ({} faces{repairs}, {:.2} s): closed, manifold, oriented, no \

@@ -71,6 +71,7 @@ fn solids_and_their_cavities_are_kept_as_they_are() {
 
 #[test]
 fn zero_area_faces_go_and_t_junctions_are_split_without_moving_a_vertex() {
+    use gwn::products::remesh::exact_repair::RepairCounts;
     use gwn::products::remesh::keep_input::InputCheck;
     let cube = common::unit_cube();
     let input_check = |m: &Mesh| kept(m, 64).map(|o| o.stats.input);
@@ -81,8 +82,11 @@ fn zero_area_faces_go_and_t_junctions_are_split_without_moving_a_vertex() {
             assert_eq!(
                 input_check(&junction),
                 Ok(Some(InputCheck::Kept {
-                    zero_area_faces,
-                    split_faces: 1
+                    repairs: RepairCounts {
+                        zero_area_faces,
+                        cancelled_faces: 0,
+                        split_faces: 1
+                    }
                 })),
                 "face {face}, mode {mode}"
             );
@@ -127,6 +131,58 @@ fn zero_area_faces_go_and_t_junctions_are_split_without_moving_a_vertex() {
     t.push([8, b, c]);
     let cracked = Mesh::new(p, t).unwrap();
     assert!(matches!(kept(&cracked, 64), Err(NotKept::Open { .. })));
+}
+
+#[test]
+fn two_cubes_sharing_a_wall_written_once_for_each_are_one_solid() {
+    use gwn::products::remesh::exact_repair::RepairCounts;
+    use gwn::products::remesh::keep_input::InputCheck;
+    let cube = common::unit_cube();
+    // The cube mirrored across x = 1 (faces turned to stay outward): its wall at x = 1 has the
+    // same two triangles as the cube's, turned the other way. They cancel (w is 1 on both
+    // sides); what is left is the 2 x 1 x 1 box, with coplanar faces.
+    let p: Vec<[f64; 3]> = cube
+        .positions()
+        .iter()
+        .map(|p| [2.0 - p[0], p[1], p[2]])
+        .collect();
+    let mirrored = Mesh::new(p, cube.triangles().to_vec()).unwrap().flipped();
+    let pair = join(&[cube.clone(), mirrored]);
+    let out = kept(&pair, 64).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(
+        out.stats.input,
+        Some(InputCheck::Kept {
+            repairs: RepairCounts {
+                zero_area_faces: 0,
+                cancelled_faces: 4,
+                split_faces: 0
+            }
+        })
+    );
+    assert_eq!((out.triangles.len(), out.positions.len()), (20, 12));
+    let wn = WindingNumber::new(&Mesh::new(out.positions, out.triangles).unwrap()).unwrap();
+    for (q, w) in [
+        ([0.5, 0.5, 0.5], 1.0),
+        ([1.5, 0.3, 0.7], 1.0),
+        ([2.5, 0.5, 0.5], 0.0),
+    ] {
+        assert_eq!(wn.eval(q), w, "{q:?}");
+    }
+    // The same cubes with their shared wall's diagonals crossing: nothing cancels, and its rim
+    // edges are in four faces.
+    let shifted = join(&[cube.clone(), cube.translated([1.0, 0.0, 0.0])]);
+    assert!(matches!(
+        kept(&shifted, 64),
+        Err(NotKept::NotManifold { .. })
+    ));
+    // Twice the same orientation doubles w there: no cancelling.
+    let mut faces = cube.triangles().to_vec();
+    faces.extend([faces[4], faces[4]]);
+    let doubled = Mesh::new(cube.positions().to_vec(), faces).unwrap();
+    assert!(matches!(
+        kept(&doubled, 64),
+        Err(NotKept::NotManifold { .. })
+    ));
 }
 
 #[test]

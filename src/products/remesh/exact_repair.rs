@@ -2,6 +2,8 @@
 //!
 //! - **zero-area faces out**: a face that repeats a vertex, or whose corners are collinear
 //!   (exactly, on the input's own coordinates), spans no solid angle from any point off it;
+//! - **pairs of faces on the same three vertices with opposite orientations out**: their solid
+//!   angles cancel from every point (a wall two touching solids share, written once for each);
 //! - **faces split at the vertices on their boundary edges** (T-junctions): when a vertex `p`
 //!   lies strictly inside the edge `a b` of face `a b c`, the faces `a p c` and `p b c` tile it
 //!   with its orientation (`p − a` is a positive multiple of `b − a`), so every solid angle sum,
@@ -21,16 +23,52 @@ use std::collections::HashMap;
 
 use super::intersect::ExactPoint;
 
+/// What [`repair`] changed: faces only, never a position.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RepairCounts {
+    /// Zero-area faces left out.
+    pub zero_area_faces: usize,
+    /// Faces left out in pairs on the same three vertices with opposite orientations.
+    pub cancelled_faces: usize,
+    /// Faces split at vertices on their boundary edges.
+    pub split_faces: usize,
+}
+
+impl RepairCounts {
+    /// Whether nothing was changed.
+    pub fn is_empty(&self) -> bool {
+        *self == RepairCounts::default()
+    }
+}
+
+impl std::fmt::Display for RepairCounts {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let s = |n: usize| if n == 1 { "" } else { "s" };
+        let parts = [
+            (self.zero_area_faces, "zero-area face{} left out"),
+            (self.cancelled_faces, "face{} cancelled in opposite pairs"),
+            (self.split_faces, "face{} split at vertices on their edges"),
+        ];
+        let mut first = true;
+        for (n, text) in parts {
+            if n > 0 {
+                let sep = if first { "" } else { ", " };
+                write!(f, "{sep}{n} {}", text.replace("{}", s(n)))?;
+                first = false;
+            }
+        }
+        Ok(())
+    }
+}
+
 /// The result of [`repair`].
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Repaired {
-    /// The faces: the input's in their order, zero-area ones left out, split ones replaced by
-    /// their pieces where they were.
+    /// The faces: the input's in their order, zero-area and cancelled ones left out, split ones
+    /// replaced by their pieces where they were.
     pub triangles: Vec<[u32; 3]>,
-    /// Zero-area faces left out.
-    pub zero_area_faces: usize,
-    /// Faces split at vertices on their boundary edges.
-    pub split_faces: usize,
+    /// What changed.
+    pub counts: RepairCounts,
 }
 
 /// `triangles` on the exact `points` without zero-area faces and split at the vertices that lie
@@ -56,10 +94,11 @@ pub fn repair<T: ExactPoint>(
         .copied()
         .collect();
     let zero_area_faces = triangles.len() - kept.len();
-    if closed && zero_area_faces == 0 {
+    let (kept, cancelled_faces) = without_opposite_pairs(kept);
+    if closed && zero_area_faces == 0 && cancelled_faces == 0 {
         return Repaired {
             triangles: kept,
-            ..Repaired::default()
+            counts: RepairCounts::default(),
         };
     }
     // Undirected edges in one face only.
@@ -81,8 +120,11 @@ pub fn repair<T: ExactPoint>(
     if junctions.is_empty() {
         return Repaired {
             triangles: kept,
-            zero_area_faces,
-            split_faces: 0,
+            counts: RepairCounts {
+                zero_area_faces,
+                cancelled_faces,
+                split_faces: 0,
+            },
         };
     }
     let on_edge = |a: u32, b: u32| -> &[u32] {
@@ -99,9 +141,59 @@ pub fn repair<T: ExactPoint>(
     }
     Repaired {
         triangles: out,
-        zero_area_faces,
-        split_faces,
+        counts: RepairCounts {
+            zero_area_faces,
+            cancelled_faces,
+            split_faces,
+        },
     }
+}
+
+/// `triangles` without pairs of faces on the same three vertices with opposite orientations
+/// (their solid angles cancel from every point off them), and how many faces that left out.
+fn without_opposite_pairs(triangles: Vec<[u32; 3]>) -> (Vec<[u32; 3]>, usize) {
+    // A face as its vertices rotated to start at the least, and whether it then runs
+    // `least, lower, higher` (one orientation) or not.
+    let key = |&[a, b, c]: &[u32; 3]| {
+        let r = if a < b && a < c {
+            [a, b, c]
+        } else if b < c {
+            [b, c, a]
+        } else {
+            [c, a, b]
+        };
+        ([r[0], r[1].min(r[2]), r[1].max(r[2])], r[1] < r[2])
+    };
+    let mut count: HashMap<[u32; 3], [usize; 2]> = HashMap::new();
+    for t in &triangles {
+        let (k, up) = key(t);
+        count.entry(k).or_default()[usize::from(up)] += 1;
+    }
+    // Of each set, the first `min(up, down)` faces of each orientation go.
+    let mut left: HashMap<[u32; 3], [usize; 2]> = count
+        .into_iter()
+        .filter(|(_, [d, u])| *d > 0 && *u > 0)
+        .map(|(k, [d, u])| (k, [d.min(u); 2]))
+        .collect();
+    if left.is_empty() {
+        return (triangles, 0);
+    }
+    let before = triangles.len();
+    let kept: Vec<[u32; 3]> = triangles
+        .into_iter()
+        .filter(|t| {
+            let (k, up) = key(t);
+            match left.get_mut(&k) {
+                Some(n) if n[usize::from(up)] > 0 => {
+                    n[usize::from(up)] -= 1;
+                    false
+                }
+                _ => true,
+            }
+        })
+        .collect();
+    let cancelled = before - kept.len();
+    (kept, cancelled)
 }
 
 /// For each boundary edge (as `(min, max)` vertex indices), the boundary vertices strictly
@@ -262,8 +354,8 @@ mod tests {
         let (p, mut t) = capped_cube();
         let plain = repair(&p, &t, false, 1000);
         // Without the cap the front face's edge 0 1 meets 0 8 and 8 1: split there.
-        assert_eq!(plain.zero_area_faces, 0);
-        assert_eq!(plain.split_faces, 1);
+        assert_eq!(plain.counts.zero_area_faces, 0);
+        assert_eq!(plain.counts.split_faces, 1);
         assert_eq!(plain.triangles.len(), t.len() + 1);
         assert!(plain.triangles.contains(&[0, 8, 5]) && plain.triangles.contains(&[8, 1, 5]));
         // With a cap `0 8 1` closing it instead, the cap goes and the same split is made; a
@@ -271,10 +363,10 @@ mod tests {
         t.push([0, 8, 1]);
         t.push([3, 3, 7]);
         let capped = repair(&p, &t, false, 1000);
-        assert_eq!(capped.zero_area_faces, 2);
+        assert_eq!(capped.counts.zero_area_faces, 2);
         assert_eq!(capped.triangles, plain.triangles);
         // Over budget: nothing is split.
-        assert_eq!(repair(&p, &t, false, 0).split_faces, 0);
+        assert_eq!(repair(&p, &t, false, 0).counts.split_faces, 0);
     }
 
     #[test]
@@ -302,7 +394,7 @@ mod tests {
         let mut p = p;
         p.push([20, 20, -10]);
         let r = repair(&p, &t, false, 1000);
-        assert_eq!(r.split_faces, 1);
+        assert_eq!(r.counts.split_faces, 1);
         let pieces: Vec<[u32; 3]> = r
             .triangles
             .iter()

@@ -170,13 +170,10 @@ impl std::fmt::Display for NotKept {
 /// What happened to the input before the lattice ([`RemeshStats::input`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum InputCheck {
-    /// The input is the output ([`keep_input`]), its zero-area faces left out and its faces
-    /// split at the vertices on their edges ([`exact_repair`]).
+    /// The input is the output ([`keep_input`]), after the repairs of [`exact_repair`].
     Kept {
-        /// Zero-area faces left out.
-        zero_area_faces: usize,
-        /// Faces split at a T-junction.
-        split_faces: usize,
+        /// What they changed.
+        repairs: exact_repair::RepairCounts,
     },
     /// Some of the input's components were kept as they are and the rest remeshed
     /// ([`super::keep_parts`]), as the whole was not kept, for `why`.
@@ -266,7 +263,7 @@ pub fn keep_input(
         original.closed,
         1000 * triangles.len() as u64,
     );
-    let (positions, fixed, triangles) = if repaired.zero_area_faces + repaired.split_faces > 0 {
+    let (positions, fixed, triangles) = if !repaired.counts.is_empty() {
         let topology = TopologyReport::of(&positions, &repaired.triangles);
         if let Some(problem) = topology_problem(&topology) {
             return Err(topology_problem(&original).unwrap_or(problem));
@@ -290,8 +287,7 @@ pub fn keep_input(
         cell_sizes: lattice.h,
         stats: RemeshStats {
             input: Some(InputCheck::Kept {
-                zero_area_faces: repaired.zero_area_faces,
-                split_faces: repaired.split_faces,
+                repairs: repaired.counts,
             }),
             ..RemeshStats::default()
         },

@@ -286,13 +286,11 @@ impl RemeshReport {
             ("seconds", format!("{:.3}", self.seconds)),
         ];
         match s.input {
-            Some(InputCheck::Kept {
-                zero_area_faces,
-                split_faces,
-            }) => members.extend([
+            Some(InputCheck::Kept { repairs }) => members.extend([
                 ("input", json_string("kept")),
-                ("input_zero_area_faces", zero_area_faces.to_string()),
-                ("input_split_faces", split_faces.to_string()),
+                ("input_zero_area_faces", repairs.zero_area_faces.to_string()),
+                ("input_cancelled_faces", repairs.cancelled_faces.to_string()),
+                ("input_split_faces", repairs.split_faces.to_string()),
             ]),
             Some(InputCheck::PartlyKept {
                 kept_components,
