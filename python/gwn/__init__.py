@@ -159,13 +159,14 @@ def remesh_dataset(paths, out_dir, res=128, *, root=None, format="ply", samples=
     one output are a ``ValueError`` before anything is written. ``sub_cell_levels`` and
     ``planar_levels`` and ``bisect``: ``None`` for ``gwn remesh``'s defaults. A mesh that already
     is a closed, manifold, oriented surface without self-intersections bounding ``w > 1/2``
-    (exact tests) is written as it is (the row's ``kept``) unless ``always_remesh``.
+    (exact tests) is written as it is (the row's ``kept``) unless ``always_remesh``; otherwise its
+    clean components can be (``kept_faces``: the input's faces written as they are).
 
     ``progress`` as in ``gwn.label_dataset``. Returns the manifest rows (dicts with ``mesh``,
     ``output``, ``status`` in ``ok``/``done``/``failed``/``timeout``, ``error``, ``input`` (the
     kind: ``mesh``, ``point cloud``, ``patch set``, ``STEP model``), ``faces`` (triangles,
     patches or B-rep faces), ``vertices`` (mesh vertices or points), ``output_faces``,
-    ``kept``, ``output_vertices``, ``valid`` (closed, manifold, oriented, no exact
+    ``kept``, ``kept_faces``, ``output_vertices``, ``valid`` (closed, manifold, oriented, no exact
     self-intersection),
     ``components``, ``self_intersections``, ``hausdorff_cells``, ``occupancy_agreement``,
     ``seconds``, ``redone``), in input order. For a cluster, see ``gwn.dask.remesh_dataset``.

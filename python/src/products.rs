@@ -518,8 +518,10 @@ pub fn filter_tets<'py>(
 /// probe of the input finds pay (none on curved inputs), as ``gwn remesh --planar-levels``.
 /// With the exact method, a mesh that already is a closed, manifold, oriented surface without
 /// self-intersections bounding ``w > 1/2`` (proved with exact tests) comes back as it is, when
-/// it has at most the simplification target's faces (the report's ``input`` says ``kept``, or
-/// ``remeshed`` and ``input_not_kept`` why); ``always_remesh=True`` remeshes it anyway, as
+/// it has at most the simplification target's faces (zero-area faces and cancelling pairs left
+/// out, faces split at T-junctions; the report's ``input`` says ``kept``, or ``remeshed`` and
+/// ``input_not_kept`` why); otherwise its clean components can come back as they are with the
+/// rest remeshed (``partly kept``); ``always_remesh=True`` remeshes it all anyway, as
 /// ``gwn remesh --always-remesh``.
 /// ``gwn.remesh(model, res=...)`` remeshes a :class:`StepModel` (``gwn.load("part.step")``)
 /// the way ``gwn remesh part.step`` does: no ``F``, exact method only (``tolerance=`` as in

@@ -164,6 +164,8 @@ fn remesh_dataset_writes_what_gwn_remesh_writes_and_resumes() {
         ["true", "true", "false"]
     );
     assert_eq!(kept[0].stats.get("output_faces").unwrap().to_string(), "12");
+    let kept_faces = |i: usize| kept[i].stats.get("kept_faces").unwrap().to_string();
+    assert_eq!([kept_faces(0), kept_faces(2)], ["12", "0"]);
     assert_eq!(
         std::fs::read(out.join("cube.off.ply")).unwrap(),
         remeshed_by_the_cli(&fixture("cube.off"), 24, dir, &[])

@@ -33,6 +33,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use super::crossings::SegmentBvh;
+use super::keep_input::InputCheck;
 use super::report::{DistanceReference, RemeshReport};
 use super::thicken::{self, MeshField, ThickenedSheets};
 use super::write::{SurfaceFormat, write_surface};
@@ -119,6 +120,7 @@ impl MeshJob for RemeshJob {
         ("faces", "null"),
         ("vertices", "null"),
         ("kept", "null"),
+        ("kept_faces", "null"),
         ("output_faces", "null"),
         ("output_vertices", "null"),
         ("valid", "null"),
@@ -402,6 +404,14 @@ impl RemeshJob {
         write_surface(&mut bytes, self.format, &surface)?;
         let t = report.topology;
         stats.set("kept", out.stats.input.is_some_and(|i| i.is_kept()));
+        // The input's faces in the output as they are: all of a kept input, the components
+        // kept of one kept in part.
+        let kept_faces = match out.stats.input {
+            Some(InputCheck::Kept { .. }) => t.faces,
+            Some(InputCheck::PartlyKept { kept_faces, .. }) => kept_faces,
+            _ => 0,
+        };
+        stats.set("kept_faces", kept_faces);
         stats.set("output_faces", t.faces);
         stats.set("output_vertices", t.vertices);
         let intersections = report.self_intersections.as_ref().ok().map(|r| r.pairs);
