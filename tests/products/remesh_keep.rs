@@ -602,3 +602,78 @@ fn clean_components_are_kept_and_only_the_rest_is_remeshed() {
     );
     assert!(out.triangles.is_empty());
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// Boxes on a grid, each clean, open (no top), inward, or inward and open, free to touch,
+    /// cross or nest: the default remesh (the whole kept, its clean parts kept, or all remeshed)
+    /// is valid, the faces it says it kept are the input's own, and every clean box it kept (at
+    /// least two units thick) has its centre inside the full remesh of the same input too: a
+    /// part is kept only where `w` says its solid is.
+    #[test]
+    fn kept_parts_are_where_the_full_remesh_has_solid(
+        drawn in prop::collection::vec(
+            (([0u8..6, 0u8..6, 0u8..6], [2u8..8, 2u8..8, 2u8..8], 0u8..4), any::<bool>()),
+            2..5,
+        ),
+    ) {
+        use gwn::products::remesh::{crossings::SegmentBvh, keep_input::InputCheck, remesh_mesh};
+        // Half the boxes go inside the one before them, clean, when it has room (a clean box in
+        // an inward one is where keeping it would be wrong).
+        let mut boxes: Vec<([u8; 3], [u8; 3], u8)> = Vec::new();
+        for (b, nest) in drawn {
+            match boxes.last() {
+                Some(&(lo, size, _)) if nest && size.iter().all(|&s| s >= 4) => {
+                    boxes.push((lo.map(|c| c + 1), size.map(|s| s - 2), 0));
+                }
+                _ => boxes.push(b),
+            }
+        }
+        let parts: Vec<Mesh> = boxes
+            .iter()
+            .map(|&(lo, size, kind)| {
+                let hi = std::array::from_fn(|k| f64::from(lo[k] + size[k]));
+                let b = cuboid(lo.map(f64::from), hi, kind >= 2);
+                if kind % 2 == 1 {
+                    Mesh::new(b.positions().to_vec(), b.triangles()[..10].to_vec()).unwrap()
+                } else {
+                    b
+                }
+            })
+            .collect();
+        let mesh = join(&parts);
+        let out = remesh_default(&mesh, 16);
+        assert_valid(&out);
+        let Some(InputCheck::PartlyKept { kept_faces, .. }) = out.stats.input else {
+            return Ok(());
+        };
+        let bits = |p: [f64; 3]| p.map(f64::to_bits);
+        let key = |p: &[[f64; 3]], t: &[u32; 3]| {
+            let mut k = t.map(|v| bits(p[v as usize]));
+            k.sort_unstable();
+            k
+        };
+        let input: std::collections::HashSet<[[u64; 3]; 3]> =
+            mesh.triangles().iter().map(|t| key(mesh.positions(), t)).collect();
+        let kept: std::collections::HashSet<[[u64; 3]; 3]> = out.triangles[..kept_faces]
+            .iter()
+            .map(|t| key(&out.positions, t))
+            .collect();
+        prop_assert!(kept.is_subset(&input));
+        // The full remesh of the same input, without keeping anything.
+        let wn = WindingNumber::new(&mesh).unwrap();
+        let guide = SegmentBvh::of_field_mesh(&mesh);
+        let options = RemeshOptions::with_resolution(16);
+        let bounds = mesh.bounding_box().unwrap();
+        let full = remesh_mesh(&mesh, false, &wn, Some(&guide), bounds, &options, &|_| {}).unwrap();
+        let full = WindingNumber::new(&Mesh::new(full.positions, full.triangles).unwrap()).unwrap();
+        for (b, part) in boxes.iter().zip(&parts) {
+            let whole = part.triangles().iter().all(|t| kept.contains(&key(part.positions(), t)));
+            if b.2 == 0 && whole && b.1.iter().all(|&s| s >= 2) {
+                let centre = std::array::from_fn(|k| f64::from(b.0[k]) + f64::from(b.1[k]) / 2.0);
+                prop_assert_eq!(full.eval(centre), 1.0, "box {:?}", b);
+            }
+        }
+    }
+}
