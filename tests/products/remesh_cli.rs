@@ -2,6 +2,26 @@
 
 use crate::cli::gwn;
 
+/// `gwn remesh INPUT --res RES --out OUT [--report REPORT] --samples SAMPLES EXTRA...`: whether
+/// it succeeded, its stdout and its stderr.
+fn remesh(
+    input: &std::path::Path,
+    res: &str,
+    out: &std::path::Path,
+    report: Option<&std::path::Path>,
+    samples: &str,
+    extra: &[&str],
+) -> (bool, String, String) {
+    let mut args = vec!["remesh", input.to_str().unwrap(), "--res", res];
+    args.extend(["--out", out.to_str().unwrap()]);
+    if let Some(report) = report {
+        args.extend(["--report", report.to_str().unwrap()]);
+    }
+    args.extend(["--samples", samples]);
+    args.extend(extra);
+    gwn(&args)
+}
+
 #[test]
 fn remesh_writes_every_format_and_a_report() {
     let dir = std::env::temp_dir().join(format!("gwn-cli-remesh-{}", std::process::id()));
@@ -12,20 +32,15 @@ fn remesh_writes_every_format_and_a_report() {
     for ext in ["obj", "ply", "stl", "glb"] {
         let out = dir.join(format!("out.{ext}"));
         let report = dir.join(format!("report-{ext}.json"));
-        let (ok, stdout, stderr) = gwn(&[
-            "remesh",
-            input.to_str().unwrap(),
-            "--res",
+        // The cube already is its own answer (below): the remesher's path here.
+        let (ok, stdout, stderr) = remesh(
+            &input,
             "20",
-            "--out",
-            out.to_str().unwrap(),
-            "--report",
-            report.to_str().unwrap(),
-            "--samples",
+            &out,
+            Some(&report),
             "2000",
-            // The cube already is its own answer (below): the remesher's path here.
-            "--always-remesh",
-        ]);
+            &["--always-remesh"],
+        );
         assert!(ok, "{stderr}");
         assert!(stdout.contains("closed: yes") && stdout.contains("Euler characteristic 2"));
         assert!(stdout.contains("to the input where it bounds the solid (w > 1/2 on one side only: 100.0 % of its samples)"), "{stdout}");
@@ -64,18 +79,7 @@ fn remesh_writes_every_format_and_a_report() {
     // Without --always-remesh the clean cube is written as it is, and the report says so.
     let out = dir.join("kept.obj");
     let report = dir.join("kept.json");
-    let (ok, stdout, stderr) = gwn(&[
-        "remesh",
-        input.to_str().unwrap(),
-        "--res",
-        "20",
-        "--out",
-        out.to_str().unwrap(),
-        "--report",
-        report.to_str().unwrap(),
-        "--samples",
-        "2000",
-    ]);
+    let (ok, stdout, stderr) = remesh(&input, "20", &out, Some(&report), "2000", &[]);
     assert!(ok, "{stderr}");
     assert!(stdout.contains("the input as it is (12 faces"), "{stdout}");
     assert!(
@@ -102,18 +106,7 @@ fn remesh_writes_every_format_and_a_report() {
     t.extend([[8, b, c], [a, b, 8]]);
     let with_cap = gwn::Mesh::new(p.clone(), t).unwrap();
     gwn::mesh::write_obj(std::fs::File::create(&capped).unwrap(), &with_cap).unwrap();
-    let (ok, stdout, stderr) = gwn(&[
-        "remesh",
-        capped.to_str().unwrap(),
-        "--res",
-        "20",
-        "--out",
-        out.to_str().unwrap(),
-        "--report",
-        report.to_str().unwrap(),
-        "--samples",
-        "2000",
-    ]);
+    let (ok, stdout, stderr) = remesh(&capped, "20", &out, Some(&report), "2000", &[]);
     assert!(ok, "{stderr}");
     assert!(
         stdout.contains(
@@ -128,17 +121,7 @@ fn remesh_writes_every_format_and_a_report() {
     let back = gwn::io::load_mesh(&out).unwrap().mesh;
     assert_eq!(back.positions(), p.as_slice());
     // With --no-weld the exact method's boundary is by index: not tried.
-    let (ok, stdout, stderr) = gwn(&[
-        "remesh",
-        input.to_str().unwrap(),
-        "--res",
-        "12",
-        "--out",
-        out.to_str().unwrap(),
-        "--samples",
-        "0",
-        "--no-weld",
-    ]);
+    let (ok, stdout, stderr) = remesh(&input, "12", &out, None, "0", &["--no-weld"]);
     assert!(ok, "{stderr}");
     assert!(
         !stdout.contains("the input as it is") && !stdout.contains("not kept"),
@@ -151,18 +134,7 @@ fn remesh_writes_every_format_and_a_report() {
         &gwn::testing::unit_cube(true),
     )
     .unwrap();
-    let (ok, stdout, stderr) = gwn(&[
-        "remesh",
-        open.to_str().unwrap(),
-        "--res",
-        "12",
-        "--out",
-        out.to_str().unwrap(),
-        "--report",
-        report.to_str().unwrap(),
-        "--samples",
-        "0",
-    ]);
+    let (ok, stdout, stderr) = remesh(&open, "12", &out, Some(&report), "0", &[]);
     assert!(ok, "{stderr}");
     assert!(
         stdout.contains("remeshed: the input is not kept as it is: it is open (4 boundary edges)"),

@@ -315,37 +315,19 @@ mod tests {
 
     type P = [i64; 3];
 
-    /// A unit cube (outward) with its front bottom edge's cap: the face `0 1 2` of the bottom is
-    /// replaced by `0 8 2`, `8 1 2` on one side and a zero-area cap `0 1 8` fills the other.
+    /// A cube of edge 2 (outward) whose bottom face `0 2 1` is split at `8`, the midpoint of its
+    /// front edge `1 0`, while the front face `0 1 5` across that edge is not: a T-junction.
     fn capped_cube() -> (Vec<P>, Vec<[u32; 3]>) {
-        let s = 2;
-        let p: Vec<P> = vec![
-            [0, 0, 0],
-            [s, 0, 0],
-            [s, s, 0],
-            [0, s, 0],
-            [0, 0, s],
-            [s, 0, s],
-            [s, s, s],
-            [0, s, s],
-            [1, 0, 0],
-        ];
-        let t = vec![
-            [0, 2, 8],
-            [8, 2, 1],
-            [0, 3, 2],
-            // The front face, `0 1 5 4`, split at 8 on its bottom edge only on the other side.
-            [0, 1, 5],
-            [0, 5, 4],
-            [1, 2, 6],
-            [1, 6, 5],
-            [2, 3, 7],
-            [2, 7, 6],
-            [3, 0, 4],
-            [3, 4, 7],
-            [4, 5, 6],
-            [4, 6, 7],
-        ];
+        let unit = crate::testing::unit_cube(false);
+        let mut p: Vec<P> = unit
+            .positions()
+            .iter()
+            .map(|v| v.map(|c| 2 * c as i64))
+            .collect();
+        p.push([1, 0, 0]);
+        let mut t = unit.triangles().to_vec();
+        assert_eq!(t[0], [0, 2, 1]);
+        t.splice(0..1, [[0, 2, 8], [8, 2, 1]]);
         (p, t)
     }
 
