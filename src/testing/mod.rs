@@ -62,6 +62,18 @@ pub fn exact_evaluator(mesh: &Mesh, ray: RayAxis) -> Result<WindingNumber, Build
     )
 }
 
+/// The octahedron's 8 outward faces over the corners `+x, −x, +y, −y, +z, −z` (in that order).
+pub const OCTAHEDRON_FACES: [[u32; 3]; 8] = [
+    [0, 2, 4],
+    [2, 1, 4],
+    [1, 3, 4],
+    [3, 0, 4],
+    [2, 0, 5],
+    [1, 2, 5],
+    [3, 1, 5],
+    [0, 3, 5],
+];
+
 /// The unit cube `[0, 1]³` as 12 outward-oriented triangles with the top face (`z = 1`) last:
 /// `unit_cube(false)` is closed (`w = 1` inside, 0 outside); `unit_cube(true)` lacks the top face
 /// (open, `w = 5/6` at the centre, where the missing face subtends a sixth of the sphere).

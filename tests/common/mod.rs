@@ -13,17 +13,7 @@ pub fn open_cube() -> Mesh {
     gwn::testing::unit_cube(true)
 }
 
-/// The octahedron's 8 outward faces over the corners `+x, −x, +y, −y, +z, −z` (in that order).
-pub const OCTAHEDRON_FACES: [[u32; 3]; 8] = [
-    [0, 2, 4],
-    [2, 1, 4],
-    [1, 3, 4],
-    [3, 0, 4],
-    [2, 0, 5],
-    [1, 2, 5],
-    [3, 1, 5],
-    [0, 3, 5],
-];
+pub use gwn::testing::OCTAHEDRON_FACES;
 
 /// The repository's root, the `gwn` package's directory (`tests/cli` and `tests/products` belong
 /// to the `gwn-cli` package in `cli/`, whose manifest directory is one below).

@@ -2,6 +2,11 @@
 
 use crate::cli::gwn;
 
+/// Writes `mesh` as OBJ at `path`.
+fn write_obj_file(path: &std::path::Path, mesh: &gwn::Mesh) {
+    gwn::mesh::write_obj(std::fs::File::create(path).unwrap(), mesh).unwrap();
+}
+
 /// `gwn remesh INPUT --res RES --out OUT [--report REPORT] --samples SAMPLES EXTRA...`: whether
 /// it succeeded, its stdout and its stderr.
 fn remesh(
@@ -28,7 +33,7 @@ fn remesh_writes_every_format_and_a_report() {
     std::fs::create_dir_all(&dir).unwrap();
     let input = dir.join("cube.obj");
     let cube = gwn::testing::unit_cube(false);
-    gwn::mesh::write_obj(std::fs::File::create(&input).unwrap(), &cube).unwrap();
+    write_obj_file(&input, &cube);
     for ext in ["obj", "ply", "stl", "glb"] {
         let out = dir.join(format!("out.{ext}"));
         let report = dir.join(format!("report-{ext}.json"));
@@ -105,7 +110,7 @@ fn remesh_writes_every_format_and_a_report() {
     t[1] = [a, 8, c];
     t.extend([[8, b, c], [a, b, 8]]);
     let with_cap = gwn::Mesh::new(p.clone(), t).unwrap();
-    gwn::mesh::write_obj(std::fs::File::create(&capped).unwrap(), &with_cap).unwrap();
+    write_obj_file(&capped, &with_cap);
     let (ok, stdout, stderr) = remesh(&capped, "20", &out, Some(&report), "2000", &[]);
     assert!(ok, "{stderr}");
     assert!(
@@ -129,11 +134,7 @@ fn remesh_writes_every_format_and_a_report() {
     );
     // An open box is remeshed, and the report names why.
     let open = dir.join("open.obj");
-    gwn::mesh::write_obj(
-        std::fs::File::create(&open).unwrap(),
-        &gwn::testing::unit_cube(true),
-    )
-    .unwrap();
+    write_obj_file(&open, &gwn::testing::unit_cube(true));
     let (ok, stdout, stderr) = remesh(&open, "12", &out, Some(&report), "0", &[]);
     assert!(ok, "{stderr}");
     assert!(
@@ -155,11 +156,7 @@ fn no_simplify_writes_the_marching_tetrahedra_surface() {
     let dir = std::env::temp_dir().join(format!("gwn-cli-remesh-raw-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let input = dir.join("cube.obj");
-    gwn::mesh::write_obj(
-        std::fs::File::create(&input).unwrap(),
-        &gwn::testing::unit_cube(false),
-    )
-    .unwrap();
+    write_obj_file(&input, &gwn::testing::unit_cube(false));
     let faces = |extra: &[&str]| -> (usize, usize) {
         let out = dir.join("o.ply");
         let report = dir.join("r.json");
@@ -203,11 +200,7 @@ fn remesh_errors_are_one_line() {
     let dir = std::env::temp_dir().join(format!("gwn-cli-remesh-err-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let input = dir.join("cube.obj");
-    gwn::mesh::write_obj(
-        std::fs::File::create(&input).unwrap(),
-        &gwn::testing::unit_cube(false),
-    )
-    .unwrap();
+    write_obj_file(&input, &gwn::testing::unit_cube(false));
     let input = input.to_str().unwrap();
     let out = dir.join("o.obj");
     let out = out.to_str().unwrap();
@@ -456,7 +449,7 @@ fn remesh_reports_the_plate_refinement_and_can_turn_it_off() {
     let mesh = block([40.0, 40.0, 0.0], [60.0, 60.0, 40.0])
         .concatenated(&block([0.0, 0.0, 25.8], [100.0, 100.0, 27.3]))
         .unwrap();
-    gwn::mesh::write_obj(std::fs::File::create(&input).unwrap(), &mesh).unwrap();
+    write_obj_file(&input, &mesh);
     let run = |extra: &[&str]| {
         let (out, report) = (dir.join("o.ply"), dir.join("r.json"));
         let mut args = vec![
@@ -532,7 +525,7 @@ fn remesh_points_closed_unoriented_inputs_to_the_parity_method() {
         .collect();
     let flipped = gwn::Mesh::new(cube.positions().to_vec(), flipped).unwrap();
     let input = dir.join("flipped.obj");
-    gwn::mesh::write_obj(std::fs::File::create(&input).unwrap(), &flipped).unwrap();
+    write_obj_file(&input, &flipped);
     let out = dir.join("out.ply");
     let run = |also: &[&str]| {
         let mut args = vec![
@@ -564,11 +557,7 @@ fn remesh_points_closed_unoriented_inputs_to_the_parity_method() {
         "{stdout}"
     );
     let open = dir.join("open.obj");
-    gwn::mesh::write_obj(
-        std::fs::File::create(&open).unwrap(),
-        &gwn::testing::unit_cube(true),
-    )
-    .unwrap();
+    write_obj_file(&open, &gwn::testing::unit_cube(true));
     let (ok, _, stderr) = gwn(&[
         "remesh",
         open.to_str().unwrap(),

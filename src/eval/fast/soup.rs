@@ -599,17 +599,7 @@ mod tests {
             [0.0, 0.0, 1.0],
             [0.0, 0.0, -1.0],
         ];
-        let t = [
-            [0, 2, 4],
-            [2, 1, 4],
-            [1, 3, 4],
-            [3, 0, 4],
-            [2, 0, 5],
-            [1, 2, 5],
-            [3, 1, 5],
-            [0, 3, 5],
-        ];
-        Mesh::from_slices(&p, &t).unwrap()
+        Mesh::from_slices(&p, &crate::testing::OCTAHEDRON_FACES).unwrap()
     }
 
     /// A sphere-like closed mesh with many triangles (subdivided octahedron).

@@ -724,18 +724,6 @@ mod tests {
 
     const T: [P; 3] = [[0, 0, 0], [10, 0, 0], [0, 10, 0]];
 
-    /// The octahedron's outward faces over the corners `+x, −x, +y, −y, +z, −z`.
-    const OCTAHEDRON: [[u32; 3]; 8] = [
-        [0, 2, 4],
-        [2, 1, 4],
-        [1, 3, 4],
-        [3, 0, 4],
-        [2, 0, 5],
-        [1, 2, 5],
-        [3, 1, 5],
-        [0, 3, 5],
-    ];
-
     #[test]
     fn piercing_and_separate() {
         // A vertical triangle through T's interior.
@@ -896,7 +884,7 @@ mod tests {
             [0.0, 0.0, 1.0],
             [0.0, tiny, -1.0],
         ];
-        let f = OCTAHEDRON;
+        let f = crate::testing::OCTAHEDRON_FACES;
         let r = self_intersections_of_positions(&p, &f, u64::MAX).unwrap();
         assert_eq!((r.pairs, r.degenerate_faces), (0, 0));
         let mut p2 = p.to_vec();
@@ -933,7 +921,7 @@ mod tests {
             [0, 0, 10],
             [0, 0, -10],
         ];
-        let f = OCTAHEDRON;
+        let f = crate::testing::OCTAHEDRON_FACES;
         let r = self_intersections(&p, &f, u64::MAX).unwrap();
         assert_eq!((r.pairs, r.degenerate_faces), (0, 0));
         let mut p2 = p.to_vec();
