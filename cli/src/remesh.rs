@@ -193,7 +193,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     )
     .map_err(|e| CliError::msg(format!("--samples: {e}")))?;
     report.seconds = secs;
-    let kept = out.stats.input.is_some_and(|i| i.is_kept());
+    let kept = out.stats.input.is_some_and(|i| i.is_input_surface());
     report.phase_seconds = (!kept).then_some(phase_seconds);
     report.thicken = thickened.as_ref().map(|t| t.eps());
     drop(curved_surface);
@@ -220,6 +220,27 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 "{}: the input as it is ({} faces{repairs}, {:.2} s): closed, manifold, oriented, no \
                  self-intersection (exact) and the boundary of w > 1/2 (--always-remesh remeshes \
                  it at res {})",
+                args.out.display(),
+                topology.faces,
+                secs,
+                args.res
+            )?;
+            outln!("{topology}")?;
+        }
+        Some(InputCheck::Cut {
+            repairs,
+            cut,
+            uncut_faces,
+        }) => {
+            let repairs = if repairs.is_empty() {
+                String::new()
+            } else {
+                format!("; {repairs}")
+            };
+            outln!(
+                "{}: the input cut at its self-intersections ({cut}{repairs}; {} faces, {uncut_faces} \
+                 of them the input's, {:.2} s): closed, manifold, oriented, no self-intersection \
+                 (exact) and the boundary of w > 1/2 (--always-remesh remeshes it at res {})",
                 args.out.display(),
                 topology.faces,
                 secs,

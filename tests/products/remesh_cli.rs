@@ -379,6 +379,32 @@ fn remesh_keeps_a_printer_plate_thinner_than_a_cube_cell() {
     assert!(agreement >= 0.99, "agreement {agreement}");
 }
 
+/// Closed inputs whose parts pass through each other are cut along their intersections, not
+/// remeshed (the shared corpus: `cgal-bull.off`, 3 pairs of faces folded through each other at a
+/// shared vertex; `cgal-camel.off`, 20 pairs, two of whose patches are pieces of cut faces
+/// only). The output is the input's solid exactly (every sample agrees), and its faces the
+/// input's but for the cut ones.
+#[test]
+fn remesh_cuts_closed_inputs_along_their_self_intersections() {
+    for (name, pairs, faces) in [
+        ("cgal-bull.off", 3.0, 12396.0),
+        ("cgal-camel.off", 20.0, 19536.0),
+    ] {
+        let Some(input) = crate::common::shared_file(&format!("meshes/{name}")) else {
+            return;
+        };
+        let json = remesh_report(&input, "256", "20000", &["\"input\": \"cut\""]);
+        assert_eq!(
+            report_number(&json, "input_intersecting_pairs"),
+            pairs,
+            "{json}"
+        );
+        assert_eq!(report_number(&json, "occupancy_agreement"), 1.0, "{json}");
+        let kept = report_number(&json, "input_kept_faces");
+        assert!(kept > faces - 100.0 && kept < faces, "{json}");
+    }
+}
+
 /// Runs `gwn remesh INPUT --res RES --samples SAMPLES` and returns its JSON report, after
 /// checking that the run succeeded and that the report says closed, manifold, oriented, one
 /// component, no self-intersection, and every member of `also`.

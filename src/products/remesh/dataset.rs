@@ -409,6 +409,7 @@ impl RemeshJob {
         let kept_faces = match out.stats.input {
             Some(InputCheck::Kept { .. }) => t.faces,
             Some(InputCheck::PartlyKept { kept_faces, .. }) => kept_faces,
+            Some(InputCheck::Cut { uncut_faces, .. }) => uncut_faces,
             _ => 0,
         };
         stats.set("kept_faces", kept_faces);

@@ -94,6 +94,9 @@ impl std::error::Error for IntersectError {}
 
 type P = [i64; 3];
 
+/// What the tests call with each intersecting pair of faces.
+type OnPair<'a> = dyn Fn(u32, u32) + Sync + 'a;
+
 /// Counts the self-intersecting face pairs of `triangles` over the exact integer `points`,
 /// testing at most `budget` candidate pairs (grid neighbours, before the box test).
 pub fn self_intersections(
@@ -104,13 +107,12 @@ pub fn self_intersections(
     narrow_intersections(points, triangles, budget, None)
 }
 
-/// [`self_intersections`], marking the faces of every intersecting pair in `marks` (one per
-/// face) when given.
+/// [`self_intersections`], calling `on_pair` with every intersecting pair when given.
 fn narrow_intersections(
     points: &[P],
     triangles: &[[u32; 3]],
     budget: u64,
-    marks: Option<&[AtomicBool]>,
+    on_pair: Option<&OnPair<'_>>,
 ) -> Result<SelfIntersections, IntersectError> {
     if let Some(vertex) = points
         .iter()
@@ -129,7 +131,7 @@ fn narrow_intersections(
             )
         })
         .collect();
-    count_intersecting_pairs(points, triangles, &boxes, budget, marks)
+    count_intersecting_pairs(points, triangles, &boxes, budget, on_pair)
 }
 
 /// [`self_intersections`] of a surface with `f64` vertices, exact on those very coordinates
@@ -164,8 +166,37 @@ pub fn intersecting_faces_wide(
     budget: u64,
 ) -> Result<Vec<bool>, IntersectError> {
     let marks: Vec<AtomicBool> = triangles.iter().map(|_| AtomicBool::new(false)).collect();
-    wide_intersections(wide, triangles, budget, Some(&marks))?;
+    let mark = |f: u32, g: u32| {
+        marks[f as usize].store(true, Ordering::Relaxed);
+        marks[g as usize].store(true, Ordering::Relaxed);
+    };
+    wide_intersections(wide, triangles, budget, Some(&mark))?;
     Ok(marks.into_iter().map(AtomicBool::into_inner).collect())
+}
+
+/// The pairs of faces of [`self_intersections_wide`]'s surface that meet outside what they
+/// share (each as `(f, g)` with `f < g`, in increasing order), or `Ok(None)` when there are
+/// more than `max_pairs`.
+pub fn intersecting_pairs_wide(
+    wide: &[[i128; 3]],
+    triangles: &[[u32; 3]],
+    budget: u64,
+    max_pairs: usize,
+) -> Result<Option<Vec<(u32, u32)>>, IntersectError> {
+    let pairs = std::sync::Mutex::new(Vec::new());
+    let collect = |f: u32, g: u32| {
+        let mut pairs = pairs.lock().unwrap_or_else(|e| e.into_inner());
+        if pairs.len() <= max_pairs {
+            pairs.push((f.min(g), f.max(g)));
+        }
+    };
+    wide_intersections(wide, triangles, budget, Some(&collect))?;
+    let mut pairs = pairs.into_inner().unwrap_or_else(|e| e.into_inner());
+    if pairs.len() > max_pairs {
+        return Ok(None);
+    }
+    pairs.sort_unstable();
+    Ok(Some(pairs))
 }
 
 /// [`self_intersections_wide`], marking as [`narrow_intersections`] does.
@@ -173,7 +204,7 @@ fn wide_intersections(
     wide: &[[i128; 3]],
     triangles: &[[u32; 3]],
     budget: u64,
-    marks: Option<&[AtomicBool]>,
+    on_pair: Option<&OnPair<'_>>,
 ) -> Result<SelfIntersections, IntersectError> {
     if wide
         .iter()
@@ -191,7 +222,7 @@ fn wide_intersections(
     let narrow_bits = MAX_COORDINATE.trailing_zeros();
     if top < narrow_bits {
         let narrow: Vec<P> = wide.iter().map(|p| p.map(|c| c as i64)).collect();
-        return narrow_intersections(&narrow, triangles, budget, marks);
+        return narrow_intersections(&narrow, triangles, budget, on_pair);
     }
     check_indices(wide.len(), triangles)?;
     let shift = top - (narrow_bits - 1);
@@ -208,7 +239,7 @@ fn wide_intersections(
             )
         })
         .collect();
-    count_intersecting_pairs(wide, triangles, &boxes, budget, marks)
+    count_intersecting_pairs(wide, triangles, &boxes, budget, on_pair)
 }
 
 fn check_indices(points: usize, triangles: &[[u32; 3]]) -> Result<(), IntersectError> {
@@ -222,13 +253,13 @@ fn check_indices(points: usize, triangles: &[[u32; 3]]) -> Result<(), IntersectE
 }
 
 /// The pairs of [`self_intersections`], with each face's box (exact, or rounded outward),
-/// their faces marked in `marks` when given.
+/// `on_pair` called with each when given.
 fn count_intersecting_pairs<T: ExactPoint>(
     points: &[T],
     triangles: &[[u32; 3]],
     boxes: &[(P, P)],
     budget: u64,
-    marks: Option<&[AtomicBool]>,
+    on_pair: Option<&OnPair<'_>>,
 ) -> Result<SelfIntersections, IntersectError> {
     let tri = |f: usize| triangles[f].map(|v| points[v as usize]);
     // One grid at the largest extent; by size classes only when that is over the budget.
@@ -267,9 +298,8 @@ fn count_intersecting_pairs<T: ExactPoint>(
         acc[1] += 1;
         if faces_intersect(tri(f), tri(g)) {
             acc[0] += 1;
-            if let Some(marks) = marks {
-                marks[f].store(true, Ordering::Relaxed);
-                marks[g].store(true, Ordering::Relaxed);
+            if let Some(on_pair) = on_pair {
+                on_pair(f as u32, g as u32);
             }
         }
     };
@@ -610,7 +640,7 @@ pub fn faces_intersect<T: ExactPoint>(s: [T; 3], t: [T; 3]) -> bool {
 }
 
 /// Whether the closed segment `p q` meets the closed (non-degenerate) triangle `t`.
-fn segment_meets_triangle<T: ExactPoint>(p: T, q: T, t: [T; 3]) -> bool {
+pub fn segment_meets_triangle<T: ExactPoint>(p: T, q: T, t: [T; 3]) -> bool {
     let sides = (orient(t[0], t[1], t[2], p), orient(t[0], t[1], t[2], q));
     segment_meets_triangle_on_sides(p, q, t, sides)
 }

@@ -48,6 +48,7 @@ use crate::eval::antipodal::WindingNumber;
 use crate::kernel::predicates::closed_surface_orientation;
 use crate::kernel::quantize::common_fixed_point;
 
+use super::cut_intersections::cut_intersections;
 use super::exact_repair;
 use super::intersect::{self, IntersectError, self_intersections_wide};
 use super::lattice::Lattice;
@@ -100,6 +101,9 @@ pub enum NotKept {
     SelfIntersecting {
         /// Pairs of faces.
         pairs: usize,
+        /// Why the input was not cut along them instead ([`super::cut_intersections`]), when
+        /// that was tried.
+        not_cut: Option<super::cut_intersections::NotCut>,
     },
     /// A component with the wrong winding number around it: nested in another of the same
     /// orientation, or an inward-facing shell outside any solid.
@@ -146,8 +150,12 @@ impl std::fmt::Display for NotKept {
                 f,
                 "its face sizes are too uneven for the intersection test's broad phase"
             ),
-            NotKept::SelfIntersecting { pairs } => {
-                write!(f, "it self-intersects ({pairs} pairs of faces)")
+            NotKept::SelfIntersecting { pairs, not_cut } => {
+                write!(f, "it self-intersects ({pairs} pairs of faces")?;
+                match not_cut {
+                    Some(why) => write!(f, "; not cut along them: {why})"),
+                    None => write!(f, ")"),
+                }
             }
             NotKept::Winding {
                 outside,
@@ -175,6 +183,17 @@ pub enum InputCheck {
         /// What they changed.
         repairs: exact_repair::RepairCounts,
     },
+    /// The input, closed but self-intersecting, was cut along its intersections and kept where
+    /// it bounds `{w > ½}` ([`super::cut_intersections`]), after the repairs of
+    /// [`exact_repair`].
+    Cut {
+        /// What the repairs changed.
+        repairs: exact_repair::RepairCounts,
+        /// What the cut did.
+        cut: super::cut_intersections::CutCounts,
+        /// Output faces that are input faces as they were.
+        uncut_faces: usize,
+    },
     /// Some of the input's components were kept as they are and the rest remeshed
     /// ([`super::keep_parts`]), as the whole was not kept, for `why`.
     PartlyKept {
@@ -195,6 +214,12 @@ impl InputCheck {
     /// Whether the input was kept whole.
     pub fn is_kept(&self) -> bool {
         matches!(self, InputCheck::Kept { .. })
+    }
+
+    /// Whether the output is made of the input's own surface, whole or cut at its
+    /// self-intersections, without a lattice.
+    pub fn is_input_surface(&self) -> bool {
+        matches!(self, InputCheck::Kept { .. } | InputCheck::Cut { .. })
     }
 }
 
@@ -277,7 +302,31 @@ pub fn keep_input(
         }
         (positions, fixed, triangles)
     };
-    bounds_its_solid(&positions, &fixed, &triangles)?;
+    let (positions, triangles, input) = match bounds_its_solid(&positions, &fixed, &triangles) {
+        Ok(()) => (
+            positions,
+            triangles,
+            InputCheck::Kept {
+                repairs: repaired.counts,
+            },
+        ),
+        // Overlapping shells: their union, cut out of them, when that is provably the answer.
+        Err(NotKept::SelfIntersecting { pairs, .. }) => {
+            let cut = cut_intersections(&positions, &fixed, &triangles).map_err(|why| {
+                NotKept::SelfIntersecting {
+                    pairs,
+                    not_cut: Some(why),
+                }
+            })?;
+            let input = InputCheck::Cut {
+                repairs: repaired.counts,
+                cut: cut.counts,
+                uncut_faces: cut.uncut_faces,
+            };
+            (cut.positions, cut.triangles, input)
+        }
+        Err(e) => return Err(e),
+    };
     Ok(Remeshed {
         positions,
         triangles,
@@ -286,9 +335,7 @@ pub fn keep_input(
         cell_size: lattice.largest_cell(),
         cell_sizes: lattice.h,
         stats: RemeshStats {
-            input: Some(InputCheck::Kept {
-                repairs: repaired.counts,
-            }),
+            input: Some(input),
             ..RemeshStats::default()
         },
     })
@@ -321,7 +368,10 @@ pub(super) fn bounds_its_solid(
         });
     }
     if si.pairs > 0 {
-        return Err(NotKept::SelfIntersecting { pairs: si.pairs });
+        return Err(NotKept::SelfIntersecting {
+            pairs: si.pairs,
+            not_cut: None,
+        });
     }
     let surface = Mesh::from_slices(positions, triangles).map_err(|_| NotKept::CoordinateRange)?;
     check_winding(&surface, fixed)

@@ -50,6 +50,7 @@
 //! ```
 
 pub mod crossings;
+pub mod cut_intersections;
 pub mod dataset;
 mod deadline;
 pub mod exact_repair;

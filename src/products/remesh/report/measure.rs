@@ -292,6 +292,24 @@ impl RemeshReport {
                 ("input_cancelled_faces", repairs.cancelled_faces.to_string()),
                 ("input_split_faces", repairs.split_faces.to_string()),
             ]),
+            Some(InputCheck::Cut {
+                repairs,
+                cut,
+                uncut_faces,
+            }) => members.extend([
+                ("input", json_string("cut")),
+                ("input_zero_area_faces", repairs.zero_area_faces.to_string()),
+                ("input_cancelled_faces", repairs.cancelled_faces.to_string()),
+                ("input_split_faces", repairs.split_faces.to_string()),
+                (
+                    "input_intersecting_pairs",
+                    cut.intersecting_pairs.to_string(),
+                ),
+                ("input_cut_faces", cut.cut_faces.to_string()),
+                ("input_new_vertices", cut.new_vertices.to_string()),
+                ("input_removed_faces", cut.removed_faces.to_string()),
+                ("input_kept_faces", uncut_faces.to_string()),
+            ]),
             Some(InputCheck::PartlyKept {
                 kept_components,
                 components,

@@ -1,0 +1,767 @@
+//! A closed input that only fails [`super::keep_input`] by self-intersecting, cut along its
+//! intersections and kept where it bounds `{w > ½}`: the union of overlapping shells (a
+//! character's eyes sunk into its head, a model's parts pushed into each other), as a mesh
+//! arrangement gives it, instead of a lattice remesh.
+//!
+//! The input is closed, manifold and oriented, so its `w` is an integer off the surface and
+//! jumps by exactly one, up against the normal, across every face that no other face
+//! overlaps. Then:
+//!
+//! 1. **Cut.** Every intersecting pair of faces (exact, [`intersecting_pairs_wide`]) must meet
+//!    in general position: no shared vertex, not coplanar, no corner on the other face's plane,
+//!    and exactly two edges (of either face) piercing the other face's interior, each with
+//!    exact signs. Their segment joins those two piercing points; a piercing point is named by
+//!    its edge and the face it pierces, so every face through it gets the same vertex. Each cut
+//!    face is triangulated with its segments as constraints (a constrained Delaunay
+//!    triangulation in the plane of its largest normal component, `spade`); its pieces keep its
+//!    orientation.
+//! 2. **Patches.** The pieces and the uncut faces, joined across edges in exactly two faces,
+//!    form patches; the intersection curves (edges in four faces) separate them. Along a patch
+//!    `w` is the same on its front side: moving along it crosses no other surface.
+//! 3. **Labels, exact.** A patch is kept when `w = 0` in front of it (so `1` behind). `w` is
+//!    read at the point `q = a/2 + b/4 + c/4` of one of its uncut faces `a b c`, when that sum is
+//!    exact in `f64` (checked by error-free sums): `q` then lies inside that face and on no
+//!    other, and the exact evaluator answers at `q + (ε1, ε2, ε3)` (docs/robustness.md, section
+//!    4), in front of the face when the first non-zero component of its normal is positive,
+//!    behind it otherwise. A patch without such a face is not labelled (the input is remeshed).
+//! 4. **Proof.** The kept pieces, with the new vertices rounded to `f64`, go through
+//!    [`super::keep_input`]'s steps 1–3 on their own coordinates: closed, manifold, oriented,
+//!    no self-intersection, `w = 0` in front of every face and `1` behind. So the output is
+//!    exactly the boundary of a solid; that solid is the input's up to the rounding of the
+//!    intersection points (each within a few units in the last place of the exact rational
+//!    point).
+//!
+//! Anything outside this (a degenerate contact, a triple point that makes two segments of one
+//! face cross, a patch without a certified point, a rounded output that fails step 4) returns
+//! `None`, and the input is remeshed as before.
+
+use std::collections::HashMap;
+
+use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
+
+use crate::Mesh;
+use crate::eval::antipodal::WindingNumber;
+use crate::kernel::quantize::common_fixed_point;
+
+use super::intersect::{self, ExactPoint, intersecting_pairs_wide, segment_meets_triangle};
+use super::keep_input::{self, NotKept, referenced};
+use super::report::TopologyReport;
+
+/// At most this many intersecting pairs are cut (the corpus has at most 848); more, and the
+/// input is remeshed.
+pub const MAX_CUT_PAIRS: usize = 100_000;
+
+/// Faces of one patch tried for a certified value of `w` before giving up.
+const MAX_LABEL_TRIES: usize = 8;
+
+/// What [`cut_intersections`] did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CutCounts {
+    /// Pairs of faces that met outside what they share.
+    pub intersecting_pairs: usize,
+    /// Faces cut along the intersections.
+    pub cut_faces: usize,
+    /// Faces (uncut, or pieces of cut ones) left out: inside the solid or outside it.
+    pub removed_faces: usize,
+    /// Vertices made where an edge pierces a face.
+    pub new_vertices: usize,
+}
+
+impl std::fmt::Display for CutCounts {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} intersecting face pairs, {} faces cut, {} new vertices, {} faces left out",
+            self.intersecting_pairs, self.cut_faces, self.new_vertices, self.removed_faces
+        )
+    }
+}
+
+/// The cut surface of the module documentation.
+#[derive(Clone, Debug)]
+pub struct CutSurface {
+    /// Vertex positions (the input's, then the piercing points, unreferenced ones dropped).
+    pub positions: Vec<[f64; 3]>,
+    /// Faces: the input's kept faces and the kept pieces of cut ones.
+    pub triangles: Vec<[u32; 3]>,
+    /// Output faces that are input faces as they were.
+    pub uncut_faces: usize,
+    /// What was done.
+    pub counts: CutCounts,
+}
+
+/// Why [`cut_intersections`] made no cut.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NotCut {
+    /// More than [`MAX_CUT_PAIRS`] intersecting pairs, or the broad phase over its budget.
+    TooManyPairs,
+    /// Two intersecting faces share an edge (coplanar, folded onto each other).
+    SharedEdge,
+    /// A corner on the other face's plane, or an edge through the other's edge or corner.
+    NotGeneral,
+    /// Two segments of one face cross (three faces through one point), or a point of the cut
+    /// rounds onto or across an edge of its face, or onto another point.
+    SegmentsCross,
+    /// An edge of the cut surface in other than two or four faces.
+    EdgeUse,
+    /// A patch with no certified value of `w`, and none across a curve.
+    NoCertifiedPoint,
+    /// The patches' values of `w` disagree along an intersection curve.
+    Labels,
+    /// Nothing is left, or the kept pieces, rounded, fail [`super::keep_input`]'s steps 1–3:
+    /// the first that fails.
+    Proof(&'static str),
+}
+
+impl std::fmt::Display for NotCut {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            NotCut::TooManyPairs => write!(f, "too many intersecting pairs to cut"),
+            NotCut::SharedEdge => write!(f, "two intersecting faces share an edge"),
+            NotCut::NotGeneral => write!(f, "two faces touch in a degenerate way"),
+            NotCut::SegmentsCross => {
+                write!(
+                    f,
+                    "intersection segments cross, or round onto an edge, inside a face"
+                )
+            }
+            NotCut::EdgeUse => write!(f, "the cut has edges in other than two or four faces"),
+            NotCut::NoCertifiedPoint => write!(f, "a patch has no certified value of w"),
+            NotCut::Labels => write!(f, "the values of w disagree along an intersection curve"),
+            NotCut::Proof(why) => write!(f, "the cut surface is {why}"),
+        }
+    }
+}
+
+/// A piercing point: the edge (its vertices, smaller first) and the face it pierces.
+type Piercing = ((u32, u32), u32);
+
+/// An end of an intersection segment: a piercing point, or the vertex two faces share.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum End {
+    Pierce(Piercing),
+    Shared(u32),
+}
+
+/// The input (`positions`, their exact fixed-point coordinates `fixed`, `triangles`: closed,
+/// manifold, oriented, no zero-area face) cut along its self-intersections and kept where it
+/// bounds `{w > ½}`, proved as in the module documentation; else why the cut is not made.
+pub fn cut_intersections(
+    positions: &[[f64; 3]],
+    fixed: &[[i128; 3]],
+    triangles: &[[u32; 3]],
+) -> Result<CutSurface, NotCut> {
+    cut_labelling_pieces(positions, fixed, triangles, true)
+}
+
+/// [`cut_intersections`]; with `read_pieces` false, `w` is read on uncut faces only and every
+/// patch of pieces takes its value across a curve (what a patch of slivers does).
+fn cut_labelling_pieces(
+    positions: &[[f64; 3]],
+    fixed: &[[i128; 3]],
+    triangles: &[[u32; 3]],
+    read_pieces: bool,
+) -> Result<CutSurface, NotCut> {
+    let budget = keep_input::intersection_budget(triangles.len());
+    let pairs = intersecting_pairs_wide(fixed, triangles, budget, MAX_CUT_PAIRS)
+        .ok()
+        .flatten()
+        .ok_or(NotCut::TooManyPairs)?;
+    let tri = |f: u32| triangles[f as usize].map(|v| fixed[v as usize]);
+    // Step 1: the segments, and the piercing points' positions.
+    let mut points: HashMap<Piercing, [f64; 3]> = HashMap::new();
+    let mut segments: HashMap<u32, Vec<[End; 2]>> = HashMap::new();
+    for &(f, g) in &pairs {
+        let (tf, tg) = (triangles[f as usize], triangles[g as usize]);
+        let shared: Vec<u32> = tf.iter().copied().filter(|v| tg.contains(v)).collect();
+        let mut ends: Vec<End> = shared.iter().map(|&v| End::Shared(v)).collect();
+        if shared.len() > 1 {
+            return Err(NotCut::SharedEdge);
+        }
+        for (a, b) in [(f, g), (g, f)] {
+            let (ta, tb) = (triangles[a as usize], triangles[b as usize]);
+            // With a shared vertex, only the edge opposite it can pierce the other face: the
+            // other two leave its plane at the shared vertex.
+            let edges = match shared.first() {
+                None => piercings(tri(a), tri(b)),
+                Some(&v) => {
+                    let k = ta.iter().position(|&x| x == v).expect("shared");
+                    opposite_edge_piercing(tri(a), tri(b), k)
+                }
+            }
+            .ok_or(NotCut::NotGeneral)?;
+            for (p, q) in edges {
+                let (u, v) = (ta[p], ta[q]);
+                let key = ((u.min(v), u.max(v)), b);
+                ends.push(End::Pierce(key));
+                points
+                    .entry(key)
+                    .or_insert_with(|| piercing_point(positions, tb, key.0));
+            }
+        }
+        let [s, t] = ends[..] else {
+            return Err(NotCut::NotGeneral);
+        };
+        segments.entry(f).or_default().push([s, t]);
+        segments.entry(g).or_default().push([s, t]);
+    }
+    // New vertices after the input's, in a fixed order (the output does not depend on hashing).
+    let mut keys: Vec<Piercing> = points.keys().copied().collect();
+    keys.sort_unstable();
+    let mut all_positions = positions.to_vec();
+    let mut vertex_of: HashMap<Piercing, u32> = HashMap::with_capacity(keys.len());
+    for key in &keys {
+        vertex_of.insert(*key, all_positions.len() as u32);
+        all_positions.push(points[key]);
+    }
+    let mut cut: Vec<u32> = segments.keys().copied().collect();
+    cut.sort_unstable();
+    let mut faces: Vec<[u32; 3]> = Vec::with_capacity(triangles.len() + 8 * cut.len());
+    let mut uncut: Vec<bool> = Vec::with_capacity(faces.capacity());
+    // The input face each face is (uncut) or is a piece of.
+    let mut origin: Vec<u32> = Vec::with_capacity(faces.capacity());
+    let mut is_cut = vec![false; triangles.len()];
+    for &f in &cut {
+        is_cut[f as usize] = true;
+    }
+    for (f, t) in triangles.iter().enumerate() {
+        if !is_cut[f] {
+            faces.push(*t);
+            uncut.push(true);
+            origin.push(f as u32);
+        }
+    }
+    for &f in &cut {
+        let pieces = pieces_of_face(
+            &all_positions,
+            triangles[f as usize],
+            &segments[&f],
+            &vertex_of,
+        )
+        .ok_or(NotCut::SegmentsCross)?;
+        uncut.extend(pieces.iter().map(|_| false));
+        origin.extend(pieces.iter().map(|_| f));
+        faces.extend(pieces);
+    }
+    // Step 2: patches across edges in exactly two faces; every other edge in four.
+    let mut edge_faces: HashMap<(u32, u32), Vec<u32>> = HashMap::with_capacity(faces.len() * 3);
+    for (i, t) in faces.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            edge_faces
+                .entry((a.min(b), a.max(b)))
+                .or_default()
+                .push(i as u32);
+        }
+    }
+    let mut parent: Vec<u32> = (0..faces.len() as u32).collect();
+    let mut curve_edges: Vec<[u32; 4]> = Vec::new();
+    for list in edge_faces.values() {
+        match list[..] {
+            [x, y] => super::report::union(&mut parent, x, y),
+            [a, b, c, d] => curve_edges.push([a, b, c, d]),
+            _ => return Err(NotCut::EdgeUse),
+        }
+    }
+    curve_edges.sort_unstable();
+    // Step 3: one exact value of `w` per patch.
+    let not_evaluated = NotCut::Proof("beyond the evaluator's range");
+    let input = Mesh::from_slices(positions, triangles).map_err(|_| not_evaluated)?;
+    let wn = WindingNumber::new(&input).map_err(|_| not_evaluated)?;
+    let mut front: HashMap<u32, i64> = HashMap::new();
+    let mut tries: HashMap<u32, usize> = HashMap::new();
+    for i in 0..faces.len() {
+        let root = super::report::find(&mut parent, i as u32);
+        if front.contains_key(&root) || !(read_pieces || uncut[i]) {
+            continue;
+        }
+        // Each try scans the faces near one face: a few per patch.
+        let tried = tries.entry(root).or_default();
+        if *tried == MAX_LABEL_TRIES {
+            continue;
+        }
+        *tried += 1;
+        let (piece, face) = (faces[i], origin[i] as usize);
+        if let Some(w) = front_winding(&wn, &all_positions, positions, triangles, piece, face) {
+            front.insert(root, w);
+        }
+    }
+    // Patches without a certified value (pieces of cut faces only: a lens between two curves,
+    // a corner poking through a face) take one across a curve. Near a curve edge the two faces
+    // through it are two planes, so `w = w0 + [behind A] + [behind B]` there: a piece of one
+    // face on the negative side of the other's plane has `w0 + 1` in front, on the positive
+    // side `w0`. Every labelled piece of the edge must give the same `w0`.
+    let mut sides: Vec<Option<[(u32, i32); 4]>> = Vec::with_capacity(curve_edges.len());
+    for edge in &curve_edges {
+        let mut out = [(0, 0); 4];
+        let mut known = true;
+        for (k, &x) in edge.iter().enumerate() {
+            let other = edge
+                .iter()
+                .find(|&&z| origin[z as usize] != origin[x as usize])
+                .ok_or(NotCut::EdgeUse)?;
+            let plane = triangles[origin[*other as usize] as usize];
+            let root = super::report::find(&mut parent, x);
+            match side_of_plane(&all_positions, faces[x as usize], plane, positions) {
+                Some(side) => out[k] = (root, side),
+                None => known = false,
+            }
+        }
+        sides.push(known.then_some(out));
+    }
+    let mut changed = true;
+    while changed {
+        changed = false;
+        for pieces in sides.iter().flatten() {
+            let behind = |side: i32| i64::from(side < 0);
+            let mut w0 = None;
+            for &(root, side) in pieces {
+                if let Some(&w) = front.get(&root) {
+                    if w0.is_some_and(|w0| w0 != w - behind(side)) {
+                        return Err(NotCut::Labels);
+                    }
+                    w0 = Some(w - behind(side));
+                }
+            }
+            let Some(w0) = w0 else { continue };
+            for &(root, side) in pieces {
+                if let std::collections::hash_map::Entry::Vacant(e) = front.entry(root) {
+                    e.insert(w0 + behind(side));
+                    changed = true;
+                }
+            }
+        }
+    }
+    let mut kept = Vec::with_capacity(faces.len());
+    let mut uncut_faces = 0;
+    for (i, t) in faces.iter().enumerate() {
+        let root = super::report::find(&mut parent, i as u32);
+        if *front.get(&root).ok_or(NotCut::NoCertifiedPoint)? == 0 {
+            kept.push(*t);
+            uncut_faces += usize::from(uncut[i]);
+        }
+    }
+    let removed_faces = faces.len() - kept.len();
+    let (out_positions, out_triangles) = referenced(&all_positions, &kept);
+    // Step 4: the proof, on the rounded coordinates.
+    if out_triangles.is_empty() {
+        return Err(NotCut::Proof("empty"));
+    }
+    let topology = TopologyReport::of(&out_positions, &out_triangles);
+    if let Some(problem) = keep_input::topology_problem(&topology) {
+        return Err(NotCut::Proof(proof_step(problem)));
+    }
+    let bits = intersect::MAX_WIDE_COORDINATE.trailing_zeros();
+    let out_fixed = common_fixed_point(&out_positions, bits)
+        .ok_or(NotCut::Proof("beyond the exact tests' range"))?;
+    keep_input::bounds_its_solid(&out_positions, &out_fixed, &out_triangles)
+        .map_err(|e| NotCut::Proof(proof_step(e)))?;
+    Ok(CutSurface {
+        positions: out_positions,
+        triangles: out_triangles,
+        uncut_faces,
+        counts: CutCounts {
+            intersecting_pairs: pairs.len(),
+            cut_faces: cut.len(),
+            removed_faces,
+            new_vertices: keys.len(),
+        },
+    })
+}
+
+/// What the cut surface is, in [`NotCut::Proof`], when it fails `problem`.
+fn proof_step(problem: NotKept) -> &'static str {
+    match problem {
+        NotKept::Empty => "empty",
+        NotKept::Open { .. } => "open",
+        NotKept::NotManifold { .. } => "not manifold",
+        NotKept::Misoriented { .. } => "not consistently oriented",
+        NotKept::DegenerateFaces { .. } => "made of degenerate faces",
+        NotKept::CoincidentVertices { .. } => "pinched at coincident vertices",
+        NotKept::CoordinateRange | NotKept::UnevenFaces => "beyond the exact tests' range",
+        NotKept::SelfIntersecting { .. } => "self-intersecting after rounding",
+        NotKept::Winding { .. } => "not the boundary of w > 1/2",
+        NotKept::TooManyFaces { .. } => "too fine",
+    }
+}
+
+/// The side of the plane of the input face `plane` that the piece `piece` (of another face)
+/// lies on, `±1`, decided in `f64` at its centroid with a margin of `10⁻⁹` of its size; `None`
+/// within it.
+fn side_of_plane(
+    all_positions: &[[f64; 3]],
+    piece: [u32; 3],
+    plane: [u32; 3],
+    positions: &[[f64; 3]],
+) -> Option<i32> {
+    let [a, b, c] = plane.map(|v| positions[v as usize]);
+    let [x, y, z] = piece.map(|v| all_positions[v as usize]);
+    let sub = |p: [f64; 3], q: [f64; 3]| [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
+    let (e1, e2) = (sub(b, a), sub(c, a));
+    let n = [
+        e1[1] * e2[2] - e1[2] * e2[1],
+        e1[2] * e2[0] - e1[0] * e2[2],
+        e1[0] * e2[1] - e1[1] * e2[0],
+    ];
+    let norm = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    let centroid: [f64; 3] = std::array::from_fn(|k| (x[k] + y[k] + z[k]) / 3.0);
+    let d = sub(centroid, a);
+    let distance = (d[0] * n[0] + d[1] * n[1] + d[2] * n[2]) / norm;
+    let size = [sub(y, x), sub(z, y), sub(x, z)]
+        .iter()
+        .map(|e| (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt())
+        .fold(0.0, f64::max);
+    // NaN (a zero-area plane) fails too.
+    if distance.abs().partial_cmp(&(1e-9 * size)) != Some(std::cmp::Ordering::Greater) {
+        return None;
+    }
+    Some(if distance > 0.0 { 1 } else { -1 })
+}
+
+/// The edges `(p, q)` (corner indices) of `a` that pierce `b` strictly inside; `None` when a
+/// sign is zero (a corner on the other's plane, an edge through an edge of `b`): not in
+/// general position.
+fn piercings<T: ExactPoint>(a: [T; 3], b: [T; 3]) -> Option<Vec<(usize, usize)>> {
+    let side = a.map(|p| T::orient(b[0], b[1], b[2], p));
+    if side.contains(&0) {
+        return None;
+    }
+    let mut out = Vec::with_capacity(2);
+    for p in 0..3 {
+        let q = (p + 1) % 3;
+        if side[p] != side[q] && edge_pierces(a[p], a[q], b)? {
+            out.push((p, q));
+        }
+    }
+    Some(out)
+}
+
+/// [`piercings`] of the edge of `a` opposite its corner `k`, a vertex `b` shares.
+fn opposite_edge_piercing<T: ExactPoint>(
+    a: [T; 3],
+    b: [T; 3],
+    k: usize,
+) -> Option<Vec<(usize, usize)>> {
+    let (p, q) = ((k + 1) % 3, (k + 2) % 3);
+    let side = [a[p], a[q]].map(|x| T::orient(b[0], b[1], b[2], x));
+    if side.contains(&0) {
+        return None;
+    }
+    Some(if side[0] != side[1] && edge_pierces(a[p], a[q], b)? {
+        vec![(p, q)]
+    } else {
+        Vec::new()
+    })
+}
+
+/// Whether the segment `p q`, whose ends are on opposite sides of `b`'s plane, meets `b`
+/// strictly inside; `None` when it meets `b`'s boundary.
+fn edge_pierces<T: ExactPoint>(p: T, q: T, b: [T; 3]) -> Option<bool> {
+    let s = [
+        T::orient(p, q, b[0], b[1]),
+        T::orient(p, q, b[1], b[2]),
+        T::orient(p, q, b[2], b[0]),
+    ];
+    if s.contains(&0) {
+        return None;
+    }
+    Some(s[0] == s[1] && s[1] == s[2])
+}
+
+/// Where the edge `(u, v)` meets the plane of the face `face` (in `f64`: the exact point
+/// rounded, up to the error of the two volumes' quotient).
+fn piercing_point(positions: &[[f64; 3]], face: [u32; 3], (u, v): (u32, u32)) -> [f64; 3] {
+    let [a, b, c] = face.map(|i| positions[i as usize]);
+    let (p, q) = (positions[u as usize], positions[v as usize]);
+    let sub = |x: [f64; 3], y: [f64; 3]| [x[0] - y[0], x[1] - y[1], x[2] - y[2]];
+    let (e1, e2) = (sub(b, a), sub(c, a));
+    let n = [
+        e1[1] * e2[2] - e1[2] * e2[1],
+        e1[2] * e2[0] - e1[0] * e2[2],
+        e1[0] * e2[1] - e1[1] * e2[0],
+    ];
+    let dot = |x: [f64; 3]| x[0] * n[0] + x[1] * n[1] + x[2] * n[2];
+    let (dp, dq) = (dot(sub(p, a)), dot(sub(q, a)));
+    let t = (dp / (dp - dq)).clamp(0.0, 1.0);
+    std::array::from_fn(|k| p[k] + t * (q[k] - p[k]))
+}
+
+/// The pieces of the face `t` cut by its `segments` (piercing points named as in
+/// [`cut_intersections`], vertices in `vertex_of`), oriented as `t`; `None` when two segments
+/// cross or two points coincide after rounding.
+fn pieces_of_face(
+    positions: &[[f64; 3]],
+    t: [u32; 3],
+    segments: &[[End; 2]],
+    vertex_of: &HashMap<Piercing, u32>,
+) -> Option<Vec<[u32; 3]>> {
+    let id = |end: &End| match end {
+        End::Pierce(key) => vertex_of[key],
+        End::Shared(v) => *v,
+    };
+    let [a, b, c] = t.map(|v| positions[v as usize]);
+    let (e1, e2) = (
+        [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+        [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
+    );
+    let n = [
+        e1[1] * e2[2] - e1[2] * e2[1],
+        e1[2] * e2[0] - e1[0] * e2[2],
+        e1[0] * e2[1] - e1[1] * e2[0],
+    ];
+    // Project along the largest normal component: the face is widest there.
+    let axis = (0..3).max_by(|&i, &j| n[i].abs().total_cmp(&n[j].abs()))?;
+    let (i, j) = ((axis + 1) % 3, (axis + 2) % 3);
+    let flip = n[axis] < 0.0;
+    // Each vertex with the edges of `t` it lies on (bit k: edge t[k] t[k+1]).
+    let mut vertices: Vec<(u32, u8)> = vec![(t[0], 0b101), (t[1], 0b011), (t[2], 0b110)];
+    let mut on_edge: [Vec<(f64, u32)>; 3] = Default::default();
+    for end in segments.iter().flatten() {
+        let v = id(end);
+        if vertices.iter().any(|&(w, _)| w == v) {
+            continue;
+        }
+        let End::Pierce(key) = end else {
+            // A shared vertex not a corner of `t`: not in general position.
+            return None;
+        };
+        let edge = (0..3).find(|&k| {
+            let (p, q) = (t[k], t[(k + 1) % 3]);
+            key.0 == (p.min(q), p.max(q))
+        });
+        match edge {
+            Some(k) => {
+                let (p, q) = (positions[t[k] as usize], positions[t[(k + 1) % 3] as usize]);
+                let x = positions[v as usize];
+                let along = (0..3).map(|d| (x[d] - p[d]) * (q[d] - p[d])).sum::<f64>();
+                on_edge[k].push((along, v));
+                vertices.push((v, 1 << k));
+            }
+            None => vertices.push((v, 0)),
+        }
+    }
+    // A piercing point inside `t` that rounding put on or beyond one of its edges would merge
+    // into that edge's chain: exactly inside, on the rounded coordinates, or no cut.
+    if vertices.iter().any(|&(v, mask)| {
+        mask == 0
+            && !strictly_inside(
+                t.map(|c| positions[c as usize]),
+                positions[v as usize],
+                (i, j),
+            )
+    }) {
+        return None;
+    }
+    let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::new();
+    let mut handles = Vec::with_capacity(vertices.len());
+    for &(v, _) in &vertices {
+        let p = positions[v as usize];
+        let h = cdt.insert(Point2::new(p[i], p[j])).ok()?;
+        if h.index() != handles.len() {
+            return None;
+        }
+        handles.push(h);
+    }
+    let slot = |v: u32| vertices.iter().position(|&(w, _)| w == v);
+    let mut constrain = |x: usize, y: usize| -> Option<()> {
+        if cdt.can_add_constraint(handles[x], handles[y]) {
+            cdt.add_constraint(handles[x], handles[y]);
+            Some(())
+        } else {
+            None
+        }
+    };
+    for (k, points) in on_edge.iter_mut().enumerate() {
+        points.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let mut chain = vec![k];
+        chain.extend(points.iter().map(|&(_, v)| slot(v).expect("listed")));
+        chain.push((k + 1) % 3);
+        for w in chain.windows(2) {
+            constrain(w[0], w[1])?;
+        }
+    }
+    for [s, e] in segments {
+        constrain(slot(id(s))?, slot(id(e))?)?;
+    }
+    // Faces outside the chains of `t`'s edges (where a rounded point on an edge fell outside
+    // the hull of the others) are reached from the hull across no edge of `t`.
+    let on_boundary = |x: usize, y: usize| vertices[x].1 & vertices[y].1 != 0;
+    let mut outside = vec![false; cdt.num_all_faces()];
+    let mut stack = Vec::new();
+    for edge in cdt.convex_hull() {
+        let (x, y) = (edge.from().fix().index(), edge.to().fix().index());
+        if cdt.is_constraint_edge(edge.as_undirected().fix()) && on_boundary(x, y) {
+            continue;
+        }
+        for face in [edge.face(), edge.rev().face()] {
+            if let Some(inner) = face.as_inner() {
+                if !outside[inner.fix().index()] {
+                    outside[inner.fix().index()] = true;
+                    stack.push(inner.fix());
+                }
+            }
+        }
+    }
+    while let Some(face) = stack.pop() {
+        for edge in cdt.face(face).adjacent_edges() {
+            let (x, y) = (edge.from().fix().index(), edge.to().fix().index());
+            if cdt.is_constraint_edge(edge.as_undirected().fix()) && on_boundary(x, y) {
+                continue;
+            }
+            if let Some(next) = edge.rev().face().as_inner() {
+                if !outside[next.fix().index()] {
+                    outside[next.fix().index()] = true;
+                    stack.push(next.fix());
+                }
+            }
+        }
+    }
+    let mut pieces = Vec::new();
+    for face in cdt.inner_faces() {
+        if outside[face.fix().index()] {
+            continue;
+        }
+        let [x, y, z] = face.vertices().map(|h| vertices[h.fix().index()].0);
+        pieces.push(if flip { [x, z, y] } else { [x, y, z] });
+    }
+    Some(pieces)
+}
+
+/// Whether `p` lies strictly inside the triangle `t` projected on the axes `(i, j)` (exact, on
+/// the coordinates as they are).
+fn strictly_inside(t: [[f64; 3]; 3], p: [f64; 3], axes: (usize, usize)) -> bool {
+    let bits = intersect::MAX_WIDE_COORDINATE.trailing_zeros();
+    let Some(fx) = common_fixed_point(&[t[0], t[1], t[2], p], bits) else {
+        return false;
+    };
+    let orient2 = <[i128; 3]>::orient2;
+    let s = orient2(fx[0], fx[1], fx[2], axes);
+    s != 0 && (0..3).all(|k| orient2(fx[k], fx[(k + 1) % 3], fx[3], axes) == s)
+}
+
+/// `w` just in front of the face `piece` (an input face, or a piece of the input face `face`),
+/// or `None` when it is not certified (step 3 of the module documentation).
+///
+/// Two points `q±` on either side of `face`'s plane (exact signs), a thousandth of the piece's
+/// inradius from its centroid along the normal, are joined by a segment that meets `face` and
+/// no other input face (exact tests): so `w(q₋) − w(q₊)` is the one jump across `face`, at a
+/// point of the piece (the segment is much closer to the centroid than the piece's edges are),
+/// and `w` in front is the value on the positive side. A sliver piece is not used.
+fn front_winding(
+    wn: &WindingNumber,
+    all_positions: &[[f64; 3]],
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    piece: [u32; 3],
+    face: usize,
+) -> Option<i64> {
+    let corners = triangles[face].map(|v| positions[v as usize]);
+    let [x, y, z] = piece.map(|v| all_positions[v as usize]);
+    let sub = |p: [f64; 3], q: [f64; 3]| [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
+    let length = |e: [f64; 3]| (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
+    let cross = |u: [f64; 3], v: [f64; 3]| {
+        [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ]
+    };
+    let n = cross(sub(corners[1], corners[0]), sub(corners[2], corners[0]));
+    let n = n.map(|c| c / length(n));
+    let perimeter = length(sub(y, x)) + length(sub(z, y)) + length(sub(x, z));
+    let inradius = length(cross(sub(y, x), sub(z, x))) / perimeter;
+    if inradius.partial_cmp(&(1e-6 * perimeter)) != Some(std::cmp::Ordering::Greater) {
+        return None;
+    }
+    let centroid: [f64; 3] = std::array::from_fn(|k| (x[k] + y[k] + z[k]) / 3.0);
+    let delta = 1e-3 * inradius;
+    let plus: [f64; 3] = std::array::from_fn(|k| centroid[k] + delta * n[k]);
+    let minus: [f64; 3] = std::array::from_fn(|k| centroid[k] - delta * n[k]);
+    // The input faces whose boxes meet the segment's (widened: the boxes are in `f64`), in one
+    // fixed-point scale with `face`'s corners and the two points (exact predicates do not
+    // depend on the scale).
+    let margin = 2.0 * delta;
+    let near: Vec<usize> = (0..triangles.len())
+        .filter(|&g| {
+            g != face
+                && (0..3).all(|k| {
+                    let (l, h) = triangles[g]
+                        .iter()
+                        .fold((f64::MAX, f64::MIN), |(l, h), &v| {
+                            let c = positions[v as usize][k];
+                            (l.min(c), h.max(c))
+                        });
+                    l <= plus[k].max(minus[k]) + margin && plus[k].min(minus[k]) - margin <= h
+                })
+        })
+        .collect();
+    let mut local: Vec<[f64; 3]> = vec![corners[0], corners[1], corners[2], plus, minus];
+    local.extend(
+        near.iter()
+            .flat_map(|&g| triangles[g].map(|v| positions[v as usize])),
+    );
+    let bits = intersect::MAX_WIDE_COORDINATE.trailing_zeros();
+    let fx = common_fixed_point(&local, bits)?;
+    let (f, qp, qm) = ([fx[0], fx[1], fx[2]], fx[3], fx[4]);
+    let orient = <[i128; 3]>::orient;
+    let (sp, sm) = (orient(f[0], f[1], f[2], qp), orient(f[0], f[1], f[2], qm));
+    if sp == 0 || sm != -sp || !segment_meets_triangle(qp, qm, f) {
+        return None;
+    }
+    let crossed = |g: usize| {
+        let t = [fx[5 + 3 * g], fx[6 + 3 * g], fx[7 + 3 * g]];
+        segment_meets_triangle(qp, qm, t)
+    };
+    if (0..near.len()).any(crossed) {
+        return None;
+    }
+    let (w_plus, w_minus) = (wn.eval(plus).round() as i64, wn.eval(minus).round() as i64);
+    // Up against the normal, `w` grows by one across `face`.
+    let (front, back) = if sp > 0 {
+        (w_plus, w_minus)
+    } else {
+        (w_minus, w_plus)
+    };
+    (back == front + 1).then_some(front)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A cube and a tetrahedron poking one corner through its top face: the corner inside the
+    /// cube and the part of the face inside the tetrahedron are patches of pieces only, which
+    /// take their values across the curve when only uncut faces are read; the cut is the same.
+    #[test]
+    fn patches_of_pieces_take_their_value_across_the_curve() {
+        let cube = crate::testing::unit_cube(false);
+        let mut positions = cube.positions().to_vec();
+        let mut triangles = cube.triangles().to_vec();
+        let tip = [0.5131, 0.4727, 1.1213];
+        let base = [
+            [0.2113, 0.3019, 0.6871],
+            [0.7927, 0.2531, 0.7213],
+            [0.5519, 0.8173, 0.7037],
+        ];
+        let n = positions.len() as u32;
+        positions.push(tip);
+        positions.extend(base);
+        // Outward: the base seen from below is clockwise.
+        triangles.extend([
+            [n, n + 1, n + 2],
+            [n, n + 2, n + 3],
+            [n, n + 3, n + 1],
+            [n + 1, n + 3, n + 2],
+        ]);
+        let bits = intersect::MAX_WIDE_COORDINATE.trailing_zeros();
+        let fixed = common_fixed_point(&positions, bits).unwrap();
+        let read = cut_labelling_pieces(&positions, &fixed, &triangles, true).unwrap();
+        let across = cut_labelling_pieces(&positions, &fixed, &triangles, false).unwrap();
+        assert_eq!(read.triangles, across.triangles);
+        assert_eq!(read.positions, across.positions);
+        // The tetrahedron's three faces through the tip are cut; the top face's two triangles
+        // may be cut or not, by where the curve runs.
+        assert!(read.counts.cut_faces >= 4, "{:?}", read.counts);
+        assert!(read.counts.removed_faces > 0);
+    }
+}

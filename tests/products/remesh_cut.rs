@@ -1,0 +1,314 @@
+//! `products::remesh::cut_intersections`: a closed input whose shells overlap is cut along its
+//! self-intersections into the boundary of its `w > ½` solid (their union, or a solid minus a
+//! cavity), proved exactly, instead of being remeshed.
+
+use proptest::prelude::*;
+
+use crate::common::{self, Rng};
+use crate::remesh::sphere;
+
+use gwn::Mesh;
+use gwn::eval::antipodal::WindingNumber;
+use gwn::products::remesh::cut_intersections::{NotCut, cut_intersections};
+use gwn::products::remesh::keep_input::{InputCheck, NotKept, keep_input};
+use gwn::products::remesh::{RemeshOptions, Remeshed, intersect, report::TopologyReport};
+
+fn kept(mesh: &Mesh) -> Result<Remeshed, NotKept> {
+    keep_input(
+        mesh,
+        mesh.bounding_box().unwrap(),
+        &RemeshOptions::with_resolution(64),
+    )
+}
+
+fn join(parts: &[Mesh]) -> Mesh {
+    parts[1..]
+        .iter()
+        .fold(parts[0].clone(), |m, p| m.concatenated(p).unwrap())
+}
+
+/// `mesh` turned by the rotation of unit quaternion `(w, x, y, z)` (normalised here) about the
+/// origin, then moved by `offset`.
+fn placed(mesh: &Mesh, q: [f64; 4], offset: [f64; 3]) -> Mesh {
+    let n = q.iter().map(|c| c * c).sum::<f64>().sqrt();
+    let [w, x, y, z] = q.map(|c| c / n);
+    let r = [
+        [
+            1.0 - 2.0 * (y * y + z * z),
+            2.0 * (x * y - w * z),
+            2.0 * (x * z + w * y),
+        ],
+        [
+            2.0 * (x * y + w * z),
+            1.0 - 2.0 * (x * x + z * z),
+            2.0 * (y * z - w * x),
+        ],
+        [
+            2.0 * (x * z - w * y),
+            2.0 * (y * z + w * x),
+            1.0 - 2.0 * (x * x + y * y),
+        ],
+    ];
+    let p = mesh
+        .positions()
+        .iter()
+        .map(|p| std::array::from_fn(|i| (0..3).map(|j| r[i][j] * p[j]).sum::<f64>() + offset[i]))
+        .collect();
+    Mesh::new(p, mesh.triangles().to_vec()).unwrap()
+}
+
+/// A cube of side 1 centred at the origin.
+fn centred_cube() -> Mesh {
+    common::unit_cube().translated([-0.5; 3])
+}
+
+/// A regular tetrahedron around the origin, outward, with circumradius `r`.
+fn tetrahedron(r: f64) -> Mesh {
+    let s = r / 3f64.sqrt();
+    Mesh::new(
+        vec![[s, s, s], [s, -s, -s], [-s, s, -s], [-s, -s, s]],
+        vec![[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]],
+    )
+    .unwrap()
+}
+
+/// An octahedron with vertices at distance `r` on the axes, outward.
+fn octahedron(r: f64) -> Mesh {
+    let p = vec![
+        [r, 0.0, 0.0],
+        [-r, 0.0, 0.0],
+        [0.0, r, 0.0],
+        [0.0, -r, 0.0],
+        [0.0, 0.0, r],
+        [0.0, 0.0, -r],
+    ];
+    Mesh::new(p, gwn::testing::OCTAHEDRON_FACES.to_vec()).unwrap()
+}
+
+/// The input cut, with its counts; panics with the reason otherwise.
+fn cut(
+    mesh: &Mesh,
+) -> (
+    Remeshed,
+    gwn::products::remesh::cut_intersections::CutCounts,
+) {
+    let out = match kept(mesh) {
+        Ok(out) => out,
+        Err(e) => panic!("not cut: {e}"),
+    };
+    let Some(InputCheck::Cut { cut, .. }) = out.stats.input else {
+        panic!("not cut: {:?}", out.stats.input);
+    };
+    (out, cut)
+}
+
+/// Closed, manifold, oriented, without self-intersections on its `f64` vertices, and with
+/// `w > ½` where the input has it at `samples` random points of the input's box.
+fn assert_same_solid(input: &Mesh, out: &Remeshed, samples: usize, seed: u64) {
+    let t = TopologyReport::of(&out.positions, &out.triangles);
+    assert!(
+        t.closed && t.edge_manifold && t.vertex_manifold && t.oriented,
+        "{t}"
+    );
+    let si = intersect::self_intersections_of_positions(&out.positions, &out.triangles, 1 << 40)
+        .unwrap();
+    assert_eq!((si.pairs, si.degenerate_faces), (0, 0));
+    let output = Mesh::from_slices(&out.positions, &out.triangles).unwrap();
+    let (w_in, w_out) = (
+        WindingNumber::new(input).unwrap(),
+        WindingNumber::new(&output).unwrap(),
+    );
+    let b = input.bounding_box().unwrap();
+    let mut rng = Rng(seed);
+    let mut inside = 0;
+    for _ in 0..samples {
+        // The output differs from the input's solid only within rounding of the intersection
+        // curves: a random point is never there.
+        let q: [f64; 3] = std::array::from_fn(|k| rng.range(b.min[k], b.max[k]));
+        let (a, o) = (w_in.eval(q), w_out.eval(q));
+        assert_eq!(a > 0.5, o > 0.5, "at {q:?}: input w {a}, output w {o}");
+        assert!(o == 0.0 || o == 1.0, "output w {o} at {q:?}");
+        inside += usize::from(a > 0.5);
+    }
+    assert!(inside > 0, "no sample inside the solid");
+}
+
+#[test]
+fn overlapping_shells_are_cut_into_their_union() {
+    // A cube and a turned copy pushed into it: every piercing in general position.
+    let turned = placed(
+        &centred_cube(),
+        [0.8813, 0.3377, 0.2291, 0.1517],
+        [0.6113, 0.3529, 0.2071],
+    );
+    let two_cubes = join(&[centred_cube(), turned]);
+    let (out, counts) = cut(&two_cubes);
+    assert_same_solid(&two_cubes, &out, 4000, 1);
+    assert!(counts.intersecting_pairs > 0 && counts.new_vertices > 0);
+    // Faces no other face meets are written as they were.
+    let Some(InputCheck::Cut { uncut_faces, .. }) = out.stats.input else {
+        unreachable!()
+    };
+    assert!(uncut_faces > 0);
+    let input_faces: std::collections::HashSet<[[u64; 3]; 3]> = (0..two_cubes.triangles().len())
+        .map(|f| two_cubes.triangle_positions(f).map(|p| p.map(f64::to_bits)))
+        .collect();
+    let verbatim = out
+        .triangles
+        .iter()
+        .filter(|t| input_faces.contains(&t.map(|v| out.positions[v as usize].map(f64::to_bits))))
+        .count();
+    assert_eq!(verbatim, uncut_faces);
+
+    // A tetrahedron poking one corner through a cube's face: the corner inside the cube and the
+    // part of the face inside the tetrahedron are patches made only of pieces of cut faces,
+    // which take their values across the intersection curve.
+    let tip = placed(
+        &tetrahedron(0.5),
+        [0.7919, -0.2143, 0.5087, 0.2963],
+        [0.0; 3],
+    );
+    let top = tip
+        .positions()
+        .iter()
+        .map(|p| p[2])
+        .fold(f64::MIN, f64::max);
+    let poking = join(&[
+        centred_cube(),
+        tip.translated([0.0531, -0.0327, -0.5 - top + 0.1093]),
+    ]);
+    let (out, counts) = cut(&poking);
+    assert_same_solid(&poking, &out, 4000, 2);
+    assert!(counts.removed_faces > 0);
+
+    // A ball overlapping a cavity's wall: the solid minus the cavity.
+    let carved = join(&[
+        sphere([0.0; 3], 1.0, 10, false),
+        placed(
+            &sphere([0.0; 3], 0.5, 8, true),
+            [0.9087, 0.2213, 0.1171, 0.2939],
+            [0.8123, 0.1037, -0.0519],
+        ),
+    ]);
+    let (out, _) = cut(&carved);
+    assert_same_solid(&carved, &out, 4000, 4);
+}
+
+#[test]
+fn contacts_that_are_not_in_general_position_are_remeshed() {
+    let cube = centred_cube();
+    // Two cubes offset along a diagonal: an edge of one pierces the other on a face diagonal.
+    let diagonal = join(&[cube.clone(), cube.translated([0.5, 0.5, 0.5])]);
+    assert!(matches!(
+        kept(&diagonal),
+        Err(NotKept::SelfIntersecting {
+            not_cut: Some(NotCut::NotGeneral),
+            ..
+        })
+    ));
+    // Touching along a face.
+    let touching = join(&[cube.clone(), cube.translated([1.0, 0.25, 0.25])]);
+    assert!(matches!(
+        kept(&touching),
+        Err(NotKept::SelfIntersecting {
+            not_cut: Some(_),
+            ..
+        })
+    ));
+    // Three cubes through one region: their intersection segments cross inside faces.
+    let three = join(&[
+        cube.clone(),
+        placed(
+            &cube,
+            [0.8813, 0.3377, 0.2291, 0.1517],
+            [0.4127, 0.3019, 0.2203],
+        ),
+        placed(
+            &cube,
+            [0.8171, -0.1093, 0.4129, 0.2207],
+            [0.3011, -0.2137, 0.4519],
+        ),
+    ]);
+    match kept(&three) {
+        // Where no triple point falls inside a face, the cut is proved like any other.
+        Ok(out) => assert_same_solid(&three, &out, 2000, 5),
+        Err(NotKept::SelfIntersecting { not_cut, .. }) => {
+            assert!(not_cut.is_some(), "the cut was not tried")
+        }
+        Err(e) => panic!("{e}"),
+    }
+}
+
+/// Without intersections the cut is the input as it is, every face labelled `w = 0` in front;
+/// turned inward, every face is left out.
+#[test]
+fn an_input_without_intersections_is_its_own_cut() {
+    let cube = centred_cube();
+    let (positions, triangles) = (cube.positions(), cube.triangles());
+    // Integers in one scale (twice the coordinates, which are ±½).
+    let fixed: Vec<[i128; 3]> = positions
+        .iter()
+        .map(|p| p.map(|x| (x * 2.0) as i128))
+        .collect();
+    let out = cut_intersections(positions, &fixed, triangles).unwrap();
+    assert_eq!(
+        (out.positions.as_slice(), out.triangles.as_slice()),
+        (positions, triangles)
+    );
+    assert_eq!((out.uncut_faces, out.counts.removed_faces), (12, 0));
+    let inward = cube.flipped();
+    assert_eq!(
+        cut_intersections(positions, &fixed, inward.triangles()).err(),
+        Some(NotCut::Proof("empty"))
+    );
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: 24,
+        failure_persistence: None,
+        ..ProptestConfig::default()
+    })]
+
+    /// Two shells (cube, tetrahedron, octahedron or ball; either may be a cavity's wall, turned
+    /// inward) in general position, overlapping: the cut always succeeds and bounds the input's
+    /// solid. Two shells have no triple points, so nothing here may fall back.
+    #[test]
+    fn two_overlapping_shells_are_cut_exactly(
+        shapes in (0usize..4, 0usize..4),
+        q1 in prop::array::uniform4(-1.0f64..1.0),
+        q2 in prop::array::uniform4(-1.0f64..1.0),
+        offset in prop::array::uniform3(-0.45f64..0.45),
+        inward in any::<bool>(),
+        seed in any::<u64>(),
+    ) {
+        // Away from the special rotations and offsets, whose coincidences (an edge through
+        // another, a corner on a face) are not in general position.
+        prop_assume!(q1.iter().chain(&q2).chain(&offset).all(|c| c.abs() > 0.01));
+        let shape = |k: usize| match k {
+            0 => centred_cube(),
+            1 => tetrahedron(0.9),
+            2 => octahedron(0.7),
+            _ => sphere([0.0; 3], 0.6, 6, false),
+        };
+        let a = placed(&shape(shapes.0), q1, [0.0; 3]);
+        let mut b = placed(&shape(shapes.1), q2, offset);
+        if inward {
+            // A cavity's wall, smaller, inside-out: the solid minus it where they overlap.
+            b = Mesh::new(
+                b.positions().iter().map(|p| std::array::from_fn(|k| 0.6 * p[k] + 0.4 * offset[k])).collect(),
+                b.triangles().to_vec(),
+            ).unwrap().flipped();
+        }
+        let input = join(&[a, b]);
+        match kept(&input) {
+            Ok(out) => {
+                prop_assert!(out.stats.input.is_some_and(|i| i.is_input_surface()));
+                assert_same_solid(&input, &out, 600, seed);
+            }
+            // Apart or nested without touching: nothing to cut (kept or refused whole).
+            Err(NotKept::Winding { .. }) => {}
+            Err(e) => prop_assert!(false, "{e}"),
+        }
+    }
+}
