@@ -312,3 +312,33 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: 24,
+        failure_persistence: None,
+        ..ProptestConfig::default()
+    })]
+
+    /// Three shells through one region: triple points, where intersection segments cross
+    /// inside a face, are not cut; whatever is cut bounds the input's solid, and nothing panics.
+    #[test]
+    fn three_shells_are_cut_or_remeshed_never_wrong(
+        q in prop::array::uniform12(-1.0f64..1.0),
+        offsets in prop::array::uniform6(-0.4f64..0.4),
+        seed in any::<u64>(),
+    ) {
+        prop_assume!(q.iter().chain(&offsets).all(|c| c.abs() > 0.01));
+        let input = join(&[
+            placed(&centred_cube(), [q[0], q[1], q[2], q[3]], [0.0; 3]),
+            placed(&octahedron(0.7), [q[4], q[5], q[6], q[7]], [offsets[0], offsets[1], offsets[2]]),
+            placed(&tetrahedron(0.9), [q[8], q[9], q[10], q[11]], [offsets[3], offsets[4], offsets[5]]),
+        ]);
+        match kept(&input) {
+            Ok(out) => assert_same_solid(&input, &out, 600, seed),
+            Err(NotKept::SelfIntersecting { not_cut, .. }) => prop_assert!(not_cut.is_some()),
+            Err(NotKept::Winding { .. }) => {}
+            Err(e) => prop_assert!(false, "{e}"),
+        }
+    }
+}
