@@ -520,8 +520,10 @@ pub fn filter_tets<'py>(
 /// self-intersections bounding ``w > 1/2`` (proved with exact tests) comes back as it is, when
 /// it has at most the simplification target's faces (zero-area faces and cancelling pairs left
 /// out, faces split at T-junctions; the report's ``input`` says ``kept``, or ``remeshed`` and
-/// ``input_not_kept`` why); otherwise its clean components can come back as they are with the
-/// rest remeshed (``partly kept``); ``always_remesh=True`` remeshes it all anyway, as
+/// ``input_not_kept`` why); one that only self-intersects comes back cut along its
+/// intersections, the pieces inside its solid left out (``cut``: the union of overlapping
+/// shells, proved the same way); otherwise its clean components can come back as they are with
+/// the rest remeshed (``partly kept``); ``always_remesh=True`` remeshes it all anyway, as
 /// ``gwn remesh --always-remesh``.
 /// ``gwn.remesh(model, res=...)`` remeshes a :class:`StepModel` (``gwn.load("part.step")``)
 /// the way ``gwn remesh part.step`` does: no ``F``, exact method only (``tolerance=`` as in
