@@ -6,12 +6,13 @@ use proptest::prelude::*;
 
 use crate::common::{self, Rng};
 use crate::remesh::sphere;
+use crate::remesh_keep::assert_valid;
 
 use gwn::Mesh;
 use gwn::eval::antipodal::WindingNumber;
 use gwn::products::remesh::cut_intersections::{NotCut, cut_intersections};
 use gwn::products::remesh::keep_input::{InputCheck, NotKept, keep_input};
-use gwn::products::remesh::{RemeshOptions, Remeshed, intersect, report::TopologyReport};
+use gwn::products::remesh::{RemeshOptions, Remeshed};
 
 fn kept(mesh: &Mesh) -> Result<Remeshed, NotKept> {
     keep_input(
@@ -105,14 +106,7 @@ fn cut(
 /// Closed, manifold, oriented, without self-intersections on its `f64` vertices, and with
 /// `w > ½` where the input has it at `samples` random points of the input's box.
 fn assert_same_solid(input: &Mesh, out: &Remeshed, samples: usize, seed: u64) {
-    let t = TopologyReport::of(&out.positions, &out.triangles);
-    assert!(
-        t.closed && t.edge_manifold && t.vertex_manifold && t.oriented,
-        "{t}"
-    );
-    let si = intersect::self_intersections_of_positions(&out.positions, &out.triangles, 1 << 40)
-        .unwrap();
-    assert_eq!((si.pairs, si.degenerate_faces), (0, 0));
+    assert_valid(out);
     let output = Mesh::from_slices(&out.positions, &out.triangles).unwrap();
     let (w_in, w_out) = (
         WindingNumber::new(input).unwrap(),
@@ -215,7 +209,13 @@ fn contacts_that_are_not_in_general_position_are_remeshed() {
             ..
         })
     ));
-    // Three cubes through one region: their intersection segments cross inside faces.
+}
+
+/// Three cubes through one region: where three faces meet in a point, two intersection
+/// segments cross inside each of them; they are split there, the same way in all three.
+#[test]
+fn three_shells_meeting_in_points_are_cut_there() {
+    let cube = centred_cube();
     let three = join(&[
         cube.clone(),
         placed(
@@ -229,14 +229,9 @@ fn contacts_that_are_not_in_general_position_are_remeshed() {
             [0.3011, -0.2137, 0.4519],
         ),
     ]);
-    match kept(&three) {
-        // Where no triple point falls inside a face, the cut is proved like any other.
-        Ok(out) => assert_same_solid(&three, &out, 2000, 5),
-        Err(NotKept::SelfIntersecting { not_cut, .. }) => {
-            assert!(not_cut.is_some(), "the cut was not tried")
-        }
-        Err(e) => panic!("{e}"),
-    }
+    let (out, counts) = cut(&three);
+    assert_same_solid(&three, &out, 4000, 5);
+    assert!(counts.triple_points > 0, "{counts:?}");
 }
 
 /// Without intersections the cut is the input as it is, every face labelled `w = 0` in front;
@@ -261,6 +256,20 @@ fn an_input_without_intersections_is_its_own_cut() {
         cut_intersections(positions, &fixed, inward.triangles()).err(),
         Some(NotCut::Proof("empty"))
     );
+}
+
+/// The input kept (whole, or cut) with the same solid, or refused whole for its winding (apart,
+/// or nested without touching: nothing to cut).
+fn cut_or_refused(input: &Mesh, seed: u64) -> Result<(), TestCaseError> {
+    match kept(input) {
+        Ok(out) => {
+            prop_assert!(out.stats.input.is_some_and(|i| i.is_input_surface()));
+            assert_same_solid(input, &out, 600, seed);
+        }
+        Err(NotKept::Winding { .. }) => {}
+        Err(e) => prop_assert!(false, "{e}"),
+    }
+    Ok(())
 }
 
 proptest! {
@@ -301,15 +310,7 @@ proptest! {
             ).unwrap().flipped();
         }
         let input = join(&[a, b]);
-        match kept(&input) {
-            Ok(out) => {
-                prop_assert!(out.stats.input.is_some_and(|i| i.is_input_surface()));
-                assert_same_solid(&input, &out, 600, seed);
-            }
-            // Apart or nested without touching: nothing to cut (kept or refused whole).
-            Err(NotKept::Winding { .. }) => {}
-            Err(e) => prop_assert!(false, "{e}"),
-        }
+        cut_or_refused(&input, seed)?;
     }
 }
 
@@ -320,10 +321,10 @@ proptest! {
         ..ProptestConfig::default()
     })]
 
-    /// Three shells through one region: triple points, where intersection segments cross
-    /// inside a face, are not cut; whatever is cut bounds the input's solid, and nothing panics.
+    /// Three shells through one region, in general position: cut at their triple points too,
+    /// and the same solid.
     #[test]
-    fn three_shells_are_cut_or_remeshed_never_wrong(
+    fn three_overlapping_shells_are_cut_exactly(
         q in prop::array::uniform12(-1.0f64..1.0),
         offsets in prop::array::uniform6(-0.4f64..0.4),
         seed in any::<u64>(),
@@ -334,11 +335,6 @@ proptest! {
             placed(&octahedron(0.7), [q[4], q[5], q[6], q[7]], [offsets[0], offsets[1], offsets[2]]),
             placed(&tetrahedron(0.9), [q[8], q[9], q[10], q[11]], [offsets[3], offsets[4], offsets[5]]),
         ]);
-        match kept(&input) {
-            Ok(out) => assert_same_solid(&input, &out, 600, seed),
-            Err(NotKept::SelfIntersecting { not_cut, .. }) => prop_assert!(not_cut.is_some()),
-            Err(NotKept::Winding { .. }) => {}
-            Err(e) => prop_assert!(false, "{e}"),
-        }
+        cut_or_refused(&input, seed)?;
     }
 }

@@ -514,7 +514,7 @@ fn remesh_default(mesh: &Mesh, res: usize) -> gwn::products::remesh::Remeshed {
 }
 
 /// Closed, manifold, oriented and without self-intersections on its `f64` vertices.
-fn assert_valid(out: &gwn::products::remesh::Remeshed) {
+pub(crate) fn assert_valid(out: &gwn::products::remesh::Remeshed) {
     use gwn::products::remesh::{intersect, report::TopologyReport};
     let t = TopologyReport::of(&out.positions, &out.triangles);
     assert!(

@@ -37,6 +37,7 @@
 
 use std::collections::HashMap;
 
+use glam::DVec3;
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 
 use crate::Mesh;
@@ -63,16 +64,23 @@ pub struct CutCounts {
     pub cut_faces: usize,
     /// Faces (uncut, or pieces of cut ones) left out: inside the solid or outside it.
     pub removed_faces: usize,
-    /// Vertices made where an edge pierces a face.
+    /// Vertices made where an edge pierces a face, or three faces meet.
     pub new_vertices: usize,
+    /// Points where three faces meet (two segments of each cross there).
+    pub triple_points: usize,
 }
 
 impl std::fmt::Display for CutCounts {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "{} intersecting face pairs, {} faces cut, {} new vertices, {} faces left out",
-            self.intersecting_pairs, self.cut_faces, self.new_vertices, self.removed_faces
+            "{} intersecting face pairs, {} faces cut, {} new vertices ({} where three faces \
+             meet), {} faces left out",
+            self.intersecting_pairs,
+            self.cut_faces,
+            self.new_vertices,
+            self.triple_points,
+            self.removed_faces
         )
     }
 }
@@ -170,7 +178,7 @@ fn cut_labelling_pieces(
     let tri = |f: u32| triangles[f as usize].map(|v| fixed[v as usize]);
     // Step 1: the segments, and the piercing points' positions.
     let mut points: HashMap<Piercing, [f64; 3]> = HashMap::new();
-    let mut segments: HashMap<u32, Vec<[End; 2]>> = HashMap::new();
+    let mut segments: HashMap<u32, Vec<(u32, [End; 2])>> = HashMap::new();
     for &(f, g) in &pairs {
         let (tf, tg) = (triangles[f as usize], triangles[g as usize]);
         let shared: Vec<u32> = tf.iter().copied().filter(|v| tg.contains(v)).collect();
@@ -202,8 +210,8 @@ fn cut_labelling_pieces(
         let [s, t] = ends[..] else {
             return Err(NotCut::NotGeneral);
         };
-        segments.entry(f).or_default().push([s, t]);
-        segments.entry(g).or_default().push([s, t]);
+        segments.entry(f).or_default().push((g, [s, t]));
+        segments.entry(g).or_default().push((f, [s, t]));
     }
     // New vertices after the input's, in a fixed order (the output does not depend on hashing).
     let mut keys: Vec<Piercing> = points.keys().copied().collect();
@@ -216,6 +224,73 @@ fn cut_labelling_pieces(
     }
     let mut cut: Vec<u32> = segments.keys().copied().collect();
     cut.sort_unstable();
+    // Step 1b: triple points, where the segments of two partners cross inside a face. The
+    // three faces meet there, so each of them sees two of its segments cross: found three
+    // times, or not cut. Each of the three segments is split there.
+    let end_at = |e: &End| match e {
+        End::Pierce(key) => points[key],
+        End::Shared(v) => positions[*v as usize],
+    };
+    let mut triples: HashMap<[u32; 3], usize> = HashMap::new();
+    for &f in &cut {
+        let list = &segments[&f];
+        let axes = projection_axes(positions, triangles[f as usize]);
+        for (k, &(g, s1)) in list.iter().enumerate() {
+            for &(h, s2) in &list[k + 1..] {
+                if s1.iter().any(|e| s2.contains(e)) {
+                    continue;
+                }
+                let ends = [s1[0], s1[1], s2[0], s2[1]].map(|e| end_at(&e));
+                if segments_cross(ends, axes).ok_or(NotCut::SegmentsCross)? {
+                    let mut key = [f, g, h];
+                    key.sort_unstable();
+                    *triples.entry(key).or_default() += 1;
+                }
+            }
+        }
+    }
+    let mut triple_keys: Vec<[u32; 3]> = triples.keys().copied().collect();
+    triple_keys.sort_unstable();
+    let mut splits: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
+    for key in &triple_keys {
+        if triples[key] != 3 {
+            return Err(NotCut::SegmentsCross);
+        }
+        let v = all_positions.len() as u32;
+        all_positions.push(triple_point(positions, key.map(|f| triangles[f as usize])));
+        for (a, b) in [(key[0], key[1]), (key[0], key[2]), (key[1], key[2])] {
+            splits.entry((a, b)).or_default().push(v);
+        }
+    }
+    // Each face's segments as chains of vertices, split at their triple points in order along
+    // them (the same order for both faces of a segment: its ends are stored once).
+    let id = |e: &End| match e {
+        End::Pierce(key) => vertex_of[key],
+        End::Shared(v) => *v,
+    };
+    let chain = |f: u32, g: u32, [s, e]: [End; 2]| {
+        let (a, b) = (id(&s), id(&e));
+        let mut chain = vec![a];
+        if let Some(inner) = splits.get(&(f.min(g), f.max(g))) {
+            let (pa, pb) = (
+                DVec3::from(all_positions[a as usize]),
+                DVec3::from(all_positions[b as usize]),
+            );
+            let mut inner: Vec<(f64, u32)> = inner
+                .iter()
+                .map(|&v| {
+                    (
+                        (DVec3::from(all_positions[v as usize]) - pa).dot(pb - pa),
+                        v,
+                    )
+                })
+                .collect();
+            inner.sort_by(|x, y| x.0.total_cmp(&y.0));
+            chain.extend(inner.iter().map(|&(_, v)| v));
+        }
+        chain.push(b);
+        chain
+    };
     let mut faces: Vec<[u32; 3]> = Vec::with_capacity(triangles.len() + 8 * cut.len());
     let mut uncut: Vec<bool> = Vec::with_capacity(faces.capacity());
     // The input face each face is (uncut) or is a piece of.
@@ -232,13 +307,29 @@ fn cut_labelling_pieces(
         }
     }
     for &f in &cut {
-        let pieces = pieces_of_face(
-            &all_positions,
-            triangles[f as usize],
-            &segments[&f],
-            &vertex_of,
-        )
-        .ok_or(NotCut::SegmentsCross)?;
+        let t = triangles[f as usize];
+        let mut chains = Vec::new();
+        let mut edge_of: HashMap<u32, usize> = HashMap::new();
+        for &(g, ends) in &segments[&f] {
+            for end in ends {
+                match end {
+                    End::Pierce(key) => {
+                        if let Some(k) = (0..3).find(|&k| {
+                            let (p, q) = (t[k], t[(k + 1) % 3]);
+                            key.0 == (p.min(q), p.max(q))
+                        }) {
+                            edge_of.insert(vertex_of[&key], k);
+                        }
+                    }
+                    // A shared vertex not a corner of `t`: not in general position.
+                    End::Shared(v) if !t.contains(&v) => return Err(NotCut::NotGeneral),
+                    End::Shared(_) => {}
+                }
+            }
+            chains.push(chain(f, g, ends));
+        }
+        let pieces =
+            pieces_of_face(&all_positions, t, &chains, &edge_of).ok_or(NotCut::SegmentsCross)?;
         uncut.extend(pieces.iter().map(|_| false));
         origin.extend(pieces.iter().map(|_| f));
         faces.extend(pieces);
@@ -364,7 +455,8 @@ fn cut_labelling_pieces(
             intersecting_pairs: pairs.len(),
             cut_faces: cut.len(),
             removed_faces,
-            new_vertices: keys.len(),
+            new_vertices: keys.len() + triple_keys.len(),
+            triple_points: triple_keys.len(),
         },
     })
 }
@@ -394,23 +486,11 @@ fn side_of_plane(
     plane: [u32; 3],
     positions: &[[f64; 3]],
 ) -> Option<i32> {
-    let [a, b, c] = plane.map(|v| positions[v as usize]);
-    let [x, y, z] = piece.map(|v| all_positions[v as usize]);
-    let sub = |p: [f64; 3], q: [f64; 3]| [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
-    let (e1, e2) = (sub(b, a), sub(c, a));
-    let n = [
-        e1[1] * e2[2] - e1[2] * e2[1],
-        e1[2] * e2[0] - e1[0] * e2[2],
-        e1[0] * e2[1] - e1[1] * e2[0],
-    ];
-    let norm = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-    let centroid: [f64; 3] = std::array::from_fn(|k| (x[k] + y[k] + z[k]) / 3.0);
-    let d = sub(centroid, a);
-    let distance = (d[0] * n[0] + d[1] * n[1] + d[2] * n[2]) / norm;
-    let size = [sub(y, x), sub(z, y), sub(x, z)]
-        .iter()
-        .map(|e| (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt())
-        .fold(0.0, f64::max);
+    let [a, b, c] = plane.map(|v| DVec3::from(positions[v as usize]));
+    let [x, y, z] = piece.map(|v| DVec3::from(all_positions[v as usize]));
+    let n = (b - a).cross(c - a);
+    let distance = ((x + y + z) / 3.0 - a).dot(n) / n.length();
+    let size = (y - x).length().max((z - y).length()).max((x - z).length());
     // NaN (a zero-area plane) fails too.
     if distance.abs().partial_cmp(&(1e-9 * size)) != Some(std::cmp::Ordering::Greater) {
         return None;
@@ -471,66 +551,39 @@ fn edge_pierces<T: ExactPoint>(p: T, q: T, b: [T; 3]) -> Option<bool> {
 /// Where the edge `(u, v)` meets the plane of the face `face` (in `f64`: the exact point
 /// rounded, up to the error of the two volumes' quotient).
 fn piercing_point(positions: &[[f64; 3]], face: [u32; 3], (u, v): (u32, u32)) -> [f64; 3] {
-    let [a, b, c] = face.map(|i| positions[i as usize]);
-    let (p, q) = (positions[u as usize], positions[v as usize]);
-    let sub = |x: [f64; 3], y: [f64; 3]| [x[0] - y[0], x[1] - y[1], x[2] - y[2]];
-    let (e1, e2) = (sub(b, a), sub(c, a));
-    let n = [
-        e1[1] * e2[2] - e1[2] * e2[1],
-        e1[2] * e2[0] - e1[0] * e2[2],
-        e1[0] * e2[1] - e1[1] * e2[0],
-    ];
-    let dot = |x: [f64; 3]| x[0] * n[0] + x[1] * n[1] + x[2] * n[2];
-    let (dp, dq) = (dot(sub(p, a)), dot(sub(q, a)));
+    let [a, b, c] = face.map(|i| DVec3::from(positions[i as usize]));
+    let (p, q) = (
+        DVec3::from(positions[u as usize]),
+        DVec3::from(positions[v as usize]),
+    );
+    let n = (b - a).cross(c - a);
+    let (dp, dq) = ((p - a).dot(n), (q - a).dot(n));
     let t = (dp / (dp - dq)).clamp(0.0, 1.0);
-    std::array::from_fn(|k| p[k] + t * (q[k] - p[k]))
+    (p + t * (q - p)).to_array()
 }
 
-/// The pieces of the face `t` cut by its `segments` (piercing points named as in
-/// [`cut_intersections`], vertices in `vertex_of`), oriented as `t`; `None` when two segments
-/// cross or two points coincide after rounding.
+/// The pieces of the face `t` cut along its `chains` (vertex paths: intersection segments, split
+/// at triple points), oriented as `t`; `edge_of` gives the edge of `t` (`k`: from `t[k]` to
+/// `t[k + 1]`) that a chain's end lies on, when it does. `None` when two chains cross or a
+/// point rounds onto an edge or another point.
 fn pieces_of_face(
     positions: &[[f64; 3]],
     t: [u32; 3],
-    segments: &[[End; 2]],
-    vertex_of: &HashMap<Piercing, u32>,
+    chains: &[Vec<u32>],
+    edge_of: &HashMap<u32, usize>,
 ) -> Option<Vec<[u32; 3]>> {
-    let id = |end: &End| match end {
-        End::Pierce(key) => vertex_of[key],
-        End::Shared(v) => *v,
-    };
-    let [a, b, c] = t.map(|v| positions[v as usize]);
-    let (e1, e2) = (
-        [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
-        [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
-    );
-    let n = [
-        e1[1] * e2[2] - e1[2] * e2[1],
-        e1[2] * e2[0] - e1[0] * e2[2],
-        e1[0] * e2[1] - e1[1] * e2[0],
-    ];
-    // Project along the largest normal component: the face is widest there.
-    let axis = (0..3).max_by(|&i, &j| n[i].abs().total_cmp(&n[j].abs()))?;
-    let (i, j) = ((axis + 1) % 3, (axis + 2) % 3);
-    let flip = n[axis] < 0.0;
+    let (i, j) = projection_axes(positions, t);
+    let [a, b, c] = t.map(|v| DVec3::from(positions[v as usize]));
+    let flip = (b - a).cross(c - a).to_array()[(i + 2) % 3] < 0.0;
     // Each vertex with the edges of `t` it lies on (bit k: edge t[k] t[k+1]).
     let mut vertices: Vec<(u32, u8)> = vec![(t[0], 0b101), (t[1], 0b011), (t[2], 0b110)];
     let mut on_edge: [Vec<(f64, u32)>; 3] = Default::default();
-    for end in segments.iter().flatten() {
-        let v = id(end);
+    for &v in chains.iter().flatten() {
         if vertices.iter().any(|&(w, _)| w == v) {
             continue;
         }
-        let End::Pierce(key) = end else {
-            // A shared vertex not a corner of `t`: not in general position.
-            return None;
-        };
-        let edge = (0..3).find(|&k| {
-            let (p, q) = (t[k], t[(k + 1) % 3]);
-            key.0 == (p.min(q), p.max(q))
-        });
-        match edge {
-            Some(k) => {
+        match edge_of.get(&v) {
+            Some(&k) => {
                 let (p, q) = (positions[t[k] as usize], positions[t[(k + 1) % 3] as usize]);
                 let x = positions[v as usize];
                 let along = (0..3).map(|d| (x[d] - p[d]) * (q[d] - p[d])).sum::<f64>();
@@ -580,8 +633,10 @@ fn pieces_of_face(
             constrain(w[0], w[1])?;
         }
     }
-    for [s, e] in segments {
-        constrain(slot(id(s))?, slot(id(e))?)?;
+    for chain in chains {
+        for w in chain.windows(2) {
+            constrain(slot(w[0])?, slot(w[1])?)?;
+        }
     }
     // Faces outside the chains of `t`'s edges (where a rounded point on an edge fell outside
     // the hull of the others) are reached from the hull across no edge of `t`.
@@ -627,6 +682,66 @@ fn pieces_of_face(
     Some(pieces)
 }
 
+/// The axes of the plane a face is projected on: the two other than its normal's largest
+/// component (the face is widest there).
+fn projection_axes(positions: &[[f64; 3]], t: [u32; 3]) -> (usize, usize) {
+    let [a, b, c] = t.map(|v| DVec3::from(positions[v as usize]));
+    let n = (b - a).cross(c - a).abs().to_array();
+    let axis = (0..3).max_by(|&i, &j| n[i].total_cmp(&n[j])).unwrap_or(2);
+    ((axis + 1) % 3, (axis + 2) % 3)
+}
+
+/// Whether the segments `ends[0] ends[1]` and `ends[2] ends[3]`, projected on `axes`, cross
+/// (each one's ends strictly on either side of the other's line), in `f64` with a margin of
+/// `10⁻¹⁰` of the products; `None` within it. An end on the other's line (within the margin)
+/// but clearly beyond that segment's ends is no crossing: the segments of two coplanar faces of
+/// one shell (a square's two triangles) lie on one line.
+fn segments_cross(ends: [[f64; 3]; 4], (i, j): (usize, usize)) -> Option<bool> {
+    let flat = |p: [f64; 3]| [p[i], p[j]];
+    let [p, q, r, s] = ends.map(flat);
+    // Whether the segment `c d` crosses the line of `a b` strictly (`Some(true)`), stays on
+    // one side or meets the line outside `a b` (`Some(false)`), or cannot be told.
+    let meets_line = |a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]| {
+        let u = [b[0] - a[0], b[1] - a[1]];
+        let side = |x: [f64; 2]| {
+            let (l, r) = (u[0] * (x[1] - a[1]), u[1] * (x[0] - a[0]));
+            let det = l - r;
+            (det.abs() > 1e-10 * (l.abs() + r.abs())).then_some(det > 0.0)
+        };
+        let along = |x: [f64; 2]| {
+            ((x[0] - a[0]) * u[0] + (x[1] - a[1]) * u[1]) / (u[0] * u[0] + u[1] * u[1])
+        };
+        let beyond = |t: f64| !(-1e-9..=1.0 + 1e-9).contains(&t);
+        match (side(c), side(d)) {
+            (Some(x), Some(y)) => Some(x != y),
+            // Both on the line: apart unless they overlap along it.
+            (None, None) => {
+                let (tc, td) = (along(c), along(d));
+                let apart = (tc < -1e-9 && td < -1e-9) || (tc > 1.0 + 1e-9 && td > 1.0 + 1e-9);
+                apart.then_some(false)
+            }
+            (None, Some(_)) => beyond(along(c)).then_some(false),
+            (Some(_), None) => beyond(along(d)).then_some(false),
+        }
+    };
+    if !meets_line(p, q, r, s)? {
+        return Some(false);
+    }
+    meets_line(r, s, p, q)
+}
+
+/// Where the planes of three faces meet (in `f64`: Cramer's rule on their normals).
+fn triple_point(positions: &[[f64; 3]], faces: [[u32; 3]; 3]) -> [f64; 3] {
+    let planes = faces.map(|t| {
+        let [a, b, c] = t.map(|v| DVec3::from(positions[v as usize]));
+        let n = (b - a).cross(c - a);
+        (n, n.dot(a))
+    });
+    let [(n1, d1), (n2, d2), (n3, d3)] = planes;
+    let det = n1.dot(n2.cross(n3));
+    ((d1 * n2.cross(n3) + d2 * n3.cross(n1) + d3 * n1.cross(n2)) / det).to_array()
+}
+
 /// Whether `p` lies strictly inside the triangle `t` projected on the axes `(i, j)` (exact, on
 /// the coordinates as they are).
 fn strictly_inside(t: [[f64; 3]; 3], p: [f64; 3], axes: (usize, usize)) -> bool {
@@ -656,27 +771,20 @@ fn front_winding(
     face: usize,
 ) -> Option<i64> {
     let corners = triangles[face].map(|v| positions[v as usize]);
-    let [x, y, z] = piece.map(|v| all_positions[v as usize]);
-    let sub = |p: [f64; 3], q: [f64; 3]| [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
-    let length = |e: [f64; 3]| (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
-    let cross = |u: [f64; 3], v: [f64; 3]| {
-        [
-            u[1] * v[2] - u[2] * v[1],
-            u[2] * v[0] - u[0] * v[2],
-            u[0] * v[1] - u[1] * v[0],
-        ]
-    };
-    let n = cross(sub(corners[1], corners[0]), sub(corners[2], corners[0]));
-    let n = n.map(|c| c / length(n));
-    let perimeter = length(sub(y, x)) + length(sub(z, y)) + length(sub(x, z));
-    let inradius = length(cross(sub(y, x), sub(z, x))) / perimeter;
+    let [a, b, c] = corners.map(DVec3::from);
+    let [x, y, z] = piece.map(|v| DVec3::from(all_positions[v as usize]));
+    let n = (b - a).cross(c - a).normalize();
+    let perimeter = (y - x).length() + (z - y).length() + (x - z).length();
+    let inradius = (y - x).cross(z - x).length() / perimeter;
     if inradius.partial_cmp(&(1e-6 * perimeter)) != Some(std::cmp::Ordering::Greater) {
         return None;
     }
-    let centroid: [f64; 3] = std::array::from_fn(|k| (x[k] + y[k] + z[k]) / 3.0);
+    let centroid = (x + y + z) / 3.0;
     let delta = 1e-3 * inradius;
-    let plus: [f64; 3] = std::array::from_fn(|k| centroid[k] + delta * n[k]);
-    let minus: [f64; 3] = std::array::from_fn(|k| centroid[k] - delta * n[k]);
+    let (plus, minus) = (
+        (centroid + delta * n).to_array(),
+        (centroid - delta * n).to_array(),
+    );
     // The input faces whose boxes meet the segment's (widened: the boxes are in `f64`), in one
     // fixed-point scale with `face`'s corners and the two points (exact predicates do not
     // depend on the scale).
