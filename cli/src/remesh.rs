@@ -209,41 +209,28 @@ pub fn run(args: Args) -> Result<(), CliError> {
         format!("cells {x:.4e} x {y:.4e} x {z:.4e}")
     };
     match s.input {
-        Some(InputCheck::Kept { repairs }) => {
-            // What the kept input lost or gained: faces only, never a position.
+        Some(InputCheck::Kept { repairs }) | Some(InputCheck::Cut { repairs, .. }) => {
+            // What the kept input lost or gained (faces only, never a position), and what the
+            // cut changed.
             let repairs = if repairs.is_empty() {
                 String::new()
             } else {
                 format!(", {repairs}")
             };
-            outln!(
-                "{}: the input as it is ({} faces{repairs}, {:.2} s): closed, manifold, oriented, no \
-                 self-intersection (exact) and the boundary of w > 1/2 (--always-remesh remeshes \
-                 it at res {})",
-                args.out.display(),
-                topology.faces,
-                secs,
-                args.res
-            )?;
-            outln!("{topology}")?;
-        }
-        Some(InputCheck::Cut {
-            repairs,
-            cut,
-            uncut_faces,
-        }) => {
-            let repairs = if repairs.is_empty() {
-                String::new()
-            } else {
-                format!("; {repairs}")
+            let what = match s.input {
+                Some(InputCheck::Cut {
+                    cut, uncut_faces, ..
+                }) => format!(
+                    "the input cut at its self-intersections ({cut}{repairs}; {} faces, \
+                     {uncut_faces} of them the input's",
+                    topology.faces
+                ),
+                _ => format!("the input as it is ({} faces{repairs}", topology.faces),
             };
             outln!(
-                "{}: the input cut at its self-intersections ({cut}{repairs}; {} faces, {uncut_faces} \
-                 of them the input's, {:.2} s): closed, manifold, oriented, no self-intersection \
+                "{}: {what}, {secs:.2} s): closed, manifold, oriented, no self-intersection \
                  (exact) and the boundary of w > 1/2 (--always-remesh remeshes it at res {})",
                 args.out.display(),
-                topology.faces,
-                secs,
                 args.res
             )?;
             outln!("{topology}")?;

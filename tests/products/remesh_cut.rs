@@ -312,14 +312,6 @@ proptest! {
         let input = join(&[a, b]);
         cut_or_refused(&input, seed)?;
     }
-}
-
-proptest! {
-    #![proptest_config(ProptestConfig {
-        cases: 24,
-        failure_persistence: None,
-        ..ProptestConfig::default()
-    })]
 
     /// Three shells through one region, in general position: cut at their triple points too,
     /// and the same solid.
