@@ -359,6 +359,17 @@ fn cut_labelling_pieces(
     let not_evaluated = NotCut::Proof("beyond the evaluator's range");
     let input = Mesh::from_slices(positions, triangles).map_err(|_| not_evaluated)?;
     let wn = WindingNumber::new(&input).map_err(|_| not_evaluated)?;
+    // The input faces' boxes, for each read's scan of the faces near it.
+    let boxes: Vec<([f64; 3], [f64; 3])> = triangles
+        .iter()
+        .map(|t| {
+            let p = t.map(|v| positions[v as usize]);
+            (
+                std::array::from_fn(|k| p[0][k].min(p[1][k]).min(p[2][k])),
+                std::array::from_fn(|k| p[0][k].max(p[1][k]).max(p[2][k])),
+            )
+        })
+        .collect();
     let mut front: HashMap<u32, i64> = HashMap::new();
     let mut tries: HashMap<u32, usize> = HashMap::new();
     for i in 0..faces.len() {
@@ -373,7 +384,15 @@ fn cut_labelling_pieces(
         }
         *tried += 1;
         let (piece, face) = (faces[i], origin[i] as usize);
-        if let Some(w) = front_winding(&wn, &all_positions, positions, triangles, piece, face) {
+        if let Some(w) = front_winding(
+            &wn,
+            &all_positions,
+            positions,
+            triangles,
+            &boxes,
+            piece,
+            face,
+        ) {
             front.insert(root, w);
         }
     }
@@ -754,7 +773,8 @@ fn strictly_inside(t: [[f64; 3]; 3], p: [f64; 3], axes: (usize, usize)) -> bool 
     s != 0 && (0..3).all(|k| orient2(fx[k], fx[(k + 1) % 3], fx[3], axes) == s)
 }
 
-/// `w` just in front of the face `piece` (an input face, or a piece of the input face `face`),
+/// `w` just in front of the face `piece` (an input face, or a piece of the input face `face`;
+/// `boxes`: the input faces' bounding boxes),
 /// or `None` when it is not certified (step 3 of the module documentation).
 ///
 /// Two points `q±` on either side of `face`'s plane (exact signs), a thousandth of the piece's
@@ -767,6 +787,7 @@ fn front_winding(
     all_positions: &[[f64; 3]],
     positions: &[[f64; 3]],
     triangles: &[[u32; 3]],
+    boxes: &[([f64; 3], [f64; 3])],
     piece: [u32; 3],
     face: usize,
 ) -> Option<i64> {
@@ -791,15 +812,11 @@ fn front_winding(
     let margin = 2.0 * delta;
     let near: Vec<usize> = (0..triangles.len())
         .filter(|&g| {
+            let (lo, hi) = boxes[g];
             g != face
                 && (0..3).all(|k| {
-                    let (l, h) = triangles[g]
-                        .iter()
-                        .fold((f64::MAX, f64::MIN), |(l, h), &v| {
-                            let c = positions[v as usize][k];
-                            (l.min(c), h.max(c))
-                        });
-                    l <= plus[k].max(minus[k]) + margin && plus[k].min(minus[k]) - margin <= h
+                    lo[k] <= plus[k].max(minus[k]) + margin
+                        && plus[k].min(minus[k]) - margin <= hi[k]
                 })
         })
         .collect();
