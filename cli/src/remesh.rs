@@ -209,14 +209,20 @@ pub fn run(args: Args) -> Result<(), CliError> {
         format!("cells {x:.4e} x {y:.4e} x {z:.4e}")
     };
     match s.input {
-        Some(InputCheck::Kept { repairs }) | Some(InputCheck::Cut { repairs, .. }) => {
-            // What the kept input lost or gained (faces only, never a position), and what the
-            // cut changed.
-            let repairs = if repairs.is_empty() {
+        Some(InputCheck::Kept { repairs, separated })
+        | Some(InputCheck::Cut {
+            repairs, separated, ..
+        }) => {
+            // What the kept input lost or gained (faces; positions only where solids touching
+            // were pulled apart), and what the cut changed.
+            let mut repairs = if repairs.is_empty() {
                 String::new()
             } else {
                 format!(", {repairs}")
             };
+            if !separated.is_empty() {
+                repairs += &format!(", {separated}");
+            }
             let what = match s.input {
                 Some(InputCheck::Cut {
                     cut, uncut_faces, ..
@@ -225,6 +231,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
                      {uncut_faces} of them the input's",
                     topology.faces
                 ),
+                _ if !separated.is_empty() => {
+                    format!("the input ({} faces{repairs}", topology.faces)
+                }
                 _ => format!("the input as it is ({} faces{repairs}", topology.faces),
             };
             outln!(

@@ -19,5 +19,6 @@ mod remesh_keep;
 mod remesh_levels;
 mod remesh_planar;
 mod remesh_report;
+mod remesh_separate;
 mod remesh_simplify;
 mod remesh_sub_cell;

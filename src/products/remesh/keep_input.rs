@@ -53,6 +53,7 @@ use super::exact_repair;
 use super::intersect::{self, IntersectError, self_intersections_wide};
 use super::lattice::Lattice;
 use super::report::TopologyReport;
+use super::separate_pinches::{LARGEST_MOVE_IN_CELLS, SeparatedCounts, separate_pinches};
 use super::{RemeshOptions, RemeshStats, Remeshed};
 
 /// Inputs of at most this many faces are never too fine to keep: the estimate of step 4 is
@@ -176,12 +177,15 @@ impl std::fmt::Display for NotKept {
 }
 
 /// What happened to the input before the lattice ([`RemeshStats::input`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum InputCheck {
     /// The input is the output ([`keep_input`]), after the repairs of [`exact_repair`].
     Kept {
         /// What they changed.
         repairs: exact_repair::RepairCounts,
+        /// Solids touching at vertices or edges pulled apart ([`super::separate_pinches`]):
+        /// empty when the input's own coordinates were kept, bit for bit.
+        separated: SeparatedCounts,
     },
     /// The input, closed but self-intersecting, was cut along its intersections and kept where
     /// it bounds `{w > ½}` ([`super::cut_intersections`]), after the repairs of
@@ -189,6 +193,8 @@ pub enum InputCheck {
     Cut {
         /// What the repairs changed.
         repairs: exact_repair::RepairCounts,
+        /// Pinches pulled apart before the cut ([`super::separate_pinches`]).
+        separated: SeparatedCounts,
         /// What the cut did.
         cut: super::cut_intersections::CutCounts,
         /// Output faces that are input faces as they were.
@@ -288,44 +294,61 @@ pub fn keep_input(
         original.closed,
         1000 * triangles.len() as u64,
     );
-    let (positions, fixed, triangles) = if !repaired.counts.is_empty() {
-        let topology = TopologyReport::of(&positions, &repaired.triangles);
-        if let Some(problem) = topology_problem(&topology) {
-            return Err(topology_problem(&original).unwrap_or(problem));
-        }
+    let (positions, fixed, triangles, topology) = if !repaired.counts.is_empty() {
         let (kept, triangles) = referenced(&fixed, &repaired.triangles);
         let (positions, _) = referenced(&positions, &repaired.triangles);
-        (positions, kept, triangles)
+        let topology = TopologyReport::of(&positions, &triangles);
+        (positions, kept, triangles, topology)
     } else {
-        if let Some(problem) = topology_problem(&original) {
-            return Err(problem);
-        }
-        (positions, fixed, triangles)
+        (positions, fixed, triangles, original)
     };
+    // The reason given is the input's own first problem, whatever the repairs changed.
+    let reason = |problem: NotKept| topology_problem(&original).unwrap_or(problem);
+    // Solids touching at a vertex or along an edge: pulled apart by a fraction of a cell, then
+    // proved like any other input.
+    let (positions, fixed, triangles, separated) = match topology_problem(&topology) {
+        None => (positions, fixed, triangles, SeparatedCounts::default()),
+        Some(problem @ NotKept::NotManifold { .. }) => {
+            let finest = lattice.h.into_iter().fold(f64::INFINITY, f64::min);
+            let pulled = separate_pinches(&positions, &triangles, finest * LARGEST_MOVE_IN_CELLS)
+                .filter(|s| {
+                    topology_problem(&TopologyReport::of(&s.positions, &s.triangles)).is_none()
+                })
+                .ok_or_else(|| reason(problem))?;
+            let fixed =
+                common_fixed_point(&pulled.positions, bits).ok_or_else(|| reason(problem))?;
+            (pulled.positions, fixed, pulled.triangles, pulled.counts)
+        }
+        Some(problem) => return Err(reason(problem)),
+    };
+    // A separated input that fails the proof is reported for its pinches, its first problem.
+    let given = |e: NotKept| if separated.is_empty() { e } else { reason(e) };
     let (positions, triangles, input) = match bounds_its_solid(&positions, &fixed, &triangles) {
         Ok(()) => (
             positions,
             triangles,
             InputCheck::Kept {
                 repairs: repaired.counts,
+                separated,
             },
         ),
         // Overlapping shells: their union, cut out of them, when that is provably the answer.
         Err(NotKept::SelfIntersecting { pairs, .. }) => {
             let cut = cut_intersections(&positions, &fixed, &triangles).map_err(|why| {
-                NotKept::SelfIntersecting {
+                given(NotKept::SelfIntersecting {
                     pairs,
                     not_cut: Some(why),
-                }
+                })
             })?;
             let input = InputCheck::Cut {
                 repairs: repaired.counts,
+                separated,
                 cut: cut.counts,
                 uncut_faces: cut.uncut_faces,
             };
             (cut.positions, cut.triangles, input)
         }
-        Err(e) => return Err(e),
+        Err(e) => return Err(given(e)),
     };
     Ok(Remeshed {
         positions,

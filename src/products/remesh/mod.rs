@@ -65,6 +65,7 @@ pub mod octree;
 pub mod place;
 pub mod plates;
 pub mod report;
+pub mod separate_pinches;
 pub mod simplify;
 pub mod thicken;
 pub mod transition;

@@ -3,10 +3,12 @@
 //! with the run's counters — what `gwn remesh` prints and writes with `--report`, and what
 //! `gwn.remesh(..., report=True)` returns, measured once here for both.
 
+use super::super::exact_repair::RepairCounts;
 use super::super::intersect::{
     IntersectError, SelfIntersections, self_intersections, self_intersections_of_positions,
 };
 use super::super::keep_input::InputCheck;
+use super::super::separate_pinches::SeparatedCounts;
 use super::super::{RemeshOptions, RemeshStats, Remeshed};
 use super::{
     BoundaryHausdorff, NoSurface, TopologyReport, hausdorff_distance, hausdorff_to_solid_boundary,
@@ -286,30 +288,29 @@ impl RemeshReport {
             ("seconds", format!("{:.3}", self.seconds)),
         ];
         match s.input {
-            Some(InputCheck::Kept { repairs }) => members.extend([
-                ("input", json_string("kept")),
-                ("input_zero_area_faces", repairs.zero_area_faces.to_string()),
-                ("input_cancelled_faces", repairs.cancelled_faces.to_string()),
-                ("input_split_faces", repairs.split_faces.to_string()),
-            ]),
+            Some(InputCheck::Kept { repairs, separated }) => {
+                members.push(("input", json_string("kept")));
+                members.extend(input_changes(repairs, separated));
+            }
             Some(InputCheck::Cut {
                 repairs,
+                separated,
                 cut,
                 uncut_faces,
-            }) => members.extend([
-                ("input", json_string("cut")),
-                ("input_zero_area_faces", repairs.zero_area_faces.to_string()),
-                ("input_cancelled_faces", repairs.cancelled_faces.to_string()),
-                ("input_split_faces", repairs.split_faces.to_string()),
-                (
-                    "input_intersecting_pairs",
-                    cut.intersecting_pairs.to_string(),
-                ),
-                ("input_cut_faces", cut.cut_faces.to_string()),
-                ("input_new_vertices", cut.new_vertices.to_string()),
-                ("input_removed_faces", cut.removed_faces.to_string()),
-                ("input_kept_faces", uncut_faces.to_string()),
-            ]),
+            }) => {
+                members.push(("input", json_string("cut")));
+                members.extend(input_changes(repairs, separated));
+                members.extend([
+                    (
+                        "input_intersecting_pairs",
+                        cut.intersecting_pairs.to_string(),
+                    ),
+                    ("input_cut_faces", cut.cut_faces.to_string()),
+                    ("input_new_vertices", cut.new_vertices.to_string()),
+                    ("input_removed_faces", cut.removed_faces.to_string()),
+                    ("input_kept_faces", uncut_faces.to_string()),
+                ]);
+            }
             Some(InputCheck::PartlyKept {
                 kept_components,
                 components,
@@ -396,4 +397,27 @@ impl RemeshReport {
         }
         self.topology.to_json(&members)
     }
+}
+
+/// The report's members for what the input went through before it was kept or cut: the exact
+/// repairs, and the pinches pulled apart (only when there were any, so a report of an input
+/// kept bit for bit is as before).
+fn input_changes(repairs: RepairCounts, separated: SeparatedCounts) -> Vec<(&'static str, String)> {
+    let mut members = vec![
+        ("input_zero_area_faces", repairs.zero_area_faces.to_string()),
+        ("input_cancelled_faces", repairs.cancelled_faces.to_string()),
+        ("input_split_faces", repairs.split_faces.to_string()),
+    ];
+    if !separated.is_empty() {
+        members.extend([
+            ("input_separated_edges", separated.edges.to_string()),
+            ("input_separated_vertices", separated.vertices.to_string()),
+            ("input_added_vertices", separated.added_vertices.to_string()),
+            (
+                "input_largest_move",
+                format!("{:?}", separated.largest_move),
+            ),
+        ]);
+    }
+    members
 }

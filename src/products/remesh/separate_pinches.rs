@@ -1,0 +1,281 @@
+//! Solids that touch at a vertex or along an edge, pulled apart by a fraction of a cell.
+//!
+//! Two cubes sharing a corner, a bed's clip meeting its plate along an edge, a leg touching a
+//! body at one point: the input is closed and oriented, but a vertex's faces form several fans
+//! or an edge lies in four faces, so [`super::keep_input`] cannot keep it as it is, and a
+//! lattice remesh costs the whole surface's area in cells and rounds every sharp feature.
+//!
+//! `{w > ½}` is an open set: two solids touching at a point or along an edge are two
+//! components there (and two cavities touching inside a solid leave it one). This module gives
+//! the surface that topology with the input's own faces:
+//!
+//! 1. **Pairing.** Around an edge `a → b` in `2k` faces, the faces are sorted by their angle
+//!    `θ` about the axis `b − a`. A face using the edge as `a → b` has its normal towards
+//!    increasing `θ` (`(b − a) × r` turns `r` by +90° about the axis), so its solid lies before
+//!    it; a face using `b → a` has its solid after it. Each `b → a` face is joined to the next
+//!    face counter-clockwise, which must use `a → b`: they bound one solid wedge. (Any other
+//!    arrangement, or two faces at one angle, is not separated.)
+//! 2. **Fans.** Joined across every edge (the pairs above, and the two faces of every other
+//!    edge), the faces around each vertex fall into fans; a vertex in several fans becomes one
+//!    vertex per fan.
+//! 3. **Pull.** Each new vertex moves from `v` towards its fan's link centroid `c` (the mean of
+//!    the midpoints of the fan's opposite edges) by [`PULL_FRACTION`] of `|c − v|`, at most
+//!    `largest_move`: into its solid for a solid's fan (a cone around its solid), into its
+//!    cavity for a cavity's (a cone around the empty side), so in both cases away from the
+//!    other fans. When every input coordinate is an `f32`, the moved ones are rounded to `f32`
+//!    too, so a file written in single precision (STL, glTF) still has the proved surface.
+//!
+//! Nothing here is trusted: the caller proves the result as it proves any kept input (steps
+//! 1–3 of [`super::keep_input`] on the moved coordinates), and gives up when it fails. What
+//! changes is the solid within `largest_move` of the moved vertices (the faces around `v`
+//! sweep a sliver no thicker than the move).
+
+use std::cmp::Ordering;
+
+use glam::DVec3;
+
+use super::report::{find, union};
+
+/// Each split vertex moves this fraction of the way to its fan's link centroid: small enough
+/// that a fan around a convex cone stays embedded and the solid barely changes, large enough
+/// that the move survives rounding to `f32`.
+pub const PULL_FRACTION: f64 = 1.0 / 64.0;
+
+/// The most a vertex moves, in finest cells of the remesh's lattice: the output stays far
+/// within the remesh's own error (one cell) of the input's solid.
+pub const LARGEST_MOVE_IN_CELLS: f64 = 1.0 / 64.0;
+
+/// What [`separate_pinches`] changed.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SeparatedCounts {
+    /// Edges in more than two faces, split into one edge per solid wedge.
+    pub edges: usize,
+    /// Vertices whose faces formed several fans, split into one vertex per fan.
+    pub vertices: usize,
+    /// Vertices the splits added (each moved, as is the one that kept the index).
+    pub added_vertices: usize,
+    /// The largest distance a vertex moved.
+    pub largest_move: f64,
+}
+
+impl SeparatedCounts {
+    /// Whether nothing was separated.
+    pub fn is_empty(&self) -> bool {
+        self.vertices == 0
+    }
+}
+
+impl std::fmt::Display for SeparatedCounts {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let s = |n: usize, one: &'static str, many: &'static str| if n == 1 { one } else { many };
+        write!(
+            f,
+            "solids touching at {} {} and {} {} pulled apart, no vertex moved more than {:.3e}",
+            self.vertices,
+            s(self.vertices, "vertex", "vertices"),
+            self.edges,
+            s(self.edges, "edge", "edges"),
+            self.largest_move
+        )
+    }
+}
+
+/// The surface of [`separate_pinches`].
+pub struct Separated {
+    /// The input's vertices, the split ones moved, then the copies the splits added.
+    pub positions: Vec<[f64; 3]>,
+    /// The input's faces in their order, each corner on its fan's vertex.
+    pub triangles: Vec<[u32; 3]>,
+    /// What changed.
+    pub counts: SeparatedCounts,
+}
+
+/// The closed, oriented surface `triangles` on `positions` with its pinches pulled apart (see
+/// the [module documentation](self)), each vertex moving at most `largest_move`; `None` when an
+/// edge's faces do not pair into solid wedges, a pulled vertex would not move, or there is
+/// nothing to separate.
+pub fn separate_pinches(
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    largest_move: f64,
+) -> Option<Separated> {
+    let p = |v: u32| DVec3::from_array(positions[v as usize]);
+    let (partner, separated_edges) = pair_edges(positions, triangles)?;
+    // Corner `3f + k` is face `f`'s corner at `triangles[f][k]`; its slot `3f + k` is the
+    // edge from that corner to the next.
+    let mut parent: Vec<u32> = (0..3 * triangles.len() as u32).collect();
+    for (slot, &other) in partner.iter().enumerate() {
+        let (f, k) = (slot / 3, slot % 3);
+        let (g, j) = (other as usize / 3, other as usize % 3);
+        // The partner runs the other way: its corner `j` is at our `k + 1`, `j + 1` at `k`.
+        union(
+            &mut parent,
+            (3 * f + k) as u32,
+            (3 * g + (j + 1) % 3) as u32,
+        );
+        union(
+            &mut parent,
+            (3 * f + (k + 1) % 3) as u32,
+            (3 * g + j) as u32,
+        );
+    }
+    // One vertex per (vertex, fan): the fan's root corner names it.
+    let mut fan_of_root = vec![u32::MAX; parent.len()];
+    let mut first_fan = vec![u32::MAX; positions.len()];
+    // Per fan: its vertex, the sum of its corners' opposite-edge midpoints, and their count.
+    let mut fans: Vec<(u32, DVec3, usize)> = Vec::new();
+    let mut corner_fan = vec![0u32; 3 * triangles.len()];
+    for (f, t) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            let root = find(&mut parent, (3 * f + k) as u32) as usize;
+            if fan_of_root[root] == u32::MAX {
+                fan_of_root[root] = fans.len() as u32;
+                fans.push((t[k], DVec3::ZERO, 0));
+            }
+            let fan = fan_of_root[root];
+            corner_fan[3 * f + k] = fan;
+            let (prev, next) = (t[(k + 2) % 3], t[(k + 1) % 3]);
+            let entry = &mut fans[fan as usize];
+            entry.1 += 0.5 * (p(prev) + p(next));
+            entry.2 += 1;
+            if first_fan[t[k] as usize] == u32::MAX {
+                first_fan[t[k] as usize] = fan;
+            }
+        }
+    }
+    let mut fans_at = vec![0u32; positions.len()];
+    for &(v, _, _) in &fans {
+        fans_at[v as usize] += 1;
+    }
+    let single_precision = positions
+        .iter()
+        .flatten()
+        .all(|&x| f64::from(x as f32) == x);
+    let mut out = positions.to_vec();
+    let mut vertex_of_fan = vec![0u32; fans.len()];
+    let mut counts = SeparatedCounts {
+        edges: separated_edges,
+        ..SeparatedCounts::default()
+    };
+    for (fan, &(v, link, corners)) in fans.iter().enumerate() {
+        if fans_at[v as usize] < 2 {
+            vertex_of_fan[fan] = v;
+            continue;
+        }
+        let from = p(v);
+        let toward = link / corners as f64 - from;
+        let length = toward.length();
+        if length == 0.0 || !length.is_finite() {
+            return None;
+        }
+        let step = toward * (PULL_FRACTION * length).min(largest_move) / length;
+        let mut moved = (from + step).to_array();
+        if single_precision {
+            moved = std::array::from_fn(|k| single_toward(moved[k], from[k]));
+        }
+        if moved == from.to_array() {
+            return None;
+        }
+        counts.largest_move = counts
+            .largest_move
+            .max(DVec3::from_array(moved).distance(from));
+        vertex_of_fan[fan] = if first_fan[v as usize] == fan as u32 {
+            counts.vertices += 1;
+            out[v as usize] = moved;
+            v
+        } else {
+            counts.added_vertices += 1;
+            out.push(moved);
+            (out.len() - 1) as u32
+        };
+    }
+    if counts.is_empty() {
+        return None;
+    }
+    let triangles = (0..triangles.len())
+        .map(|f| std::array::from_fn(|k| vertex_of_fan[corner_fan[3 * f + k] as usize]))
+        .collect();
+    Some(Separated {
+        positions: out,
+        triangles,
+        counts,
+    })
+}
+
+/// For every edge slot (`3f + k`: face `f`'s edge from corner `k` to `k + 1`), the slot it is
+/// joined to across that edge (step 1 of the [module documentation](self)), and how many edges
+/// had more than two faces; `None` when some edge's faces do not pair.
+fn pair_edges(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Option<(Vec<u32>, usize)> {
+    let p = |v: u32| DVec3::from_array(positions[v as usize]);
+    // Slots sorted by their undirected edge.
+    let mut slots: Vec<(u32, u32, u32)> = triangles
+        .iter()
+        .enumerate()
+        .flat_map(|(f, t)| {
+            (0..3).map(move |k| {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                (a.min(b), a.max(b), (3 * f + k) as u32)
+            })
+        })
+        .collect();
+    slots.sort_unstable();
+    let mut partner = vec![u32::MAX; slots.len()];
+    let mut separated = 0;
+    let forward = |slot: u32| {
+        let t = triangles[slot as usize / 3];
+        let k = slot as usize % 3;
+        t[k] < t[(k + 1) % 3]
+    };
+    for group in slots.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
+        let ahead = group.iter().filter(|s| forward(s.2)).count();
+        if 2 * ahead != group.len() {
+            return None;
+        }
+        if group.len() == 2 {
+            partner[group[0].2 as usize] = group[1].2;
+            partner[group[1].2 as usize] = group[0].2;
+            continue;
+        }
+        separated += 1;
+        let (a, b) = (p(group[0].0), p(group[0].1));
+        let axis = (b - a).normalize();
+        let e1 = axis.any_orthonormal_vector();
+        let e2 = axis.cross(e1);
+        let mut around: Vec<(f64, u32)> = group
+            .iter()
+            .map(|&(_, _, slot)| {
+                let t = triangles[slot as usize / 3];
+                let r = p(t[(slot as usize % 3 + 2) % 3]) - a;
+                (r.dot(e2).atan2(r.dot(e1)), slot)
+            })
+            .collect();
+        around.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let increasing = |w: &[(f64, u32)]| w[0].0.partial_cmp(&w[1].0) == Some(Ordering::Less);
+        if !around.windows(2).all(increasing) {
+            return None;
+        }
+        for i in 0..around.len() {
+            let (this, next) = (around[i].1, around[(i + 1) % around.len()].1);
+            if !forward(this) {
+                if !forward(next) {
+                    return None;
+                }
+                partner[this as usize] = next;
+                partner[next as usize] = this;
+            }
+        }
+    }
+    Some((partner, separated))
+}
+
+/// `x` rounded to an `f32`, towards `from` (itself an `f32`) where rounding to nearest would
+/// move it away: the rounded move is no longer than the exact one, on every axis.
+fn single_toward(x: f64, from: f64) -> f64 {
+    let r = x as f32;
+    let r = if (f64::from(r) - from).abs() > (x - from).abs() {
+        if from < x { r.next_down() } else { r.next_up() }
+    } else {
+        r
+    };
+    f64::from(r)
+}
