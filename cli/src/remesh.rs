@@ -488,7 +488,9 @@ pub struct RemeshKnobs {
     /// self-intersections bounding w > 1/2 (by default such an input, proved so with exact
     /// tests, is written as it is when it has at most the simplification target's faces, or at
     /// most 10,000; one that only self-intersects is cut along its intersections and kept where
-    /// it bounds w > 1/2; otherwise its clean components can be, with the rest remeshed; not tried
+    /// it bounds w > 1/2, and solids touching at a vertex or along an edge are pulled apart
+    /// there by at most 1/64 of a cell; otherwise its clean components can be, with the rest
+    /// remeshed; not tried
     /// with --no-weld, --thicken, --no-simplify or a method other than exact).
     #[arg(long)]
     pub always_remesh: bool,

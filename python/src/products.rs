@@ -522,7 +522,9 @@ pub fn filter_tets<'py>(
 /// out, faces split at T-junctions; the report's ``input`` says ``kept``, or ``remeshed`` and
 /// ``input_not_kept`` why); one that only self-intersects comes back cut along its
 /// intersections, the pieces inside its solid left out (``cut``: the union of overlapping
-/// shells, proved the same way); otherwise its clean components can come back as they are with
+/// shells, proved the same way); solids touching at a vertex or along an edge come back pulled
+/// apart there by at most a 64th of a cell (``input_separated_vertices``,
+/// ``input_largest_move``); otherwise its clean components can come back as they are with
 /// the rest remeshed (``partly kept``); ``always_remesh=True`` remeshes it all anyway, as
 /// ``gwn remesh --always-remesh``.
 /// ``gwn.remesh(model, res=...)`` remeshes a :class:`StepModel` (``gwn.load("part.step")``)

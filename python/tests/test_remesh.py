@@ -311,3 +311,21 @@ def test_overlapping_solids_are_cut_into_their_union():
     before = gwn.winding_number(V, F, Q) > 0.5
     after = gwn.winding_number(V2, F2, Q) > 0.5
     np.testing.assert_array_equal(before, after)
+
+
+def test_cubes_touching_at_a_corner_are_pulled_apart_and_kept():
+    """Two cubes sharing one corner (welded into a vertex with two fans): that vertex becomes
+    one per cube, each moved into its own cube by at most a 64th of a cell; every other vertex
+    is the input's, bit for bit."""
+    V = np.vstack([CUBE_V, CUBE_V + 1.0])
+    F = np.vstack([CUBE_F, CUBE_F + 8])
+    V2, F2, report = gwn.remesh(V, F, res=32, report=True, samples=4000)
+    assert report["input"] == "kept", report.get("input_not_kept")
+    assert report["input_separated_vertices"] == 1 and report["input_added_vertices"] == 1
+    assert report["input_separated_edges"] == 0
+    cell = (V.max() - V.min()) / 32
+    assert 0 < report["input_largest_move"] <= cell / 64
+    assert report["closed"] and report["vertex_manifold"] and report["self_intersections"] == 0
+    assert len(F2) == len(F) and len(V2) == len(V)
+    unmoved = {tuple(p) for p in V} & {tuple(p) for p in V2}
+    assert len(unmoved) == len(V) - 2
