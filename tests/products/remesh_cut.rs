@@ -267,7 +267,7 @@ fn an_input_without_intersections_is_its_own_cut() {
         .iter()
         .map(|p| p.map(|x| (x * 2.0) as i128))
         .collect();
-    let out = cut_intersections(positions, &fixed, triangles).unwrap();
+    let out = cut_intersections(positions, &fixed, triangles, 0.0).unwrap();
     assert_eq!(
         (out.positions.as_slice(), out.triangles.as_slice()),
         (positions, triangles)
@@ -275,7 +275,7 @@ fn an_input_without_intersections_is_its_own_cut() {
     assert_eq!((out.uncut_faces, out.counts.removed_faces), (12, 0));
     let inward = cube.flipped();
     assert_eq!(
-        cut_intersections(positions, &fixed, inward.triangles()).err(),
+        cut_intersections(positions, &fixed, inward.triangles(), 0.0).err(),
         Some(NotCut::Proof("empty"))
     );
 }

@@ -192,3 +192,24 @@ proptest! {
         prop_assert_eq!(counts(s), expected);
     }
 }
+
+/// Pinched and crossing: two cubes sharing a corner, and a turned cube through one of them.
+/// The corner is pulled apart first, then the crossing cut.
+#[test]
+fn a_pinch_is_pulled_apart_before_a_cut() {
+    let centred = common::unit_cube().translated([-0.5; 3]);
+    let turned = placed(
+        &centred,
+        [0.8813, 0.3377, 0.2291, 0.1517],
+        [0.6113, 0.3529, 0.2071],
+    );
+    let touching = cuboid([-1.5; 3], [-0.5; 3], false);
+    let input = join(&[centred, turned, touching]);
+    let out = kept(&input).unwrap_or_else(|e| panic!("not kept: {e}"));
+    let Some(InputCheck::Cut { separated, cut, .. }) = out.stats.input else {
+        panic!("not cut: {:?}", out.stats.input);
+    };
+    assert_eq!(counts(separated), [0, 1, 1]);
+    assert!(cut.intersecting_pairs > 0);
+    assert_same_solid(&input, &out, 4000, 5, separated.largest_move);
+}

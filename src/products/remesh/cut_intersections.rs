@@ -47,6 +47,7 @@ use crate::kernel::quantize::common_fixed_point;
 use super::intersect::{self, ExactPoint, intersecting_pairs_wide, segment_meets_triangle};
 use super::keep_input::{self, NotKept, referenced};
 use super::report::TopologyReport;
+use super::separate_pinches::SeparatedCounts;
 
 /// At most this many intersecting pairs are cut (the corpus has at most 848); more, and the
 /// input is remeshed.
@@ -94,6 +95,8 @@ pub struct CutSurface {
     pub triangles: Vec<[u32; 3]>,
     /// Output faces that are input faces as they were.
     pub uncut_faces: usize,
+    /// Kept pieces touching at a vertex or along an edge, pulled apart.
+    pub separated: SeparatedCounts,
     /// What was done.
     pub counts: CutCounts,
 }
@@ -153,13 +156,16 @@ enum End {
 
 /// The input (`positions`, their exact fixed-point coordinates `fixed`, `triangles`: closed,
 /// manifold, oriented, no zero-area face) cut along its self-intersections and kept where it
-/// bounds `{w > ½}`, proved as in the module documentation; else why the cut is not made.
+/// bounds `{w > ½}`, proved as in the module documentation; else why the cut is not made. Where
+/// the kept pieces touch at a vertex or along an edge, they are pulled apart by at most
+/// `largest_move` ([`super::separate_pinches`]) before the proof.
 pub fn cut_intersections(
     positions: &[[f64; 3]],
     fixed: &[[i128; 3]],
     triangles: &[[u32; 3]],
+    largest_move: f64,
 ) -> Result<CutSurface, NotCut> {
-    cut_labelling_pieces(positions, fixed, triangles, true)
+    cut_labelling_pieces(positions, fixed, triangles, largest_move, true)
 }
 
 /// [`cut_intersections`]; with `read_pieces` false, `w` is read on uncut faces only and every
@@ -168,6 +174,7 @@ fn cut_labelling_pieces(
     positions: &[[f64; 3]],
     fixed: &[[i128; 3]],
     triangles: &[[u32; 3]],
+    largest_move: f64,
     read_pieces: bool,
 ) -> Result<CutSurface, NotCut> {
     let budget = keep_input::intersection_budget(triangles.len());
@@ -443,24 +450,42 @@ fn cut_labelling_pieces(
         }
     }
     let mut kept = Vec::with_capacity(faces.len());
-    let mut uncut_faces = 0;
+    let mut kept_uncut = Vec::with_capacity(faces.len());
     for (i, t) in faces.iter().enumerate() {
         let root = super::report::find(&mut parent, i as u32);
         if *front.get(&root).ok_or(NotCut::NoCertifiedPoint)? == 0 {
             kept.push(*t);
-            uncut_faces += usize::from(uncut[i]);
+            kept_uncut.push(uncut[i]);
         }
     }
     let removed_faces = faces.len() - kept.len();
     let (out_positions, out_triangles) = referenced(&all_positions, &kept);
-    // Step 4: the proof, on the rounded coordinates.
+    // Step 4: the proof, on the rounded coordinates, where kept pieces that touch at a vertex
+    // or along an edge are first pulled apart.
     if out_triangles.is_empty() {
         return Err(NotCut::Proof("empty"));
     }
     let topology = TopologyReport::of(&out_positions, &out_triangles);
-    if let Some(problem) = keep_input::topology_problem(&topology) {
-        return Err(NotCut::Proof(proof_step(problem)));
-    }
+    let pulled = keep_input::pulled_apart_if_pinched(
+        &out_positions,
+        &out_triangles,
+        &topology,
+        largest_move,
+    )
+    .map_err(|problem| NotCut::Proof(proof_step(problem)))?;
+    let (out_positions, out_triangles, separated) = match pulled {
+        None => (out_positions, out_triangles, SeparatedCounts::default()),
+        Some(pulled) => {
+            // An uncut face with a moved vertex is no longer the input's.
+            let same =
+                |v: u32| out_positions.get(v as usize) == Some(&pulled.positions[v as usize]);
+            for (flag, t) in kept_uncut.iter_mut().zip(&pulled.triangles) {
+                *flag &= t.iter().all(|&v| same(v));
+            }
+            (pulled.positions, pulled.triangles, pulled.counts)
+        }
+    };
+    let uncut_faces = kept_uncut.iter().filter(|&&u| u).count();
     let bits = intersect::MAX_WIDE_COORDINATE.trailing_zeros();
     let out_fixed = common_fixed_point(&out_positions, bits)
         .ok_or(NotCut::Proof("beyond the exact tests' range"))?;
@@ -470,6 +495,7 @@ fn cut_labelling_pieces(
         positions: out_positions,
         triangles: out_triangles,
         uncut_faces,
+        separated,
         counts: CutCounts {
             intersecting_pairs: pairs.len(),
             cut_faces: cut.len(),
@@ -880,8 +906,8 @@ mod tests {
         ]);
         let bits = intersect::MAX_WIDE_COORDINATE.trailing_zeros();
         let fixed = common_fixed_point(&positions, bits).unwrap();
-        let read = cut_labelling_pieces(&positions, &fixed, &triangles, true).unwrap();
-        let across = cut_labelling_pieces(&positions, &fixed, &triangles, false).unwrap();
+        let read = cut_labelling_pieces(&positions, &fixed, &triangles, 0.0, true).unwrap();
+        let across = cut_labelling_pieces(&positions, &fixed, &triangles, 0.0, false).unwrap();
         assert_eq!(read.triangles, across.triangles);
         assert_eq!(read.positions, across.positions);
         // The tetrahedron's three faces through the tip are cut; the top face's two triangles

@@ -53,7 +53,9 @@ use super::exact_repair;
 use super::intersect::{self, IntersectError, self_intersections_wide};
 use super::lattice::Lattice;
 use super::report::TopologyReport;
-use super::separate_pinches::{LARGEST_MOVE_IN_CELLS, SeparatedCounts, separate_pinches};
+use super::separate_pinches::{
+    LARGEST_MOVE_IN_CELLS, Separated, SeparatedCounts, separate_pinches,
+};
 use super::{RemeshOptions, RemeshStats, Remeshed};
 
 /// Inputs of at most this many faces are never too fine to keep: the estimate of step 4 is
@@ -306,21 +308,19 @@ pub fn keep_input(
     let reason = |problem: NotKept| topology_problem(&original).unwrap_or(problem);
     // Solids touching at a vertex or along an edge: pulled apart by a fraction of a cell, then
     // proved like any other input.
-    let (positions, fixed, triangles, separated) = match topology_problem(&topology) {
-        None => (positions, fixed, triangles, SeparatedCounts::default()),
-        Some(problem @ NotKept::NotManifold { .. }) => {
-            let finest = lattice.h.into_iter().fold(f64::INFINITY, f64::min);
-            let pulled = separate_pinches(&positions, &triangles, finest * LARGEST_MOVE_IN_CELLS)
-                .filter(|s| {
-                    topology_problem(&TopologyReport::of(&s.positions, &s.triangles)).is_none()
-                })
-                .ok_or_else(|| reason(problem))?;
-            let fixed =
-                common_fixed_point(&pulled.positions, bits).ok_or_else(|| reason(problem))?;
-            (pulled.positions, fixed, pulled.triangles, pulled.counts)
-        }
-        Some(problem) => return Err(reason(problem)),
-    };
+    let finest = lattice.h.into_iter().fold(f64::INFINITY, f64::min);
+    let largest_move = finest * LARGEST_MOVE_IN_CELLS;
+    let (positions, fixed, triangles, separated) =
+        match pulled_apart_if_pinched(&positions, &triangles, &topology, largest_move)
+            .map_err(reason)?
+        {
+            None => (positions, fixed, triangles, SeparatedCounts::default()),
+            Some(pulled) => {
+                let fixed = common_fixed_point(&pulled.positions, bits)
+                    .ok_or_else(|| reason(NotKept::CoordinateRange))?;
+                (pulled.positions, fixed, pulled.triangles, pulled.counts)
+            }
+        };
     // A separated input that fails the proof is reported for its pinches, its first problem.
     let given = |e: NotKept| if separated.is_empty() { e } else { reason(e) };
     let (positions, triangles, input) = match bounds_its_solid(&positions, &fixed, &triangles) {
@@ -334,15 +334,16 @@ pub fn keep_input(
         ),
         // Overlapping shells: their union, cut out of them, when that is provably the answer.
         Err(NotKept::SelfIntersecting { pairs, .. }) => {
-            let cut = cut_intersections(&positions, &fixed, &triangles).map_err(|why| {
-                given(NotKept::SelfIntersecting {
-                    pairs,
-                    not_cut: Some(why),
-                })
-            })?;
+            let cut =
+                cut_intersections(&positions, &fixed, &triangles, largest_move).map_err(|why| {
+                    given(NotKept::SelfIntersecting {
+                        pairs,
+                        not_cut: Some(why),
+                    })
+                })?;
             let input = InputCheck::Cut {
                 repairs: repaired.counts,
-                separated,
+                separated: separated.and(cut.separated),
                 cut: cut.counts,
                 uncut_faces: cut.uncut_faces,
             };
@@ -398,6 +399,29 @@ pub(super) fn bounds_its_solid(
     }
     let surface = Mesh::from_slices(positions, triangles).map_err(|_| NotKept::CoordinateRange)?;
     check_winding(&surface, fixed)
+}
+
+/// Step 1's verdict on a surface with this `topology`, where a failure for its pinches only
+/// (solids touching at a vertex or along an edge) is mended by [`separate_pinches`]: nothing to
+/// do, the surface pulled apart (closed, manifold and oriented), or the first problem.
+pub(super) fn pulled_apart_if_pinched(
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    topology: &TopologyReport,
+    largest_move: f64,
+) -> Result<Option<Separated>, NotKept> {
+    match topology_problem(topology) {
+        None => Ok(None),
+        Some(problem @ NotKept::NotManifold { .. }) => {
+            separate_pinches(positions, triangles, largest_move)
+                .filter(|s| {
+                    topology_problem(&TopologyReport::of(&s.positions, &s.triangles)).is_none()
+                })
+                .map(Some)
+                .ok_or(problem)
+        }
+        Some(problem) => Err(problem),
+    }
 }
 
 /// The candidate pairs the intersection tests may take: linear on evenly sized faces.

@@ -63,6 +63,17 @@ impl SeparatedCounts {
     pub fn is_empty(&self) -> bool {
         self.vertices == 0
     }
+
+    /// Both separations, one after the other: counts added, and the moves too (a vertex may
+    /// move in both).
+    pub fn and(self, then: SeparatedCounts) -> SeparatedCounts {
+        SeparatedCounts {
+            edges: self.edges + then.edges,
+            vertices: self.vertices + then.vertices,
+            added_vertices: self.added_vertices + then.added_vertices,
+            largest_move: self.largest_move + then.largest_move,
+        }
+    }
 }
 
 impl std::fmt::Display for SeparatedCounts {
