@@ -77,17 +77,46 @@ fn cubes_touching_at_a_corner_or_along_an_edge_are_pulled_apart() {
     assert_eq!(counts(separated(&four).1), [6, 7, 9]);
 }
 
-/// Not done: a block whose edge touches part of another's has a vertex inside that edge, which
-/// no face there has (the faces are split only at vertices on boundary edges), so the contact
-/// is a self-intersection, and a degenerate one the cut refuses.
+/// A block whose edge touches part of another's: the vertices of each inside the other's edge
+/// are in no face of the other, so the contact is a self-intersection, and a degenerate one the
+/// cut refuses. The faces along those edges split at them (`exact_repair::split_at_contacts`)
+/// share the edge, and the pull takes it apart.
 #[test]
-fn a_block_touching_part_of_an_edge_is_a_self_intersection() {
+fn a_block_touching_part_of_an_edge_is_split_there_then_pulled_apart() {
     let block = cuboid([0.0; 3], [2.0; 3], false);
-    let small = cuboid([2.0, 2.0, 0.5], [3.0, 3.0, 1.5], false);
-    assert!(matches!(
-        kept(&join(&[block, small])),
-        Err(NotKept::SelfIntersecting { .. })
-    ));
+    for (lo, hi, split) in [(0.5, 1.5, 2), (1.0, 3.0, 4)] {
+        let small = cuboid([2.0, 2.0, lo], [3.0, 3.0, hi], false);
+        let pair = join(&[block.clone(), small]);
+        let (out, s) = separated(&pair);
+        let Some(InputCheck::Kept { repairs, .. }) = out.stats.input else {
+            unreachable!()
+        };
+        assert_eq!(repairs.split_faces, split, "{lo}..{hi}: {repairs:?}");
+        assert_eq!(counts(s), [1, 2, 2], "{lo}..{hi}");
+    }
+    // A tetrahedron's corner on the middle of the block's edge: the block's two faces there
+    // split at it, and it becomes a vertex of both.
+    let tip = Mesh::new(
+        vec![
+            [2.0, 2.0, 1.0],
+            [3.0, 2.2, 0.5],
+            [2.2, 3.0, 0.5],
+            [2.6, 2.6, 1.8],
+        ],
+        vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+    )
+    .unwrap();
+    let tip = if kept(&tip).is_ok() {
+        tip
+    } else {
+        tip.flipped()
+    };
+    let (out, s) = separated(&join(&[block, tip]));
+    let Some(InputCheck::Kept { repairs, .. }) = out.stats.input else {
+        unreachable!()
+    };
+    assert_eq!(repairs.split_faces, 2);
+    assert_eq!(counts(s), [0, 1, 1]);
 }
 
 #[test]

@@ -15,9 +15,11 @@
 //! [`super::keep_input`] proves the result closed, manifold, embedded and the boundary of
 //! `{w > ½}` as for any input.
 //!
-//! Only *boundary* edges (in one face) are split, and only at vertices of other boundary edges:
-//! splitting an edge that two faces share would open it, and a vertex that ends no boundary edge
-//! closes no crack.
+//! [`repair`] splits only *boundary* edges (in one face), and only at vertices of other
+//! boundary edges: splitting one face of an edge that two faces share would open it, and a
+//! vertex that ends no boundary edge closes no crack. [`split_at_contacts`] splits both faces
+//! of an edge at once, at the vertices of faces that meet another: where solids touch, a vertex
+//! of one inside an edge of the other becomes a vertex of both.
 
 use std::collections::HashMap;
 
@@ -116,7 +118,7 @@ pub fn repair<T: ExactPoint>(
         .collect();
     // The hash map's order is random; the budget's cut-off must not be.
     boundary.sort_unstable();
-    let junctions = boundary_junctions(points, &boundary, budget);
+    let junctions = edge_junctions(points, &boundary, budget);
     if junctions.is_empty() {
         return Repaired {
             triangles: kept,
@@ -147,6 +149,48 @@ pub fn repair<T: ExactPoint>(
             split_faces,
         },
     }
+}
+
+/// `triangles` with every face split at the vertices of `faces` (indices into `triangles`: the
+/// faces found meeting another) that lie strictly inside an edge of `faces`, and how many faces
+/// that split; `None` when no such vertex is found within `budget` candidates. Both faces of
+/// an edge are split at the same vertices, so a closed surface stays closed, and each piece
+/// keeps its face's orientation on its face's plane: `w` is unchanged off the surface, no
+/// vertex moves. Where solids touch, a vertex of one lying inside an edge of another (a block
+/// standing on part of another's edge) becomes a vertex of both, and the contact a shared edge
+/// or vertex that [`super::separate_pinches`] can pull apart.
+pub fn split_at_contacts<T: ExactPoint>(
+    points: &[T],
+    triangles: &[[u32; 3]],
+    faces: &[u32],
+    budget: u64,
+) -> Option<(Vec<[u32; 3]>, usize)> {
+    let mut edges: Vec<(u32, u32)> = faces
+        .iter()
+        .flat_map(|&f| {
+            let t = triangles[f as usize];
+            (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3])))
+        })
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    let junctions = edge_junctions(points, &edges, budget);
+    if junctions.is_empty() {
+        return None;
+    }
+    let on_edge = |a: u32, b: u32| -> &[u32] {
+        junctions
+            .get(&(a.min(b), a.max(b)))
+            .map_or(&[][..], Vec::as_slice)
+    };
+    let mut out = Vec::with_capacity(triangles.len() + 2 * junctions.len());
+    let mut split_faces = 0;
+    for &t in triangles {
+        let before = out.len();
+        split_face(t, &on_edge, &mut out);
+        split_faces += usize::from(out.len() > before + 1);
+    }
+    Some((out, split_faces))
 }
 
 /// `triangles` without pairs of faces on the same three vertices with opposite orientations
@@ -196,14 +240,14 @@ fn without_opposite_pairs(triangles: Vec<[u32; 3]>) -> (Vec<[u32; 3]>, usize) {
     (kept, cancelled)
 }
 
-/// For each boundary edge (as `(min, max)` vertex indices), the boundary vertices strictly
-/// inside it, ordered from `min` to `max`; empty when the search would exceed `budget`.
-fn boundary_junctions<T: ExactPoint>(
+/// For each of `edges` (as `(min, max)` vertex indices), the ends of `edges` strictly inside
+/// it, ordered from `min` to `max`; empty when the search would exceed `budget`.
+fn edge_junctions<T: ExactPoint>(
     points: &[T],
-    boundary: &[(u32, u32)],
+    edges: &[(u32, u32)],
     budget: u64,
 ) -> HashMap<(u32, u32), Vec<u32>> {
-    let mut ends: Vec<u32> = boundary.iter().flat_map(|&(a, b)| [a, b]).collect();
+    let mut ends: Vec<u32> = edges.iter().flat_map(|&(a, b)| [a, b]).collect();
     ends.sort_unstable();
     ends.dedup();
     // The ends sorted along each axis; an edge's candidates are those whose coordinate on one
@@ -215,7 +259,7 @@ fn boundary_junctions<T: ExactPoint>(
     });
     let mut junctions = HashMap::new();
     let mut tested = 0u64;
-    for &(a, b) in boundary {
+    for &(a, b) in edges {
         let (pa, pb) = (points[a as usize], points[b as usize]);
         let range = |k: usize| {
             let (lo, hi) = (pa.at(k).min(pb.at(k)), pa.at(k).max(pb.at(k)));

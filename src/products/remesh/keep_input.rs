@@ -39,6 +39,14 @@
 //! What is kept is the input with bit-identical vertices merged and the repairs made: its
 //! referenced vertices in their order, and its faces in theirs. Where the repaired mesh fails
 //! step 1, the reason given is the input's own first problem there.
+//!
+//! Two ways on when a step fails, each proved by the same steps on its result:
+//! - where solids touch at a vertex or along an edge (step 1 fails for several fans or
+//!   four-face edges), [`super::separate_pinches`] pulls them apart by at most a 64th of a cell,
+//!   after [`exact_repair::split_at_contacts`] has made a vertex lying inside another solid's
+//!   edge a vertex of both;
+//! - where closed shells pass through each other (step 2), [`super::cut_intersections`] cuts
+//!   them along their intersections and keeps their union.
 
 use rayon::slice::ParallelSliceMut;
 
@@ -296,61 +304,53 @@ pub fn keep_input(
         original.closed,
         1000 * triangles.len() as u64,
     );
-    let (positions, fixed, triangles, topology) = if !repaired.counts.is_empty() {
+    let mut repairs = repaired.counts;
+    let (positions, fixed, triangles) = if !repairs.is_empty() {
         let (kept, triangles) = referenced(&fixed, &repaired.triangles);
         let (positions, _) = referenced(&positions, &repaired.triangles);
-        let topology = TopologyReport::of(&positions, &triangles);
-        (positions, kept, triangles, topology)
+        (positions, kept, triangles)
     } else {
-        (positions, fixed, triangles, original)
+        (positions, fixed, triangles)
     };
-    // The reason given is the input's own first problem, whatever the repairs changed.
-    let reason = |problem: NotKept| topology_problem(&original).unwrap_or(problem);
-    // Solids touching at a vertex or along an edge: pulled apart by a fraction of a cell, then
-    // proved like any other input.
+    let first_problem = topology_problem(&original);
     let finest = lattice.h.into_iter().fold(f64::INFINITY, f64::min);
     let largest_move = finest * LARGEST_MOVE_IN_CELLS;
-    let (positions, fixed, triangles, separated) =
-        match pulled_apart_if_pinched(&positions, &triangles, &topology, largest_move)
-            .map_err(reason)?
-        {
-            None => (positions, fixed, triangles, SeparatedCounts::default()),
-            Some(pulled) => {
-                let fixed = common_fixed_point(&pulled.positions, bits)
-                    .ok_or_else(|| reason(NotKept::CoordinateRange))?;
-                (pulled.positions, fixed, pulled.triangles, pulled.counts)
-            }
-        };
-    // A separated input that fails the proof is reported for its pinches, its first problem.
-    let given = |e: NotKept| if separated.is_empty() { e } else { reason(e) };
-    let (positions, triangles, input) = match bounds_its_solid(&positions, &fixed, &triangles) {
-        Ok(()) => (
-            positions,
-            triangles,
-            InputCheck::Kept {
-                repairs: repaired.counts,
-                separated,
-            },
-        ),
-        // Overlapping shells: their union, cut out of them, when that is provably the answer.
-        Err(NotKept::SelfIntersecting { pairs, .. }) => {
-            let cut =
-                cut_intersections(&positions, &fixed, &triangles, largest_move).map_err(|why| {
-                    given(NotKept::SelfIntersecting {
-                        pairs,
-                        not_cut: Some(why),
-                    })
-                })?;
-            let input = InputCheck::Cut {
-                repairs: repaired.counts,
-                separated: separated.and(cut.separated),
-                cut: cut.counts,
-                uncut_faces: cut.uncut_faces,
-            };
-            (cut.positions, cut.triangles, input)
-        }
-        Err(e) => return Err(given(e)),
+    let attempt = |triangles: &[[u32; 3]]| {
+        kept_or_cut(&positions, &fixed, triangles, largest_move, first_problem)
     };
+    let surface = match attempt(&triangles) {
+        Ok(surface) => surface,
+        // Solids touching where a vertex of one lies inside an edge of another: that edge's
+        // faces split there (exact, `w` unchanged) make the contact a shared vertex or edge,
+        // which the pull can take apart.
+        Err(e @ (NotKept::SelfIntersecting { .. } | NotKept::NotManifold { .. })) => {
+            let budget = intersection_budget(triangles.len());
+            let meeting =
+                intersect::intersecting_faces_wide(&fixed, &triangles, budget).map_err(|_| e)?;
+            let faces: Vec<u32> = (0..triangles.len() as u32)
+                .filter(|&f| meeting[f as usize])
+                .collect();
+            let (split, split_faces) =
+                exact_repair::split_at_contacts(&fixed, &triangles, &faces, budget).ok_or(e)?;
+            let surface = attempt(&split).map_err(|_| e)?;
+            repairs.split_faces += split_faces;
+            surface
+        }
+        Err(e) => return Err(e),
+    };
+    let input = match surface.cut {
+        None => InputCheck::Kept {
+            repairs,
+            separated: surface.separated,
+        },
+        Some((cut, uncut_faces)) => InputCheck::Cut {
+            repairs,
+            separated: surface.separated,
+            cut,
+            uncut_faces,
+        },
+    };
+    let (positions, triangles) = (surface.positions, surface.triangles);
     Ok(Remeshed {
         positions,
         triangles,
@@ -363,6 +363,74 @@ pub fn keep_input(
             ..RemeshStats::default()
         },
     })
+}
+
+/// The surface [`keep_input`] gives for a repaired input, and how it was made.
+struct KeptSurface {
+    positions: Vec<[f64; 3]>,
+    triangles: Vec<[u32; 3]>,
+    /// Pinches pulled apart (before the cut, and in it).
+    separated: SeparatedCounts,
+    /// The cut's counts and its uncut faces, when the input was cut.
+    cut: Option<(super::cut_intersections::CutCounts, usize)>,
+}
+
+/// Steps 1–3 on a repaired input (`positions`, their exact coordinates `fixed`, `triangles`),
+/// its pinches pulled apart when only they fail step 1, and its self-intersections cut when
+/// only they fail step 2; else why not: the input's `first_problem` (of step 1, before the
+/// repairs) where the repaired input fails step 1 or was pulled apart, else the step's reason.
+fn kept_or_cut(
+    positions: &[[f64; 3]],
+    fixed: &[[i128; 3]],
+    triangles: &[[u32; 3]],
+    largest_move: f64,
+    first_problem: Option<NotKept>,
+) -> Result<KeptSurface, NotKept> {
+    let bits = intersect::MAX_WIDE_COORDINATE.trailing_zeros();
+    let topology = TopologyReport::of(positions, triangles);
+    let reason = |problem: NotKept| first_problem.unwrap_or(problem);
+    let pulled =
+        pulled_apart_if_pinched(positions, triangles, &topology, largest_move).map_err(reason)?;
+    let was_pulled = pulled.is_some();
+    let given = |e: NotKept| if was_pulled { reason(e) } else { e };
+    let (positions, fixed, triangles, separated) = match pulled {
+        None => (
+            positions.to_vec(),
+            fixed.to_vec(),
+            triangles.to_vec(),
+            SeparatedCounts::default(),
+        ),
+        Some(pulled) => {
+            let fixed =
+                common_fixed_point(&pulled.positions, bits).ok_or(NotKept::CoordinateRange)?;
+            (pulled.positions, fixed, pulled.triangles, pulled.counts)
+        }
+    };
+    match bounds_its_solid(&positions, &fixed, &triangles) {
+        Ok(()) => Ok(KeptSurface {
+            positions,
+            triangles,
+            separated,
+            cut: None,
+        }),
+        // Overlapping shells: their union, cut out of them, when that is provably the answer.
+        Err(NotKept::SelfIntersecting { pairs, .. }) => {
+            let cut =
+                cut_intersections(&positions, &fixed, &triangles, largest_move).map_err(|why| {
+                    given(NotKept::SelfIntersecting {
+                        pairs,
+                        not_cut: Some(why),
+                    })
+                })?;
+            Ok(KeptSurface {
+                positions: cut.positions,
+                triangles: cut.triangles,
+                separated: separated.and(cut.separated),
+                cut: Some((cut.counts, cut.uncut_faces)),
+            })
+        }
+        Err(e) => Err(given(e)),
+    }
 }
 
 /// Steps 2 and 3 of the module documentation on a surface that passed step 1 (with no
