@@ -105,6 +105,26 @@ pub struct Separated {
 /// the [module documentation](self)), each vertex moving at most `largest_move`; `None` when an
 /// edge's faces do not pair into solid wedges, a pulled vertex would not move, or there is
 /// nothing to separate.
+///
+/// ```
+/// use gwn::products::remesh::separate_pinches::separate_pinches;
+/// // Two unit cubes, outward, sharing the corner (1, 1, 1): vertex 6 of the first, 0 of the
+/// // second (its other vertices are 8 to 14).
+/// let cube = [[0.,0.,0.],[1.,0.,0.],[1.,1.,0.],[0.,1.,0.],[0.,0.,1.],[1.,0.,1.],[1.,1.,1.],[0.,1.,1.]];
+/// let faces: [[u32; 3]; 12] = [[0,2,1],[0,3,2],[0,1,5],[0,5,4],[1,2,6],[1,6,5],[2,3,7],[2,7,6],
+///                              [3,0,4],[3,4,7],[4,5,6],[4,6,7]];
+/// let mut p = cube.to_vec();
+/// p.extend(cube[1..].iter().map(|v: &[f64; 3]| v.map(|c| c + 1.0)));
+/// let shift = |v: u32| if v == 0 { 6 } else { v + 7 };
+/// let mut t = faces.to_vec();
+/// t.extend(faces.iter().map(|f| f.map(shift)));
+/// let pulled = separate_pinches(&p, &t, 1e-3).unwrap();
+/// assert_eq!((pulled.counts.vertices, pulled.counts.added_vertices), (1, 1));
+/// // The shared corner moved into the first cube, its copy into the second.
+/// let (a, b) = (pulled.positions[6], pulled.positions[15]);
+/// assert!(a.iter().all(|&c| c < 1.0) && b.iter().all(|&c| c > 1.0));
+/// assert!(pulled.counts.largest_move <= 1e-3);
+/// ```
 pub fn separate_pinches(
     positions: &[[f64; 3]],
     triangles: &[[u32; 3]],
