@@ -129,18 +129,7 @@ pub fn repair<T: ExactPoint>(
             },
         };
     }
-    let on_edge = |a: u32, b: u32| -> &[u32] {
-        junctions
-            .get(&(a.min(b), a.max(b)))
-            .map_or(&[][..], Vec::as_slice)
-    };
-    let mut out = Vec::with_capacity(kept.len() + 2 * junctions.len());
-    let mut split_faces = 0;
-    for &t in &kept {
-        let before = out.len();
-        split_face(t, &on_edge, &mut out);
-        split_faces += usize::from(out.len() > before + 1);
-    }
+    let (out, split_faces) = split_at_junctions(&kept, &junctions);
     Repaired {
         triangles: out,
         counts: RepairCounts {
@@ -178,6 +167,15 @@ pub fn split_at_contacts<T: ExactPoint>(
     if junctions.is_empty() {
         return None;
     }
+    Some(split_at_junctions(triangles, &junctions))
+}
+
+/// Every face of `triangles` split at the vertices `junctions` lists inside its edges (see
+/// [`split_face`]), and how many faces were split.
+fn split_at_junctions(
+    triangles: &[[u32; 3]],
+    junctions: &HashMap<(u32, u32), Vec<u32>>,
+) -> (Vec<[u32; 3]>, usize) {
     let on_edge = |a: u32, b: u32| -> &[u32] {
         junctions
             .get(&(a.min(b), a.max(b)))
@@ -190,7 +188,7 @@ pub fn split_at_contacts<T: ExactPoint>(
         split_face(t, &on_edge, &mut out);
         split_faces += usize::from(out.len() > before + 1);
     }
-    Some((out, split_faces))
+    (out, split_faces)
 }
 
 /// `triangles` without pairs of faces on the same three vertices with opposite orientations
