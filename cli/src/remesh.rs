@@ -215,6 +215,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
         }) => {
             // What the kept input lost or gained (faces; positions only where solids touching
             // were pulled apart), and what the cut changed.
+            // Faces of one plane replaced, or vertices moved: no longer the input as it is.
+            let changed = !separated.is_empty() || !repairs.coplanar.is_empty();
             let mut repairs = if repairs.is_empty() {
                 String::new()
             } else {
@@ -231,7 +233,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
                      {uncut_faces} of them the input's",
                     topology.faces
                 ),
-                _ if !separated.is_empty() => {
+                _ if changed => {
                     format!("the input ({} faces{repairs}", topology.faces)
                 }
                 _ => format!("the input as it is ({} faces{repairs}", topology.faces),

@@ -23,6 +23,7 @@
 
 use std::collections::HashMap;
 
+use super::coplanar_overlaps::CoplanarCounts;
 use super::intersect::ExactPoint;
 
 /// What [`repair`] changed: faces only, never a position.
@@ -34,6 +35,9 @@ pub struct RepairCounts {
     pub cancelled_faces: usize,
     /// Faces split at vertices on their boundary edges.
     pub split_faces: usize,
+    /// Faces overlapping in one plane, replaced by their sum there
+    /// ([`super::coplanar_overlaps`]).
+    pub coplanar: CoplanarCounts,
 }
 
 impl RepairCounts {
@@ -52,6 +56,10 @@ impl std::fmt::Display for RepairCounts {
             (self.split_faces, "face{} split at vertices on their edges"),
         ];
         let mut first = true;
+        if !self.coplanar.is_empty() {
+            write!(f, "{}", self.coplanar)?;
+            first = false;
+        }
         for (n, text) in parts {
             if n > 0 {
                 let sep = if first { "" } else { ", " };
@@ -126,6 +134,7 @@ pub fn repair<T: ExactPoint>(
                 zero_area_faces,
                 cancelled_faces,
                 split_faces: 0,
+                ..RepairCounts::default()
             },
         };
     }
@@ -136,6 +145,7 @@ pub fn repair<T: ExactPoint>(
             zero_area_faces,
             cancelled_faces,
             split_faces,
+            ..RepairCounts::default()
         },
     }
 }
@@ -172,7 +182,7 @@ pub fn split_at_contacts<T: ExactPoint>(
 
 /// Every face of `triangles` split at the vertices `junctions` lists inside its edges (see
 /// [`split_face`]), and how many faces were split.
-fn split_at_junctions(
+pub(super) fn split_at_junctions(
     triangles: &[[u32; 3]],
     junctions: &HashMap<(u32, u32), Vec<u32>>,
 ) -> (Vec<[u32; 3]>, usize) {

@@ -56,6 +56,7 @@ use crate::eval::antipodal::WindingNumber;
 use crate::kernel::predicates::closed_surface_orientation;
 use crate::kernel::quantize::common_fixed_point;
 
+use super::coplanar_overlaps;
 use super::cut_intersections::cut_intersections;
 use super::exact_repair;
 use super::intersect::{self, IntersectError, self_intersections_wide};
@@ -315,29 +316,48 @@ pub fn keep_input(
     let first_problem = topology_problem(&original);
     let finest = lattice.h.into_iter().fold(f64::INFINITY, f64::min);
     let largest_move = finest * LARGEST_MOVE_IN_CELLS;
-    let attempt = |triangles: &[[u32; 3]]| {
-        kept_or_cut(&positions, &fixed, triangles, largest_move, first_problem)
+    // The input as repaired, or the same with its faces split where solids touch at a vertex
+    // inside an edge; and the number of faces that split.
+    let attempt = |positions: &[[f64; 3]], fixed: &[[i128; 3]], triangles: &[[u32; 3]]| {
+        match kept_or_cut(positions, fixed, triangles, largest_move, first_problem) {
+            Ok(surface) => Ok((surface, 0)),
+            // Solids touching where a vertex of one lies inside an edge of another: that
+            // edge's faces split there (exact, `w` unchanged) make the contact a shared vertex
+            // or edge, which the pull can take apart.
+            Err(e @ (NotKept::SelfIntersecting { .. } | NotKept::NotManifold { .. })) => {
+                let budget = intersection_budget(triangles.len());
+                let meeting =
+                    intersect::intersecting_faces_wide(fixed, triangles, budget).map_err(|_| e)?;
+                let faces: Vec<u32> = (0..triangles.len() as u32)
+                    .filter(|&f| meeting[f as usize])
+                    .collect();
+                let (split, split_faces) =
+                    exact_repair::split_at_contacts(fixed, triangles, &faces, budget).ok_or(e)?;
+                let surface = kept_or_cut(positions, fixed, &split, largest_move, first_problem)
+                    .map_err(|_| e)?;
+                Ok((surface, split_faces))
+            }
+            Err(e) => Err(e),
+        }
     };
-    let surface = match attempt(&triangles) {
-        Ok(surface) => surface,
-        // Solids touching where a vertex of one lies inside an edge of another: that edge's
-        // faces split there (exact, `w` unchanged) make the contact a shared vertex or edge,
-        // which the pull can take apart.
+    let (surface, split_faces) = match attempt(&positions, &fixed, &triangles) {
+        Ok(done) => done,
+        // Faces overlapping in one plane (a part standing on a plate, a fold): replaced by
+        // what they add up to there, then the same steps.
         Err(e @ (NotKept::SelfIntersecting { .. } | NotKept::NotManifold { .. })) => {
             let budget = intersection_budget(triangles.len());
-            let meeting =
-                intersect::intersecting_faces_wide(&fixed, &triangles, budget).map_err(|_| e)?;
-            let faces: Vec<u32> = (0..triangles.len() as u32)
-                .filter(|&f| meeting[f as usize])
-                .collect();
-            let (split, split_faces) =
-                exact_repair::split_at_contacts(&fixed, &triangles, &faces, budget).ok_or(e)?;
-            let surface = attempt(&split).map_err(|_| e)?;
-            repairs.split_faces += split_faces;
-            surface
+            let merged =
+                coplanar_overlaps::merge_coplanar_overlaps(&positions, &fixed, &triangles, budget)
+                    .ok_or(e)?;
+            let (positions, triangles) = referenced(&merged.positions, &merged.triangles);
+            let fixed = common_fixed_point(&positions, bits).ok_or(e)?;
+            let done = attempt(&positions, &fixed, &triangles).map_err(|_| e)?;
+            repairs.coplanar = merged.counts;
+            done
         }
         Err(e) => return Err(e),
     };
+    repairs.split_faces += split_faces;
     let input = match surface.cut {
         None => InputCheck::Kept {
             repairs,

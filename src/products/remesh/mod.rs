@@ -49,6 +49,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod coplanar_overlaps;
 pub mod crossings;
 pub mod cut_intersections;
 pub mod dataset;
