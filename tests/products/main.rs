@@ -13,6 +13,7 @@ mod label;
 mod products;
 mod remesh;
 mod remesh_cli;
+mod remesh_coplanar;
 mod remesh_cut;
 mod remesh_dataset;
 mod remesh_keep;

@@ -441,6 +441,31 @@ fn remesh_pulls_apart_solids_that_touch() {
     }
 }
 
+/// Printer beds whose parts stand on their plates (faces overlapping in one plane) are kept
+/// with those faces replaced by their sum, agreeing with the input's solid at every sample.
+#[test]
+fn remesh_keeps_parts_standing_on_plates() {
+    for (name, input_kind, components, planes) in [
+        ("prusa-A350_bed.stl", "kept", 1, 2.0),
+        ("cura-ultimaker2_platform.obj", "kept", 2, 4.0),
+        ("openscad-bad-stl-pcbvicebar.stl", "kept", 1, 1.0),
+        ("cura-voron0_120_bed.stl", "cut", 1, 15.0),
+    ] {
+        let Some(input) = crate::common::shared_file(&format!("meshes/{name}")) else {
+            return;
+        };
+        let kind = format!("\"input\": \"{input_kind}\"");
+        let json = remesh_report_of(&input, "256", "20000", components, &[&kind]);
+        assert_eq!(
+            report_number(&json, "input_coplanar_planes"),
+            planes,
+            "{json}"
+        );
+        assert!(report_number(&json, "input_coplanar_faces") > 0.0, "{json}");
+        assert_eq!(report_number(&json, "occupancy_agreement"), 1.0, "{json}");
+    }
+}
+
 /// Runs `gwn remesh INPUT --res RES --samples SAMPLES` and returns its JSON report, after
 /// checking that the run succeeded and that the report says closed, manifold, oriented, one
 /// component, no self-intersection, and every member of `also`.

@@ -81,7 +81,8 @@ fn zero_area_faces_go_and_t_junctions_are_split_without_moving_a_vertex() {
                     repairs: RepairCounts {
                         zero_area_faces,
                         cancelled_faces: 0,
-                        split_faces: 1
+                        split_faces: 1,
+                        ..RepairCounts::default()
                     },
                     separated: SeparatedCounts::default(),
                 })),
@@ -152,7 +153,8 @@ fn two_cubes_sharing_a_wall_written_once_for_each_are_one_solid() {
             repairs: RepairCounts {
                 zero_area_faces: 0,
                 cancelled_faces: 4,
-                split_faces: 0
+                split_faces: 0,
+                ..RepairCounts::default()
             },
             separated: SeparatedCounts::default(),
         })

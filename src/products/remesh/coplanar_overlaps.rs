@@ -144,7 +144,14 @@ pub fn merge_coplanar_overlaps(
         }
         let plane = Plane::of(fixed, triangles[group[0] as usize])?;
         let before = out_positions.len();
-        let arrangement = arrangement(&plane, fixed, &mut out_positions, triangles, group);
+        let arrangement = arrangement(
+            &plane,
+            fixed,
+            &mut out_positions,
+            triangles,
+            group,
+            budget - work,
+        )?;
         work += arrangement.tested;
         if work > budget {
             return None;
@@ -198,24 +205,29 @@ impl Plane {
     }
 }
 
+/// An edge `(min, max)` and the vertices strictly inside it, from `min` to `max`.
+type EdgeVertices = ((u32, u32), Vec<u32>);
+
 /// Step 2: the group's edges, and the vertices strictly inside each (ordered from its lower
 /// vertex index to its higher one).
 struct Arrangement {
-    /// Each edge `(min, max)` of the group's faces and the vertices inside it.
-    inside: Vec<((u32, u32), Vec<u32>)>,
-    /// Segment pairs tested.
+    /// Each edge of the group's faces and the vertices inside it.
+    inside: Vec<EdgeVertices>,
+    /// Pairs of edges looked at.
     tested: u64,
 }
 
 /// The arrangement of the edges of the faces `group` (module documentation, step 2); new
-/// vertices are appended to `positions`.
+/// vertices are appended to `positions`. `None` when more than `budget` pairs of edges
+/// overlap along the first axis.
 fn arrangement(
     plane: &Plane,
     fixed: &[[i128; 3]],
     positions: &mut Vec<[f64; 3]>,
     triangles: &[[u32; 3]],
     group: &[u32],
-) -> Arrangement {
+    budget: u64,
+) -> Option<Arrangement> {
     let mut edges: Vec<(u32, u32)> = group
         .iter()
         .flat_map(|&f| {
@@ -258,14 +270,24 @@ fn arrangement(
         );
         (DVec3::from(positions[v as usize]) - pa).dot(pb - pa)
     };
+    // A sweep along the first axis: each edge meets the later ones whose range there starts
+    // before its own ends.
+    let mut order: Vec<usize> = (0..edges.len()).collect();
+    order.sort_by_key(|&x| (boxes[x][0].0, x));
     let mut tested = 0u64;
-    for x in 0..edges.len() {
-        for y in x + 1..edges.len() {
+    for (k, &x) in order.iter().enumerate() {
+        for &y in &order[k + 1..] {
             let (bx, by) = (boxes[x], boxes[y]);
-            if bx[0].1 < by[0].0 || by[0].1 < bx[0].0 || bx[1].1 < by[1].0 || by[1].1 < bx[1].0 {
-                continue;
+            if by[0].0 > bx[0].1 {
+                break;
             }
             tested += 1;
+            if tested > budget {
+                return None;
+            }
+            if bx[1].1 < by[1].0 || by[1].1 < bx[1].0 {
+                continue;
+            }
             let (e, f) = (edges[x], edges[y]);
             // Touching: an end of one strictly inside the other (also where they overlap
             // along one line).
@@ -301,7 +323,7 @@ fn arrangement(
             (e, list.into_iter().map(|(_, v)| v).collect())
         })
         .collect();
-    Arrangement { inside, tested }
+    Some(Arrangement { inside, tested })
 }
 
 /// Where the edges `e` and `f` (crossing properly in the plane) cross: on `e`, at the
@@ -326,7 +348,7 @@ fn covered_triangles(
     triangles: &[[u32; 3]],
     group: &[u32],
     arrangement: &Arrangement,
-) -> Option<(Vec<[u32; 3]>, Vec<((u32, u32), Vec<u32>)>)> {
+) -> Option<(Vec<[u32; 3]>, Vec<EdgeVertices>)> {
     let two = |v: u32| plane.project(positions[v as usize]);
     let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::new();
     let mut vertices: Vec<u32> = arrangement

@@ -40,13 +40,16 @@
 //! referenced vertices in their order, and its faces in theirs. Where the repaired mesh fails
 //! step 1, the reason given is the input's own first problem there.
 //!
-//! Two ways on when a step fails, each proved by the same steps on its result:
+//! Three ways on when a step fails, each proved by the same steps on its result:
 //! - where solids touch at a vertex or along an edge (step 1 fails for several fans or
 //!   four-face edges), [`super::separate_pinches`] pulls them apart by at most a 64th of a cell,
 //!   after [`exact_repair::split_at_contacts`] has made a vertex lying inside another solid's
 //!   edge a vertex of both;
 //! - where closed shells pass through each other (step 2), [`super::cut_intersections`] cuts
-//!   them along their intersections and keeps their union.
+//!   them along their intersections and keeps their union;
+//! - where that still fails for a self-intersection or a pinch, faces overlapping in one plane
+//!   (a part standing on a plate) are replaced by what they add up to there
+//!   ([`super::coplanar_overlaps`]), and both ways above are tried again on the result.
 
 use rayon::slice::ParallelSliceMut;
 

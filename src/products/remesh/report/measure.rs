@@ -400,14 +400,27 @@ impl RemeshReport {
 }
 
 /// The report's members for what the input went through before it was kept or cut: the exact
-/// repairs, and the pinches pulled apart (only when there were any, so a report of an input
-/// kept bit for bit is as before).
+/// repairs, and the coplanar faces replaced and the pinches pulled apart (only when there
+/// were any, so a report of an input kept bit for bit is as before).
 fn input_changes(repairs: RepairCounts, separated: SeparatedCounts) -> Vec<(&'static str, String)> {
     let mut members = vec![
         ("input_zero_area_faces", repairs.zero_area_faces.to_string()),
         ("input_cancelled_faces", repairs.cancelled_faces.to_string()),
         ("input_split_faces", repairs.split_faces.to_string()),
     ];
+    let coplanar = repairs.coplanar;
+    if !coplanar.is_empty() {
+        members.extend([
+            ("input_coplanar_planes", coplanar.planes.to_string()),
+            ("input_coplanar_faces", coplanar.faces.to_string()),
+            ("input_coplanar_pieces", coplanar.pieces.to_string()),
+            ("input_crossing_vertices", coplanar.crossings.to_string()),
+            (
+                "input_coplanar_split_neighbours",
+                coplanar.split_neighbours.to_string(),
+            ),
+        ]);
+    }
     if !separated.is_empty() {
         members.extend([
             ("input_separated_edges", separated.edges.to_string()),
