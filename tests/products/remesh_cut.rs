@@ -211,7 +211,7 @@ fn overlapping_shells_are_cut_into_their_union() {
 }
 
 #[test]
-fn contacts_that_are_not_in_general_position_are_remeshed() {
+fn contacts_that_are_not_in_general_position_are_remeshed_or_replaced() {
     let cube = centred_cube();
     // Two cubes offset along a diagonal: an edge of one pierces the other on a face diagonal.
     let diagonal = join(&[cube.clone(), cube.translated([0.5, 0.5, 0.5])]);
@@ -222,15 +222,15 @@ fn contacts_that_are_not_in_general_position_are_remeshed() {
             ..
         })
     ));
-    // Touching along a face.
+    // Touching along a face: not cut, but the faces of that plane are replaced by what they
+    // add up to there (`coplanar_overlaps`), and the two are kept as one solid.
     let touching = join(&[cube.clone(), cube.translated([1.0, 0.25, 0.25])]);
-    assert!(matches!(
-        kept(&touching),
-        Err(NotKept::SelfIntersecting {
-            not_cut: Some(_),
-            ..
-        })
-    ));
+    let out = kept(&touching).unwrap_or_else(|e| panic!("{e}"));
+    let Some(InputCheck::Kept { repairs, .. }) = out.stats.input else {
+        panic!("not kept: {:?}", out.stats.input);
+    };
+    assert_eq!(repairs.coplanar.planes, 1, "{repairs:?}");
+    assert_same_solid(&touching, &out, 2000, 9, 0.0);
 }
 
 /// Three cubes through one region: where three faces meet in a point, two intersection

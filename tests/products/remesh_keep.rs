@@ -168,13 +168,20 @@ fn two_cubes_sharing_a_wall_written_once_for_each_are_one_solid() {
     ] {
         assert_eq!(wn.eval(q), w, "{q:?}");
     }
-    // The same cubes with their shared wall's diagonals crossing: nothing cancels, and its rim
-    // edges are in four faces.
+    // The same cubes with their shared wall's diagonals crossing: no pair cancels, but the
+    // wall's four faces cover it once each way, and are replaced by nothing
+    // (`coplanar_overlaps`; the diagonals' crossing is in no face).
     let shifted = join(&[cube.clone(), cube.translated([1.0, 0.0, 0.0])]);
-    assert!(matches!(
-        kept(&shifted, 64),
-        Err(NotKept::NotManifold { .. })
-    ));
+    let out = kept(&shifted, 64).unwrap_or_else(|e| panic!("{e}"));
+    let Some(InputCheck::Kept { repairs, .. }) = out.stats.input else {
+        panic!("not kept: {:?}", out.stats.input);
+    };
+    assert_eq!(
+        (repairs.coplanar.faces, repairs.coplanar.pieces),
+        (4, 0),
+        "{repairs:?}"
+    );
+    assert_eq!((out.triangles.len(), out.positions.len()), (20, 12));
     // Twice the same orientation doubles w there: no cancelling.
     let mut faces = cube.triangles().to_vec();
     faces.extend([faces[4], faces[4]]);
@@ -230,24 +237,23 @@ fn every_way_of_not_bounding_the_solid_is_remeshed() {
         kept(&overlap, 64),
         Err(NotKept::SelfIntersecting { .. })
     ));
-    // Touching along a face: coplanar faces meet.
-    let touching = join(&[cube.clone(), cube.translated([1.0, 0.25, 0.25])]);
-    assert!(matches!(
-        kept(&touching, 64),
-        Err(NotKept::SelfIntersecting { .. })
-    ));
+    // Touching along a face: coplanar faces meet, not kept as they are, but their plane's faces
+    // are replaced by what they add up to (`coplanar_overlaps`): tests/products/remesh_coplanar.rs.
     // Sharing a corner: welded into one vertex whose faces are two fans, pulled apart and kept
-    // (`separate_pinches`); with a third cube's face on that corner, not.
+    // (`separate_pinches`); with a third cube standing against the first one's face through
+    // that corner, the faces of that plane are replaced by their sum first
+    // (`coplanar_overlaps`), then the corners pulled apart: kept too, the same solid.
     let corner = join(&[cube.clone(), cube.translated([1.0, 1.0, 1.0])]);
     assert!(kept(&corner, 64).is_ok());
     let on_face = join(&[corner, cube.translated([1.0, 0.5, 0.0])]);
-    assert!(matches!(
-        kept(&on_face, 64),
-        Err(NotKept::NotManifold {
-            edges: 0,
-            vertices: 1
-        })
-    ));
+    let out = kept(&on_face, 64).unwrap_or_else(|e| panic!("{e}"));
+    let Some(InputCheck::Kept { repairs, separated }) = out.stats.input else {
+        panic!("not kept: {:?}", out.stats.input);
+    };
+    // Four planes: the contact at x = 1, the corner cube's bottom on the third's top at z = 1,
+    // and faces of one plane meeting along an edge or at a corner.
+    assert_eq!(repairs.coplanar.planes, 4, "{repairs:?}");
+    crate::remesh_cut::assert_same_solid(&on_face, &out, 2000, 3, separated.largest_move);
     // A duplicated face: an edge in three faces.
     let mut faces = cube.triangles().to_vec();
     faces.push(faces[0]);
@@ -267,6 +273,7 @@ fn every_way_of_not_bounding_the_solid_is_remeshed() {
         vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]],
     )
     .unwrap();
+    // (Its faces cover their plane 0 times: replaced by nothing, which is not kept.)
     assert!(matches!(
         kept(&flat, 64),
         Err(NotKept::SelfIntersecting { .. })
@@ -303,11 +310,23 @@ fn the_tests_are_exact_beyond_sixty_bits() {
         cuboid([tiny, 0.25, 0.25], [1.0, 0.75, 0.75], false),
     ]);
     kept(&apart, 64).unwrap_or_else(|e| panic!("{e}"));
+    // Touching along a face: the faces of that plane replaced by their sum, decided by the
+    // wide predicates (the two boxes' faces overlap in a strip `2^-70` from an edge).
     let touching = join(&[left, cuboid([0.0, tiny, 0.25], [1.0, 0.75, 0.75], false)]);
-    assert!(matches!(
-        kept(&touching, 64),
-        Err(NotKept::SelfIntersecting { .. })
-    ));
+    let out = kept(&touching, 64).unwrap_or_else(|e| panic!("{e}"));
+    let Some(InputCheck::Kept { repairs, .. }) = out.stats.input else {
+        panic!("not kept: {:?}", out.stats.input);
+    };
+    assert_eq!(repairs.coplanar.planes, 1, "{repairs:?}");
+    let wn = WindingNumber::new(&Mesh::new(out.positions, out.triangles).unwrap()).unwrap();
+    for (q, w) in [
+        ([-0.5, 0.5, 0.5], 1.0),
+        ([0.5, 0.5, 0.5], 1.0),
+        ([0.5, tiny / 2.0, 0.5], 0.0),
+        ([0.5, 0.9, 0.5], 0.0),
+    ] {
+        assert_eq!(wn.eval(q), w, "{q:?}");
+    }
     // A span no integer scale below 2^125 holds: not tested, remeshed.
     let far = cube.translated([1e-300, 0.0, 0.0]);
     assert!(matches!(
@@ -449,10 +468,17 @@ proptest! {
             o.stats.input,
             Some(InputCheck::Kept { separated, .. }) if !separated.is_empty()
         ));
+        // Boxes touching along faces have those faces replaced by what they add up to in
+        // their plane (`coplanar_overlaps`): kept then too, and held to the same test.
+        let merged = got.as_ref().is_ok_and(|o| matches!(
+            o.stats.input,
+            Some(InputCheck::Kept { repairs, .. } | InputCheck::Cut { repairs, .. })
+                if !repairs.coplanar.is_empty()
+        ));
         if expected {
             prop_assert!(got.is_ok() && !cut, "{:?}", got.as_ref().err());
         } else {
-            prop_assert!(got.is_err() || cut || separated);
+            prop_assert!(got.is_err() || cut || separated || merged);
         }
         if let Ok(out) = got {
             let wn = WindingNumber::new(&mesh).unwrap();
@@ -508,9 +534,15 @@ proptest! {
             _ => 0.0,
         };
         let new = used.iter().filter(|p| !input.contains(&bits(p))).count();
+        // New positions: those pulled apart, and crossings of coplanar faces' edges
+        // (`coplanar_overlaps`, within rounding of the exact crossing).
         match out.stats.input {
-            Some(InputCheck::Kept { separated, .. }) => {
+            Some(InputCheck::Kept { separated, repairs }) if repairs.coplanar.is_empty() => {
                 prop_assert_eq!(new, separated.vertices + separated.added_vertices);
+            }
+            Some(InputCheck::Kept { separated, repairs }) => {
+                let most = separated.vertices + separated.added_vertices + repairs.coplanar.crossings;
+                prop_assert!(new <= most, "{} new vertices", new);
             }
             _ => prop_assert_eq!(new, 0),
         }

@@ -99,7 +99,8 @@ pub struct Merged {
 /// The surface `positions` (with their exact fixed-point coordinates `fixed`), `triangles`
 /// (no zero-area face), with every group of faces that overlap in one plane replaced by faces
 /// of the same coverage (module documentation); `None` when no faces overlap in a plane, the
-/// intersection search exceeds `budget` or [`MAX_PAIRS`], or a group is refused.
+/// intersection search exceeds `budget` or [`MAX_PAIRS`], a group is refused, or no face is
+/// left.
 pub fn merge_coplanar_overlaps(
     positions: &[[f64; 3]],
     fixed: &[[i128; 3]],
@@ -177,6 +178,11 @@ pub fn merge_coplanar_overlaps(
     let (mut out_triangles, split) = exact_repair::split_at_junctions(&outside, &junctions);
     counts.split_neighbours = split;
     out_triangles.extend(pieces);
+    // Nothing left (a closed surface folded flat): its solid is empty, which a remesh says
+    // as well; not an input to keep.
+    if out_triangles.is_empty() {
+        return None;
+    }
     Some(Merged {
         positions: out_positions,
         triangles: out_triangles,

@@ -319,44 +319,55 @@ pub fn keep_input(
     let first_problem = topology_problem(&original);
     let finest = lattice.h.into_iter().fold(f64::INFINITY, f64::min);
     let largest_move = finest * LARGEST_MOVE_IN_CELLS;
-    // The input as repaired, or the same with its faces split where solids touch at a vertex
-    // inside an edge; and the number of faces that split.
-    let attempt = |positions: &[[f64; 3]], fixed: &[[i128; 3]], triangles: &[[u32; 3]]| {
-        match kept_or_cut(positions, fixed, triangles, largest_move, first_problem) {
-            Ok(surface) => Ok((surface, 0)),
-            // Solids touching where a vertex of one lies inside an edge of another: that
-            // edge's faces split there (exact, `w` unchanged) make the contact a shared vertex
-            // or edge, which the pull can take apart.
-            Err(e @ (NotKept::SelfIntersecting { .. } | NotKept::NotManifold { .. })) => {
-                let budget = intersection_budget(triangles.len());
-                let meeting =
-                    intersect::intersecting_faces_wide(fixed, triangles, budget).map_err(|_| e)?;
-                let faces: Vec<u32> = (0..triangles.len() as u32)
-                    .filter(|&f| meeting[f as usize])
-                    .collect();
-                let (split, split_faces) =
-                    exact_repair::split_at_contacts(fixed, triangles, &faces, budget).ok_or(e)?;
-                let surface = kept_or_cut(positions, fixed, &split, largest_move, first_problem)
-                    .map_err(|_| e)?;
-                Ok((surface, split_faces))
-            }
-            Err(e) => Err(e),
-        }
+    let kept = |positions: &[[f64; 3]], fixed: &[[i128; 3]], triangles: &[[u32; 3]]| {
+        kept_or_cut(positions, fixed, triangles, largest_move, first_problem)
     };
-    let (surface, split_faces) = match attempt(&positions, &fixed, &triangles) {
-        Ok(done) => done,
-        // Faces overlapping in one plane (a part standing on a plate, a fold): replaced by
-        // what they add up to there, then the same steps.
+    // Solids touching where a vertex of one lies inside an edge of another: that edge's faces
+    // split there (exact, `w` unchanged) make the contact a shared vertex or edge, which the
+    // pull can take apart. The surface, and how many faces were split; else `e`.
+    let split_at_contacts =
+        |positions: &[[f64; 3]], fixed: &[[i128; 3]], triangles: &[[u32; 3]], e: NotKept| {
+            let budget = intersection_budget(triangles.len());
+            let meeting =
+                intersect::intersecting_faces_wide(fixed, triangles, budget).map_err(|_| e)?;
+            let faces: Vec<u32> = (0..triangles.len() as u32)
+                .filter(|&f| meeting[f as usize])
+                .collect();
+            let (split, split_faces) =
+                exact_repair::split_at_contacts(fixed, triangles, &faces, budget).ok_or(e)?;
+            let surface = kept(positions, fixed, &split).map_err(|_| e)?;
+            Ok((surface, split_faces))
+        };
+    let (surface, split_faces) = match kept(&positions, &fixed, &triangles) {
+        Ok(surface) => (surface, 0),
         Err(e @ (NotKept::SelfIntersecting { .. } | NotKept::NotManifold { .. })) => {
+            // Faces overlapping in one plane (a part standing on a plate, a fold) first:
+            // replaced by what they add up to there, then the same steps, the contact split
+            // included; where there are none, or that fails, the contact split alone.
             let budget = intersection_budget(triangles.len());
             let merged =
                 coplanar_overlaps::merge_coplanar_overlaps(&positions, &fixed, &triangles, budget)
-                    .ok_or(e)?;
-            let (positions, triangles) = referenced(&merged.positions, &merged.triangles);
-            let fixed = common_fixed_point(&positions, bits).ok_or(e)?;
-            let done = attempt(&positions, &fixed, &triangles).map_err(|_| e)?;
-            repairs.coplanar = merged.counts;
-            done
+                    .and_then(|merged| {
+                        let (positions, triangles) =
+                            referenced(&merged.positions, &merged.triangles);
+                        let fixed = common_fixed_point(&positions, bits)?;
+                        let done = match kept(&positions, &fixed, &triangles) {
+                            Ok(surface) => Ok((surface, 0)),
+                            Err(
+                                e
+                                @ (NotKept::SelfIntersecting { .. } | NotKept::NotManifold { .. }),
+                            ) => split_at_contacts(&positions, &fixed, &triangles, e),
+                            Err(e) => Err(e),
+                        };
+                        Some((done.ok()?, merged.counts))
+                    });
+            match merged {
+                Some((done, counts)) => {
+                    repairs.coplanar = counts;
+                    done
+                }
+                None => split_at_contacts(&positions, &fixed, &triangles, e)?,
+            }
         }
         Err(e) => return Err(e),
     };
