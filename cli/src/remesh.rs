@@ -491,7 +491,8 @@ pub struct RemeshKnobs {
     /// tests, is written as it is when it has at most the simplification target's faces, or at
     /// most 10,000; one that only self-intersects is cut along its intersections and kept where
     /// it bounds w > 1/2, and solids touching at a vertex or along an edge are pulled apart
-    /// there by at most 1/64 of a cell; otherwise its clean components can be, with the rest
+    /// there by at most 1/64 of a cell, and faces overlapping in one plane (a part on a plate)
+    /// are replaced by what they add up to there; otherwise its clean components can be, with the rest
     /// remeshed; not tried
     /// with --no-weld, --thicken, --no-simplify or a method other than exact).
     #[arg(long)]

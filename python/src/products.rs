@@ -524,7 +524,9 @@ pub fn filter_tets<'py>(
 /// intersections, the pieces inside its solid left out (``cut``: the union of overlapping
 /// shells, proved the same way); solids touching at a vertex or along an edge come back pulled
 /// apart there by at most a 64th of a cell (``input_separated_vertices``,
-/// ``input_largest_move``); otherwise its clean components can come back as they are with
+/// ``input_largest_move``); faces overlapping in one plane (a part standing on a plate) are
+/// replaced by what they add up to there (``input_coplanar_faces``,
+/// ``input_crossing_vertices``); otherwise its clean components can come back as they are with
 /// the rest remeshed (``partly kept``); ``always_remesh=True`` remeshes it all anyway, as
 /// ``gwn remesh --always-remesh``.
 /// ``gwn.remesh(model, res=...)`` remeshes a :class:`StepModel` (``gwn.load("part.step")``)
