@@ -194,3 +194,130 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+
+    /// The replacement's own claim, on triangles of one plane at random (corners on a 5 × 5
+    /// grid, so edges overlap, cross, end inside each other and faces repeat, either
+    /// orientation), in the plane z = 0 or the tilted plane z = x + y: wherever it is made,
+    /// `w` off the plane is the input's (the solid angles' sum, exactly up to the rounding of
+    /// the crossings); where it is refused, some region is covered twice the same way.
+    #[test]
+    fn the_replacement_keeps_w_off_the_plane(
+        faces in prop::collection::vec(
+            ([(0u8..5, 0u8..5), (0u8..5, 0u8..5), (0u8..5, 0u8..5)], any::<bool>()),
+            2..8,
+        ),
+        tilted: bool,
+        seed in any::<u64>(),
+    ) {
+        let lift = |(a, b): (u8, u8)| {
+            let (x, y) = (f64::from(a), f64::from(b));
+            [x, y, if tilted { x + y } else { 0.0 }]
+        };
+        let mut positions: Vec<[f64; 3]> = Vec::new();
+        let mut index = |p: [f64; 3]| match positions.iter().position(|q| *q == p) {
+            Some(i) => i as u32,
+            None => {
+                positions.push(p);
+                positions.len() as u32 - 1
+            }
+        };
+        let mut triangles = Vec::new();
+        for (corners, flip) in &faces {
+            let [a, b, c] = corners.map(|g| index(lift(g)));
+            // Zero-area faces are the repair's, not this replacement's.
+            let [p, q, r] = corners.map(|(x, y)| [i32::from(x), i32::from(y)]);
+            if (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]) == 0 {
+                continue;
+            }
+            triangles.push(if *flip { [a, c, b] } else { [a, b, c] });
+        }
+        prop_assume!(triangles.len() >= 2);
+        let fixed: Vec<[i128; 3]> = positions.iter().map(|p| p.map(|c| c as i128)).collect();
+        let Some(merged) = merge_coplanar_overlaps(&positions, &fixed, &triangles, 1 << 24) else {
+            return Ok(());
+        };
+        let input = Mesh::new(positions.clone(), triangles.clone()).unwrap();
+        let output = Mesh::new(merged.positions.clone(), merged.triangles.clone()).unwrap();
+        let (wi, wo) = (
+            gwn::eval::antipodal::WindingNumber::new(&input).unwrap(),
+            gwn::eval::antipodal::WindingNumber::new(&output).unwrap(),
+        );
+        let mut rng = crate::common::Rng(seed);
+        for _ in 0..64 {
+            let (x, y) = (rng.range(-1.0, 5.0), rng.range(-1.0, 5.0));
+            let off = rng.range(0.05, 2.0) * if rng.range(0.0, 1.0) < 0.5 { -1.0 } else { 1.0 };
+            let z = if tilted { x + y } else { 0.0 } + off;
+            let (a, b) = (wi.eval([x, y, z]), wo.eval([x, y, z]));
+            prop_assert!((a - b).abs() < 1e-9, "w {} against {} at {:?}", a, b, [x, y, z]);
+        }
+    }
+}
+
+/// Crossings that are one exact point (three edges through it) but round apart on their own
+/// edges: one vertex, else the pieces of edges through them cross each other near there and
+/// the replacement is refused. Two cases found by a search over the proptest's faces, on the
+/// tilted plane z = x + y and on z = 0 (each `(corners, turned)`).
+#[test]
+fn crossings_within_rounding_of_each_other_are_one_vertex() {
+    type Face = ([[i32; 2]; 3], bool);
+    let cases: [(bool, &[Face]); 2] = [
+        (
+            true,
+            &[
+                ([[2, 4], [2, 1], [0, 2]], true),
+                ([[2, 3], [4, 2], [1, 3]], false),
+                ([[0, 4], [3, 1], [3, 2]], true),
+            ],
+        ),
+        (
+            false,
+            &[
+                ([[2, 3], [4, 1], [3, 4]], false),
+                ([[2, 4], [1, 1], [2, 3]], false),
+                ([[3, 0], [3, 4], [0, 3]], true),
+                ([[1, 2], [0, 2], [2, 1]], true),
+            ],
+        ),
+    ];
+    for (tilted, faces) in cases {
+        let lift = |[x, y]: [i32; 2]| {
+            let (x, y) = (f64::from(x), f64::from(y));
+            [x, y, if tilted { x + y } else { 0.0 }]
+        };
+        let mut positions: Vec<[f64; 3]> = Vec::new();
+        let mut triangles = Vec::new();
+        for (corners, turned) in faces {
+            let n = positions.len() as u32;
+            positions.extend(corners.map(lift));
+            triangles.push(if *turned {
+                [n, n + 2, n + 1]
+            } else {
+                [n, n + 1, n + 2]
+            });
+        }
+        let (mesh, _) = Mesh::new(positions, triangles).unwrap().welded();
+        let fixed: Vec<[i128; 3]> = mesh
+            .positions()
+            .iter()
+            .map(|p| p.map(|c| c as i128))
+            .collect();
+        let merged = merge_coplanar_overlaps(mesh.positions(), &fixed, mesh.triangles(), 1 << 20)
+            .unwrap_or_else(|| panic!("refused (tilted: {tilted})"));
+        let output = Mesh::new(merged.positions.clone(), merged.triangles.clone()).unwrap();
+        let (wi, wo) = (
+            gwn::eval::antipodal::WindingNumber::new(&mesh).unwrap(),
+            gwn::eval::antipodal::WindingNumber::new(&output).unwrap(),
+        );
+        let mut rng = crate::common::Rng(3);
+        for _ in 0..200 {
+            let (x, y) = (rng.range(-1.0, 5.0), rng.range(-1.0, 5.0));
+            let side = if rng.range(0.0, 1.0) < 0.5 { -1.0 } else { 1.0 };
+            let plane = if tilted { x + y } else { 0.0 };
+            let q = [x, y, plane + side * rng.range(0.05, 1.0)];
+            assert!((wi.eval(q) - wo.eval(q)).abs() < 1e-9, "{q:?}");
+        }
+    }
+}

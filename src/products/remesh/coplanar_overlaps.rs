@@ -16,7 +16,9 @@
 //!    component.
 //! 2. **Arrangement.** Every edge of a group's faces is split where another of its edges
 //!    crosses it (a new vertex, the exact crossing rounded to `f64` along the edge) or ends on
-//!    it (an input vertex; exact orientations decide crossing, touching and overlap).
+//!    it (an input vertex; exact orientations decide crossing, touching and overlap). One
+//!    exact point crossed by three edges is rounded on each of them: crossings within
+//!    [`COINCIDENT`] of the group's size are one vertex.
 //! 3. **Coverage.** The group's vertices and those pieces of edges are triangulated with the
 //!    pieces as constraints (spade's constrained Delaunay triangulation); every triangle lies
 //!    inside or outside each face of the group, so its coverage is the sum of the orientations
@@ -42,6 +44,11 @@ use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 use super::exact_repair;
 use super::intersect::{ExactPoint, intersecting_pairs_wide};
 use super::report::{find, union};
+
+/// Crossings closer than this fraction of their group's size are one point (module
+/// documentation, step 2): far above the rounding of one crossing (a few ulps), far below any
+/// feature of a mesh.
+pub const COINCIDENT: f64 = 1e-12;
 
 /// At most this many intersecting pairs are looked at (the corpus has at most 135,853).
 pub const MAX_PAIRS: usize = 1_000_000;
@@ -157,7 +164,16 @@ pub fn merge_coplanar_overlaps(
         if work > budget {
             return None;
         }
-        counts.crossings += out_positions.len() - before;
+        // Distinct crossings (those that are one point count once).
+        let mut crossings: Vec<u32> = arrangement
+            .inside
+            .iter()
+            .flat_map(|(_, inside)| inside.iter().copied())
+            .filter(|&v| v as usize >= before)
+            .collect();
+        crossings.sort_unstable();
+        crossings.dedup();
+        counts.crossings += crossings.len();
         let (made, inside) =
             covered_triangles(&plane, &out_positions, triangles, group, &arrangement)?;
         counts.faces += group.len();
@@ -280,6 +296,7 @@ fn arrangement(
     // before its own ends.
     let mut order: Vec<usize> = (0..edges.len()).collect();
     order.sort_by_key(|&x| (boxes[x][0].0, x));
+    let first_new = positions.len();
     let mut tested = 0u64;
     for (k, &x) in order.iter().enumerate() {
         for &y in &order[k + 1..] {
@@ -321,15 +338,73 @@ fn arrangement(
             }
         }
     }
+    let same = coincident(positions, first_new, &inside);
     let inside = edges
         .into_iter()
         .zip(inside)
         .map(|(e, mut list)| {
             list.sort_by(|a, b| a.0.total_cmp(&b.0));
-            (e, list.into_iter().map(|(_, v)| v).collect())
+            let mut list: Vec<u32> = list.into_iter().map(|(_, v)| same(v)).collect();
+            list.dedup();
+            (e, list)
         })
         .collect();
     Some(Arrangement { inside, tested })
+}
+
+/// One exact point can be the crossing of several pairs of edges (three edges through one
+/// point, or two crossing at a vertex inside both), each rounded on its own edge: the vertex
+/// each of the points inside the edges stands for, one per cluster within [`COINCIDENT`] of
+/// the group's size (the input's vertex when there is one, else the first crossing).
+fn coincident(
+    positions: &[[f64; 3]],
+    first_new: usize,
+    inside: &[Vec<(f64, u32)>],
+) -> impl Fn(u32) -> u32 + use<> {
+    let mut points: Vec<u32> = inside.iter().flatten().map(|&(_, v)| v).collect();
+    points.sort_unstable();
+    points.dedup();
+    let at = |v: u32| positions[v as usize];
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for &v in &points {
+        for k in 0..3 {
+            lo[k] = lo[k].min(at(v)[k]);
+            hi[k] = hi[k].max(at(v)[k]);
+        }
+    }
+    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
+    let eps = COINCIDENT * size;
+    let mut by_x = points.clone();
+    by_x.sort_by(|&a, &b| at(a)[0].total_cmp(&at(b)[0]).then(a.cmp(&b)));
+    let mut rep: HashMap<u32, u32> = HashMap::new();
+    let root = |rep: &HashMap<u32, u32>, mut v: u32| {
+        while let Some(&r) = rep.get(&v) {
+            v = r;
+        }
+        v
+    };
+    for (k, &a) in by_x.iter().enumerate() {
+        for &b in &by_x[k + 1..] {
+            if at(b)[0] - at(a)[0] > eps {
+                break;
+            }
+            // Two input vertices are never one: only crossings are merged.
+            if (a as usize) < first_new && (b as usize) < first_new {
+                continue;
+            }
+            let d = (0..3)
+                .map(|i| (at(a)[i] - at(b)[i]).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            if d <= eps {
+                let (ra, rb) = (root(&rep, a), root(&rep, b));
+                if ra != rb {
+                    rep.insert(ra.max(rb), ra.min(rb));
+                }
+            }
+        }
+    }
+    move |v| root(&rep, v)
 }
 
 /// Where the edges `e` and `f` (crossing properly in the plane) cross: on `e`, at the
