@@ -250,15 +250,7 @@ fn arrangement(
     group: &[u32],
     budget: u64,
 ) -> Option<Arrangement> {
-    let mut edges: Vec<(u32, u32)> = group
-        .iter()
-        .flat_map(|&f| {
-            let t = triangles[f as usize];
-            (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3])))
-        })
-        .collect();
-    edges.sort_unstable();
-    edges.dedup();
+    let edges = exact_repair::edges_of(triangles, group);
     let p = |v: u32| fixed[v as usize];
     let axes = plane.axes;
     let range = |(a, b): (u32, u32), k: usize| {
@@ -277,12 +269,7 @@ fn arrangement(
         } else {
             axes.1
         };
-        let (lo, hi) = range(e, axis);
-        v != e.0
-            && v != e.1
-            && lo < p(v)[axis]
-            && p(v)[axis] < hi
-            && <[i128; 3]>::orient2(p(e.0), p(e.1), p(v), axes) == 0
+        v != e.0 && v != e.1 && exact_repair::strictly_inside(p(v), p(e.0), p(e.1), axis)
     };
     let mut inside: Vec<Vec<(f64, u32)>> = vec![Vec::new(); edges.len()];
     let along = |positions: &[[f64; 3]], (a, b): (u32, u32), v: u32| {

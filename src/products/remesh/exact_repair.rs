@@ -164,15 +164,7 @@ pub fn split_at_contacts<T: ExactPoint>(
     faces: &[u32],
     budget: u64,
 ) -> Option<(Vec<[u32; 3]>, usize)> {
-    let mut edges: Vec<(u32, u32)> = faces
-        .iter()
-        .flat_map(|&f| {
-            let t = triangles[f as usize];
-            (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3])))
-        })
-        .collect();
-    edges.sort_unstable();
-    edges.dedup();
+    let edges = edges_of(triangles, faces);
     let junctions = edge_junctions(points, &edges, budget);
     if junctions.is_empty() {
         return None;
@@ -303,9 +295,23 @@ fn edge_junctions<T: ExactPoint>(
     junctions
 }
 
+/// The edges of the faces `faces` of `triangles`, each once as `(min, max)`, sorted.
+pub(super) fn edges_of(triangles: &[[u32; 3]], faces: &[u32]) -> Vec<(u32, u32)> {
+    let mut edges: Vec<(u32, u32)> = faces
+        .iter()
+        .flat_map(|&f| {
+            let t = triangles[f as usize];
+            (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3])))
+        })
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    edges
+}
+
 /// Whether `p` lies strictly between `a` and `b` on their segment (`a ≠ b`, differing on
 /// `axis`): collinear, exactly, and strictly between them on `axis`.
-fn strictly_inside<T: ExactPoint>(p: T, a: T, b: T, axis: usize) -> bool {
+pub(super) fn strictly_inside<T: ExactPoint>(p: T, a: T, b: T, axis: usize) -> bool {
     let (lo, hi) = (a.at(axis).min(b.at(axis)), a.at(axis).max(b.at(axis)));
     lo < p.at(axis) && p.at(axis) < hi && T::projection_axis(a, b, p).is_none()
 }
