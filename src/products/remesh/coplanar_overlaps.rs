@@ -485,9 +485,8 @@ fn covered_triangles(
         if m == 0 {
             continue;
         }
-        if !cdt.can_add_constraint(handles[x], handles[y]) {
-            return None;
-        }
+        // Empty (and nothing changed) when the piece would cross another one: rounding moved
+        // a crossing across a piece.
         let edges = cdt.try_add_constraint(handles[x], handles[y]);
         if edges.is_empty() {
             return None;
