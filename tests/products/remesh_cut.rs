@@ -210,13 +210,60 @@ fn overlapping_shells_are_cut_into_their_union() {
     assert_same_solid(&carved, &out, 4000, 4, 0.0);
 }
 
+/// Two cubes offset along their diagonal by half a side: each edge of one that pierces the
+/// other does so at a face's centre, on its diagonal. The crossing point is a vertex of the
+/// four faces through the two edges, found the same from each pair.
+#[test]
+fn edges_crossing_edges_are_cut_there() {
+    let cube = centred_cube();
+    let diagonal = join(&[cube.clone(), cube.translated([0.5, 0.5, 0.5])]);
+    let (out, counts) = cut(&diagonal);
+    assert_same_solid(&diagonal, &out, 4000, 3, 0.0);
+    // The six face centres where an edge crosses a diagonal are among the new vertices.
+    let centres = [
+        [0.5, 0.0, 0.0],
+        [0.0, 0.5, 0.0],
+        [0.0, 0.0, 0.5],
+        [0.5, 0.5, 0.0],
+        [0.5, 0.0, 0.5],
+        [0.0, 0.5, 0.5],
+    ];
+    for c in centres {
+        assert!(out.positions.contains(&c), "{c:?} not a vertex: {counts:?}");
+    }
+    // An octahedron and its mirror image across x = 0, pushed into each other: every edge that
+    // crosses the mirror plane crosses its image there (mirror-symmetric parts, as a model's
+    // legs), and the solid is their union.
+    let half = placed(&octahedron(0.5), [0.9, 0.2, 0.3, 0.1], [0.125, 0.0, 0.0]);
+    let both = join(&[half.clone(), mirrored(&half)]);
+    let (out, _) = cut(&both);
+    assert_same_solid(&both, &out, 4000, 6, 0.0);
+}
+
+/// `mesh` reflected across the plane `x = 0` (exactly: a sign), still outward.
+fn mirrored(mesh: &Mesh) -> Mesh {
+    Mesh::new(
+        mesh.positions()
+            .iter()
+            .map(|&[x, y, z]| [-x, y, z])
+            .collect(),
+        mesh.triangles().to_vec(),
+    )
+    .unwrap()
+    .flipped()
+}
+
 #[test]
 fn contacts_that_are_not_in_general_position_are_remeshed_or_replaced() {
     let cube = centred_cube();
-    // Two cubes offset along a diagonal: an edge of one pierces the other on a face diagonal.
-    let diagonal = join(&[cube.clone(), cube.translated([0.5, 0.5, 0.5])]);
+    // A corner of an octahedron inside a cube's top face, and its edges from there in that
+    // face's plane: not cut.
+    let on_plane = join(&[
+        cube.clone(),
+        octahedron(0.25).translated([0.125, 0.0625, 0.5]),
+    ]);
     assert!(matches!(
-        kept(&diagonal),
+        kept(&on_plane),
         Err(NotKept::SelfIntersecting {
             not_cut: Some(NotCut::NotGeneral),
             ..
@@ -332,6 +379,30 @@ proptest! {
             ).unwrap().flipped();
         }
         let input = join(&[a, b]);
+        cut_or_refused(&input, seed)?;
+    }
+
+    /// A shell and its mirror image across `x = 0`, overlapping: their faces meet on the mirror
+    /// plane where edges cross edges (and elsewhere in general position). Cut, or refused
+    /// only for the winding, and the same solid.
+    #[test]
+    fn mirrored_shells_are_cut_where_their_edges_cross(
+        shape in 0usize..4,
+        q in prop::array::uniform4(-1.0f64..1.0),
+        offset in prop::array::uniform3(-0.3f64..0.3),
+        seed in any::<u64>(),
+    ) {
+        prop_assume!(q.iter().all(|c| c.abs() > 0.01) && offset[0].abs() > 0.01);
+        let shape = match shape {
+            0 => centred_cube(),
+            1 => tetrahedron(0.9),
+            2 => octahedron(0.7),
+            _ => sphere([0.0; 3], 0.6, 6, false),
+        };
+        let half = placed(&shape, q, offset);
+        // A corner on the mirror plane is another contact (a vertex on a face).
+        prop_assume!(half.positions().iter().all(|p| p[0] != 0.0));
+        let input = join(&[half.clone(), mirrored(&half)]);
         cut_or_refused(&input, seed)?;
     }
 

@@ -144,14 +144,45 @@ impl std::fmt::Display for NotCut {
     }
 }
 
-/// A piercing point: the edge (its vertices, smaller first) and the face it pierces.
-type Piercing = ((u32, u32), u32);
+/// An edge as its vertices, the smaller first.
+type Edge = (u32, u32);
+
+/// A vertex the cut makes, named by what meets there so that every face through it gets the
+/// same one: an edge piercing a face's interior, or two edges crossing inside both (the
+/// smaller edge first; mirror-symmetric parts pushed into each other cross that way on their
+/// plane of symmetry).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+enum Piercing {
+    Face(Edge, u32),
+    Edges(Edge, Edge),
+}
+
+impl Piercing {
+    /// The edges of the input this point lies inside.
+    fn edges(self) -> impl Iterator<Item = Edge> {
+        let (first, second) = match self {
+            Piercing::Face(e, _) => (e, None),
+            Piercing::Edges(e, f) => (e, Some(f)),
+        };
+        std::iter::once(first).chain(second)
+    }
+}
 
 /// An end of an intersection segment: a piercing point, or the vertex two faces share.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum End {
     Pierce(Piercing),
     Shared(u32),
+}
+
+/// How an edge of one face meets another face (see [`piercings`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Contact {
+    /// The edge between corners `p` and `q` pierces the other face's interior.
+    Interior(usize, usize),
+    /// The edge between corners `p` and `q` crosses the other face's edge `k` (from its corner
+    /// `k` to `k + 1`) inside both.
+    Edge(usize, usize, usize),
 }
 
 /// The input (`positions`, their exact fixed-point coordinates `fixed`, `triangles`: closed,
@@ -205,16 +236,35 @@ fn cut_labelling_pieces(
                 }
             }
             .ok_or(NotCut::NotGeneral)?;
-            for (p, q) in edges {
-                let (u, v) = (ta[p], ta[q]);
-                let key = ((u.min(v), u.max(v)), b);
-                ends.push(End::Pierce(key));
-                points
-                    .entry(key)
-                    .or_insert_with(|| piercing_point(positions, tb, key.0));
+            for contact in edges {
+                let edge = |p: usize, q: usize| {
+                    let (u, v) = (ta[p], ta[q]);
+                    (u.min(v), u.max(v))
+                };
+                let key = match contact {
+                    Contact::Interior(p, q) => Piercing::Face(edge(p, q), b),
+                    Contact::Edge(p, q, k) => {
+                        let (x, y) = (tb[k], tb[(k + 1) % 3]);
+                        let (mine, theirs) = (edge(p, q), (x.min(y), x.max(y)));
+                        Piercing::Edges(mine.min(theirs), mine.max(theirs))
+                    }
+                };
+                // Two crossing edges are found from both faces.
+                if !ends.contains(&End::Pierce(key)) {
+                    ends.push(End::Pierce(key));
+                }
+                points.entry(key).or_insert_with(|| match key {
+                    Piercing::Face(e, _) => piercing_point(positions, tb, e),
+                    Piercing::Edges(e, f) => crossing_point(positions, e, f),
+                });
             }
         }
         let [s, t] = ends[..] else {
+            // Faces touching only where their edges cross: no segment, but the point splits
+            // those edges in every face through them (below).
+            if let [End::Pierce(Piercing::Edges(..))] = ends[..] {
+                continue;
+            }
             return Err(NotCut::NotGeneral);
         };
         segments.entry(f).or_default().push((g, [s, t]));
@@ -229,7 +279,31 @@ fn cut_labelling_pieces(
         vertex_of.insert(*key, all_positions.len() as u32);
         all_positions.push(points[key]);
     }
+    // Where two edges cross, every face through either is split there, whether or not a
+    // segment of it ends there (a face can touch the other surface only at that point).
+    let mut on_edge: HashMap<Edge, Vec<u32>> = HashMap::new();
+    for key in &keys {
+        if let Piercing::Edges(e, f) = key {
+            on_edge.entry(*e).or_default().push(vertex_of[key]);
+            on_edge.entry(*f).or_default().push(vertex_of[key]);
+        }
+    }
+    let mut crossings_in: HashMap<u32, Vec<u32>> = HashMap::new();
+    if !on_edge.is_empty() {
+        for (f, t) in triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                if let Some(list) = on_edge.get(&(a.min(b), a.max(b))) {
+                    crossings_in
+                        .entry(f as u32)
+                        .or_default()
+                        .extend(list.iter().copied());
+                }
+            }
+        }
+    }
     let mut cut: Vec<u32> = segments.keys().copied().collect();
+    cut.extend(crossings_in.keys().filter(|f| !segments.contains_key(f)));
     cut.sort_unstable();
     // Step 1b: triple points, where the segments of two partners cross inside a face. The
     // three faces meet there, so each of them sees two of its segments cross: found three
@@ -240,7 +314,9 @@ fn cut_labelling_pieces(
     };
     let mut triples: HashMap<[u32; 3], usize> = HashMap::new();
     for &f in &cut {
-        let list = &segments[&f];
+        let Some(list) = segments.get(&f) else {
+            continue;
+        };
         let axes = projection_axes(positions, triangles[f as usize]);
         for (k, &(g, s1)) in list.iter().enumerate() {
             for &(h, s2) in &list[k + 1..] {
@@ -317,14 +393,24 @@ fn cut_labelling_pieces(
         let t = triangles[f as usize];
         let mut chains = Vec::new();
         let mut edge_of: HashMap<u32, usize> = HashMap::new();
-        for &(g, ends) in &segments[&f] {
+        let edge_index = |e: Edge| {
+            (0..3).find(|&k| {
+                let (p, q) = (t[k], t[(k + 1) % 3]);
+                e == (p.min(q), p.max(q))
+            })
+        };
+        for &x in crossings_in.get(&f).into_iter().flatten() {
+            let key = keys[(x as usize) - positions.len()];
+            if let Some(k) = key.edges().find_map(edge_index) {
+                edge_of.insert(x, k);
+                chains.push(vec![x]);
+            }
+        }
+        for &(g, ends) in segments.get(&f).into_iter().flatten() {
             for end in ends {
                 match end {
                     End::Pierce(key) => {
-                        if let Some(k) = (0..3).find(|&k| {
-                            let (p, q) = (t[k], t[(k + 1) % 3]);
-                            key.0 == (p.min(q), p.max(q))
-                        }) {
+                        if let Some(k) = key.edges().find_map(edge_index) {
                             edge_of.insert(vertex_of[&key], k);
                         }
                     }
@@ -543,10 +629,10 @@ fn side_of_plane(
     Some(if distance > 0.0 { 1 } else { -1 })
 }
 
-/// The edges `(p, q)` (corner indices) of `a` that pierce `b` strictly inside; `None` when a
-/// sign is zero (a corner on the other's plane, an edge through an edge of `b`): not in
-/// general position.
-fn piercings<T: ExactPoint>(a: [T; 3], b: [T; 3]) -> Option<Vec<(usize, usize)>> {
+/// How the edges of `a` meet `b` ([`Contact`]: piercing its interior, or crossing one of its
+/// edges inside both); `None` when a sign is zero otherwise (a corner on the other's plane, an
+/// edge through a corner of `b`): not in general position.
+fn piercings<T: ExactPoint>(a: [T; 3], b: [T; 3]) -> Option<Vec<Contact>> {
     let side = a.map(|p| T::orient(b[0], b[1], b[2], p));
     if side.contains(&0) {
         return None;
@@ -554,43 +640,66 @@ fn piercings<T: ExactPoint>(a: [T; 3], b: [T; 3]) -> Option<Vec<(usize, usize)>>
     let mut out = Vec::with_capacity(2);
     for p in 0..3 {
         let q = (p + 1) % 3;
-        if side[p] != side[q] && edge_pierces(a[p], a[q], b)? {
-            out.push((p, q));
+        if side[p] != side[q] {
+            out.extend(edge_contact(a[p], a[q], b, (p, q))?);
         }
     }
     Some(out)
 }
 
 /// [`piercings`] of the edge of `a` opposite its corner `k`, a vertex `b` shares.
-fn opposite_edge_piercing<T: ExactPoint>(
-    a: [T; 3],
-    b: [T; 3],
-    k: usize,
-) -> Option<Vec<(usize, usize)>> {
+fn opposite_edge_piercing<T: ExactPoint>(a: [T; 3], b: [T; 3], k: usize) -> Option<Vec<Contact>> {
     let (p, q) = ((k + 1) % 3, (k + 2) % 3);
     let side = [a[p], a[q]].map(|x| T::orient(b[0], b[1], b[2], x));
     if side.contains(&0) {
         return None;
     }
-    Some(if side[0] != side[1] && edge_pierces(a[p], a[q], b)? {
-        vec![(p, q)]
+    let contact = if side[0] != side[1] {
+        edge_contact(a[p], a[q], b, (p, q))?
     } else {
-        Vec::new()
-    })
+        None
+    };
+    Some(contact.into_iter().collect())
 }
 
-/// Whether the segment `p q`, whose ends are on opposite sides of `b`'s plane, meets `b`
-/// strictly inside; `None` when it meets `b`'s boundary.
-fn edge_pierces<T: ExactPoint>(p: T, q: T, b: [T; 3]) -> Option<bool> {
+/// How the segment `p q` (the corners `(i, j)` of its face), whose ends are on opposite sides
+/// of `b`'s plane, meets `b`: through its interior, across the inside of one of its edges, or
+/// not at all; `None` when it passes through a corner of `b`. Where the segment meets the
+/// plane, the three signs are its side of each edge of `b`: all equal inside, one zero (the
+/// other two equal) on that edge strictly between its corners, two zeros at a corner.
+fn edge_contact<T: ExactPoint>(
+    p: T,
+    q: T,
+    b: [T; 3],
+    (i, j): (usize, usize),
+) -> Option<Option<Contact>> {
     let s = [
         T::orient(p, q, b[0], b[1]),
         T::orient(p, q, b[1], b[2]),
         T::orient(p, q, b[2], b[0]),
     ];
-    if s.contains(&0) {
-        return None;
-    }
-    Some(s[0] == s[1] && s[1] == s[2])
+    let zeros = s.iter().filter(|&&x| x == 0).count();
+    Some(match zeros {
+        0 => (s[0] == s[1] && s[1] == s[2]).then_some(Contact::Interior(i, j)),
+        1 => {
+            let k = s.iter().position(|&x| x == 0).expect("one zero");
+            let (x, y) = (s[(k + 1) % 3], s[(k + 2) % 3]);
+            (x == y).then_some(Contact::Edge(i, j, k))
+        }
+        _ => return None,
+    })
+}
+
+/// Where the edges `e` and `f` cross (in `f64`: the exact point rounded, up to the error of
+/// the quotient of two cross products), found from `e`'s parameter: the same for every pair of
+/// faces that finds it.
+fn crossing_point(positions: &[[f64; 3]], (a, b): Edge, (c, d): Edge) -> [f64; 3] {
+    let at = |v: u32| DVec3::from(positions[v as usize]);
+    let (p, q, r, s) = (at(a), at(b), at(c), at(d));
+    // p + t (q − p) = r + u (s − r): crossing both sides with (s − r) leaves t.
+    let n = (q - p).cross(s - r);
+    let t = ((r - p).cross(s - r).dot(n) / n.dot(n)).clamp(0.0, 1.0);
+    (p + t * (q - p)).to_array()
 }
 
 /// Where the edge `(u, v)` meets the plane of the face `face` (in `f64`: the exact point
