@@ -240,6 +240,61 @@ fn edges_crossing_edges_are_cut_there() {
     assert_same_solid(&both, &out, 4000, 6, 0.0);
 }
 
+/// An octahedron `centre ± x, ± y, ± z` (its corners in that order: any three independent
+/// vectors give a convex one), outward.
+fn affine_octahedron(centre: [f64; 3], x: [f64; 3], y: [f64; 3], z: [f64; 3]) -> Mesh {
+    let at = |d: [f64; 3], s: f64| std::array::from_fn(|k| centre[k] + s * d[k]);
+    let p = vec![
+        at(x, 1.0),
+        at(x, -1.0),
+        at(y, 1.0),
+        at(y, -1.0),
+        at(z, 1.0),
+        at(z, -1.0),
+    ];
+    let mesh = Mesh::new(p, gwn::testing::OCTAHEDRON_FACES.to_vec()).unwrap();
+    let det = x[0] * (y[1] * z[2] - y[2] * z[1]) - x[1] * (y[0] * z[2] - y[2] * z[0])
+        + x[2] * (y[0] * z[1] - y[1] * z[0]);
+    if det > 0.0 { mesh } else { mesh.flipped() }
+}
+
+/// An octahedron with a corner exactly inside a cube's top face (`z = ½`, off its diagonal):
+/// crossing the face there (faces around that corner on both sides of its plane), touching it
+/// from inside the cube, or from outside. The corner becomes a vertex of the face, the two
+/// surfaces are cut along their curves from it, and where they only touch, the kept pieces
+/// meeting at that vertex are pulled apart.
+#[test]
+fn a_corner_inside_a_face_is_a_vertex_of_the_cut() {
+    let cube = centred_cube();
+    let corner = [0.125, 0.0625, 0.5];
+    let below = |d: [f64; 3]| std::array::from_fn(|k| corner[k] - d[k]);
+    let cases = [
+        // Crossing: the ring corners `+x` above the plane, the others below.
+        ([0.125, 0.0625, 0.25], [0.25, 0.0, 0.375]),
+        // Touching from inside (the whole octahedron below the plane but its corner).
+        ([0.125, 0.0625, 0.25], [0.25, 0.0, 0.0625]),
+        // Touching from outside (above it).
+        ([0.125, 0.0625, -0.25], [0.25, 0.0, -0.0625]),
+    ];
+    for (i, (to_centre, x)) in cases.into_iter().enumerate() {
+        let centre = below(to_centre);
+        let z = std::array::from_fn(|k| corner[k] - centre[k]);
+        let y = [0.0, 0.25, 0.125 * to_centre[2].signum()];
+        let octahedron = affine_octahedron(centre, x, y, z);
+        assert!(octahedron.positions().contains(&corner));
+        let input = join(&[cube.clone(), octahedron]);
+        let (out, _) = cut(&input);
+        assert_same_solid(&input, &out, 4000, 10 + i as u64, 0.0);
+        // A vertex of the face's pieces (pulled apart by at most a 64th of a cell where the
+        // two kept surfaces only touch there).
+        let near = out
+            .positions
+            .iter()
+            .any(|p| (0..3).all(|k| (p[k] - corner[k]).abs() < 1e-3));
+        assert!(near, "case {i}: the corner is not a vertex of the output");
+    }
+}
+
 /// `mesh` reflected across the plane `x = 0` (exactly: a sign), still outward.
 fn mirrored(mesh: &Mesh) -> Mesh {
     Mesh::new(

@@ -8,10 +8,13 @@
 //! overlaps. Then:
 //!
 //! 1. **Cut.** Every intersecting pair of faces (exact, [`intersecting_pairs_wide`]) must meet
-//!    in general position: no shared vertex, not coplanar, no corner on the other face's plane,
-//!    and exactly two edges (of either face) piercing the other face's interior, each with
-//!    exact signs. Their segment joins those two piercing points; a piercing point is named by
-//!    its edge and the face it pierces, so every face through it gets the same vertex. Each cut
+//!    along a segment with two ends, each (by exact signs) an edge of one face piercing the
+//!    other's interior, an edge crossing an edge of the other inside both, a corner of one
+//!    strictly inside the other, or a vertex the two share; not coplanar, no corner on the
+//!    other's boundary, at most one on its plane. A piercing point is named by its edge and the
+//!    face it pierces, a crossing by its two edges, so every face through it gets the same
+//!    vertex; every face through a crossing's edges, or with a corner inside it, is split there
+//!    even where it touches the other surface only at that point. Each cut
 //!    face is triangulated with its segments as constraints (a constrained Delaunay
 //!    triangulation in the plane of its largest normal component, `spade`); its pieces keep its
 //!    orientation.
@@ -65,7 +68,7 @@ pub struct CutCounts {
     pub cut_faces: usize,
     /// Faces (uncut, or pieces of cut ones) left out: inside the solid or outside it.
     pub removed_faces: usize,
-    /// Vertices made where an edge pierces a face, or three faces meet.
+    /// Vertices made where an edge pierces a face, two edges cross, or three faces meet.
     pub new_vertices: usize,
     /// Points where three faces meet (two segments of each cross there).
     pub triple_points: usize,
@@ -108,7 +111,8 @@ pub enum NotCut {
     TooManyPairs,
     /// Two intersecting faces share an edge (coplanar, folded onto each other).
     SharedEdge,
-    /// A corner on the other face's plane, or an edge through the other's edge or corner.
+    /// Two corners on the other face's plane, a corner on its boundary, or an edge through its
+    /// corner.
     NotGeneral,
     /// Two segments of one face cross (three faces through one point), or a point of the cut
     /// rounds onto or across an edge of its face, or onto another point.
@@ -168,11 +172,12 @@ impl Piercing {
     }
 }
 
-/// An end of an intersection segment: a piercing point, or the vertex two faces share.
+/// An end of an intersection segment: a piercing point, or a vertex of the input (one the two
+/// faces share, or a corner of one strictly inside the other).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum End {
     Pierce(Piercing),
-    Shared(u32),
+    Vertex(u32),
 }
 
 /// How an edge of one face meets another face (see [`piercings`]).
@@ -183,6 +188,8 @@ enum Contact {
     /// The edge between corners `p` and `q` crosses the other face's edge `k` (from its corner
     /// `k` to `k + 1`) inside both.
     Edge(usize, usize, usize),
+    /// Corner `k` lies strictly inside the other face.
+    Corner(usize),
 }
 
 /// The input (`positions`, their exact fixed-point coordinates `fixed`, `triangles`: closed,
@@ -217,10 +224,13 @@ fn cut_labelling_pieces(
     // Step 1: the segments, and the piercing points' positions.
     let mut points: HashMap<Piercing, [f64; 3]> = HashMap::new();
     let mut segments: HashMap<u32, Vec<(u32, [End; 2])>> = HashMap::new();
+    // Faces with a corner of another face strictly inside, where the two touch only there.
+    let mut touched: Vec<(u32, u32)> = Vec::new();
     for &(f, g) in &pairs {
         let (tf, tg) = (triangles[f as usize], triangles[g as usize]);
         let shared: Vec<u32> = tf.iter().copied().filter(|v| tg.contains(v)).collect();
-        let mut ends: Vec<End> = shared.iter().map(|&v| End::Shared(v)).collect();
+        let mut ends: Vec<End> = shared.iter().map(|&v| End::Vertex(v)).collect();
+        let mut touches = None;
         if shared.len() > 1 {
             return Err(NotCut::SharedEdge);
         }
@@ -237,11 +247,17 @@ fn cut_labelling_pieces(
             }
             .ok_or(NotCut::NotGeneral)?;
             for contact in edges {
+                if let Contact::Corner(k) = contact {
+                    ends.push(End::Vertex(ta[k]));
+                    touches = Some((b, ta[k]));
+                    continue;
+                }
                 let edge = |p: usize, q: usize| {
                     let (u, v) = (ta[p], ta[q]);
                     (u.min(v), u.max(v))
                 };
                 let key = match contact {
+                    Contact::Corner(_) => unreachable!("taken above"),
                     Contact::Interior(p, q) => Piercing::Face(edge(p, q), b),
                     Contact::Edge(p, q, k) => {
                         let (x, y) = (tb[k], tb[(k + 1) % 3]);
@@ -260,12 +276,17 @@ fn cut_labelling_pieces(
             }
         }
         let [s, t] = ends[..] else {
-            // Faces touching only where their edges cross: no segment, but the point splits
-            // those edges in every face through them (below).
-            if let [End::Pierce(Piercing::Edges(..))] = ends[..] {
-                continue;
+            // Faces touching only where their edges cross, or at a corner of one inside the
+            // other: no segment, but the point splits those edges in every face through them,
+            // or that face (below).
+            match ends[..] {
+                [End::Pierce(Piercing::Edges(..))] => continue,
+                [End::Vertex(v)] if touches.is_some_and(|(_, x)| x == v) => {
+                    touched.extend(touches);
+                    continue;
+                }
+                _ => return Err(NotCut::NotGeneral),
             }
-            return Err(NotCut::NotGeneral);
         };
         segments.entry(f).or_default().push((g, [s, t]));
         segments.entry(g).or_default().push((f, [s, t]));
@@ -289,6 +310,9 @@ fn cut_labelling_pieces(
         }
     }
     let mut crossings_in: HashMap<u32, Vec<u32>> = HashMap::new();
+    for &(f, v) in &touched {
+        crossings_in.entry(f).or_default().push(v);
+    }
     if !on_edge.is_empty() {
         for (f, t) in triangles.iter().enumerate() {
             for k in 0..3 {
@@ -310,7 +334,7 @@ fn cut_labelling_pieces(
     // times, or not cut. Each of the three segments is split there.
     let end_at = |e: &End| match e {
         End::Pierce(key) => points[key],
-        End::Shared(v) => positions[*v as usize],
+        End::Vertex(v) => positions[*v as usize],
     };
     let mut triples: HashMap<[u32; 3], usize> = HashMap::new();
     for &f in &cut {
@@ -349,7 +373,7 @@ fn cut_labelling_pieces(
     // them (the same order for both faces of a segment: its ends are stored once).
     let id = |e: &End| match e {
         End::Pierce(key) => vertex_of[key],
-        End::Shared(v) => *v,
+        End::Vertex(v) => *v,
     };
     let chain = |f: u32, g: u32, [s, e]: [End; 2]| {
         let (a, b) = (id(&s), id(&e));
@@ -400,11 +424,12 @@ fn cut_labelling_pieces(
             })
         };
         for &x in crossings_in.get(&f).into_iter().flatten() {
-            let key = keys[(x as usize) - positions.len()];
-            if let Some(k) = key.edges().find_map(edge_index) {
+            // A vertex of the input there is inside `t`; a new one on one of its edges.
+            let on = (x as usize).checked_sub(positions.len()).map(|i| keys[i]);
+            if let Some(k) = on.and_then(|key| key.edges().find_map(edge_index)) {
                 edge_of.insert(x, k);
-                chains.push(vec![x]);
             }
+            chains.push(vec![x]);
         }
         for &(g, ends) in segments.get(&f).into_iter().flatten() {
             for end in ends {
@@ -414,9 +439,8 @@ fn cut_labelling_pieces(
                             edge_of.insert(vertex_of[&key], k);
                         }
                     }
-                    // A shared vertex not a corner of `t`: not in general position.
-                    End::Shared(v) if !t.contains(&v) => return Err(NotCut::NotGeneral),
-                    End::Shared(_) => {}
+                    // A corner of `t`, or a corner of the other face strictly inside `t`.
+                    End::Vertex(_) => {}
                 }
             }
             chains.push(chain(f, g, ends));
@@ -629,37 +653,64 @@ fn side_of_plane(
     Some(if distance > 0.0 { 1 } else { -1 })
 }
 
-/// How the edges of `a` meet `b` ([`Contact`]: piercing its interior, or crossing one of its
-/// edges inside both); `None` when a sign is zero otherwise (a corner on the other's plane, an
-/// edge through a corner of `b`): not in general position.
+/// How `a` meets `b` ([`Contact`]: an edge piercing its interior, an edge crossing one of its
+/// edges inside both, a corner strictly inside it); `None` when a sign is zero otherwise (two
+/// corners on the other's plane, a corner on its boundary, an edge through a corner of `b`):
+/// not in general position.
 fn piercings<T: ExactPoint>(a: [T; 3], b: [T; 3]) -> Option<Vec<Contact>> {
     let side = a.map(|p| T::orient(b[0], b[1], b[2], p));
-    if side.contains(&0) {
-        return None;
-    }
     let mut out = Vec::with_capacity(2);
+    match side.iter().filter(|&&s| s == 0).count() {
+        0 => {}
+        // The two edges from that corner meet the plane only there.
+        1 => {
+            let k = side.iter().position(|&s| s == 0).expect("one zero");
+            if corner_inside(a[k], b)? {
+                out.push(Contact::Corner(k));
+            }
+        }
+        _ => return None,
+    }
     for p in 0..3 {
         let q = (p + 1) % 3;
-        if side[p] != side[q] {
+        if side[p] * side[q] < 0 {
             out.extend(edge_contact(a[p], a[q], b, (p, q))?);
         }
     }
     Some(out)
 }
 
-/// [`piercings`] of the edge of `a` opposite its corner `k`, a vertex `b` shares.
+/// [`piercings`] of the edge of `a` opposite its corner `k`, a vertex `b` shares. One end of
+/// that edge on `b`'s plane makes the edge from the shared vertex to it lie in the plane: a
+/// contact only when that end is strictly inside `b` (the edge then lies in `b`).
 fn opposite_edge_piercing<T: ExactPoint>(a: [T; 3], b: [T; 3], k: usize) -> Option<Vec<Contact>> {
     let (p, q) = ((k + 1) % 3, (k + 2) % 3);
     let side = [a[p], a[q]].map(|x| T::orient(b[0], b[1], b[2], x));
-    if side.contains(&0) {
-        return None;
-    }
-    let contact = if side[0] != side[1] {
-        edge_contact(a[p], a[q], b, (p, q))?
-    } else {
-        None
+    let contact = match side {
+        [0, 0] => return None,
+        [0, _] => corner_inside(a[p], b)?.then_some(Contact::Corner(p)),
+        [_, 0] => corner_inside(a[q], b)?.then_some(Contact::Corner(q)),
+        _ if side[0] != side[1] => edge_contact(a[p], a[q], b, (p, q))?,
+        _ => None,
     };
     Some(contact.into_iter().collect())
+}
+
+/// Whether `v`, on the plane of `b`, lies strictly inside `b` (exact signs in the plane of
+/// projection along a nonzero component of `b`'s normal, which keeps inside and outside);
+/// `None` on its boundary.
+fn corner_inside<T: ExactPoint>(v: T, b: [T; 3]) -> Option<bool> {
+    let axes = intersect::plane_axes(T::projection_axis(b[0], b[1], b[2])?);
+    let s = [0, 1, 2].map(|i| T::orient2(b[i], b[(i + 1) % 3], v, axes));
+    match s.iter().filter(|&&x| x == 0).count() {
+        0 => Some(s[0] == s[1] && s[1] == s[2]),
+        // On an edge's line: on the edge when the other two agree, else outside.
+        1 => {
+            let k = s.iter().position(|&x| x == 0).expect("one zero");
+            (s[(k + 1) % 3] != s[(k + 2) % 3]).then_some(false)
+        }
+        _ => None,
+    }
 }
 
 /// How the segment `p q` (the corners `(i, j)` of its face), whose ends are on opposite sides

@@ -569,7 +569,7 @@ fn orient2<T: ExactPoint>(a: T, b: T, c: T, axes: (usize, usize)) -> i32 {
 }
 
 /// The two axes kept when projecting along `axis`.
-fn plane_axes(axis: usize) -> (usize, usize) {
+pub(super) fn plane_axes(axis: usize) -> (usize, usize) {
     ((axis + 1) % 3, (axis + 2) % 3)
 }
 
