@@ -466,6 +466,21 @@ fn remesh_keeps_parts_standing_on_plates() {
     }
 }
 
+/// Parts pushed into each other whose faces meet in the degenerate ways the cut takes: edges
+/// crossing edges exactly (pyvista-ant's mirror-symmetric legs) and corners exactly inside
+/// faces (cura-ultimaker3_platform, after its faces overlapping in a plane are replaced).
+#[test]
+fn remesh_cuts_parts_meeting_at_edges_and_corners() {
+    for (name, components) in [("pyvista-ant.ply", 9), ("cura-ultimaker3_platform.obj", 9)] {
+        let Some(input) = crate::common::shared_file(&format!("meshes/{name}")) else {
+            return;
+        };
+        let json = remesh_report_of(&input, "256", "20000", components, &["\"input\": \"cut\""]);
+        assert!(report_number(&json, "input_new_vertices") > 0.0, "{json}");
+        assert_eq!(report_number(&json, "occupancy_agreement"), 1.0, "{json}");
+    }
+}
+
 /// Runs `gwn remesh INPUT --res RES --samples SAMPLES` and returns its JSON report, after
 /// checking that the run succeeded and that the report says closed, manifold, oriented, one
 /// component, no self-intersection, and every member of `also`.
