@@ -295,6 +295,34 @@ fn a_corner_inside_a_face_is_a_vertex_of_the_cut() {
     }
 }
 
+/// An octahedron with an edge exactly in a cube's top plane (`z = ½`), from outside the cube to
+/// inside its top face, its two poles above and below: the faces through that edge meet the
+/// cube along it (from where it crosses the cube's edge to its end inside the face); the
+/// union is cut.
+#[test]
+fn an_edge_in_a_face_plane_is_cut_along_it() {
+    let cube = centred_cube();
+    let octahedron = affine_octahedron(
+        [0.375, 0.125, 0.375],
+        [0.25, 0.0, 0.125],
+        [0.0, 0.1875, 0.125],
+        [-0.0625, 0.0625, 0.25],
+    );
+    let p = octahedron.positions();
+    assert_eq!((p[0][2], p[2][2]), (0.5, 0.5), "the edge from +x to +y");
+    let input = join(&[cube, octahedron]);
+    let (out, counts) = cut(&input);
+    assert_same_solid(&input, &out, 4000, 20, 0.0);
+    // Where the edge crosses the cube's edge `x = ½, z = ½`.
+    let crossing = [0.5, 0.125 + 0.1875 / 2.0, 0.5];
+    assert!(
+        out.positions
+            .iter()
+            .any(|q| (0..3).all(|k| (q[k] - crossing[k]).abs() < 1e-12)),
+        "{counts:?}"
+    );
+}
+
 /// `mesh` reflected across the plane `x = 0` (exactly: a sign), still outward.
 fn mirrored(mesh: &Mesh) -> Mesh {
     Mesh::new(
@@ -309,21 +337,17 @@ fn mirrored(mesh: &Mesh) -> Mesh {
 }
 
 #[test]
-fn contacts_that_are_not_in_general_position_are_remeshed_or_replaced() {
+fn contacts_in_a_face_plane_are_cut_or_replaced() {
     let cube = centred_cube();
-    // A corner of an octahedron inside a cube's top face, and its edges from there in that
-    // face's plane: not cut.
+    // An octahedron whose four equator edges lie inside a cube's top face: each face through
+    // one meets the cube along it (two corners inside the top face).
     let on_plane = join(&[
         cube.clone(),
         octahedron(0.25).translated([0.125, 0.0625, 0.5]),
     ]);
-    assert!(matches!(
-        kept(&on_plane),
-        Err(NotKept::SelfIntersecting {
-            not_cut: Some(NotCut::NotGeneral),
-            ..
-        })
-    ));
+    let (out, counts) = cut(&on_plane);
+    assert_eq!(counts.intersecting_pairs, 12, "{counts:?}");
+    assert_same_solid(&on_plane, &out, 4000, 8, 0.0);
     // Touching along a face: not cut, but the faces of that plane are replaced by what they
     // add up to there (`coplanar_overlaps`), and the two are kept as one solid.
     let touching = join(&[cube.clone(), cube.translated([1.0, 0.25, 0.25])]);

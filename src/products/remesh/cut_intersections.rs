@@ -10,8 +10,8 @@
 //! 1. **Cut.** Every intersecting pair of faces (exact, [`intersecting_pairs_wide`]) must meet
 //!    along a segment with two ends, each (by exact signs) an edge of one face piercing the
 //!    other's interior, an edge crossing an edge of the other inside both, a corner of one
-//!    strictly inside the other, or a vertex the two share; not coplanar, no corner on the
-//!    other's boundary, at most one on its plane. A piercing point is named by its edge and the
+//!    strictly inside the other, or a vertex the two share (an edge of one lying in the other's
+//!    plane gives the first three); not coplanar, no corner on the other's boundary. A piercing point is named by its edge and the
 //!    face it pierces, a crossing by its two edges, so every face through it gets the same
 //!    vertex; every face through a crossing's edges, or with a corner inside it, is split there
 //!    even where it touches the other surface only at that point. Each cut
@@ -111,8 +111,7 @@ pub enum NotCut {
     TooManyPairs,
     /// Two intersecting faces share an edge (coplanar, folded onto each other).
     SharedEdge,
-    /// Two corners on the other face's plane, a corner on its boundary, or an edge through its
-    /// corner.
+    /// A corner on the other face's boundary, or an edge through its corner.
     NotGeneral,
     /// Two segments of one face cross (three faces through one point), or a point of the cut
     /// rounds onto or across an edge of its face, or onto another point.
@@ -654,9 +653,9 @@ fn side_of_plane(
 }
 
 /// How `a` meets `b` ([`Contact`]: an edge piercing its interior, an edge crossing one of its
-/// edges inside both, a corner strictly inside it); `None` when a sign is zero otherwise (two
-/// corners on the other's plane, a corner on its boundary, an edge through a corner of `b`):
-/// not in general position.
+/// edges inside both, a corner strictly inside it); `None` when a sign is zero otherwise (`a`
+/// in `b`'s plane, a corner on its boundary, an edge through a corner of `b`): not in general
+/// position.
 fn piercings<T: ExactPoint>(a: [T; 3], b: [T; 3]) -> Option<Vec<Contact>> {
     let side = a.map(|p| T::orient(b[0], b[1], b[2], p));
     let mut out = Vec::with_capacity(2);
@@ -668,6 +667,17 @@ fn piercings<T: ExactPoint>(a: [T; 3], b: [T; 3]) -> Option<Vec<Contact>> {
             if corner_inside(a[k], b)? {
                 out.push(Contact::Corner(k));
             }
+        }
+        // An edge in `b`'s plane, the third corner off it: `a` meets the plane along that edge
+        // only. Its ends inside `b` are contacts; where it crosses an edge of `b`, that edge
+        // crosses `a`'s plane on it, and is found from `b`.
+        2 => {
+            for k in (0..3).filter(|&k| side[k] == 0) {
+                if corner_inside(a[k], b)? {
+                    out.push(Contact::Corner(k));
+                }
+            }
+            return Some(out);
         }
         _ => return None,
     }
