@@ -246,17 +246,16 @@ fn cut_labelling_pieces(
             }
             .ok_or(NotCut::NotGeneral)?;
             for contact in edges {
-                if let Contact::Corner(k) = contact {
-                    ends.push(End::Vertex(ta[k]));
-                    touches = Some((b, ta[k]));
-                    continue;
-                }
                 let edge = |p: usize, q: usize| {
                     let (u, v) = (ta[p], ta[q]);
                     (u.min(v), u.max(v))
                 };
                 let key = match contact {
-                    Contact::Corner(_) => unreachable!("taken above"),
+                    Contact::Corner(k) => {
+                        ends.push(End::Vertex(ta[k]));
+                        touches = Some((b, ta[k]));
+                        continue;
+                    }
                     Contact::Interior(p, q) => Piercing::Face(edge(p, q), b),
                     Contact::Edge(p, q, k) => {
                         let (x, y) = (tb[k], tb[(k + 1) % 3]);
