@@ -11,10 +11,11 @@
 //!    along a segment with two ends, each (by exact signs) an edge of one face piercing the
 //!    other's interior, an edge crossing an edge of the other inside both, a corner of one
 //!    strictly inside the other, or a vertex the two share (an edge of one lying in the other's
-//!    plane gives the first three); not coplanar, no corner on the other's boundary. A piercing point is named by its edge and the
-//!    face it pierces, a crossing by its two edges, so every face through it gets the same
-//!    vertex; every face through a crossing's edges, or with a corner inside it, is split there
-//!    even where it touches the other surface only at that point. Each cut
+//!    plane gives the first three); not coplanar, no corner on the other's boundary. A
+//!    piercing point is named by its edge and the face it pierces, a crossing by its two
+//!    edges, so every face through it gets the same vertex; every face through a crossing's
+//!    edges, or with a corner inside it, is split there even where it touches the other
+//!    surface only at that point. Each cut
 //!    face is triangulated with its segments as constraints (a constrained Delaunay
 //!    triangulation in the plane of its largest normal component, `spade`); its pieces keep its
 //!    orientation.
@@ -307,16 +308,18 @@ fn cut_labelling_pieces(
             on_edge.entry(*f).or_default().push(vertex_of[key]);
         }
     }
-    let mut crossings_in: HashMap<u32, Vec<u32>> = HashMap::new();
+    // Per face, the points it is split at besides its segments' ends: crossings on its edges,
+    // corners of other faces touching it inside.
+    let mut split_points: HashMap<u32, Vec<u32>> = HashMap::new();
     for &(f, v) in &touched {
-        crossings_in.entry(f).or_default().push(v);
+        split_points.entry(f).or_default().push(v);
     }
     if !on_edge.is_empty() {
         for (f, t) in triangles.iter().enumerate() {
             for k in 0..3 {
                 let (a, b) = (t[k], t[(k + 1) % 3]);
                 if let Some(list) = on_edge.get(&(a.min(b), a.max(b))) {
-                    crossings_in
+                    split_points
                         .entry(f as u32)
                         .or_default()
                         .extend(list.iter().copied());
@@ -325,7 +328,7 @@ fn cut_labelling_pieces(
         }
     }
     let mut cut: Vec<u32> = segments.keys().copied().collect();
-    cut.extend(crossings_in.keys().filter(|f| !segments.contains_key(f)));
+    cut.extend(split_points.keys().filter(|f| !segments.contains_key(f)));
     cut.sort_unstable();
     // Step 1b: triple points, where the segments of two partners cross inside a face. The
     // three faces meet there, so each of them sees two of its segments cross: found three
@@ -421,7 +424,7 @@ fn cut_labelling_pieces(
                 e == (p.min(q), p.max(q))
             })
         };
-        for &x in crossings_in.get(&f).into_iter().flatten() {
+        for &x in split_points.get(&f).into_iter().flatten() {
             // A vertex of the input there is inside `t`; a new one on one of its edges.
             let on = (x as usize).checked_sub(positions.len()).map(|i| keys[i]);
             if let Some(k) = on.and_then(|key| key.edges().find_map(edge_index)) {
