@@ -450,6 +450,19 @@ pub fn remesh_mesh<E: Evaluator + ?Sized>(
     options: &RemeshOptions,
     progress: &dyn Fn(RemeshPhase),
 ) -> Result<Remeshed, RemeshError> {
+    remesh_mesh_field(mesh, keep, &evaluator, guide, bounds, options, progress)
+}
+
+/// [`remesh_mesh`] on a trait object (compiled once, as [`remesh_field`]).
+fn remesh_mesh_field(
+    mesh: &crate::Mesh,
+    keep: bool,
+    evaluator: &dyn Evaluator,
+    guide: Option<&crossings::SegmentBvh>,
+    bounds: BoundingBox,
+    options: &RemeshOptions,
+    progress: &dyn Fn(RemeshPhase),
+) -> Result<Remeshed, RemeshError> {
     options.check()?;
     // Without simplification the raw lattice surface was asked for.
     let not_kept = if keep && options.simplify.is_some() {
@@ -478,7 +491,7 @@ pub fn remesh_mesh<E: Evaluator + ?Sized>(
     } else {
         None
     };
-    let mut out = remesh_guided(evaluator, guide, bounds, options, progress)?;
+    let mut out = remesh_field(evaluator, guide, bounds, options, progress)?;
     out.stats.input = not_kept;
     Ok(out)
 }
@@ -510,7 +523,7 @@ fn remesh_rest(
         return Ok(None);
     };
     let guide = guided.then(|| crossings::SegmentBvh::of_field_mesh(&parts.rest));
-    let rest = remesh_guided(&parts.rest_field, guide.as_ref(), bounds, options, progress)?;
+    let rest = remesh_field(&parts.rest_field, guide.as_ref(), bounds, options, progress)?;
     let Some(mut out) = keep_parts::merge(&parts, rest) else {
         return Ok(None);
     };
@@ -564,6 +577,20 @@ impl RemeshPhase {
 /// `progress` hears of each [`RemeshPhase`] as it begins.
 pub fn remesh_guided<E: Evaluator + ?Sized>(
     evaluator: &E,
+    guide: Option<&crossings::SegmentBvh>,
+    bounds: BoundingBox,
+    options: &RemeshOptions,
+    progress: &dyn Fn(RemeshPhase),
+) -> Result<Remeshed, RemeshError> {
+    remesh_field(&evaluator, guide, bounds, options, progress)
+}
+
+/// [`remesh_guided`] on a trait object: the pipeline is compiled once, in this crate. Generic over
+/// the evaluator, it was compiled again (optimised) in every crate that called it with any
+/// evaluator type — the tool, the Python module, each test binary — for one virtual call per
+/// evaluation of `w`, which costs microseconds (docs/benchmarks.md, "CI time").
+fn remesh_field(
+    evaluator: &dyn Evaluator,
     guide: Option<&crossings::SegmentBvh>,
     bounds: BoundingBox,
     options: &RemeshOptions,

@@ -186,6 +186,24 @@ impl RemeshReport {
         samples: usize,
         progress: &dyn Fn(ReportPhase),
     ) -> Result<RemeshReport, TooManySamples> {
+        Self::measure_field(
+            out, surface, options, &field, reference, bounds, samples, progress,
+        )
+    }
+
+    /// [`RemeshReport::measure`] on a trait object: compiled once, in this crate, whatever the
+    /// caller's evaluator type (as `remesh_guided`'s pipeline).
+    #[allow(clippy::too_many_arguments)]
+    fn measure_field(
+        out: &Remeshed,
+        surface: &crate::Mesh,
+        options: &RemeshOptions,
+        field: &dyn Evaluator,
+        reference: DistanceReference<'_>,
+        bounds: crate::BoundingBox,
+        samples: usize,
+        progress: &dyn Fn(ReportPhase),
+    ) -> Result<RemeshReport, TooManySamples> {
         Self::check_samples(samples)?;
         let topology = TopologyReport::of(surface.positions(), surface.triangles());
         progress(ReportPhase::SelfIntersections);
