@@ -38,7 +38,9 @@
 //!
 //! What is kept is the input with bit-identical vertices merged and the repairs made: its
 //! referenced vertices in their order, and its faces in theirs. Where the repaired mesh fails
-//! step 1, the reason given is the input's own first problem there.
+//! step 1, the reason given is the input's own first problem there (what `gwn info` counts on
+//! the file), unless the repairs left another kind of problem: then that one (a zero-area face
+//! taken out is no reason, the open surface left after it is).
 //!
 //! Three ways on when a step fails, each proved by the same steps on its result:
 //! - where solids touch at a vertex or along an edge (step 1 fails for several fans or
@@ -317,6 +319,23 @@ pub fn keep_input(
         (positions, fixed, triangles)
     };
     let first_problem = topology_problem(&original);
+    // What the user is told when the input's own first problem is the answer but the repairs
+    // left another kind: a zero-area face taken out is no reason, the open or non-manifold
+    // surface left after it is (the ways on below still go by the input's problem).
+    let repaired_problem = if repairs.is_empty() {
+        first_problem
+    } else {
+        topology_problem(&TopologyReport::of(&positions, &triangles))
+    };
+    let told = |e: NotKept| match repaired_problem {
+        Some(left)
+            if Some(e) == first_problem
+                && std::mem::discriminant(&left) != std::mem::discriminant(&e) =>
+        {
+            left
+        }
+        _ => e,
+    };
     let finest = lattice.h.into_iter().fold(f64::INFINITY, f64::min);
     let largest_move = finest * LARGEST_MOVE_IN_CELLS;
     let kept = |positions: &[[f64; 3]], fixed: &[[i128; 3]], triangles: &[[u32; 3]]| {
@@ -366,10 +385,10 @@ pub fn keep_input(
                     repairs.coplanar = counts;
                     done
                 }
-                None => split_at_contacts(&positions, &fixed, &triangles, e)?,
+                None => split_at_contacts(&positions, &fixed, &triangles, e).map_err(told)?,
             }
         }
-        Err(e) => return Err(e),
+        Err(e) => return Err(told(e)),
     };
     repairs.split_faces += split_faces;
     let input = match surface.cut {
@@ -413,6 +432,8 @@ struct KeptSurface {
 /// its pinches pulled apart when only they fail step 1, and its self-intersections cut when
 /// only they fail step 2; else why not: the input's `first_problem` (of step 1, before the
 /// repairs) where the repaired input fails step 1 or was pulled apart, else the step's reason.
+/// (Which of the ways on [`keep_input`] tries depends on that reason: a pinch the repairs left
+/// is tried as the input's own problem.)
 fn kept_or_cut(
     positions: &[[f64; 3]],
     fixed: &[[i128; 3]],
