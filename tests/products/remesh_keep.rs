@@ -184,12 +184,77 @@ fn two_cubes_sharing_a_wall_written_once_for_each_are_one_solid() {
         "{repairs:?}"
     );
     assert_eq!((out.triangles.len(), out.positions.len()), (20, 12));
-    // Twice the same orientation doubles w there: no cancelling.
+    // Three times the same orientation: no cancelling, and no copy left out (two copies of a
+    // face may span more than a hemisphere from near it: `w` off by more than ½).
     let mut faces = cube.triangles().to_vec();
     faces.extend([faces[4], faces[4]]);
-    let doubled = Mesh::new(cube.positions().to_vec(), faces).unwrap();
+    let tripled = Mesh::new(cube.positions().to_vec(), faces).unwrap();
     assert!(matches!(
-        kept(&doubled, 64),
+        kept(&tripled, 64),
+        Err(NotKept::NotManifold { .. })
+    ));
+}
+
+/// A face written twice the same way (an OpenSCAD export's side, openscad-toomanyvertices)
+/// changes `w` by that face's own winding number, below ½ in magnitude: where all such copies
+/// lie in one plane, the second copies go and the rest is kept, the same `{w > ½}` (compared
+/// at random points and at points a hair off the doubled faces, where `w_D` is near ±½).
+#[test]
+fn faces_written_twice_in_one_plane_lose_their_copies() {
+    use crate::remesh_cut::assert_same_solid;
+    use gwn::products::remesh::exact_repair::RepairCounts;
+
+    let cube = common::unit_cube();
+    let t = cube.triangles().to_vec();
+    for doubled in [vec![4], vec![4, 5], vec![5, 4]] {
+        let mut faces = t.clone();
+        faces.extend(doubled.iter().map(|&f| t[f]));
+        let input = Mesh::new(cube.positions().to_vec(), faces).unwrap();
+        let out = kept(&input, 64).unwrap_or_else(|e| panic!("{doubled:?}: {e}"));
+        assert_eq!(
+            out.stats.input,
+            Some(InputCheck::Kept {
+                repairs: RepairCounts {
+                    repeated_faces: doubled.len(),
+                    ..RepairCounts::default()
+                },
+                separated: SeparatedCounts::default(),
+            }),
+            "{doubled:?}"
+        );
+        assert_eq!(out.triangles, t);
+        assert_same_solid(&input, &out, 2000, 7, 0.0);
+        let (w_in, p) = (WindingNumber::new(&input).unwrap(), cube.positions());
+        let centre = |f: usize| -> [f64; 3] {
+            std::array::from_fn(|k| t[f].iter().map(|&v| p[v as usize][k]).sum::<f64>() / 3.0)
+        };
+        for &f in &doubled {
+            let c = centre(f);
+            let [a, b, d] = t[f].map(|v| p[v as usize]);
+            let n = [
+                (b[1] - a[1]) * (d[2] - a[2]) - (b[2] - a[2]) * (d[1] - a[1]),
+                (b[2] - a[2]) * (d[0] - a[0]) - (b[0] - a[0]) * (d[2] - a[2]),
+                (b[0] - a[0]) * (d[1] - a[1]) - (b[1] - a[1]) * (d[0] - a[0]),
+            ];
+            for (side, inside) in [(1.0, false), (-1.0, true)] {
+                let q: [f64; 3] = std::array::from_fn(|k| c[k] + side * 1e-9 * n[k]);
+                let w = w_in.eval(q);
+                // Near ±½ off the doubled face, and on the same side of ½ as the cube's w.
+                assert!(
+                    (w - if inside { 1.5 } else { -0.5 }).abs() < 0.01,
+                    "{w} at {q:?}"
+                );
+                assert_eq!(w > 0.5, inside);
+            }
+        }
+    }
+    // Copies on two sides are not in one plane: not kept (the cube's solid would be right here,
+    // but not around a cavity whose walls are written twice).
+    let mut faces = t.clone();
+    faces.extend([t[4], t[0]]);
+    let two_planes = Mesh::new(cube.positions().to_vec(), faces).unwrap();
+    assert!(matches!(
+        kept(&two_planes, 64),
         Err(NotKept::NotManifold { .. })
     ));
 }
@@ -256,12 +321,14 @@ fn every_way_of_not_bounding_the_solid_is_remeshed() {
     // and faces of one plane meeting along an edge or at a corner.
     assert_eq!(repairs.coplanar.planes, 4, "{repairs:?}");
     crate::remesh_cut::assert_same_solid(&on_face, &out, 2000, 3, separated.largest_move);
-    // A duplicated face: an edge in three faces.
+    // A face written three times: edges in four faces used three times one way (a face written
+    // twice the same way is kept without its copy where the copies lie in one plane: see
+    // `faces_written_twice_in_one_plane_lose_their_copies`).
     let mut faces = cube.triangles().to_vec();
-    faces.push(faces[0]);
-    let doubled = Mesh::new(cube.positions().to_vec(), faces).unwrap();
+    faces.extend([faces[0], faces[0]]);
+    let tripled = Mesh::new(cube.positions().to_vec(), faces).unwrap();
     assert!(matches!(
-        kept(&doubled, 64),
+        kept(&tripled, 64),
         Err(NotKept::NotManifold { .. })
     ));
     // A closed surface with a flat fold: a tetrahedron whose apex lies in its base's plane.

@@ -9,6 +9,11 @@
 //!   with its orientation (`p − a` is a positive multiple of `b − a`), so every solid angle sum,
 //!   hence `w`, is unchanged.
 //!
+//! One more repair changes `w`, by less than ½ and only where the result's own `w` is an
+//! integer, so that `{w > ½}` is unchanged ([`without_repeats_in_one_plane`]): **a face written
+//! twice with the same orientation loses its second copy** when all such copies lie in one plane
+//! (an export that wrote one triangle of a side twice).
+//!
 //! What was open or degenerate only because of these (a zero-area cap over a T-junction, an
 //! export that left its junctions unsplit, a needle whose two ends were welded) comes out closed;
 //! no position moves, every vertex is one of the input's, and nothing else is decided here:
@@ -21,7 +26,7 @@
 //! of an edge at once, at the vertices of faces that meet another: where solids touch, a vertex
 //! of one inside an edge of the other becomes a vertex of both.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use super::coplanar_overlaps::CoplanarCounts;
 use super::intersect::ExactPoint;
@@ -35,6 +40,9 @@ pub struct RepairCounts {
     pub cancelled_faces: usize,
     /// Faces split at vertices on their boundary edges.
     pub split_faces: usize,
+    /// Second copies of faces written twice with the same orientation, all in one plane, left
+    /// out ([`without_repeats_in_one_plane`]).
+    pub repeated_faces: usize,
     /// Faces overlapping in one plane, replaced by their sum there
     /// ([`super::coplanar_overlaps`]).
     pub coplanar: CoplanarCounts,
@@ -54,6 +62,7 @@ impl std::fmt::Display for RepairCounts {
             (self.zero_area_faces, "zero-area face{} left out"),
             (self.cancelled_faces, "face{} cancelled in opposite pairs"),
             (self.split_faces, "face{} split at vertices on their edges"),
+            (self.repeated_faces, "repeated face{} in one plane left out"),
         ];
         let mut first = true;
         if !self.coplanar.is_empty() {
@@ -240,6 +249,108 @@ fn without_opposite_pairs(triangles: Vec<[u32; 3]>) -> (Vec<[u32; 3]>, usize) {
     (kept, cancelled)
 }
 
+/// Most second copies [`without_repeats_in_one_plane`] leaves out: their interiors are tested
+/// for overlap pair by pair.
+pub const MAX_REPEATED_FACES: usize = 256;
+
+/// `triangles` (on the exact `points`, bit-identical vertices merged) without the second copy
+/// of each face written twice with the same orientation, and how many copies went; `None` when
+/// no face repeats, or when the repeats are not all of this kind: each at most twice, the
+/// copies (at most [`MAX_REPEATED_FACES`]) in one plane with pairwise disjoint interiors, and
+/// the faces left with no signed boundary (every edge used as often each way).
+///
+/// Why `{w > ½}` stays the same, though `w` changes by `w_D`, the winding number of the copies
+/// `D` left out: the faces left have no signed boundary, so their `w'`
+/// is an integer off them; the copies are disjoint triangles in one plane, so from a point off
+/// that plane they cover disjoint parts of the open hemisphere facing it, a solid angle below
+/// `2π`, whatever their orientations, and `|w_D| < ½`, while in the plane, off them, `w_D = 0`.
+/// So `w = w' + w_D > ½` exactly where `w' ≥ 1`, that is where `w' > ½`.
+pub fn without_repeats_in_one_plane<T: ExactPoint>(
+    points: &[T],
+    triangles: &[[u32; 3]],
+) -> Option<(Vec<[u32; 3]>, usize)> {
+    // A face as its vertices rotated to start at the least: equal for the same orientation.
+    let key = |&[a, b, c]: &[u32; 3]| {
+        if a < b && a < c {
+            [a, b, c]
+        } else if b < c {
+            [b, c, a]
+        } else {
+            [c, a, b]
+        }
+    };
+    let mut copies: HashMap<[u32; 3], usize> = HashMap::new();
+    for t in triangles {
+        *copies.entry(key(t)).or_default() += 1;
+    }
+    if copies.values().all(|&n| n == 1) || copies.values().any(|&n| n > 2) {
+        return None;
+    }
+    let mut repeated: Vec<[u32; 3]> = copies
+        .iter()
+        .filter(|&(_, &n)| n == 2)
+        .map(|(k, _)| *k)
+        .collect();
+    if repeated.len() > MAX_REPEATED_FACES {
+        return None;
+    }
+    repeated.sort_unstable();
+    let corners = |t: [u32; 3]| t.map(|v| points[v as usize]);
+    let [a, b, c] = corners(repeated[0]);
+    let in_plane = repeated
+        .iter()
+        .flatten()
+        .all(|&v| T::orient(a, b, c, points[v as usize]) == 0);
+    if !in_plane {
+        return None;
+    }
+    // Coplanar faces with a normal component along `axis` project without collapsing onto the
+    // plane of the other two axes.
+    let axis = T::projection_axis(a, b, c)?;
+    let axes = ((axis + 1) % 3, (axis + 2) % 3);
+    for (i, &s) in repeated.iter().enumerate() {
+        for &t in &repeated[i + 1..] {
+            let (s, t) = (corners(s), corners(t));
+            if !(separated_by_an_edge_of(s, t, axes) || separated_by_an_edge_of(t, s, axes)) {
+                return None;
+            }
+        }
+    }
+    // Of each repeated face, the first copy stays (and leaves this set), the second goes.
+    let mut first_copy_ahead: HashSet<[u32; 3]> = repeated.iter().copied().collect();
+    let kept: Vec<[u32; 3]> = triangles
+        .iter()
+        .filter(|t| {
+            let k = key(t);
+            copies[&k] == 1 || first_copy_ahead.remove(&k)
+        })
+        .copied()
+        .collect();
+    // No signed boundary: every directed edge as often as its reverse.
+    let mut uses: HashMap<(u32, u32), i64> = HashMap::new();
+    for t in &kept {
+        for k in 0..3 {
+            let (p, q) = (t[k], t[(k + 1) % 3]);
+            *uses.entry((p.min(q), p.max(q))).or_default() += if p < q { 1 } else { -1 };
+        }
+    }
+    if uses.values().any(|&n| n != 0) {
+        return None;
+    }
+    Some((kept, repeated.len()))
+}
+
+/// Whether an edge line of the triangle `s` has all of `t` on its closed outer side, in the
+/// projection onto `axes` (where neither collapses): for two triangles, their interiors are
+/// disjoint exactly when an edge of one of them separates them so.
+fn separated_by_an_edge_of<T: ExactPoint>(s: [T; 3], t: [T; 3], axes: (usize, usize)) -> bool {
+    let inner = T::orient2(s[0], s[1], s[2], axes);
+    (0..3).any(|e| {
+        let (a, b) = (s[e], s[(e + 1) % 3]);
+        t.iter().all(|&x| T::orient2(a, b, x, axes) * inner <= 0)
+    })
+}
+
 /// For each of `edges` (as `(min, max)` vertex indices), the ends of `edges` strictly inside
 /// it, ordered from `min` to `max`; empty when the search would exceed `budget`.
 fn edge_junctions<T: ExactPoint>(
@@ -387,6 +498,102 @@ mod tests {
         assert_eq!(t[0], [0, 2, 1]);
         t.splice(0..1, [[0, 2, 8], [8, 2, 1]]);
         (p, t)
+    }
+
+    /// The unit cube's corners times 2, and its 12 outward faces (`testing::unit_cube`).
+    fn cube() -> (Vec<P>, Vec<[u32; 3]>) {
+        let unit = crate::testing::unit_cube(false);
+        let p = unit
+            .positions()
+            .iter()
+            .map(|v| v.map(|c| 2 * c as i64))
+            .collect();
+        (p, unit.triangles().to_vec())
+    }
+
+    #[test]
+    fn second_copies_in_one_plane_go_and_every_other_repeat_stays() {
+        let (p, t) = cube();
+        assert_eq!(
+            without_repeats_in_one_plane(&p, &t),
+            None,
+            "nothing repeats"
+        );
+        // One side's two faces written twice, the copies rotated: both second copies go, the
+        // first copies stay where they were.
+        let mut twice = t.clone();
+        twice.push([t[4][1], t[4][2], t[4][0]]);
+        twice.push(t[5]);
+        assert_eq!(
+            without_repeats_in_one_plane(&p, &twice),
+            Some((t.clone(), 2))
+        );
+        // Copies in two planes, or a face three times: left as they are.
+        let mut two_planes = t.clone();
+        two_planes.extend([t[4], t[0]]);
+        assert_eq!(without_repeats_in_one_plane(&p, &two_planes), None);
+        let mut thrice = t.clone();
+        thrice.extend([t[4], t[4]]);
+        assert_eq!(without_repeats_in_one_plane(&p, &thrice), None);
+        // A wall written twice in a box that does not close without it: the copy would leave a
+        // signed boundary behind.
+        let mut open = t[1..].to_vec();
+        open.push(t[4]);
+        assert_eq!(without_repeats_in_one_plane(&p, &open), None);
+    }
+
+    #[test]
+    fn overlapping_copies_in_one_plane_stay() {
+        // Two triangles in z = 0 over each other's corner, each written twice, and once the
+        // other way (so that the faces left have no signed boundary): the copies overlap, and
+        // `|w_D|` may exceed ½ over both.
+        let p: Vec<P> = vec![
+            [0, 0, 0],
+            [4, 0, 0],
+            [0, 4, 0],
+            [1, 1, 0],
+            [5, 1, 0],
+            [1, 5, 0],
+        ];
+        let (a, b) = ([0, 1, 2], [3, 4, 5]);
+        let rev = |t: [u32; 3]| [t[0], t[2], t[1]];
+        assert_eq!(
+            without_repeats_in_one_plane(&p, &[a, a, b, b, rev(a), rev(b)]),
+            None
+        );
+        // Moved apart, the same copies go.
+        let far: Vec<P> = p[..3]
+            .iter()
+            .chain(
+                &p[3..]
+                    .iter()
+                    .map(|v| [v[0] + 8, v[1], 0])
+                    .collect::<Vec<_>>(),
+            )
+            .copied()
+            .collect();
+        assert_eq!(
+            without_repeats_in_one_plane(&far, &[a, a, b, b, rev(a), rev(b)]),
+            Some((vec![a, b, rev(a), rev(b)], 2))
+        );
+        // Separated triangles, and triangles sharing an edge, have disjoint interiors.
+        let axes = (0, 1);
+        let c = |t: [u32; 3]| t.map(|v| p[v as usize]);
+        assert!(
+            !separated_by_an_edge_of(c(a), c(b), axes)
+                && !separated_by_an_edge_of(c(b), c(a), axes)
+        );
+        let q: Vec<P> = vec![
+            [0, 0, 0],
+            [4, 0, 0],
+            [0, 4, 0],
+            [4, 4, 0],
+            [9, 0, 0],
+            [9, 4, 0],
+        ];
+        let d = |t: [u32; 3]| t.map(|v| q[v as usize]);
+        assert!(separated_by_an_edge_of(d([0, 1, 2]), d([1, 3, 2]), axes));
+        assert!(separated_by_an_edge_of(d([0, 1, 2]), d([4, 5, 3]), axes));
     }
 
     #[test]

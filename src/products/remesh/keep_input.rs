@@ -7,7 +7,8 @@
 //! faces), and the test is linear in the input instead of in the surface's area in cells.
 //! [`keep_input`] keeps a mesh only when it proves all of this exactly, on the coordinates the
 //! user gave, after [`exact_repair`] (zero-area faces out, faces split at the vertices on their
-//! boundary edges: `w` unchanged off the surface, no vertex moved):
+//! boundary edges: `w` unchanged off the surface, no vertex moved; second copies of faces
+//! written twice the same way in one plane out: `{w > ½}` unchanged):
 //!
 //! 1. **Topology** ([`TopologyReport`]): every edge in exactly two faces, used once each way;
 //!    every vertex's faces one fan; no face that repeats a vertex; no two vertices at one
@@ -311,9 +312,19 @@ pub fn keep_input(
         1000 * triangles.len() as u64,
     );
     let mut repairs = repaired.counts;
+    // A face written twice the same way, all such in one plane: the second copies out, which
+    // changes `w` by less than ½ where the rest's `w` is an integer (`{w > ½}` unchanged).
+    let repaired_triangles =
+        match exact_repair::without_repeats_in_one_plane(&fixed, &repaired.triangles) {
+            Some((triangles, repeated)) => {
+                repairs.repeated_faces = repeated;
+                triangles
+            }
+            None => repaired.triangles,
+        };
     let (positions, fixed, triangles) = if !repairs.is_empty() {
-        let (kept, triangles) = referenced(&fixed, &repaired.triangles);
-        let (positions, _) = referenced(&positions, &repaired.triangles);
+        let (kept, triangles) = referenced(&fixed, &repaired_triangles);
+        let (positions, _) = referenced(&positions, &repaired_triangles);
         (positions, kept, triangles)
     } else {
         (positions, fixed, triangles)

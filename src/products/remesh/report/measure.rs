@@ -426,6 +426,9 @@ fn input_changes(repairs: RepairCounts, separated: SeparatedCounts) -> Vec<(&'st
         ("input_cancelled_faces", repairs.cancelled_faces.to_string()),
         ("input_split_faces", repairs.split_faces.to_string()),
     ];
+    if repairs.repeated_faces > 0 {
+        members.push(("input_repeated_faces", repairs.repeated_faces.to_string()));
+    }
     let coplanar = repairs.coplanar;
     if !coplanar.is_empty() {
         members.extend([
