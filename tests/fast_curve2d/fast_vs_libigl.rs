@@ -15,6 +15,8 @@
 
 use crate::common;
 
+use rayon::prelude::*;
+
 use gwn::Mesh;
 use gwn::eval::direct::winding_number_direct_batch;
 use gwn::eval::fast::{Admissibility, FastParams, FastWindingNumber};
@@ -54,81 +56,87 @@ fn fast_is_at_least_as_accurate_as_libigl_on_the_corpus() {
         return;
     };
     assert!(LIBIGL_MAX_ERROR.len() >= 90, "the table covers the corpus");
-    let mut worse = Vec::new();
-    for &(name, faces, igl) in LIBIGL_MAX_ERROR {
-        let mesh = gwn::io::load_mesh(dir.join(name))
-            .expect("corpus mesh loads")
-            .mesh;
-        assert_eq!(
-            mesh.triangles().len(),
-            faces,
-            "{name}: another file than measured"
-        );
-        let points = grid(&mesh, 32);
-        let want = (BUDGET / faces as f64)
-            .floor()
-            .max(256.0)
-            .min(points.len() as f64) as usize;
-        let step = points.len().div_ceil(want).max(1);
-        let fast = FastWindingNumber::with_params(&mesh, FastParams::barill(BETA, 2));
-        let b = mesh.bounding_box().expect("non-empty");
-        let diag = (0..3)
-            .map(|k| (b.max[k] - b.min[k]).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        let distance = SignedDistance::with_evaluator(&mesh, fast.clone());
-        let subset: Vec<[f64; 3]> = points
-            .iter()
-            .step_by(step)
-            .copied()
-            .filter(|&q| distance.unsigned(q) > 1e-6 * diag)
-            .collect();
-        let exact = winding_number_direct_batch(&mesh, &subset);
-        let max_error = |fast: &FastWindingNumber| {
-            fast.eval_batch(&subset)
+    // Meshes in parallel as well as the points: loading, the distance filter and the trees'
+    // builds are serial per mesh, and were most of this test's wall-clock time on 2 cores.
+    let worse: Vec<String> = LIBIGL_MAX_ERROR
+        .par_iter()
+        .flat_map_iter(|&(name, faces, igl)| {
+            let mut worse = Vec::new();
+            let mesh = gwn::io::load_mesh(dir.join(name))
+                .expect("corpus mesh loads")
+                .mesh;
+            assert_eq!(
+                mesh.triangles().len(),
+                faces,
+                "{name}: another file than measured"
+            );
+            let points = grid(&mesh, 32);
+            let want = (BUDGET / faces as f64)
+                .floor()
+                .max(256.0)
+                .min(points.len() as f64) as usize;
+            let step = points.len().div_ceil(want).max(1);
+            let fast = FastWindingNumber::with_params(&mesh, FastParams::barill(BETA, 2));
+            let b = mesh.bounding_box().expect("non-empty");
+            let diag = (0..3)
+                .map(|k| (b.max[k] - b.min[k]).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            let distance = SignedDistance::with_evaluator(&mesh, fast.clone());
+            let subset: Vec<[f64; 3]> = points
                 .iter()
-                .zip(&exact)
-                .map(|(a, e)| (a - e).abs())
-                .fold(0.0, f64::max)
-        };
-        let err = max_error(&fast);
-        let box_corner = FastWindingNumber::with_params(
-            &mesh,
-            FastParams {
-                beta: BOX_CORNER_BETA,
-                order: 2,
-                admissibility: Admissibility::BoxCorner,
-            },
-        );
-        let err_box = max_error(&box_corner);
-        let either = FastWindingNumber::with_params(
-            &mesh,
-            FastParams {
-                beta: RADIUS_OR_BOX_CORNER_BETA,
-                order: 2,
-                admissibility: Admissibility::RadiusOrBoxCorner,
-            },
-        );
-        let err_either = max_error(&either);
-        println!(
-            "{name}: gwn {err:.3e}, box corner {err_box:.3e}, radius or box corner \
+                .step_by(step)
+                .copied()
+                .filter(|&q| distance.unsigned(q) > 1e-6 * diag)
+                .collect();
+            let exact = winding_number_direct_batch(&mesh, &subset);
+            let max_error = |fast: &FastWindingNumber| {
+                fast.eval_batch(&subset)
+                    .iter()
+                    .zip(&exact)
+                    .map(|(a, e)| (a - e).abs())
+                    .fold(0.0, f64::max)
+            };
+            let err = max_error(&fast);
+            let box_corner = FastWindingNumber::with_params(
+                &mesh,
+                FastParams {
+                    beta: BOX_CORNER_BETA,
+                    order: 2,
+                    admissibility: Admissibility::BoxCorner,
+                },
+            );
+            let err_box = max_error(&box_corner);
+            let either = FastWindingNumber::with_params(
+                &mesh,
+                FastParams {
+                    beta: RADIUS_OR_BOX_CORNER_BETA,
+                    order: 2,
+                    admissibility: Admissibility::RadiusOrBoxCorner,
+                },
+            );
+            let err_either = max_error(&either);
+            println!(
+                "{name}: gwn {err:.3e}, box corner {err_box:.3e}, radius or box corner \
              {err_either:.3e}, libigl {igl:.3e}"
-        );
-        if err > igl {
-            worse.push(format!("{name} ({err:.3e} > {igl:.3e})"));
-        }
-        if err_box > igl {
-            worse.push(format!(
-                "{name} box corner β = {BOX_CORNER_BETA} ({err_box:.3e} > {igl:.3e})"
-            ));
-        }
-        if err_either > igl {
-            worse.push(format!(
-                "{name} radius or box corner β = {RADIUS_OR_BOX_CORNER_BETA} \
+            );
+            if err > igl {
+                worse.push(format!("{name} ({err:.3e} > {igl:.3e})"));
+            }
+            if err_box > igl {
+                worse.push(format!(
+                    "{name} box corner β = {BOX_CORNER_BETA} ({err_box:.3e} > {igl:.3e})"
+                ));
+            }
+            if err_either > igl {
+                worse.push(format!(
+                    "{name} radius or box corner β = {RADIUS_OR_BOX_CORNER_BETA} \
                  ({err_either:.3e} > {igl:.3e})"
-            ));
-        }
-    }
+                ));
+            }
+            worse
+        })
+        .collect();
     assert!(
         worse.is_empty(),
         "gwn fast at β = {BETA} (or BoxCorner {BOX_CORNER_BETA}, RadiusOrBoxCorner \
