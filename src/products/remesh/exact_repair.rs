@@ -487,14 +487,8 @@ mod tests {
     /// A cube of edge 2 (outward) whose bottom face `0 2 1` is split at `8`, the midpoint of its
     /// front edge `1 0`, while the front face `0 1 5` across that edge is not: a T-junction.
     fn capped_cube() -> (Vec<P>, Vec<[u32; 3]>) {
-        let unit = crate::testing::unit_cube(false);
-        let mut p: Vec<P> = unit
-            .positions()
-            .iter()
-            .map(|v| v.map(|c| 2 * c as i64))
-            .collect();
+        let (mut p, mut t) = cube();
         p.push([1, 0, 0]);
-        let mut t = unit.triangles().to_vec();
         assert_eq!(t[0], [0, 2, 1]);
         t.splice(0..1, [[0, 2, 8], [8, 2, 1]]);
         (p, t)
