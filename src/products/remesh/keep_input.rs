@@ -313,15 +313,20 @@ pub fn keep_input(
     );
     let mut repairs = repaired.counts;
     // A face written twice the same way, all such in one plane: the second copies out, which
-    // changes `w` by less than ½ where the rest's `w` is an integer (`{w > ½}` unchanged).
-    let repaired_triangles =
-        match exact_repair::without_repeats_in_one_plane(&fixed, &repaired.triangles) {
-            Some((triangles, repeated)) => {
-                repairs.repeated_faces = repeated;
-                triangles
-            }
-            None => repaired.triangles,
-        };
+    // changes `w` by less than ½ where the rest's `w` is an integer (`{w > ½}` unchanged). A
+    // repeated face puts its edges in more than two faces, so a clean input skips the search.
+    let repeats = if original.edge_manifold {
+        None
+    } else {
+        exact_repair::without_repeats_in_one_plane(&fixed, &repaired.triangles)
+    };
+    let repaired_triangles = match repeats {
+        Some((triangles, repeated)) => {
+            repairs.repeated_faces = repeated;
+            triangles
+        }
+        None => repaired.triangles,
+    };
     let (positions, fixed, triangles) = if !repairs.is_empty() {
         let (kept, triangles) = referenced(&fixed, &repaired_triangles);
         let (positions, _) = referenced(&positions, &repaired_triangles);
