@@ -271,11 +271,16 @@ fn remesh_thickens_an_open_sheet_on_request() {
     // empty, and the report says that empty agrees with the input at every sample.
     let mut plain = args(&["--report"]);
     plain.push(report.clone());
-    let (ok, _, stderr) = call(plain);
+    let (ok, stdout, stderr) = call(plain);
     assert!(ok, "{stderr}");
     let json = std::fs::read_to_string(&report).unwrap();
     assert!(json.contains("\"faces\": 0,"), "{json}");
     assert!(json.contains("\"occupancy_agreement\": 1.0"), "{json}");
+    // ... and the printed report says why it may be empty, and what to do.
+    assert!(
+        stdout.contains("the output is empty") && stdout.contains("--thicken EPS"),
+        "{stdout}"
+    );
     let mut with_report = args(&["--thicken", "0.08", "--report"]);
     with_report.push(report.clone());
     let (ok, stdout, stderr) = call(with_report);
@@ -305,6 +310,52 @@ fn remesh_thickens_an_open_sheet_on_request() {
             "{stderr}"
         );
     }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A closed tetrahedron with its faces turned inward has `w = -1` inside: `{w > ½}` is empty,
+/// and so is the output, with a line that says the input winds inward and that the parity
+/// method remeshes the solid it encloses (which it then does).
+#[test]
+fn remesh_of_an_inward_input_is_empty_and_says_why() {
+    let dir = std::env::temp_dir().join(format!("gwn-cli-remesh-inward-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let input = dir.join("inward.obj");
+    std::fs::write(
+        &input,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 4 2\nf 2 4 3\nf 1 3 4\n",
+    )
+    .unwrap();
+    let (input, out) = (
+        input.to_str().unwrap().to_owned(),
+        dir.join("o.obj").to_str().unwrap().to_owned(),
+    );
+    let run = |method: &str| {
+        let (ok, stdout, stderr) = gwn(&[
+            "remesh",
+            &input,
+            "--res",
+            "16",
+            "--out",
+            &out,
+            "--samples",
+            "200",
+            "--method",
+            method,
+        ]);
+        assert!(ok, "{stderr}");
+        stdout
+    };
+    let exact = run("exact");
+    assert!(exact.contains("0 faces, 0 vertices"), "{exact}");
+    assert!(
+        exact.contains("the output is empty") && exact.contains("winds inward"),
+        "{exact}"
+    );
+    let parity = run("parity");
+    assert!(parity.contains("closed: yes"), "{parity}");
+    assert!(!parity.contains("0 faces, 0 vertices"), "{parity}");
+    assert!(!parity.contains("the output is empty"), "{parity}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

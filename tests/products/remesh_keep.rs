@@ -184,6 +184,22 @@ fn two_cubes_sharing_a_wall_written_once_for_each_are_one_solid() {
         "{repairs:?}"
     );
     assert_eq!((out.triangles.len(), out.positions.len()), (20, 12));
+    // The same with a face that repeats a vertex: the input's first problem, gone after the
+    // repairs. What is tried next goes by what the repaired surface fails for (the wall's edges
+    // in four faces), not by that first problem.
+    let mut faces = shifted.triangles().to_vec();
+    faces.push([0, 0, 1]);
+    let with_needle = Mesh::new(shifted.positions().to_vec(), faces).unwrap();
+    let out = kept(&with_needle, 64).unwrap_or_else(|e| panic!("{e}"));
+    let Some(InputCheck::Kept { repairs, .. }) = out.stats.input else {
+        panic!("not kept: {:?}", out.stats.input);
+    };
+    assert_eq!(
+        (repairs.zero_area_faces, repairs.coplanar.faces),
+        (1, 4),
+        "{repairs:?}"
+    );
+    assert_eq!((out.triangles.len(), out.positions.len()), (20, 12));
     // Three times the same orientation: no cancelling, and no copy left out (two copies of a
     // face may span more than a hemisphere from near it: `w` off by more than ½).
     let mut faces = cube.triangles().to_vec();

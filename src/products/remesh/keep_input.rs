@@ -53,6 +53,11 @@
 //! - where that still fails for a self-intersection or a pinch, faces overlapping in one plane
 //!   (a part standing on a plate) are replaced by what they add up to there
 //!   ([`super::coplanar_overlaps`]), and both ways above are tried again on the result.
+//!
+//! Whether the last two are tried goes by what the repaired surface failed for (or, where it
+//! failed step 1, the input's own first problem too), not by the reason the user is told: an
+//! input whose first problem is a zero-area face, taken out by the repairs, still gets them
+//! where the rest has a pinch or crossing faces.
 
 use rayon::slice::ParallelSliceMut;
 
@@ -335,33 +340,41 @@ pub fn keep_input(
         (positions, fixed, triangles)
     };
     let first_problem = topology_problem(&original);
-    // What the user is told when the input's own first problem is the answer but the repairs
-    // left another kind: a zero-area face taken out is no reason, the open or non-manifold
-    // surface left after it is (the ways on below still go by the input's problem).
+    // What the user is told: the input's own first problem where the repaired surface failed
+    // step 1 or was pulled apart (what `gwn info` counts on the file), unless the repairs left
+    // another kind (a zero-area face taken out is no reason, the open or non-manifold surface
+    // left after it is); else what the later step found. Which ways on are tried does not
+    // depend on it (`mendable`).
     let repaired_problem = if repairs.is_empty() {
         first_problem
     } else {
         topology_problem(&TopologyReport::of(&positions, &triangles))
     };
-    let told = |e: NotKept| match repaired_problem {
-        Some(left)
-            if Some(e) == first_problem
-                && std::mem::discriminant(&left) != std::mem::discriminant(&e) =>
-        {
-            left
+    let told = |r: Refused| {
+        let e = match first_problem {
+            Some(problem) if r.in_topology => problem,
+            _ => r.found,
+        };
+        match repaired_problem {
+            Some(left)
+                if Some(e) == first_problem
+                    && std::mem::discriminant(&left) != std::mem::discriminant(&e) =>
+            {
+                left
+            }
+            _ => e,
         }
-        _ => e,
     };
     let finest = lattice.h.into_iter().fold(f64::INFINITY, f64::min);
     let largest_move = finest * LARGEST_MOVE_IN_CELLS;
     let kept = |positions: &[[f64; 3]], fixed: &[[i128; 3]], triangles: &[[u32; 3]]| {
-        kept_or_cut(positions, fixed, triangles, largest_move, first_problem)
+        kept_or_cut(positions, fixed, triangles, largest_move)
     };
     // Solids touching where a vertex of one lies inside an edge of another: that edge's faces
     // split there (exact, `w` unchanged) make the contact a shared vertex or edge, which the
     // pull can take apart. The surface, and how many faces were split; else `e`.
     let split_at_contacts =
-        |positions: &[[f64; 3]], fixed: &[[i128; 3]], triangles: &[[u32; 3]], e: NotKept| {
+        |positions: &[[f64; 3]], fixed: &[[i128; 3]], triangles: &[[u32; 3]], e: Refused| {
             let budget = intersection_budget(triangles.len());
             let meeting =
                 intersect::intersecting_faces_wide(fixed, triangles, budget).map_err(|_| e)?;
@@ -375,7 +388,7 @@ pub fn keep_input(
         };
     let (surface, split_faces) = match kept(&positions, &fixed, &triangles) {
         Ok(surface) => (surface, 0),
-        Err(e @ (NotKept::SelfIntersecting { .. } | NotKept::NotManifold { .. })) => {
+        Err(e) if e.mendable(first_problem) => {
             // Faces overlapping in one plane (a part standing on a plate, a fold) first:
             // replaced by what they add up to there, then the same steps, the contact split
             // included; where there are none, or that fails, the contact split alone.
@@ -388,10 +401,9 @@ pub fn keep_input(
                         let fixed = common_fixed_point(&positions, bits)?;
                         let done = match kept(&positions, &fixed, &triangles) {
                             Ok(surface) => Ok((surface, 0)),
-                            Err(
-                                e
-                                @ (NotKept::SelfIntersecting { .. } | NotKept::NotManifold { .. }),
-                            ) => split_at_contacts(&positions, &fixed, &triangles, e),
+                            Err(e) if e.mendable(first_problem) => {
+                                split_at_contacts(&positions, &fixed, &triangles, e)
+                            }
                             Err(e) => Err(e),
                         };
                         Some((done.ok()?, merged.counts))
@@ -444,26 +456,55 @@ struct KeptSurface {
     cut: Option<(super::cut_intersections::CutCounts, usize)>,
 }
 
+/// Why [`kept_or_cut`] refused a surface.
+#[derive(Clone, Copy, Debug)]
+struct Refused {
+    /// The first problem the steps found on the surface (the pulled-apart one, after a pull).
+    found: NotKept,
+    /// Whether it failed step 1 or was pulled apart first: then the input's own first problem
+    /// is what the user is told.
+    in_topology: bool,
+}
+
+impl Refused {
+    /// Whether [`keep_input`]'s ways on (coplanar replacement, contact split) are worth trying:
+    /// where the surface, or the input before its repairs (`first_problem`), fails for faces
+    /// meeting where they should not — touching solids (more than two faces at an edge, several
+    /// fans at a vertex) or faces crossing. Faces overlapping in one plane show as either,
+    /// before the repairs or after.
+    fn mendable(&self, first_problem: Option<NotKept>) -> bool {
+        let meeting = |e: NotKept| {
+            matches!(
+                e,
+                NotKept::SelfIntersecting { .. } | NotKept::NotManifold { .. }
+            )
+        };
+        meeting(self.found) || (self.in_topology && first_problem.is_some_and(meeting))
+    }
+}
+
 /// Steps 1–3 on a repaired input (`positions`, their exact coordinates `fixed`, `triangles`),
 /// its pinches pulled apart when only they fail step 1, and its self-intersections cut when
-/// only they fail step 2; else why not: the input's `first_problem` (of step 1, before the
-/// repairs) where the repaired input fails step 1 or was pulled apart, else the step's reason.
-/// (Which of the ways on [`keep_input`] tries depends on that reason: a pinch the repairs left
-/// is tried as the input's own problem.)
+/// only they fail step 2; else why not.
 fn kept_or_cut(
     positions: &[[f64; 3]],
     fixed: &[[i128; 3]],
     triangles: &[[u32; 3]],
     largest_move: f64,
-    first_problem: Option<NotKept>,
-) -> Result<KeptSurface, NotKept> {
+) -> Result<KeptSurface, Refused> {
     let bits = intersect::MAX_WIDE_COORDINATE.trailing_zeros();
     let topology = TopologyReport::of(positions, triangles);
-    let reason = |problem: NotKept| first_problem.unwrap_or(problem);
-    let pulled =
-        pulled_apart_if_pinched(positions, triangles, &topology, largest_move).map_err(reason)?;
+    let in_topology = |found: NotKept| Refused {
+        found,
+        in_topology: true,
+    };
+    let pulled = pulled_apart_if_pinched(positions, triangles, &topology, largest_move)
+        .map_err(in_topology)?;
     let was_pulled = pulled.is_some();
-    let given = |e: NotKept| if was_pulled { reason(e) } else { e };
+    let given = |found: NotKept| Refused {
+        found,
+        in_topology: was_pulled,
+    };
     let (positions, fixed, triangles, separated) = match pulled {
         None => (
             positions.to_vec(),
@@ -472,8 +513,8 @@ fn kept_or_cut(
             SeparatedCounts::default(),
         ),
         Some(pulled) => {
-            let fixed =
-                common_fixed_point(&pulled.positions, bits).ok_or(NotKept::CoordinateRange)?;
+            let fixed = common_fixed_point(&pulled.positions, bits)
+                .ok_or(given(NotKept::CoordinateRange))?;
             (pulled.positions, fixed, pulled.triangles, pulled.counts)
         }
     };
