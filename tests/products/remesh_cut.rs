@@ -406,6 +406,69 @@ fn an_input_without_intersections_is_its_own_cut() {
     );
 }
 
+/// A tetrahedron inside a cube, sharing one of the cube's edges: around that edge `w` runs
+/// 0, 1, 2, 1 (the cube's face, the tetrahedron's two, the cube's other), four faces that are
+/// not two solid wedges, so no pull takes them apart. Every edge is used as often each way
+/// (`w` is an integer off the surface), and the cut's labels keep the faces with `w = 0` in
+/// front: the cube, the tetrahedron left out, no face cut. Outside the cube, sharing the edge
+/// (0, 1, 0, 1 around it: solid wedges), the two are pulled apart instead.
+#[test]
+fn a_solid_inside_another_sharing_its_edge_is_left_out() {
+    let cube = common::unit_cube();
+    // Outward (`w = 2` inside it, checked below).
+    let inside = Mesh::new(
+        vec![
+            [0.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.5, 0.2, 0.5],
+            [0.2, 0.5, 0.5],
+        ],
+        vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+    )
+    .unwrap();
+    let nested = join(&[cube.clone(), inside.clone()]);
+    let wn = WindingNumber::new(&nested).unwrap();
+    assert_eq!(
+        wn.eval([0.2, 0.2, 0.5]),
+        2.0,
+        "the tetrahedron is inside the cube"
+    );
+    let (out, counts) = cut(&nested);
+    assert_eq!(
+        (
+            counts.intersecting_pairs,
+            counts.cut_faces,
+            counts.removed_faces
+        ),
+        (0, 0, 4),
+        "{counts:?}"
+    );
+    assert_eq!(out.triangles.len(), 12);
+    assert_same_solid(&nested, &out, 2_000, 11, 0.0);
+    // Turned half a turn about the edge, out of the cube: it and the cube touch along the edge
+    // only, and are kept both, pulled apart.
+    let outside = Mesh::new(
+        inside
+            .positions()
+            .iter()
+            .map(|p| [-p[0], -p[1], p[2]])
+            .collect(),
+        inside.triangles().to_vec(),
+    )
+    .unwrap();
+    let touching = join(&[cube, outside]);
+    let out = kept(&touching).unwrap_or_else(|e| panic!("{e}"));
+    let Some(InputCheck::Kept { separated, .. }) = out.stats.input else {
+        panic!("not kept: {:?}", out.stats.input);
+    };
+    assert!(
+        separated.vertices + separated.added_vertices > 0,
+        "{separated:?}"
+    );
+    assert_eq!(out.triangles.len(), 16);
+    assert_same_solid(&touching, &out, 2_000, 12, 0.01);
+}
+
 /// The input kept (whole, or cut) with the same solid, or refused whole for its winding (apart,
 /// or nested without touching: nothing to cut).
 fn cut_or_refused(input: &Mesh, seed: u64) -> Result<(), TestCaseError> {

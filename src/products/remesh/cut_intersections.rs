@@ -5,7 +5,10 @@
 //!
 //! The input is closed, manifold and oriented, so its `w` is an integer off the surface and
 //! jumps by exactly one, up against the normal, across every face that no other face
-//! overlaps. Then:
+//! overlaps. ([`super::keep_input`] also calls it on a closed input with edges in four faces
+//! that no pull takes apart, where every edge is used as often each way: `w` is an integer
+//! off the surface there too; such an edge of the input separates patches like a curve, but
+//! carries no value across, step 3.) Then:
 //!
 //! 1. **Cut.** Every intersecting pair of faces (exact, [`intersecting_pairs_wide`]) must meet
 //!    along a segment with two ends, each (by exact signs) an edge of one face piercing the
@@ -465,9 +468,17 @@ fn cut_labelling_pieces(
     }
     let mut parent: Vec<u32> = (0..faces.len() as u32).collect();
     let mut curve_edges: Vec<[u32; 4]> = Vec::new();
-    for list in edge_faces.values() {
+    for (&(u, v), list) in &edge_faces {
         match list[..] {
             [x, y] => super::report::union(&mut parent, x, y),
+            // An edge of the input in all four faces (shells sharing it, which the pull could not
+            // take apart) separates patches but is no intersection curve: its faces are not two
+            // planes crossing, so no value of `w` is carried across it.
+            [a, b, c, d]
+                if [a, b, c, d].iter().all(|&x| {
+                    let t = triangles[origin[x as usize] as usize];
+                    t.contains(&u) && t.contains(&v)
+                }) => {}
             [a, b, c, d] => curve_edges.push([a, b, c, d]),
             _ => return Err(NotCut::EdgeUse),
         }
