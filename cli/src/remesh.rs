@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use clap::Args as ClapArgs;
 use gwn::products::remesh::crossings::SegmentBvh;
-use gwn::products::remesh::keep_input::{InputCheck, NotKept};
+use gwn::products::remesh::keep_input::{InputCheck, WhyEmpty};
 use gwn::products::remesh::report::{
     DistanceReference, PhaseClock, RemeshReport, ReportPhase, curved_surface_for_distance,
 };
@@ -425,20 +425,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     // An empty output is right where `w > ½` is empty, but rarely what was meant: say why.
     if topology.faces == 0 && thickened.is_none() && input.mesh().is_some_and(|m| !m.is_empty()) {
-        let why = match s.input {
-            Some(InputCheck::Remeshed(NotKept::Winding {
-                outside: 0,
-                orientation: -1,
-            })) => {
-                "the input winds inward (w = -1 inside it, faces turned the wrong way): \
-                 --method parity remeshes the solid it encloses"
-            }
-            _ => {
-                "a surface without volume (open sheets: --thicken EPS closes them into thin \
-                 solids), or parts thinner than a cell (a finer --res)"
+        let why = WhyEmpty::of(s.input);
+        let way_out = match why {
+            WhyEmpty::WindsInward => "--method parity remeshes the solid it encloses",
+            WhyEmpty::NoVolume => {
+                "--thicken EPS closes open sheets into thin solids; a finer --res"
             }
         };
-        outln!("the output is empty: w > 1/2 at no point of the lattice; {why}")?;
+        outln!("the output is empty: w > 1/2 at no point of the lattice; {why}: {way_out}")?;
     }
     if let Some(path) = &args.report {
         std::fs::write(path, report.to_json() + "\n")

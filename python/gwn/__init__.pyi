@@ -218,7 +218,7 @@ def remesh(
     time_limit: Optional[float] = None,
     always_remesh: bool = False,
 ) -> Tuple[_F64, _I64]:
-    """A closed, manifold, oriented surface of the solid w > 1/2 as (V float64 (n, 3), F int64 (m, 3)); simplify=False: the raw marching-tetrahedra surface; refine_plates=False keeps the lattice of res alone; a mesh that already is such a surface bounding w > 1/2 (exact tests) comes back as it is unless always_remesh. remesh(model, res=...) of a StepModel or PatchSet takes no F."""
+    """A closed, manifold, oriented surface of the solid w > 1/2 as (V float64 (n, 3), F int64 (m, 3)); simplify=False: the raw marching-tetrahedra surface; refine_plates=False keeps the lattice of res alone; a mesh that already is such a surface bounding w > 1/2 (exact tests) comes back as it is unless always_remesh; an empty output of a mesh with faces comes with a UserWarning saying why (inward winding: method="parity"; no volume: thicken=). remesh(model, res=...) of a StepModel or PatchSet takes no F."""
 
 @overload
 def remesh(

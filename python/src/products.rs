@@ -528,7 +528,9 @@ pub fn filter_tets<'py>(
 /// replaced by what they add up to there (``input_coplanar_faces``,
 /// ``input_crossing_vertices``); otherwise its clean components can come back as they are with
 /// the rest remeshed (``partly kept``); ``always_remesh=True`` remeshes it all anyway, as
-/// ``gwn remesh --always-remesh``.
+/// ``gwn remesh --always-remesh``. An empty output of a mesh with faces (``{w > 1/2}`` empty)
+/// comes with a ``UserWarning`` saying why: an inward-wound input (``method="parity"``
+/// remeshes what it encloses), or no volume (``thicken=``).
 /// ``gwn.remesh(model, res=...)`` remeshes a :class:`StepModel` (``gwn.load("part.step")``)
 /// the way ``gwn remesh part.step`` does: no ``F``, exact method only (``tolerance=`` as in
 /// :class:`WindingNumber`), vertices placed at the model's own surface hits; ``thicken`` is
@@ -565,6 +567,7 @@ pub fn remesh<'py>(
 ) -> PyResult<Bound<'py, PyTuple>> {
     use gwn::products::remesh::report::{DistanceReference, PhaseClock, RemeshReport};
 
+    use gwn::products::remesh::keep_input::WhyEmpty;
     use gwn::products::remesh::{
         RemeshOptions, remesh_guided, remesh_mesh,
         thicken::{self, ThickenedSheets},
@@ -690,9 +693,29 @@ pub fn remesh<'py>(
             phase_seconds,
             thicken,
         });
-        measured(out, field, request)
+        let empty = (out.triangles.is_empty() && thick.is_none() && !mesh.is_empty())
+            .then(|| WhyEmpty::of(out.stats.input));
+        Ok((measured(out, field, request)?, empty))
     })?
     .map_err(remesh_error)?;
+    let (out, empty) = out;
+    // As `gwn remesh` prints it: an empty output is right where `w > 1/2` is empty, but rarely
+    // what was meant.
+    if let Some(why) = empty {
+        let way_out = match why {
+            WhyEmpty::WindsInward => "method='parity' remeshes the solid it encloses",
+            WhyEmpty::NoVolume => "thicken=EPS closes open sheets into thin solids; a finer res",
+        };
+        PyErr::warn(
+            py,
+            &py.get_type::<pyo3::exceptions::PyUserWarning>(),
+            &std::ffi::CString::new(format!(
+                "remesh: the output is empty: w > 1/2 at no point of the lattice; {why}: {way_out}"
+            ))
+            .expect("no NUL in the message"),
+            1,
+        )?;
+    }
     surface_tuple(py, out)
 }
 

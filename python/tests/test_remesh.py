@@ -2,6 +2,7 @@
 
 import json
 import subprocess
+import warnings
 
 import numpy as np
 import pytest
@@ -80,6 +81,23 @@ def test_bad_arguments_are_value_errors():
         gwn.remesh(CUBE_V, CUBE_F, res=8, report=True, samples=10**11)
     # Without a report, samples= measures nothing and is not looked at.
     assert len(gwn.remesh(CUBE_V, CUBE_F, res=8, samples=10**11)) == 2
+
+
+def test_an_empty_output_comes_with_a_warning_that_says_why():
+    # Inward: w = -1 inside, {w > 1/2} is empty, and so is the output; parity is the way out.
+    inward = np.ascontiguousarray(CUBE_F[:, ::-1])
+    with pytest.warns(UserWarning, match="winds inward.*method='parity'"):
+        V, F = gwn.remesh(CUBE_V, inward, res=16)
+    assert len(F) == 0
+    assert len(gwn.remesh(CUBE_V, inward, res=16, method="parity")[1]) > 0
+    # An open sheet: no volume; thicken= is the way out.
+    square = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], dtype=np.float64)
+    with pytest.warns(UserWarning, match="without volume.*thicken=EPS"):
+        gwn.remesh(square, np.array([[0, 1, 2], [0, 2, 3]]), res=16)
+    # A solid: no warning.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert len(gwn.remesh(CUBE_V, CUBE_F, res=16)[1]) > 0
 
 
 def test_thicken_turns_an_open_square_into_a_slab():
@@ -267,7 +285,8 @@ def test_a_clean_solid_comes_back_as_it_is():
                                   always_remesh=True)
     assert len(Fr) > len(F) and "input" not in remeshed
     # Inward: w = -1 inside, so not its solid's boundary (the solid is empty).
-    Vi, Fi, inward = gwn.remesh(CUBE_V, CUBE_F[:, ::-1], res=16, report=True, samples=0)
+    with pytest.warns(UserWarning, match="winds inward"):
+        Vi, Fi, inward = gwn.remesh(CUBE_V, CUBE_F[:, ::-1], res=16, report=True, samples=0)
     assert inward["input"] == "remeshed" and len(Fi) == 0
     assert "w = 0 outside it and -1 inside" in inward["input_not_kept"]
 

@@ -251,6 +251,45 @@ impl InputCheck {
     }
 }
 
+/// Why a remesh of a mesh with faces came out empty, for a user told so (`gwn remesh`,
+/// `gwn.remesh`, each naming its own option for the way out): an empty output is right where
+/// `{w > ½}` is empty, but rarely what was meant.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WhyEmpty {
+    /// The input winds inward (`w = -1` inside it): the parity method remeshes the solid it
+    /// encloses.
+    WindsInward,
+    /// A surface without volume (open sheets: thickening closes them into thin solids), or
+    /// parts thinner than a cell (a finer resolution).
+    NoVolume,
+}
+
+impl WhyEmpty {
+    /// The reason, from the run's [`RemeshStats::input`](super::RemeshStats::input).
+    pub fn of(input: Option<InputCheck>) -> WhyEmpty {
+        match input {
+            Some(InputCheck::Remeshed(NotKept::Winding {
+                outside: 0,
+                orientation: -1,
+            })) => WhyEmpty::WindsInward,
+            _ => WhyEmpty::NoVolume,
+        }
+    }
+}
+
+impl std::fmt::Display for WhyEmpty {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            WhyEmpty::WindsInward => {
+                "the input winds inward (w = -1 inside it, faces turned the wrong way)"
+            }
+            WhyEmpty::NoVolume => {
+                "a surface without volume (an open sheet), or parts thinner than a cell"
+            }
+        })
+    }
+}
+
 /// The input itself as the remesh of `mesh` (triangles whose `w > ½` solid is meant, with
 /// `bounds` and `options` as the remesh would take them), when it provably already is that
 /// surface (see the [module documentation](self)); else why not. `options.simplify` sets the
