@@ -66,6 +66,7 @@ use crate::base::bounding_box::BoundingBox;
 use crate::eval::antipodal::WindingNumber;
 use crate::kernel::predicates::closed_surface_orientation;
 use crate::kernel::quantize::common_fixed_point;
+use crate::mesh::signed_boundary::signed_boundary;
 
 use super::coplanar_overlaps;
 use super::cut_intersections::cut_intersections;
@@ -544,7 +545,9 @@ fn kept_or_cut(
         // every edge is used as often each way, `w` is an integer off the surface and jumps
         // by one across every face, and the cut's labels pick the faces with `w = 0` in front
         // (the shared edges separate its patches), with its proof on what they make.
-        Err(problem @ NotKept::NotManifold { .. }) if topology.closed && balanced(triangles) => {
+        Err(problem @ NotKept::NotManifold { .. })
+            if topology.closed && signed_boundary(triangles.iter().copied()).is_empty() =>
+        {
             let cut = cut_intersections(positions, fixed, triangles, largest_move)
                 .map_err(|_| in_topology(problem))?;
             return Ok(KeptSurface {
@@ -599,23 +602,6 @@ fn kept_or_cut(
         }
         Err(e) => Err(given(e)),
     }
-}
-
-/// Whether every edge of `triangles` is used as many times in one direction as in the other:
-/// the signed boundary is empty, so `w` is an integer off the surface.
-fn balanced(triangles: &[[u32; 3]]) -> bool {
-    let mut uses: Vec<(u32, u32, i32)> = triangles
-        .iter()
-        .flat_map(|t| {
-            (0..3).map(move |k| {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                (a.min(b), a.max(b), if a < b { 1 } else { -1 })
-            })
-        })
-        .collect();
-    uses.par_sort_unstable();
-    uses.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1))
-        .all(|group| group.iter().map(|u| u.2).sum::<i32>() == 0)
 }
 
 /// Steps 2 and 3 of the module documentation on a surface that passed step 1 (with no
