@@ -193,7 +193,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     )
     .map_err(|e| CliError::msg(format!("--samples: {e}")))?;
     report.seconds = secs;
-    let kept = out.stats.input.is_some_and(|i| i.is_input_surface());
+    let kept = out.stats.input.is_some_and(|i| i.skipped_the_lattice());
     report.phase_seconds = (!kept).then_some(phase_seconds);
     report.thicken = thickened.as_ref().map(|t| t.eps());
     drop(curved_surface);
@@ -257,6 +257,20 @@ pub fn run(args: Args) -> Result<(), CliError> {
         )?,
         Some(InputCheck::Remeshed(why)) => {
             outln!("remeshed: the input is not kept as it is: {why}")?
+        }
+        Some(InputCheck::BoundsNothing { repairs, why }) => {
+            let repairs = if repairs.is_empty() {
+                String::new()
+            } else {
+                format!(" ({repairs})")
+            };
+            outln!(
+                "{}: no lattice needed ({secs:.2} s): the input{repairs} is closed, manifold, \
+                 oriented and without self-intersection (exact), and w <= 0 on both sides of \
+                 each of its components ({why}), so w > 1/2 nowhere",
+                args.out.display()
+            )?;
+            outln!("{topology}")?;
         }
         None => {}
     }
@@ -432,7 +446,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 "--thicken EPS closes open sheets into thin solids; a finer --res"
             }
         };
-        outln!("the output is empty: w > 1/2 at no point of the lattice; {why}: {way_out}")?;
+        let nowhere = if kept {
+            "w > 1/2 nowhere"
+        } else {
+            "w > 1/2 at no point of the lattice"
+        };
+        outln!("the output is empty: {nowhere}; {why}: {way_out}")?;
     }
     if let Some(path) = &args.report {
         std::fs::write(path, report.to_json() + "\n")

@@ -523,7 +523,8 @@ pub fn filter_tets<'py>(
 /// ``input_not_kept`` why); one that only self-intersects comes back cut along its
 /// intersections, the pieces inside its solid left out (``cut``: the union of overlapping
 /// shells, proved the same way); solids touching at a vertex or along an edge come back pulled
-/// apart there by at most a 64th of a cell (``input_separated_vertices``,
+/// apart there by at most a 64th of a cell, twice that where a vertex is split again at an edge
+/// pinched flat (``input_separated_vertices``,
 /// ``input_largest_move``); faces overlapping in one plane (a part standing on a plate) are
 /// replaced by what they add up to there (``input_coplanar_faces``,
 /// ``input_crossing_vertices``); otherwise its clean components can come back as they are with

@@ -284,10 +284,12 @@ def test_a_clean_solid_comes_back_as_it_is():
     Vr, Fr, remeshed = gwn.remesh(CUBE_V, CUBE_F, res=16, report=True, samples=0,
                                   always_remesh=True)
     assert len(Fr) > len(F) and "input" not in remeshed
-    # Inward: w = -1 inside, so not its solid's boundary (the solid is empty).
+    # Inward: w = -1 inside, so not its solid's boundary: the solid is empty, proved without
+    # a lattice (no point classified).
     with pytest.warns(UserWarning, match="winds inward"):
         Vi, Fi, inward = gwn.remesh(CUBE_V, CUBE_F[:, ::-1], res=16, report=True, samples=0)
-    assert inward["input"] == "remeshed" and len(Fi) == 0
+    assert inward["input"] == "bounds nothing" and len(Fi) == 0
+    assert inward["classified_points"] == 0
     assert "w = 0 outside it and -1 inside" in inward["input_not_kept"]
 
 

@@ -352,6 +352,11 @@ fn remesh_of_an_inward_input_is_empty_and_says_why() {
         exact.contains("the output is empty") && exact.contains("winds inward"),
         "{exact}"
     );
+    // Proved (closed, embedded, w <= 0 on both sides): no lattice.
+    assert!(
+        exact.contains("no lattice needed") && !exact.contains("points classified"),
+        "{exact}"
+    );
     let parity = run("parity");
     assert!(parity.contains("closed: yes"), "{parity}");
     assert!(!parity.contains("0 faces, 0 vertices"), "{parity}");
@@ -459,14 +464,16 @@ fn remesh_cuts_closed_inputs_along_their_self_intersections() {
 /// Solids touching at a vertex or along an edge are pulled apart and kept (the shared corpus:
 /// `cgal-kingroon_kp3.stl`, a bed whose parts share 18 edges; `cgal-cow.off`, a leg touching
 /// the body at one vertex and self-intersecting elsewhere, pulled apart then cut; `cgal-man.off`,
-/// whose cut leaves four pinched vertices, cut then pulled apart). Every sample agrees with the
-/// input's solid.
+/// whose cut leaves four pinched vertices, cut then pulled apart; `npm-dragon_vrip_res4.ply`, a
+/// scan whose faces are written up to five times, whose pinches need the pull into the wedges
+/// and one edge pinched flat split at its midpoint). Every sample agrees with the input's solid.
 #[test]
 fn remesh_pulls_apart_solids_that_touch() {
-    for (name, input_kind, components, edges, vertices) in [
-        ("cura-kingroon_kp3.stl", "kept", 2, 18.0, 18.0),
-        ("cgal-cow.off", "cut", 1, 0.0, 1.0),
-        ("cgal-man.off", "cut", 2, 0.0, 4.0),
+    for (name, input_kind, components, edges, vertices, midpoints) in [
+        ("cura-kingroon_kp3.stl", "kept", 2, 18.0, 18.0, None),
+        ("cgal-cow.off", "cut", 1, 0.0, 1.0, None),
+        ("cgal-man.off", "cut", 2, 0.0, 4.0, None),
+        ("npm-dragon_vrip_res4.ply", "cut", 7, 29.0, 35.0, Some(1.0)),
     ] {
         let Some(input) = crate::common::shared_file(&format!("meshes/{name}")) else {
             return;
@@ -481,6 +488,11 @@ fn remesh_pulls_apart_solids_that_touch() {
         assert_eq!(
             report_number(&json, "input_separated_vertices"),
             vertices,
+            "{json}"
+        );
+        assert_eq!(
+            report_number(&json, "input_separated_midpoints"),
+            midpoints.unwrap_or(0.0),
             "{json}"
         );
         assert_eq!(report_number(&json, "occupancy_agreement"), 1.0, "{json}");

@@ -288,13 +288,16 @@ fn every_way_of_not_bounding_the_solid_is_remeshed() {
         kept(&flipped, 64),
         Err(NotKept::Misoriented { .. })
     ));
-    // Inward: w = -1 inside.
+    // Inward: w = -1 inside, so w > 1/2 nowhere (`inward_shells_bound_nothing`).
     assert_eq!(
-        kept(&ball.flipped(), 64).err(),
-        Some(NotKept::Winding {
-            outside: 0,
-            orientation: -1
-        })
+        kept(&ball.flipped(), 64).map(|out| out.stats.input),
+        Ok(Some(InputCheck::BoundsNothing {
+            repairs: Default::default(),
+            why: NotKept::Winding {
+                outside: 0,
+                orientation: -1
+            }
+        }))
     );
     // Nested with one orientation: w = 2 in the inner ball.
     let nested = join(&[ball.clone(), sphere([0.0; 3], 0.5, 12, false)]);
@@ -305,7 +308,7 @@ fn every_way_of_not_bounding_the_solid_is_remeshed() {
             orientation: 1
         })
     );
-    // A cavity's wall outside any solid.
+    // A cavity's wall outside any solid (beside a solid: w = 1 there, remeshed).
     let cavity = join(&[cube.clone(), sphere([5.0; 3], 0.5, 8, true)]);
     assert!(matches!(
         kept(&cavity, 64),
@@ -385,6 +388,75 @@ fn every_way_of_not_bounding_the_solid_is_remeshed() {
 
 /// Coordinates that need more than 60 bits in one scale take the wide exact predicates: a gap
 /// of `2^-70` between two solids keeps them apart, no gap makes them touch.
+/// Inward shells, alone, nested or around an outward solid: `w <= 0` on both sides of every
+/// component, so `{w > 1/2}` is empty, proved without a lattice; the lattice remesh of the same
+/// input (nothing kept) is empty too. Beside an outward solid, an inward shell is remeshed.
+#[test]
+fn inward_shells_bound_nothing() {
+    use gwn::products::remesh::remesh_mesh;
+    let outer = |inward| cuboid([-3.0; 3], [3.0; 3], inward);
+    let inner = |inward| cuboid([-1.0; 3], [1.0; 3], inward);
+    let remeshed = |mesh: &Mesh, keep: bool| {
+        let wn = WindingNumber::new(mesh).unwrap();
+        let options = RemeshOptions::with_resolution(16);
+        remesh_mesh(
+            mesh,
+            keep,
+            &wn,
+            None,
+            mesh.bounding_box().unwrap(),
+            &options,
+            &|_| {},
+        )
+        .unwrap()
+    };
+    // Each with a point and `w` there.
+    for (mesh, at, w) in [
+        (sphere([0.0; 3], 1.0, 12, true), [0.0; 3], -1.0),
+        (torus(1.0, 0.3, 12).flipped(), [1.0, 0.0, 0.0], -1.0),
+        (join(&[outer(true), inner(true)]), [0.0; 3], -2.0),
+        // `(o, s)` of the inner box is (-1, 1): w = 0 in it.
+        (join(&[outer(true), inner(false)]), [2.0, 0.0, 0.0], -1.0),
+        (join(&[outer(true), inner(false)]), [0.0; 3], 0.0),
+        (
+            join(&[inner(true), inner(true).translated([5.0, 0.0, 0.0])]),
+            [5.0, 0.0, 0.0],
+            -1.0,
+        ),
+    ] {
+        assert_eq!(WindingNumber::new(&mesh).unwrap().eval(at), w);
+        let out = kept(&mesh, 16).unwrap_or_else(|e| panic!("{e}"));
+        assert!(out.triangles.is_empty() && out.positions.is_empty());
+        assert!(
+            matches!(
+                out.stats.input,
+                Some(InputCheck::BoundsNothing {
+                    why: NotKept::Winding { .. },
+                    ..
+                })
+            ),
+            "{:?}",
+            out.stats.input
+        );
+        let proved = remeshed(&mesh, true);
+        assert!(proved.triangles.is_empty());
+        assert_eq!(proved.stats.classified_points, 0);
+        let lattice = remeshed(&mesh, false);
+        assert!(
+            lattice.triangles.is_empty(),
+            "{} faces",
+            lattice.triangles.len()
+        );
+        assert!(lattice.stats.classified_points > 0);
+    }
+    // Beside an outward solid, w = 1 in it: remeshed, and the solid is there.
+    let beside = join(&[inner(false), inner(true).translated([5.0, 0.0, 0.0])]);
+    assert!(matches!(kept(&beside, 16), Err(NotKept::Winding { .. })));
+    let out = remeshed(&beside, true);
+    assert!(matches!(out.stats.input, Some(InputCheck::Remeshed(_))));
+    assert!(!out.triangles.is_empty());
+}
+
 #[test]
 fn the_tests_are_exact_beyond_sixty_bits() {
     let cube = common::unit_cube();
@@ -560,15 +632,22 @@ proptest! {
             Some(InputCheck::Kept { repairs, .. } | InputCheck::Cut { repairs, .. })
                 if !repairs.coplanar.is_empty()
         ));
+        // Only inward boxes, alone or nested: proved to bound nothing, an empty output, held to
+        // the cut's test below (the input's `w` is never above 1/2).
+        let nothing = got.as_ref().is_ok_and(|o| matches!(
+            o.stats.input,
+            Some(InputCheck::BoundsNothing { .. })
+        ));
         if expected {
-            prop_assert!(got.is_ok() && !cut, "{:?}", got.as_ref().err());
+            prop_assert!(got.is_ok() && !cut && !nothing, "{:?}", got.as_ref().err());
         } else {
-            prop_assert!(got.is_err() || cut || separated || merged);
+            prop_assert!(got.is_err() || cut || separated || merged || nothing);
         }
         if let Ok(out) = got {
             let wn = WindingNumber::new(&mesh).unwrap();
-            let output = Mesh::new(out.positions, out.triangles).unwrap();
-            let wo = WindingNumber::new(&output).unwrap();
+            prop_assert_eq!(out.triangles.is_empty(), nothing);
+            let output = Mesh::new(out.positions, out.triangles);
+            let wo = output.as_ref().ok().and_then(|o| WindingNumber::new(o).ok());
             for x in 0..15u8 {
                 for y in 0..15u8 {
                     for z in 0..15u8 {
@@ -577,12 +656,12 @@ proptest! {
                         // The output is closed: its `w` is the crossing count alone, exact.
                         // The input's may have a boundary (an open junction) whose sum cancels
                         // only to rounding.
-                        let w = wo.eval(q);
+                        let w = if nothing { 0.0 } else { wo.as_ref().unwrap().eval(q) };
                         prop_assert!(w == 0.0 || w == 1.0, "w = {} at {:?}", w, q);
                         // A cut input has the same solid, not the same `w` (2 where two
                         // boxes overlap).
                         let wi = wn.eval(q);
-                        if cut {
+                        if cut || nothing {
                             prop_assert_eq!(wi > 0.5, w > 0.5, "the input's w {} at {:?}", wi, q);
                         } else {
                             prop_assert!((wi - w).abs() < 1e-12, "the input's w at {:?}", q);
@@ -829,6 +908,19 @@ proptest! {
         let mesh = join(&parts);
         let out = remesh_default(&mesh, 16);
         assert_valid(&out);
+        // The full remesh of the same input, without keeping anything.
+        let full_remesh = |mesh: &Mesh| {
+            let wn = WindingNumber::new(mesh).unwrap();
+            let guide = SegmentBvh::of_field_mesh(mesh);
+            let options = RemeshOptions::with_resolution(16);
+            let bounds = mesh.bounding_box().unwrap();
+            remesh_mesh(mesh, false, &wn, Some(&guide), bounds, &options, &|_| {}).unwrap()
+        };
+        // Proved empty without a lattice: so is the lattice's.
+        if matches!(out.stats.input, Some(InputCheck::BoundsNothing { .. })) {
+            prop_assert!(full_remesh(&mesh).triangles.is_empty());
+            return Ok(());
+        }
         let Some(InputCheck::PartlyKept { kept_faces, .. }) = out.stats.input else {
             return Ok(());
         };
@@ -845,12 +937,7 @@ proptest! {
             .map(|t| key(&out.positions, t))
             .collect();
         prop_assert!(kept.is_subset(&input));
-        // The full remesh of the same input, without keeping anything.
-        let wn = WindingNumber::new(&mesh).unwrap();
-        let guide = SegmentBvh::of_field_mesh(&mesh);
-        let options = RemeshOptions::with_resolution(16);
-        let bounds = mesh.bounding_box().unwrap();
-        let full = remesh_mesh(&mesh, false, &wn, Some(&guide), bounds, &options, &|_| {}).unwrap();
+        let full = full_remesh(&mesh);
         let full = WindingNumber::new(&Mesh::new(full.positions, full.triangles).unwrap()).unwrap();
         for (b, part) in boxes.iter().zip(&parts) {
             let whole = part.triangles().iter().all(|t| kept.contains(&key(part.positions(), t)));

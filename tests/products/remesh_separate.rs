@@ -1,6 +1,7 @@
 //! `products::remesh::separate_pinches`: solids that touch at a vertex or along an edge are
 //! pulled apart by a fraction of a cell and kept, proved like any kept input, instead of being
-//! remeshed; cavities touching along an edge are not (their fans do not separate them).
+//! remeshed; where an edge's wedges are one fan at each end (cavities touching along it), it is
+//! split at its midpoint and pulled apart there.
 
 use std::collections::HashSet;
 
@@ -25,7 +26,8 @@ fn kept(mesh: &Mesh) -> Result<Remeshed, NotKept> {
 
 /// The input kept with its pinches pulled apart, checked: a valid surface with the input's
 /// solid at random points, every vertex either an input position bit for bit or one of the
-/// moved ones, each within the largest move of an input vertex, and that move within its cap.
+/// moved ones, each within the largest move of an input vertex (or of an edge's midpoint, for
+/// edges pinched flat), and that move within its cap.
 fn separated(mesh: &Mesh) -> (Remeshed, SeparatedCounts) {
     let out = kept(mesh).unwrap_or_else(|e| panic!("not kept: {e}"));
     let Some(InputCheck::Kept { separated, .. }) = out.stats.input else {
@@ -44,9 +46,18 @@ fn separated(mesh: &Mesh) -> (Remeshed, SeparatedCounts) {
         .filter(|p| !input.contains(&bits(p)))
         .collect();
     assert_eq!(moved.len(), separated.vertices + separated.added_vertices);
+    let midpoints = mesh.triangles().iter().flat_map(|t| {
+        (0..3).map(|k| {
+            let (a, b) = (
+                mesh.positions()[t[k] as usize],
+                mesh.positions()[t[(k + 1) % 3] as usize],
+            );
+            std::array::from_fn::<f64, 3, _>(|c| 0.5 * (a[c] + b[c]))
+        })
+    });
+    let origins: Vec<[f64; 3]> = mesh.positions().iter().copied().chain(midpoints).collect();
     for p in moved {
-        let nearest = mesh
-            .positions()
+        let nearest = origins
             .iter()
             .map(|q| (0..3).map(|k| (p[k] - q[k]).powi(2)).sum::<f64>().sqrt())
             .fold(f64::INFINITY, f64::min);
@@ -56,6 +67,7 @@ fn separated(mesh: &Mesh) -> (Remeshed, SeparatedCounts) {
 }
 
 fn counts(s: SeparatedCounts) -> [usize; 3] {
+    assert_eq!(s.midpoints, 0, "{s:?}");
     [s.edges, s.vertices, s.added_vertices]
 }
 
@@ -126,7 +138,7 @@ fn a_block_touching_part_of_an_edge_is_split_there_then_pulled_apart() {
 }
 
 #[test]
-fn cavities_touching_at_a_corner_are_pulled_apart_but_not_along_an_edge() {
+fn cavities_touching_at_a_corner_or_along_an_edge_are_pulled_apart() {
     let solid = cuboid([-3.0; 3], [3.0; 3], false);
     let corner = join(&[
         solid.clone(),
@@ -135,18 +147,26 @@ fn cavities_touching_at_a_corner_are_pulled_apart_but_not_along_an_edge() {
     ]);
     assert_eq!(counts(separated(&corner).1), [0, 1, 1]);
     // Along an edge, the solid wedges on both sides join the two cavities' faces into one fan
-    // at each end: the edge keeps its four faces, and the lattice remeshes it.
-    let edge = join(&[
-        solid,
-        cuboid([-1.0, -1.0, 0.0], [0.0, 0.0, 1.0], true),
-        cuboid([0.0; 3], [1.0; 3], true),
-    ]);
-    let got = kept(&edge);
-    assert!(
-        matches!(got, Err(NotKept::NotManifold { .. })),
-        "{:?}",
-        got.map(|o| o.stats.input)
-    );
+    // at each end: no vertex to split, so the edge is split at its midpoint, which has one fan
+    // per wedge, and pulled apart there (the cavities become one, through a gap along the edge).
+    for (lo, hi) in [(0.0, 1.0), (-2.0, 2.0)] {
+        let edge = join(&[
+            solid.clone(),
+            cuboid([-1.0, -1.0, lo], [0.0, 0.0, hi], true),
+            cuboid([0.0, 0.0, lo], [1.0, 1.0, hi], true),
+        ]);
+        let (out, s) = separated(&edge);
+        assert_eq!(
+            [s.edges, s.midpoints, s.vertices, s.added_vertices],
+            [1, 1, 1, 1]
+        );
+        // The midpoint and its copy, each in its wedge: `x > 0 > y` or `x < 0 < y`.
+        let middle = (lo + hi) / 2.0;
+        let split: Vec<&[f64; 3]> = out.positions.iter().filter(|p| p[2] == middle).collect();
+        assert_eq!(split.len(), 2, "{split:?}");
+        assert!(split.iter().all(|p| p[0] * p[1] < 0.0), "{split:?}");
+        assert!(split[0][0] * split[1][0] < 0.0, "{split:?}");
+    }
 }
 
 #[test]

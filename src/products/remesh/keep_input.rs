@@ -28,7 +28,11 @@
 //!    wall) or `(1, −1)` (a cavity's wall). `o` is the exact evaluator's value at `C`'s
 //!    lexicographically largest vertex `v`: the evaluator answers at `v + (ε1, ε2, ε3)` (docs/
 //!    robustness.md, section 4), a point lexicographically above all of `C`, hence outside its
-//!    convex hull, and infinitely close to `v`, which no other component touches.
+//!    convex hull, and infinitely close to `v`, which no other component touches. Where some
+//!    component is wrong but every one has `o ≤ 0` and `o + s ≤ 0` (wound inward), `{w > ½}`
+//!    is empty: `w` is constant along each side of a component (the collar there is connected
+//!    and meets no other), so those values and `0` far away are all it takes. The output is
+//!    then empty, proved ([`InputCheck::BoundsNothing`]), with no lattice.
 //! 4. **Size**: the input has at most the face count the remesh would aim for, the simplifier's
 //!    fraction of a dense marching cubes' count at this resolution, estimated from the input's
 //!    area: marching cubes puts a vertex on every lattice edge the surface crosses (the faces'
@@ -45,9 +49,10 @@
 //!
 //! Three ways on when a step fails, each proved by the same steps on its result:
 //! - where solids touch at a vertex or along an edge (step 1 fails for several fans or
-//!   four-face edges), [`super::separate_pinches`] pulls them apart by at most a 64th of a cell,
-//!   after [`exact_repair::split_at_contacts`] has made a vertex lying inside another solid's
-//!   edge a vertex of both;
+//!   four-face edges), [`super::separate_pinches`] pulls them apart by at most a 64th of a cell
+//!   (in a second pass at the midpoints of edges pinched flat), after
+//!   [`exact_repair::split_at_contacts`] has made a vertex lying inside another solid's edge a
+//!   vertex of both;
 //! - where closed shells pass through each other (step 2), [`super::cut_intersections`] cuts
 //!   them along their intersections and keeps their union;
 //! - where that still fails for a self-intersection or a pinch, faces overlapping in one plane
@@ -75,7 +80,7 @@ use super::intersect::{self, IntersectError, self_intersections_wide};
 use super::lattice::Lattice;
 use super::report::TopologyReport;
 use super::separate_pinches::{
-    LARGEST_MOVE_IN_CELLS, Separated, SeparatedCounts, separate_pinches,
+    LARGEST_MOVE_IN_CELLS, Separated, SeparatedCounts, separate_pinches, split_at_midpoints,
 };
 use super::{RemeshOptions, RemeshStats, Remeshed};
 
@@ -237,6 +242,16 @@ pub enum InputCheck {
     },
     /// The input was remeshed, for this reason.
     Remeshed(NotKept),
+    /// `{w > ½}` is empty, proved on the input (after the repairs, pinches pulled apart): a
+    /// closed, manifold, oriented surface without self-intersections whose every component has
+    /// `w ≤ 0` on both of its sides (wound inward), so `w ≤ 0` everywhere. The output is empty,
+    /// without a lattice; `why` is the first component that does not bound `{w > ½}`.
+    BoundsNothing {
+        /// What the repairs changed.
+        repairs: exact_repair::RepairCounts,
+        /// The first component's verdict of step 3 ([`NotKept::Winding`]).
+        why: NotKept,
+    },
 }
 
 impl InputCheck {
@@ -249,6 +264,12 @@ impl InputCheck {
     /// self-intersections, without a lattice.
     pub fn is_input_surface(&self) -> bool {
         matches!(self, InputCheck::Kept { .. } | InputCheck::Cut { .. })
+    }
+
+    /// Whether the output was decided without a lattice: the input's own surface, or nothing
+    /// ([`InputCheck::BoundsNothing`]).
+    pub fn skipped_the_lattice(&self) -> bool {
+        self.is_input_surface() || matches!(self, InputCheck::BoundsNothing { .. })
     }
 }
 
@@ -269,10 +290,13 @@ impl WhyEmpty {
     /// The reason, from the run's [`RemeshStats::input`](super::RemeshStats::input).
     pub fn of(input: Option<InputCheck>) -> WhyEmpty {
         match input {
-            Some(InputCheck::Remeshed(NotKept::Winding {
-                outside: 0,
-                orientation: -1,
-            })) => WhyEmpty::WindsInward,
+            Some(
+                InputCheck::BoundsNothing { .. }
+                | InputCheck::Remeshed(NotKept::Winding {
+                    outside: 0,
+                    orientation: -1,
+                }),
+            ) => WhyEmpty::WindsInward,
             _ => WhyEmpty::NoVolume,
         }
     }
@@ -299,7 +323,7 @@ impl std::fmt::Display for WhyEmpty {
 ///
 /// ```
 /// use gwn::Mesh;
-/// use gwn::products::remesh::{RemeshOptions, keep_input::{NotKept, keep_input}};
+/// use gwn::products::remesh::{RemeshOptions, keep_input::{InputCheck, NotKept, keep_input}};
 /// // A unit cube, outward.
 /// let p = [[0.,0.,0.],[1.,0.,0.],[1.,1.,0.],[0.,1.,0.],[0.,0.,1.],[1.,0.,1.],[1.,1.,1.],[0.,1.,1.]];
 /// let t = [[0,2,1],[0,3,2],[0,1,5],[0,5,4],[1,2,6],[1,6,5],[2,3,7],[2,7,6],[3,0,4],[3,4,7],[4,5,6],[4,6,7]];
@@ -308,12 +332,14 @@ impl std::fmt::Display for WhyEmpty {
 /// let bounds = cube.bounding_box().unwrap();
 /// let kept = keep_input(&cube, bounds, &options).unwrap();
 /// assert_eq!(kept.triangles, t);
-/// // Inward, it bounds no solid (w = -1 inside).
+/// // Inward, it bounds no solid (w = -1 inside): the output is empty, proved.
 /// let flipped: Vec<[u32; 3]> = t.iter().map(|&[a, b, c]| [a, c, b]).collect();
 /// let inward = Mesh::from_slices(&p, &flipped)?;
+/// let empty = keep_input(&inward, bounds, &options).unwrap();
+/// assert!(empty.triangles.is_empty());
 /// assert!(matches!(
-///     keep_input(&inward, bounds, &options),
-///     Err(NotKept::Winding { outside: 0, orientation: -1 })
+///     empty.stats.input,
+///     Some(InputCheck::BoundsNothing { why: NotKept::Winding { outside: 0, orientation: -1 }, .. })
 /// ));
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
@@ -459,12 +485,13 @@ pub fn keep_input(
         Err(e) => return Err(told(e)),
     };
     repairs.split_faces += split_faces;
-    let input = match surface.cut {
-        None => InputCheck::Kept {
+    let input = match (surface.cut, surface.bounds_nothing) {
+        (_, Some(why)) => InputCheck::BoundsNothing { repairs, why },
+        (None, None) => InputCheck::Kept {
             repairs,
             separated: surface.separated,
         },
-        Some((cut, uncut_faces)) => InputCheck::Cut {
+        (Some((cut, uncut_faces)), None) => InputCheck::Cut {
             repairs,
             separated: surface.separated,
             cut,
@@ -494,6 +521,8 @@ struct KeptSurface {
     separated: SeparatedCounts,
     /// The cut's counts and its uncut faces, when the input was cut.
     cut: Option<(super::cut_intersections::CutCounts, usize)>,
+    /// Step 3's verdict, when the surface provably bounds nothing (then it has no faces).
+    bounds_nothing: Option<NotKept>,
 }
 
 /// Why [`kept_or_cut`] refused a surface.
@@ -555,6 +584,7 @@ fn kept_or_cut(
                 triangles: cut.triangles,
                 separated: cut.separated,
                 cut: Some((cut.counts, cut.uncut_faces)),
+                bounds_nothing: None,
             });
         }
         Err(problem) => return Err(in_topology(problem)),
@@ -583,7 +613,18 @@ fn kept_or_cut(
             triangles,
             separated,
             cut: None,
+            bounds_nothing: None,
         }),
+        // Wound inward: the lattice would find `w > ½` nowhere, and need not look.
+        Err(why @ NotKept::Winding { .. }) if bounds_nothing(&positions, &fixed, &triangles) => {
+            Ok(KeptSurface {
+                positions: Vec::new(),
+                triangles: Vec::new(),
+                separated,
+                cut: None,
+                bounds_nothing: Some(why),
+            })
+        }
         // Overlapping shells: their union, cut out of them, when that is provably the answer.
         Err(NotKept::SelfIntersecting { pairs, .. }) => {
             let cut =
@@ -598,6 +639,7 @@ fn kept_or_cut(
                 triangles: cut.triangles,
                 separated: separated.and(cut.separated),
                 cut: Some((cut.counts, cut.uncut_faces)),
+                bounds_nothing: None,
             })
         }
         Err(e) => Err(given(e)),
@@ -642,25 +684,55 @@ pub(super) fn bounds_its_solid(
 
 /// Step 1's verdict on a surface with this `topology`, where a failure for its pinches only
 /// (solids touching at a vertex or along an edge) is mended by [`separate_pinches`]: nothing to
-/// do, the surface pulled apart (closed, manifold and oriented), or the first problem.
+/// do, the surface pulled apart (closed, manifold and oriented), or the first problem. Edges
+/// the pull leaves in four faces (their wedges one fan at each end) are split at their
+/// midpoints ([`split_at_midpoints`]) and pulled apart there by a second pass.
 pub(super) fn pulled_apart_if_pinched(
     positions: &[[f64; 3]],
     triangles: &[[u32; 3]],
     topology: &TopologyReport,
     largest_move: f64,
 ) -> Result<Option<Separated>, NotKept> {
-    match topology_problem(topology) {
-        None => Ok(None),
-        Some(problem @ NotKept::NotManifold { .. }) => {
-            separate_pinches(positions, triangles, largest_move)
-                .filter(|s| {
-                    topology_problem(&TopologyReport::of(&s.positions, &s.triangles)).is_none()
-                })
-                .map(Some)
-                .ok_or(problem)
-        }
-        Some(problem) => Err(problem),
+    let problem = match topology_problem(topology) {
+        None => return Ok(None),
+        Some(problem @ NotKept::NotManifold { .. }) => problem,
+        Some(problem) => return Err(problem),
+    };
+    let clean =
+        |s: &Separated| topology_problem(&TopologyReport::of(&s.positions, &s.triangles)).is_none();
+    let first = separate_pinches(positions, triangles, largest_move);
+    let (between, between_triangles) = match &first {
+        Some(s) if clean(s) => return Ok(first),
+        Some(s) => (&s.positions[..], &s.triangles[..]),
+        None => (positions, triangles),
+    };
+    // Edges still in four faces (pinched flat: one fan at each end, so no vertex to split),
+    // split at their midpoints and pulled apart there by a second pass.
+    let split = split_at_midpoints(between, between_triangles).ok_or(problem)?;
+    let (p, midpoints) = (&split.positions, split.counts.midpoints);
+    let second = separate_pinches(p, &split.triangles, largest_move)
+        .filter(clean)
+        .ok_or(problem)?;
+    let mut counts = second.counts;
+    counts.midpoints = midpoints;
+    if let Some(first) = &first {
+        // The first pass counted each split edge, the second its two halves.
+        counts.edges = first.counts.edges;
+        counts.vertices += first.counts.vertices;
+        counts.added_vertices += first.counts.added_vertices;
+        // Each vertex the second pass split kept its index for one of its fans, moved; where
+        // none of them had moved in the first pass (split, or a copy), no vertex moved twice.
+        let moved_first = |v: usize| v >= positions.len() || between[v] != positions[v];
+        let twice = (0..between.len()).any(|v| second.positions[v] != p[v] && moved_first(v));
+        counts.largest_move = if twice {
+            first.counts.largest_move + counts.largest_move
+        } else {
+            first.counts.largest_move.max(counts.largest_move)
+        };
+    } else {
+        counts.edges = midpoints;
     }
+    Ok(Some(Separated { counts, ..second }))
 }
 
 /// The candidate pairs the intersection tests may take: linear on evenly sized faces.
@@ -741,6 +813,24 @@ fn check_winding(surface: &Mesh, fixed: &[[i128; 3]]) -> Result<(), NotKept> {
         }
     }
     Ok(())
+}
+
+/// Whether `w ≤ 0` everywhere for a surface that passed steps 1 and 2 (closed, manifold,
+/// oriented, embedded), its vertices' exact coordinates `fixed`: off the surface `w` changes
+/// only across a component, and is constant along each side of one (its collar on that side is
+/// connected and meets no other component), so every value it takes is `0` (far away) or one
+/// of `o` and `o + s` for some component with `w = o` just outside it and orientation `s`.
+fn bounds_nothing(positions: &[[f64; 3]], fixed: &[[i128; 3]], triangles: &[[u32; 3]]) -> bool {
+    let Ok(surface) = Mesh::from_slices(positions, triangles) else {
+        return false;
+    };
+    let Ok(wn) = WindingNumber::new(&surface) else {
+        return false;
+    };
+    components(triangles).iter().all(|faces| {
+        let (outside, orientation) = component_winding(&wn, &surface, fixed, faces);
+        outside.max(outside + i64::from(orientation)) <= 0
+    })
 }
 
 /// The faces of each connected component (faces sharing a vertex are connected), each list in

@@ -345,6 +345,11 @@ impl RemeshReport {
                 members.push(("input", json_string("remeshed")));
                 members.push(("input_not_kept", json_string(&why.to_string())));
             }
+            Some(InputCheck::BoundsNothing { repairs, why }) => {
+                members.push(("input", json_string("bounds nothing")));
+                members.extend(input_changes(repairs, SeparatedCounts::default()));
+                members.push(("input_not_kept", json_string(&why.to_string())));
+            }
             None => {}
         }
         if let Some(phases) = &self.phase_seconds {
@@ -447,6 +452,7 @@ fn input_changes(repairs: RepairCounts, separated: SeparatedCounts) -> Vec<(&'st
             ("input_separated_edges", separated.edges.to_string()),
             ("input_separated_vertices", separated.vertices.to_string()),
             ("input_added_vertices", separated.added_vertices.to_string()),
+            ("input_separated_midpoints", separated.midpoints.to_string()),
             (
                 "input_largest_move",
                 format!("{:?}", separated.largest_move),
