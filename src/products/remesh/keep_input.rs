@@ -715,6 +715,8 @@ pub(super) fn pulled_apart_if_pinched(
         .ok_or(problem)?;
     let mut counts = second.counts;
     counts.midpoints = midpoints;
+    // A midpoint rounded to `f32` left its edge by that much before the pull moved it.
+    counts.largest_move += split.counts.largest_move;
     if let Some(first) = &first {
         // The first pass counted each split edge, the second its two halves.
         counts.edges = first.counts.edges;

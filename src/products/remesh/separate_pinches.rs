@@ -263,8 +263,9 @@ pub fn separate_pinches(
 /// along the edge, two cavities touching along it), the midpoint has a fan per wedge, and a
 /// second pass pulls them apart there. With single-precision coordinates the midpoints are
 /// rounded to `f32` (off the edge by at most half a unit in the last place: the proof that
-/// follows decides whether that is harmless). The counts say how many midpoints, nothing moved
-/// yet; `None` when there is no such edge or a midpoint would land on an end.
+/// follows decides whether that is harmless). The counts say how many midpoints, and how far
+/// the rounding took one from its edge (`largest_move`); `None` when there is no such edge or
+/// a midpoint would land on an end.
 pub fn split_at_midpoints(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Option<Separated> {
     let edge = |t: &[u32; 3], k: usize| {
         let (a, b) = (t[k], t[(k + 1) % 3]);
@@ -285,6 +286,7 @@ pub fn split_at_midpoints(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Opt
     }
     let single_precision = is_single_precision(positions);
     let mut out = positions.to_vec();
+    let mut rounding = 0.0f64;
     for &(a, b) in &crowded {
         let (pa, pb) = (positions[a as usize], positions[b as usize]);
         let middle: [f64; 3] = std::array::from_fn(|k| {
@@ -298,6 +300,8 @@ pub fn split_at_midpoints(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Opt
         if middle == pa || middle == pb {
             return None;
         }
+        let exact = (DVec3::from_array(pa) + DVec3::from_array(pb)) * 0.5;
+        rounding = rounding.max(exact.distance(DVec3::from_array(middle)));
         out.push(middle);
     }
     let first = positions.len() as u32;
@@ -323,6 +327,7 @@ pub fn split_at_midpoints(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Opt
         triangles: split,
         counts: SeparatedCounts {
             midpoints: crowded.len(),
+            largest_move: rounding,
             ..SeparatedCounts::default()
         },
     })
