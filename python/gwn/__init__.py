@@ -166,7 +166,9 @@ def remesh_dataset(paths, out_dir, res=128, *, root=None, format="ply", samples=
     ``output``, ``status`` in ``ok``/``done``/``failed``/``timeout``, ``error``, ``input`` (the
     kind: ``mesh``, ``point cloud``, ``patch set``, ``STEP model``), ``faces`` (triangles,
     patches or B-rep faces), ``vertices`` (mesh vertices or points), ``output_faces``,
-    ``kept``, ``kept_faces``, ``output_vertices``, ``valid`` (closed, manifold, oriented, no exact
+    ``kept``, ``outcome`` (``kept``, ``cut``, ``partly kept``, ``remeshed`` or ``bounds nothing``),
+    ``kept_faces``, ``empty`` (``None``, or why an empty output is empty: ``winds inward`` or
+    ``no volume``), ``output_vertices``, ``valid`` (closed, manifold, oriented, no exact
     self-intersection),
     ``components``, ``self_intersections``, ``hausdorff_cells``, ``occupancy_agreement``,
     ``seconds``, ``redone``), in input order. For a cluster, see ``gwn.dask.remesh_dataset``.

@@ -38,6 +38,8 @@ def test_remesh_dataset_rows_outputs_and_resume(tmp_path, cli):
     assert cube["self_intersections"] == 0
     assert cube["hausdorff_cells"] < 1 and cube["occupancy_agreement"] > 0.99
     assert scene["components"] == 2
+    # A clean cube is written as it is; nothing came out empty.
+    assert cube["outcome"] == "kept" and cube["empty"] is None
     assert "broken.off" in broken["error"] and broken["output_faces"] is None
     # The file is what gwn.remesh makes of the loaded mesh.
     V, F = gwn.load(tmp_path / "out" / "a" / "cube.off.ply")
@@ -56,7 +58,7 @@ def test_remesh_dataset_rows_outputs_and_resume(tmp_path, cli):
     for r in rows:
         c = by_output[r["output"]]
         for key in ("status", "faces", "output_faces", "valid", "hausdorff_cells",
-                    "occupancy_agreement"):
+                    "occupancy_agreement", "outcome", "empty"):
             assert c[key] == r[key], key
     # Again: nothing to do; another option: redone, and named.
     again = gwn.remesh_dataset(paths, tmp_path / "out", 24, **OPTS)

@@ -102,6 +102,10 @@ fn remesh_dataset_writes_what_gwn_remesh_writes_and_resumes() {
     assert_eq!(stat(1, "components"), "2");
     assert_eq!(stat(2, "output_faces"), "0");
     assert_eq!(stat(2, "valid"), "true");
+    // How each output was made, and why an empty one is empty (nothing kept: remeshed).
+    assert_eq!(stat(0, "outcome"), "\"remeshed\"");
+    assert_eq!(stat(0, "empty"), "null");
+    assert_eq!(stat(2, "empty"), "\"no volume\"");
     // A failure keeps nothing it did not learn, and says why in one line.
     assert_eq!(stat(3, "faces"), "null");
     let error = rows[3].error.as_deref().unwrap();
@@ -166,6 +170,21 @@ fn remesh_dataset_writes_what_gwn_remesh_writes_and_resumes() {
     assert_eq!(kept[0].stats.get("output_faces").unwrap().to_string(), "12");
     let kept_faces = |i: usize| kept[i].stats.get("kept_faces").unwrap().to_string();
     assert_eq!([kept_faces(0), kept_faces(2)], ["12", "0"]);
+    let outcome = |i: usize| kept[i].stats.get("outcome").unwrap().to_string();
+    assert_eq!([outcome(0), outcome(2)], ["\"kept\"", "\"remeshed\""]);
+    // An inward tetrahedron: proved to bound nothing, and the row says it winds inward.
+    let inward = dir.join("in/inward.obj");
+    std::fs::write(
+        &inward,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 4 2\nf 2 4 3\nf 1 3 4\n",
+    )
+    .unwrap();
+    let rows = run_dataset(&keeping, &[inward], &dir.join("inward"), None, |_| {}).unwrap();
+    let stat = |name: &str| rows[0].stats.get(name).unwrap().to_string();
+    assert_eq!(
+        [stat("outcome"), stat("empty"), stat("output_faces")],
+        ["\"bounds nothing\"", "\"winds inward\"", "0"]
+    );
     assert_eq!(
         std::fs::read(out.join("cube.off.ply")).unwrap(),
         remeshed_by_the_cli(&fixture("cube.off"), 24, dir, &[])

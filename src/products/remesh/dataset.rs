@@ -33,7 +33,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use super::crossings::SegmentBvh;
-use super::keep_input::InputCheck;
+use super::keep_input::{InputCheck, WhyEmpty};
 use super::report::{DistanceReference, RemeshReport};
 use super::thicken::{self, MeshField, ThickenedSheets};
 use super::write::{SurfaceFormat, write_surface};
@@ -120,8 +120,10 @@ impl MeshJob for RemeshJob {
         ("faces", "null"),
         ("vertices", "null"),
         ("kept", "null"),
+        ("outcome", "null"),
         ("kept_faces", "null"),
         ("output_faces", "null"),
+        ("empty", "null"),
         ("output_vertices", "null"),
         ("valid", "null"),
         ("components", "null"),
@@ -413,13 +415,19 @@ impl RemeshJob {
             _ => 0,
         };
         stats.set("kept_faces", kept_faces);
+        let or_null = |v: Option<String>| v.unwrap_or_else(|| "null".into());
+        // How the output was made (the remesh report's `input`; `remeshed` where nothing was
+        // tried), and why an empty one is empty.
+        let outcome = out.stats.input.map_or("remeshed", |i| i.name());
+        stats.set("outcome", json_string(outcome));
+        let empty = (t.faces == 0).then(|| json_string(WhyEmpty::of(out.stats.input).name()));
         stats.set("output_faces", t.faces);
+        stats.set("empty", or_null(empty));
         stats.set("output_vertices", t.vertices);
         let intersections = report.self_intersections.as_ref().ok().map(|r| r.pairs);
         let valid = t.closed && t.edge_manifold && t.vertex_manifold && t.oriented;
         stats.set("valid", valid && intersections == Some(0));
         stats.set("components", t.components);
-        let or_null = |v: Option<String>| v.unwrap_or_else(|| "null".into());
         stats.set(
             "self_intersections",
             or_null(intersections.map(|n| n.to_string())),

@@ -266,6 +266,18 @@ impl InputCheck {
         matches!(self, InputCheck::Kept { .. } | InputCheck::Cut { .. })
     }
 
+    /// Its name in reports and manifests: `kept`, `cut`, `partly kept`, `remeshed` or
+    /// `bounds nothing`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            InputCheck::Kept { .. } => "kept",
+            InputCheck::Cut { .. } => "cut",
+            InputCheck::PartlyKept { .. } => "partly kept",
+            InputCheck::Remeshed(_) => "remeshed",
+            InputCheck::BoundsNothing { .. } => "bounds nothing",
+        }
+    }
+
     /// Whether the output was decided without a lattice: the input's own surface, or nothing
     /// ([`InputCheck::BoundsNothing`]).
     pub fn skipped_the_lattice(&self) -> bool {
@@ -298,6 +310,16 @@ impl WhyEmpty {
                 }),
             ) => WhyEmpty::WindsInward,
             _ => WhyEmpty::NoVolume,
+        }
+    }
+}
+
+impl WhyEmpty {
+    /// Its short name in manifests: `winds inward` or `no volume`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            WhyEmpty::WindsInward => "winds inward",
+            WhyEmpty::NoVolume => "no volume",
         }
     }
 }

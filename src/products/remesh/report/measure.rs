@@ -305,9 +305,11 @@ impl RemeshReport {
             ("plate_thin_fraction", triple(s.plates.thin_fraction)),
             ("seconds", format!("{:.3}", self.seconds)),
         ];
+        if let Some(check) = s.input {
+            members.push(("input", json_string(check.name())));
+        }
         match s.input {
             Some(InputCheck::Kept { repairs, separated }) => {
-                members.push(("input", json_string("kept")));
                 members.extend(input_changes(repairs, separated));
             }
             Some(InputCheck::Cut {
@@ -316,7 +318,6 @@ impl RemeshReport {
                 cut,
                 uncut_faces,
             }) => {
-                members.push(("input", json_string("cut")));
                 members.extend(input_changes(repairs, separated));
                 members.extend([
                     (
@@ -335,18 +336,15 @@ impl RemeshReport {
                 kept_faces,
                 why,
             }) => members.extend([
-                ("input", json_string("partly kept")),
                 ("input_kept_components", kept_components.to_string()),
                 ("input_components", components.to_string()),
                 ("input_kept_faces", kept_faces.to_string()),
                 ("input_not_kept", json_string(&why.to_string())),
             ]),
             Some(InputCheck::Remeshed(why)) => {
-                members.push(("input", json_string("remeshed")));
                 members.push(("input_not_kept", json_string(&why.to_string())));
             }
             Some(InputCheck::BoundsNothing { repairs, why }) => {
-                members.push(("input", json_string("bounds nothing")));
                 members.extend(input_changes(repairs, SeparatedCounts::default()));
                 members.push(("input_not_kept", json_string(&why.to_string())));
             }
