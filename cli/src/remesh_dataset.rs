@@ -98,10 +98,28 @@ pub fn run(args: Args) -> Result<(), CliError> {
         })
         .count();
     let redone = rows.iter().filter(|r| r.redone.is_some()).count();
+    // Empty outputs are right where `w > 1/2` is empty, but a dataset's user wants them
+    // counted, by reason (the manifest's `empty` column says which).
+    let empty = |why: &str| {
+        let value = format!("\"{why}\"");
+        rows.iter()
+            .filter(|r| r.stats.get("empty") == Some(value.as_str()))
+            .count()
+    };
+    let (inward, no_volume) = (empty("winds inward"), empty("no volume"));
+    let empties = if inward + no_volume > 0 {
+        format!(
+            "; {} outputs empty ({inward} wound inward, {no_volume} without volume: the \
+             manifest's empty column)",
+            inward + no_volume
+        )
+    } else {
+        String::new()
+    };
     outln!(
         "remeshed {} inputs ({} done before, {redone} redone, {} failed, {} timed out) in \
-         {secs:.3} s; {valid} outputs valid (closed, manifold, oriented, no self-intersection); \
-         manifest: {}",
+         {secs:.3} s; {valid} outputs valid (closed, manifold, oriented, no self-intersection)\
+         {empties}; manifest: {}",
         count(Status::Ok),
         count(Status::Done),
         count(Status::Failed),

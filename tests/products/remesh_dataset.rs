@@ -254,6 +254,11 @@ fn remesh_dataset_cli() {
         "{stdout}"
     );
     assert!(stdout.contains("3 outputs valid"), "{stdout}");
+    // The lone triangle bounds nothing: counted.
+    assert!(
+        stdout.contains("1 outputs empty (0 wound inward, 1 without volume"),
+        "{stdout}"
+    );
     assert!(
         stderr.contains("gwn remesh-dataset: failed") && stderr.contains("broken_nan.off"),
         "{stderr}"
