@@ -55,6 +55,8 @@ pub const MAX_PAIRS: usize = 1_000_000;
 
 /// What [`merge_coplanar_overlaps`] changed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+// Counts grow as the repairs do: built by this crate only, read by fields.
+#[non_exhaustive]
 pub struct CoplanarCounts {
     /// Groups of overlapping faces in one plane.
     pub planes: usize,

@@ -65,6 +65,8 @@ const MAX_LABEL_TRIES: usize = 8;
 
 /// What [`cut_intersections`] did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+// Counts grow as the repairs do: built by this crate only, read by fields.
+#[non_exhaustive]
 pub struct CutCounts {
     /// Pairs of faces that met outside what they share.
     pub intersecting_pairs: usize,

@@ -33,6 +33,8 @@ use super::intersect::ExactPoint;
 
 /// What [`repair`] changed: faces only, never a position.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+// Counts grow as the repairs do: built by this crate only, read by fields.
+#[non_exhaustive]
 pub struct RepairCounts {
     /// Zero-area faces left out.
     pub zero_area_faces: usize,

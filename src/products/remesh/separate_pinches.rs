@@ -57,6 +57,8 @@ pub const LARGEST_MOVE_IN_CELLS: f64 = 1.0 / 64.0;
 
 /// What [`separate_pinches`] changed.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+// Counts grow as the repairs do: built by this crate only, read by fields.
+#[non_exhaustive]
 pub struct SeparatedCounts {
     /// Edges in more than two faces, split into one edge per solid wedge.
     pub edges: usize,
