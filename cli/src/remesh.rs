@@ -438,8 +438,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
         }
     }
     // An empty output is right where `w > ½` is empty, but rarely what was meant: say why.
-    if topology.faces == 0 && thickened.is_none() && input.mesh().is_some_and(|m| !m.is_empty()) {
-        let why = WhyEmpty::of(s.input);
+    if let Some(mesh) = input
+        .mesh()
+        .filter(|m| topology.faces == 0 && thickened.is_none() && !m.is_empty())
+    {
+        let why = WhyEmpty::of_mesh(mesh, bounds, &options, s.input);
         let way_out = match why {
             WhyEmpty::WindsInward => "--method parity remeshes the solid it encloses",
             WhyEmpty::NoVolume => {

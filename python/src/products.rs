@@ -695,7 +695,7 @@ pub fn remesh<'py>(
             thicken,
         });
         let empty = (out.triangles.is_empty() && thick.is_none() && !mesh.is_empty())
-            .then(|| WhyEmpty::of(out.stats.input));
+            .then(|| WhyEmpty::of_mesh(&mesh, bounds, &options, out.stats.input));
         Ok((measured(out, field, request)?, empty))
     })?
     .map_err(remesh_error)?;

@@ -89,6 +89,9 @@ def test_an_empty_output_comes_with_a_warning_that_says_why():
     with pytest.warns(UserWarning, match="winds inward.*method='parity'"):
         V, F = gwn.remesh(CUBE_V, inward, res=16)
     assert len(F) == 0
+    # Remeshed all the same (nothing kept): the reason is still told.
+    with pytest.warns(UserWarning, match="winds inward"):
+        assert len(gwn.remesh(CUBE_V, inward, res=16, always_remesh=True)[1]) == 0
     assert len(gwn.remesh(CUBE_V, inward, res=16, method="parity")[1]) > 0
     # An open sheet: no volume; thicken= is the way out.
     square = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], dtype=np.float64)

@@ -330,8 +330,8 @@ fn remesh_of_an_inward_input_is_empty_and_says_why() {
         input.to_str().unwrap().to_owned(),
         dir.join("o.obj").to_str().unwrap().to_owned(),
     );
-    let run = |method: &str| {
-        let (ok, stdout, stderr) = gwn(&[
+    let run_with = |method: &str, extra: &[&str]| {
+        let mut args = vec![
             "remesh",
             &input,
             "--res",
@@ -342,10 +342,20 @@ fn remesh_of_an_inward_input_is_empty_and_says_why() {
             "200",
             "--method",
             method,
-        ]);
+        ];
+        args.extend_from_slice(extra);
+        let (ok, stdout, stderr) = gwn(&args);
         assert!(ok, "{stderr}");
         stdout
     };
+    let run = |method: &str| run_with(method, &[]);
+    // Remeshed all the same: the lattice finds w > 1/2 nowhere, and the reason is still told.
+    let always = run_with("exact", &["--always-remesh"]);
+    assert!(
+        always.contains("the output is empty: w > 1/2 at no point of the lattice")
+            && always.contains("winds inward"),
+        "{always}"
+    );
     let exact = run("exact");
     assert!(exact.contains("0 faces, 0 vertices"), "{exact}");
     assert!(

@@ -299,6 +299,32 @@ pub enum WhyEmpty {
 }
 
 impl WhyEmpty {
+    /// The reason for an empty remesh of `mesh` (with the run's `bounds` and `options`): from
+    /// the run's [`RemeshStats::input`](super::RemeshStats::input), or, where keeping was not
+    /// tried (`--always-remesh`), from [`keep_input`]'s check run now for its verdict alone
+    /// (whatever the input's size): an inward input is told so either way.
+    pub fn of_mesh(
+        mesh: &Mesh,
+        bounds: BoundingBox,
+        options: &RemeshOptions,
+        input: Option<InputCheck>,
+    ) -> WhyEmpty {
+        if input.is_some() {
+            return WhyEmpty::of(input);
+        }
+        // No face target: the size (step 4) is no reason here.
+        let mut check = *options;
+        check.simplify = Some(super::simplify::SimplifyOptions {
+            target_fraction_of_marching_cubes: f64::INFINITY,
+            ..options.simplify.unwrap_or_default()
+        });
+        check.deadline = None;
+        match keep_input(mesh, bounds, &check) {
+            Ok(out) => WhyEmpty::of(out.stats.input),
+            Err(why) => WhyEmpty::of(Some(InputCheck::Remeshed(why))),
+        }
+    }
+
     /// The reason, from the run's [`RemeshStats::input`](super::RemeshStats::input).
     pub fn of(input: Option<InputCheck>) -> WhyEmpty {
         match input {
