@@ -13,7 +13,9 @@ use crate::remesh_keep::cuboid;
 
 use gwn::Mesh;
 use gwn::products::remesh::keep_input::{InputCheck, NotKept, keep_input};
-use gwn::products::remesh::separate_pinches::{LARGEST_MOVE_IN_CELLS, SeparatedCounts};
+use gwn::products::remesh::separate_pinches::{
+    LARGEST_MOVE_IN_CELLS, SeparatedCounts, split_at_midpoints,
+};
 use gwn::products::remesh::{RemeshOptions, Remeshed};
 
 fn kept(mesh: &Mesh) -> Result<Remeshed, NotKept> {
@@ -170,6 +172,91 @@ fn cavities_touching_at_a_corner_or_along_an_edge_are_pulled_apart() {
         assert!(split.iter().all(|p| p[0] * p[1] < 0.0), "{split:?}");
         assert!(split[0][0] * split[1][0] < 0.0, "{split:?}");
     }
+}
+
+/// A face with one, two or three of its edges in more than two faces is split at their
+/// midpoints into pieces that tile it with its orientation (their area vectors add up to its
+/// own, each a positive part of it: none degenerate, none turned), and every face on a split
+/// edge is split the same way, so no edge runs past a midpoint.
+#[test]
+fn split_at_midpoints_tiles_each_face_with_its_orientation() {
+    let positions = vec![
+        [0.0, 0.0, 0.0],
+        [4.0, 0.0, 0.0],
+        [1.0, 3.0, 0.0],
+        [2.0, -1.0, 1.0],
+        [3.0, 2.0, 2.0],
+        [0.0, 2.0, -2.0],
+        [2.0, -1.0, -1.5],
+        [3.0, 2.0, -1.0],
+        [0.0, 2.0, 1.0],
+    ];
+    // Twice the area vector of face `t`, and vector helpers.
+    let cross = |t: [u32; 3], p: &[[f64; 3]]| -> [f64; 3] {
+        let [a, b, c] = t.map(|v| p[v as usize]);
+        let (u, w): ([f64; 3], [f64; 3]) = (
+            std::array::from_fn(|k| b[k] - a[k]),
+            std::array::from_fn(|k| c[k] - a[k]),
+        );
+        [
+            u[1] * w[2] - u[2] * w[1],
+            u[2] * w[0] - u[0] * w[2],
+            u[0] * w[1] - u[1] * w[0],
+        ]
+    };
+    let dot = |a: [f64; 3], b: [f64; 3]| (0..3).map(|k| a[k] * b[k]).sum::<f64>();
+    let length = |a: [f64; 3]| dot(a, a).sqrt();
+    // Extra faces on edges (0, 1), (1, 2), (2, 0), two each (one each way, apexes apart):
+    // crowded edges.
+    let extra = [(0, 1, 3, 6), (1, 2, 4, 7), (2, 0, 5, 8)];
+    for crowded in 1..=3usize {
+        let mut triangles = vec![[0u32, 1, 2]];
+        for &(a, b, c, d) in extra.iter().take(crowded) {
+            triangles.extend([[a, b, c], [b, a, d]]);
+        }
+        let split = split_at_midpoints(&positions, &triangles).unwrap();
+        assert_eq!(split.counts.midpoints, crowded);
+        assert_eq!(split.positions.len(), positions.len() + crowded);
+        let whole = cross([0, 1, 2], &positions);
+        let pieces: Vec<[u32; 3]> = split
+            .triangles
+            .iter()
+            .copied()
+            .filter(|&t| {
+                let c = cross(t, &split.positions);
+                dot(c, whole) > (1.0 - 1e-12) * length(c) * length(whole)
+            })
+            .collect();
+        assert_eq!(pieces.len(), 1 + crowded, "{:?}", split.triangles);
+        let sum = pieces.iter().fold([0.0; 3], |s, &t| {
+            let c = cross(t, &split.positions);
+            std::array::from_fn(|k| s[k] + c[k])
+        });
+        let gap: [f64; 3] = std::array::from_fn(|k| sum[k] - whole[k]);
+        assert!(length(gap) < 1e-12, "{sum:?} {whole:?}");
+        assert!(
+            pieces
+                .iter()
+                .all(|&t| length(cross(t, &split.positions)) > 1e-9)
+        );
+        // No face runs along a whole crowded edge past its midpoint: the most faces on an
+        // edge is the three of each half of one.
+        let mut edges: Vec<(u32, u32)> = split
+            .triangles
+            .iter()
+            .flat_map(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
+            .collect();
+        edges.sort_unstable();
+        let most = edges
+            .chunk_by(|x, y| x == y)
+            .map(|g| g.len())
+            .max()
+            .unwrap();
+        assert_eq!(most, 3, "each half of a crowded edge keeps its three faces");
+        assert_eq!(split.triangles.len(), triangles.len() + 3 * crowded);
+    }
+    // Nothing crowded: nothing to split.
+    assert!(split_at_midpoints(&positions, &[[0, 1, 2], [0, 2, 3]]).is_none());
 }
 
 #[test]
