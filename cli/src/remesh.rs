@@ -11,7 +11,9 @@ use gwn::products::remesh::report::{
 use gwn::products::remesh::simplify::SimplifyOptions;
 use gwn::products::remesh::thicken::{self, ThickenedSheets};
 use gwn::products::remesh::write::{SurfaceFormat, write_surface};
-use gwn::products::remesh::{DEFAULT_BISECTION_STEPS, RemeshOptions, remesh_guided, remesh_mesh};
+use gwn::products::remesh::{
+    DEFAULT_BISECTION_STEPS, Keep, RemeshOptions, remesh_guided, remesh_mesh,
+};
 
 use crate::common::{CliError, outln};
 use crate::method::{MethodArgs, ToleranceArgs};
@@ -143,13 +145,16 @@ pub fn run(args: Args) -> Result<(), CliError> {
         }
     };
     // A mesh that already is the boundary of its `w > ½` solid is the answer as it is (exact
-    // checks, linear in the input): the exact method's field of the mesh itself only.
-    // (Its vertices merged by position, as the exact method's boundary is by default: not with
-    // --no-weld, whose boundary is by index.)
-    let keep = matches!(method.method_for(input.kind()), Method::Exact)
-        && thickened.is_none()
-        && !args.weld.no_weld
-        && !args.knobs.always_remesh;
+    // checks, linear in the input), and under the parity method a closed mesh that is the
+    // boundary of its parity's solid once its faces are turned: the field of the mesh itself
+    // only. (Its vertices merged by position, as the exact method's boundary is by default: not
+    // with --no-weld, whose boundary is by index.)
+    let own_field = thickened.is_none() && !args.weld.no_weld && !args.knobs.always_remesh;
+    let keep = match method.method_for(input.kind()) {
+        Method::Exact if own_field => Keep::Winding,
+        Method::Parity if own_field => Keep::Parity,
+        _ => Keep::No,
+    };
     let out = match input.mesh() {
         Some(mesh) => remesh_mesh(mesh, keep, wn, guide, bounds, &options, &announce),
         None => remesh_guided(wn, guide, bounds, &options, &announce),
@@ -242,6 +247,25 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 "{}: {what}, {secs:.2} s): closed, manifold, oriented, no self-intersection \
                  (exact) and the boundary of w > 1/2 (--always-remesh remeshes it at res {})",
                 args.out.display(),
+                args.res
+            )?;
+            outln!("{topology}")?;
+        }
+        Some(InputCheck::Reoriented {
+            repairs,
+            turned_faces,
+        }) => {
+            let repairs = if repairs.is_empty() {
+                String::new()
+            } else {
+                format!(", {repairs}")
+            };
+            outln!(
+                "{}: the input with {turned_faces} of its faces turned ({} faces{repairs}, \
+                 {secs:.2} s): closed, manifold, oriented, no self-intersection (exact) and the \
+                 boundary of the parity method's solid (--always-remesh remeshes it at res {})",
+                args.out.display(),
+                topology.faces,
                 args.res
             )?;
             outln!("{topology}")?;

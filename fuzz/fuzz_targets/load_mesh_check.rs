@@ -50,6 +50,11 @@ pub fn check_load_mesh(data: &[u8]) {
                         }
                     }
                 }
+                // The parity method's keep: faces turned, every guarantee proved again.
+                use gwn::products::remesh::reorient::keep_reoriented;
+                if let Ok(kept) = keep_reoriented(&l.mesh, bounds, &options) {
+                    assert!(kept.triangles.is_empty() || valid(&kept.positions, &kept.triangles));
+                }
             }
         }
         Err(e) => {

@@ -528,7 +528,10 @@ pub fn filter_tets<'py>(
 /// ``input_largest_move``); faces overlapping in one plane (a part standing on a plate) are
 /// replaced by what they add up to there (``input_coplanar_faces``,
 /// ``input_crossing_vertices``); otherwise its clean components can come back as they are with
-/// the rest remeshed (``partly kept``); ``always_remesh=True`` remeshes it all anyway, as
+/// the rest remeshed (``partly kept``). With ``method="parity"``, a closed, manifold mesh
+/// without self-intersections comes back with its faces turned to face out of the parity's
+/// solid (``reoriented``, ``input_turned_faces``; cavities inward), proved the same way.
+/// ``always_remesh=True`` remeshes it all anyway, as
 /// ``gwn remesh --always-remesh``. An empty output of a mesh with faces (``{w > 1/2}`` empty)
 /// comes with a ``UserWarning`` saying why: an inward-wound input (``method="parity"``
 /// remeshes what it encloses), or no volume (``thicken=``).
@@ -570,7 +573,7 @@ pub fn remesh<'py>(
 
     use gwn::products::remesh::keep_input::WhyEmpty;
     use gwn::products::remesh::{
-        RemeshOptions, remesh_guided, remesh_mesh,
+        Keep, RemeshOptions, remesh_guided, remesh_mesh,
         thicken::{self, ThickenedSheets},
     };
     let method = spec_of(method, beta, order, tolerance)?;
@@ -671,9 +674,15 @@ pub fn remesh<'py>(
             reference,
         } = thicken::of_mesh(&mesh, &*wn, thick.as_ref(), bounds);
         let clock = PhaseClock::start();
-        // As `gwn remesh`: a mesh that already bounds its `w > ½` solid is kept as it is.
-        let exact = method.method_for(gwn::input::InputKind::Mesh) == gwn::spec::Method::Exact;
-        let keep = exact && thick.is_none() && !always_remesh;
+        // As `gwn remesh`: a mesh that already bounds its `w > ½` solid is kept as it is, and
+        // under the parity method a closed one that bounds its parity's solid once its faces
+        // are turned is kept turned.
+        let own_field = thick.is_none() && !always_remesh;
+        let keep = match method.method_for(gwn::input::InputKind::Mesh) {
+            gwn::spec::Method::Exact if own_field => Keep::Winding,
+            gwn::spec::Method::Parity if own_field => Keep::Parity,
+            _ => Keep::No,
+        };
         let out = remesh_mesh(
             &mesh,
             keep,

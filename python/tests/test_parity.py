@@ -34,8 +34,23 @@ def test_parity_is_the_enclosed_solid_where_w_is_not():
     assert 0 < expected.sum() < len(expected)
 
 
+def rotated_to_least(F):
+    """Each face's vertices rotated to start at its least (the same face, the same way round)."""
+    return np.array([np.roll(f, -int(np.argmin(f))) for f in F])
+
+
 def test_remesh_with_parity_encloses_the_cube():
+    # Kept: the cube's own faces, the six flipped ones turned back, no lattice.
     V, F, report = gwn.remesh(CUBE_V, FLIPPED_F, res=16, method="parity", report=True)
+    assert report["input"] == "reoriented" and report["input_turned_faces"] == 6
+    np.testing.assert_array_equal(V, CUBE_V)
+    np.testing.assert_array_equal(rotated_to_least(F), rotated_to_least(CUBE_F))
+    assert report["hausdorff_cells"] == 0
+    # Remeshed on request: the lattice surface of the same solid.
+    V, F, report = gwn.remesh(
+        CUBE_V, FLIPPED_F, res=16, method="parity", report=True, always_remesh=True
+    )
+    assert "input" not in report and report["classified_points"] > 0
     assert report["closed"] and report["oriented"] and report["components"] == 1
     # Volume by the divergence theorem: the unit cube's, within the placement's precision.
     a, b, c = (V[F[:, k]] for k in range(3))

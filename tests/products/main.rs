@@ -19,6 +19,7 @@ mod remesh_dataset;
 mod remesh_keep;
 mod remesh_levels;
 mod remesh_planar;
+mod remesh_reorient;
 mod remesh_report;
 mod remesh_separate;
 mod remesh_simplify;

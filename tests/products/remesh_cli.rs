@@ -698,8 +698,9 @@ fn remesh_reports_the_plate_refinement_and_can_turn_it_off() {
 }
 
 /// A closed cube with half its faces flipped: the exact method's `w` is fractional inside, and
-/// the remesh says so and names `--method parity`, whose output is the cube (one component
-/// within a cell of the input, which it bounds everywhere); an open box is refused by parity.
+/// the remesh says so and names `--method parity`, whose output is the cube with those faces
+/// turned back (or, with `--always-remesh`, its lattice remesh: one component within a cell of
+/// the input, which it bounds everywhere); an open box is refused by parity.
 #[test]
 fn remesh_points_closed_unoriented_inputs_to_the_parity_method() {
     let dir = std::env::temp_dir().join(format!("gwn-cli-parity-{}", std::process::id()));
@@ -736,14 +737,39 @@ fn remesh_points_closed_unoriented_inputs_to_the_parity_method() {
             && stdout.contains("--method parity"),
         "{stdout}"
     );
-    let (ok, stdout, stderr) = run(&["--method", "parity"]);
+    // Kept with its six flipped faces turned back (no lattice), or remeshed on request.
+    let report = dir.join("report.json");
+    let (ok, stdout, stderr) = run(&["--method", "parity", "--report", report.to_str().unwrap()]);
     assert!(ok, "{stderr}");
     assert!(!stdout.contains("not consistently oriented"), "{stdout}");
     assert!(
-        stdout.contains("Euler characteristic 2; 1 component(s)")
-            && stdout.contains("w > 1/2 on one side only: 100.0 % of its samples"),
+        stdout.contains("the input with 6 of its faces turned (12 faces")
+            && stdout.contains("the boundary of the parity method's solid")
+            && !stdout.contains("points classified"),
         "{stdout}"
     );
+    let json = std::fs::read_to_string(&report).unwrap();
+    assert!(
+        json.contains("\"input\": \"reoriented\"") && json.contains("\"input_turned_faces\": 6"),
+        "{json}"
+    );
+    for also in [
+        &["--method", "parity"][..],
+        &["--method", "parity", "--always-remesh"],
+    ] {
+        let (ok, stdout, stderr) = run(also);
+        assert!(ok, "{stderr}");
+        assert!(
+            stdout.contains("Euler characteristic 2; 1 component(s)")
+                && stdout.contains("w > 1/2 on one side only: 100.0 % of its samples"),
+            "{also:?}: {stdout}"
+        );
+        assert_eq!(
+            stdout.contains("points classified"),
+            also.len() == 3,
+            "{stdout}"
+        );
+    }
     let open = dir.join("open.obj");
     write_obj_file(&open, &gwn::testing::unit_cube(true));
     let (ok, _, stderr) = gwn(&[

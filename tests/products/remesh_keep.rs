@@ -385,7 +385,7 @@ fn every_way_of_not_bounding_the_solid_is_remeshed() {
 /// input (nothing kept) is empty too. Beside an outward solid, an inward shell is remeshed.
 #[test]
 fn inward_shells_bound_nothing() {
-    use gwn::products::remesh::remesh_mesh;
+    use gwn::products::remesh::{Keep, remesh_mesh};
     let outer = |inward| cuboid([-3.0; 3], [3.0; 3], inward);
     let inner = |inward| cuboid([-1.0; 3], [1.0; 3], inward);
     let remeshed = |mesh: &Mesh, keep: bool| {
@@ -393,7 +393,7 @@ fn inward_shells_bound_nothing() {
         let options = RemeshOptions::with_resolution(16);
         remesh_mesh(
             mesh,
-            keep,
+            if keep { Keep::Winding } else { Keep::No },
             &wn,
             None,
             mesh.bounding_box().unwrap(),
@@ -751,12 +751,21 @@ proptest! {
 /// The default remesh of a mesh, as the CLI runs it: the exact field, the mesh as its guide, the
 /// whole input kept when it can be, else its clean components.
 fn remesh_default(mesh: &Mesh, res: usize) -> gwn::products::remesh::Remeshed {
-    use gwn::products::remesh::{crossings::SegmentBvh, remesh_mesh};
+    use gwn::products::remesh::{Keep, crossings::SegmentBvh, remesh_mesh};
     let wn = WindingNumber::new(mesh).unwrap();
     let guide = SegmentBvh::of_field_mesh(mesh);
     let bounds = mesh.bounding_box().unwrap();
     let options = RemeshOptions::with_resolution(res);
-    remesh_mesh(mesh, true, &wn, Some(&guide), bounds, &options, &|_| {}).unwrap()
+    remesh_mesh(
+        mesh,
+        Keep::Winding,
+        &wn,
+        Some(&guide),
+        bounds,
+        &options,
+        &|_| {},
+    )
+    .unwrap()
 }
 
 /// Closed, manifold, oriented and without self-intersections on its `f64` vertices.
@@ -873,7 +882,7 @@ proptest! {
             2..5,
         ),
     ) {
-        use gwn::products::remesh::{crossings::SegmentBvh, keep_input::InputCheck, remesh_mesh};
+        use gwn::products::remesh::{Keep, crossings::SegmentBvh, keep_input::InputCheck, remesh_mesh};
         // Half the boxes go inside the one before them, clean, when it has room (a clean box in
         // an inward one is where keeping it would be wrong).
         let mut boxes: Vec<([u8; 3], [u8; 3], u8)> = Vec::new();
@@ -906,7 +915,7 @@ proptest! {
             let guide = SegmentBvh::of_field_mesh(mesh);
             let options = RemeshOptions::with_resolution(16);
             let bounds = mesh.bounding_box().unwrap();
-            remesh_mesh(mesh, false, &wn, Some(&guide), bounds, &options, &|_| {}).unwrap()
+            remesh_mesh(mesh, Keep::No, &wn, Some(&guide), bounds, &options, &|_| {}).unwrap()
         };
         // Proved empty without a lattice: so is the lattice's.
         if matches!(out.stats.input, Some(InputCheck::BoundsNothing { .. })) {

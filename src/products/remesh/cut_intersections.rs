@@ -637,6 +637,7 @@ fn proof_step(problem: NotKept) -> &'static str {
         NotKept::Open { .. } => "open",
         NotKept::NotManifold { .. } => "not manifold",
         NotKept::Misoriented { .. } => "not consistently oriented",
+        NotKept::NotOrientable => "one-sided",
         NotKept::DegenerateFaces { .. } => "made of degenerate faces",
         NotKept::CoincidentVertices { .. } => "pinched at coincident vertices",
         NotKept::CoordinateRange | NotKept::UnevenFaces => "beyond the exact tests' range",

@@ -37,7 +37,7 @@ use super::keep_input::{InputCheck, WhyEmpty};
 use super::report::{DistanceReference, RemeshReport};
 use super::thicken::{self, MeshField, ThickenedSheets};
 use super::write::{SurfaceFormat, write_surface};
-use super::{RemeshOptions, Remeshed, remesh_guided, remesh_mesh};
+use super::{Keep, RemeshOptions, Remeshed, remesh_guided, remesh_mesh};
 use crate::eval::Evaluator;
 use crate::input::{Input, InputKind, load_input_with};
 use crate::io::LoadOptions;
@@ -358,7 +358,7 @@ impl RemeshJob {
             ..self.options
         };
         let out = match kept {
-            Some(mesh) => remesh_mesh(mesh, true, field, guide, bounds, &options, &|_| {}),
+            Some(mesh) => remesh_mesh(mesh, Keep::Winding, field, guide, bounds, &options, &|_| {}),
             None => remesh_guided(field, guide, bounds, &options, &|_| {}),
         };
         out.map_err(|e| -> RemeshJobError {
@@ -412,6 +412,9 @@ impl RemeshJob {
             Some(InputCheck::Kept { .. }) => t.faces,
             Some(InputCheck::PartlyKept { kept_faces, .. }) => kept_faces,
             Some(InputCheck::Cut { uncut_faces, .. }) => uncut_faces,
+            Some(InputCheck::Reoriented { turned_faces, .. }) => {
+                t.faces.saturating_sub(turned_faces)
+            }
             _ => 0,
         };
         stats.set("kept_faces", kept_faces);

@@ -112,6 +112,10 @@ pub enum NotKept {
         /// How many.
         edges: usize,
     },
+    /// A component whose faces cannot be turned to agree across every edge: one-sided, which
+    /// a closed surface can only be while passing through itself
+    /// ([`super::reorient::keep_reoriented`]).
+    NotOrientable,
     /// Faces that repeat a vertex or whose corners are collinear.
     DegenerateFaces {
         /// How many.
@@ -166,6 +170,10 @@ impl std::fmt::Display for NotKept {
             NotKept::Misoriented { edges } => {
                 write!(f, "its faces are not consistently oriented ({edges} edges)")
             }
+            NotKept::NotOrientable => write!(
+                f,
+                "its faces cannot be oriented consistently (a one-sided component)"
+            ),
             NotKept::DegenerateFaces { faces } => write!(f, "it has {faces} degenerate faces"),
             NotKept::CoincidentVertices { vertices } => write!(
                 f,
@@ -240,6 +248,14 @@ pub enum InputCheck {
         /// Why the whole input was not kept.
         why: NotKept,
     },
+    /// The input, closed, with its faces turned to face out of the parity method's solid and
+    /// kept ([`super::reorient::keep_reoriented`]), after the repairs of [`exact_repair`].
+    Reoriented {
+        /// What the repairs changed.
+        repairs: exact_repair::RepairCounts,
+        /// Faces turned (of the repaired faces).
+        turned_faces: usize,
+    },
     /// The input was remeshed, for this reason.
     Remeshed(NotKept),
     /// `{w > ½}` is empty, proved on the input (after the repairs, pinches pulled apart): a
@@ -255,22 +271,29 @@ pub enum InputCheck {
 }
 
 impl InputCheck {
-    /// Whether the input was kept whole.
+    /// Whether the input was kept whole (its faces turned, under the parity method).
     pub fn is_kept(&self) -> bool {
-        matches!(self, InputCheck::Kept { .. })
+        matches!(
+            self,
+            InputCheck::Kept { .. } | InputCheck::Reoriented { .. }
+        )
     }
 
-    /// Whether the output is made of the input's own surface, whole or cut at its
-    /// self-intersections, without a lattice.
+    /// Whether the output is made of the input's own surface, whole (faces turned or not) or
+    /// cut at its self-intersections, without a lattice.
     pub fn is_input_surface(&self) -> bool {
-        matches!(self, InputCheck::Kept { .. } | InputCheck::Cut { .. })
+        matches!(
+            self,
+            InputCheck::Kept { .. } | InputCheck::Reoriented { .. } | InputCheck::Cut { .. }
+        )
     }
 
-    /// Its name in reports and manifests: `kept`, `cut`, `partly kept`, `remeshed` or
-    /// `bounds nothing`.
+    /// Its name in reports and manifests: `kept`, `reoriented`, `cut`, `partly kept`,
+    /// `remeshed` or `bounds nothing`.
     pub fn name(&self) -> &'static str {
         match self {
             InputCheck::Kept { .. } => "kept",
+            InputCheck::Reoriented { .. } => "reoriented",
             InputCheck::Cut { .. } => "cut",
             InputCheck::PartlyKept { .. } => "partly kept",
             InputCheck::Remeshed(_) => "remeshed",
@@ -396,40 +419,13 @@ pub fn keep_input(
     bounds: BoundingBox,
     options: &RemeshOptions,
 ) -> Result<Remeshed, NotKept> {
-    if mesh.triangles().is_empty() {
-        return Err(NotKept::Empty);
-    }
-    // Vertices at one position are one point of the surface (and of the exact evaluator's
-    // boundary by position), whatever the file's indices say.
-    let (mesh, _) = mesh.welded();
-    let triangles = mesh.triangles();
-    let lattice = Lattice::new(bounds, options.resolution).ok_or(NotKept::CoordinateRange)?;
-    let target = options
-        .simplify
-        .map(|s| s.target_fraction_of_marching_cubes * marching_cubes_faces(&mesh, lattice.h))
-        .unwrap_or(0.0);
-    if triangles.len() > ALWAYS_KEPT_FACES && triangles.len() as f64 > target {
-        return Err(NotKept::TooManyFaces {
-            faces: triangles.len(),
-            target: target as usize,
-        });
-    }
-    // The referenced vertices, in their order, and their coordinates as integers in one scale:
-    // exact for the repairs, the intersection test (narrow or wide predicates, as they fit)
-    // and the orientations.
-    let (positions, triangles) = referenced(mesh.positions(), triangles);
-    let bits = intersect::MAX_WIDE_COORDINATE.trailing_zeros();
-    let original = TopologyReport::of(&positions, &triangles);
-    let Some(fixed) = common_fixed_point(&positions, bits) else {
-        return Err(topology_problem(&original).unwrap_or(NotKept::CoordinateRange));
-    };
-    // Zero-area faces out, T-junctions split: `w` is the same everywhere off the surface.
-    let repaired = exact_repair::repair(
-        &fixed,
-        &triangles,
-        original.closed,
-        1000 * triangles.len() as u64,
-    );
+    let Prepared {
+        positions,
+        fixed,
+        original,
+        repaired,
+        lattice,
+    } = prepared(mesh, bounds, options)?;
     let mut repairs = repaired.counts;
     // A face written twice the same way, all such in one plane: the second copies out, which
     // changes `w` by less than ½ where the rest's `w` is an integer (`{w > ½}` unchanged). A
@@ -451,8 +447,9 @@ pub fn keep_input(
         let (positions, _) = referenced(&positions, &repaired_triangles);
         (positions, kept, triangles)
     } else {
-        (positions, fixed, triangles)
+        (positions, fixed, repaired_triangles)
     };
+    let bits = intersect::MAX_WIDE_COORDINATE.trailing_zeros();
     let first_problem = topology_problem(&original);
     // What the user is told: the input's own first problem where the repaired surface failed
     // step 1 or was pulled apart (what `gwn info` counts on the file), unless the repairs left
@@ -558,6 +555,76 @@ pub fn keep_input(
             input: Some(input),
             ..RemeshStats::default()
         },
+    })
+}
+
+/// The input as [`keep_input`] and [`super::reorient::keep_reoriented`] take it (see the
+/// [module documentation](self)): welded, its size checked (step 4), its referenced vertices in
+/// their order with their exact coordinates in one scale, and [`exact_repair::repair`] made on
+/// them. Both repairs leave `w` and the crossing parity unchanged off the surface (a zero-area
+/// face is crossed by no ray in general position, a split face by a ray through exactly one
+/// piece, and a cancelled pair by a ray through both or neither).
+pub(super) struct Prepared {
+    /// The welded input's referenced vertices, in their order.
+    pub positions: Vec<[f64; 3]>,
+    /// Their coordinates as integers in one scale: exact for the repairs, the intersection
+    /// test (narrow or wide predicates, as they fit) and the orientations.
+    pub fixed: Vec<[i128; 3]>,
+    /// The welded input's topology, before the repairs.
+    pub original: TopologyReport,
+    /// The repaired faces, on `positions`, and what the repairs changed.
+    pub repaired: exact_repair::Repaired,
+    /// The remesh's lattice (its finest cell caps how far a pull may move a vertex).
+    pub lattice: Lattice,
+}
+
+/// [`Prepared`] for `mesh`, or why it is not kept before any exact test: no faces, more than
+/// the remesh's face target, coordinates beyond the exact tests' range.
+pub(super) fn prepared(
+    mesh: &Mesh,
+    bounds: BoundingBox,
+    options: &RemeshOptions,
+) -> Result<Prepared, NotKept> {
+    if mesh.triangles().is_empty() {
+        return Err(NotKept::Empty);
+    }
+    // Vertices at one position are one point of the surface (and of the exact evaluator's
+    // boundary by position), whatever the file's indices say.
+    let (mesh, _) = mesh.welded();
+    let triangles = mesh.triangles();
+    let lattice = Lattice::new(bounds, options.resolution).ok_or(NotKept::CoordinateRange)?;
+    let target = options
+        .simplify
+        .map(|s| s.target_fraction_of_marching_cubes * marching_cubes_faces(&mesh, lattice.h))
+        .unwrap_or(0.0);
+    if triangles.len() > ALWAYS_KEPT_FACES && triangles.len() as f64 > target {
+        return Err(NotKept::TooManyFaces {
+            faces: triangles.len(),
+            target: target as usize,
+        });
+    }
+    // The referenced vertices, in their order, and their coordinates as integers in one scale:
+    // exact for the repairs, the intersection test (narrow or wide predicates, as they fit)
+    // and the orientations.
+    let (positions, triangles) = referenced(mesh.positions(), triangles);
+    let bits = intersect::MAX_WIDE_COORDINATE.trailing_zeros();
+    let original = TopologyReport::of(&positions, &triangles);
+    let Some(fixed) = common_fixed_point(&positions, bits) else {
+        return Err(topology_problem(&original).unwrap_or(NotKept::CoordinateRange));
+    };
+    // Zero-area faces out, T-junctions split: `w` is the same everywhere off the surface.
+    let repaired = exact_repair::repair(
+        &fixed,
+        &triangles,
+        original.closed,
+        1000 * triangles.len() as u64,
+    );
+    Ok(Prepared {
+        positions,
+        fixed,
+        original,
+        repaired,
+        lattice,
     })
 }
 
@@ -702,6 +769,15 @@ pub(super) fn bounds_its_solid(
     fixed: &[[i128; 3]],
     triangles: &[[u32; 3]],
 ) -> Result<(), NotKept> {
+    embedded(fixed, triangles)?;
+    let surface = Mesh::from_slices(positions, triangles).map_err(|_| NotKept::CoordinateRange)?;
+    check_winding(&surface, fixed)
+}
+
+/// Step 2 of the module documentation on a surface that passed step 1 (with no zero-area
+/// face), with its vertices' exact fixed-point coordinates `fixed`: no two vertices at one
+/// position, and no two faces meeting outside what they share.
+pub(super) fn embedded(fixed: &[[i128; 3]], triangles: &[[u32; 3]]) -> Result<(), NotKept> {
     // Distinct vertices at one position would pass the topology (different indices) and the
     // intersection test (coincident positions count as shared) while pinching the surface.
     let mut sorted = fixed.to_vec();
@@ -726,8 +802,7 @@ pub(super) fn bounds_its_solid(
             not_cut: None,
         });
     }
-    let surface = Mesh::from_slices(positions, triangles).map_err(|_| NotKept::CoordinateRange)?;
-    check_winding(&surface, fixed)
+    Ok(())
 }
 
 /// Step 1's verdict on a surface with this `topology`, where a failure for its pinches only
@@ -849,7 +924,7 @@ pub(super) fn referenced<V: Copy>(values: &[V], triangles: &[[u32; 3]]) -> (Vec<
 
 /// Step 3 of the module documentation on a closed, manifold, oriented, embedded `surface` with
 /// its exact fixed-point vertices.
-fn check_winding(surface: &Mesh, fixed: &[[i128; 3]]) -> Result<(), NotKept> {
+pub(super) fn check_winding(surface: &Mesh, fixed: &[[i128; 3]]) -> Result<(), NotKept> {
     // The evaluator's own perturbation is what step 3 relies on: build it with the defaults
     // (ray `+z`), whatever evaluator the caller remeshes with.
     let wn = WindingNumber::new(surface).map_err(|_| NotKept::CoordinateRange)?;

@@ -65,6 +65,7 @@ pub mod levels;
 pub mod octree;
 pub mod place;
 pub mod plates;
+pub mod reorient;
 pub mod report;
 pub mod separate_pinches;
 pub mod simplify;
@@ -435,15 +436,31 @@ pub fn remesh<E: Evaluator + ?Sized>(
     remesh_guided(evaluator, None, bounds, options, &|_| {})
 }
 
+/// Which solid of its own mesh the field given to [`remesh_mesh`] is, so that the mesh may be
+/// kept as its own remesh.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Keep {
+    /// Not the mesh's own solid, or not to be kept: a thickened field, the fast method's, a
+    /// boundary by index (no weld), or a remesh asked for whatever the input.
+    No,
+    /// The exact method's `{w > ½}` ([`keep_input::keep_input`]).
+    Winding,
+    /// The parity method's solid ([`reorient::keep_reoriented`]).
+    Parity,
+}
+
 /// [`remesh_guided`] of a mesh's own field, unless the mesh already is the surface it would aim
-/// for: with `keep` (the exact method's field of `mesh`, nothing thickened), a mesh that
-/// [`keep_input::keep_input`] proves to be the boundary of its `w > ½` solid is returned as it
-/// is (not tried without [`RemeshOptions::simplify`]: the raw lattice surface was asked for);
-/// otherwise the remesh, with [`RemeshStats::input`] saying why the input was not kept.
-/// Options are checked either way. What `gwn remesh`, `gwn remesh-dataset` and `gwn.remesh` run.
+/// for: with [`Keep::Winding`] (the exact method's field of `mesh`, nothing thickened), a mesh
+/// that [`keep_input::keep_input`] proves to be the boundary of its `w > ½` solid is returned
+/// as it is, and with [`Keep::Parity`] (the parity method's) a closed mesh that
+/// [`reorient::keep_reoriented`] proves to bound the parity's solid once its faces are turned
+/// is returned turned (neither is tried without [`RemeshOptions::simplify`]: the raw lattice
+/// surface was asked for); otherwise the remesh, with [`RemeshStats::input`] saying why the
+/// input was not kept. Options are checked either way. What `gwn remesh`,
+/// `gwn remesh-dataset` and `gwn.remesh` run.
 pub fn remesh_mesh<E: Evaluator + ?Sized>(
     mesh: &crate::Mesh,
-    keep: bool,
+    keep: Keep,
     evaluator: &E,
     guide: Option<&crossings::SegmentBvh>,
     bounds: BoundingBox,
@@ -456,7 +473,7 @@ pub fn remesh_mesh<E: Evaluator + ?Sized>(
 /// [`remesh_mesh`] on a trait object (compiled once, as [`remesh_field`]).
 fn remesh_mesh_field(
     mesh: &crate::Mesh,
-    keep: bool,
+    keep: Keep,
     evaluator: &dyn Evaluator,
     guide: Option<&crossings::SegmentBvh>,
     bounds: BoundingBox,
@@ -465,31 +482,46 @@ fn remesh_mesh_field(
 ) -> Result<Remeshed, RemeshError> {
     options.check()?;
     // Without simplification the raw lattice surface was asked for.
-    let not_kept = if keep && options.simplify.is_some() {
-        progress(RemeshPhase::KeepInput);
-        let kept = keep_input::keep_input(mesh, bounds, options);
-        // Linear in the input and not interrupted; the time limit holds after it.
-        if options
+    let keep = if options.simplify.is_some() {
+        keep
+    } else {
+        Keep::No
+    };
+    let kept = match keep {
+        Keep::No => None,
+        Keep::Winding => {
+            progress(RemeshPhase::KeepInput);
+            Some(keep_input::keep_input(mesh, bounds, options))
+        }
+        Keep::Parity => {
+            progress(RemeshPhase::KeepInput);
+            Some(reorient::keep_reoriented(mesh, bounds, options))
+        }
+    };
+    // Linear in the input and not interrupted; the time limit holds after it.
+    if kept.is_some()
+        && options
             .deadline
             .is_some_and(|at| std::time::Instant::now() > at)
-        {
-            return Err(RemeshError::TimeLimit {
-                phase: RemeshPhase::KeepInput,
-            });
-        }
-        match kept {
-            Ok(out) => return Ok(out),
-            Err(why) => {
-                if let Some(out) =
+    {
+        return Err(RemeshError::TimeLimit {
+            phase: RemeshPhase::KeepInput,
+        });
+    }
+    let not_kept = match kept {
+        None => None,
+        Some(Ok(out)) => return Ok(out),
+        Some(Err(why)) => {
+            // Its clean components kept, under the exact method's `w` only: the parity of a
+            // part is not the whole's.
+            if keep == Keep::Winding
+                && let Some(out) =
                     remesh_rest(mesh, guide.is_some(), bounds, options, why, progress)?
-                {
-                    return Ok(out);
-                }
-                Some(keep_input::InputCheck::Remeshed(why))
+            {
+                return Ok(out);
             }
+            Some(keep_input::InputCheck::Remeshed(why))
         }
-    } else {
-        None
     };
     let mut out = remesh_field(evaluator, guide, bounds, options, progress)?;
     out.stats.input = not_kept;

@@ -312,6 +312,13 @@ impl RemeshReport {
             Some(InputCheck::Kept { repairs, separated }) => {
                 members.extend(input_changes(repairs, separated));
             }
+            Some(InputCheck::Reoriented {
+                repairs,
+                turned_faces,
+            }) => {
+                members.extend(input_changes(repairs, SeparatedCounts::default()));
+                members.push(("input_turned_faces", turned_faces.to_string()));
+            }
             Some(InputCheck::Cut {
                 repairs,
                 separated,
