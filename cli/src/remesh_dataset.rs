@@ -17,7 +17,8 @@ use crate::remesh::RemeshKnobs;
 /// patch sets: their own evaluator, vertices at their surface hits; oriented point clouds: the
 /// fast evaluator), written to OUT/<path below the root>.FORMAT. OUT/manifest.jsonl gets one
 /// JSON line per input: status ok / done / failed / timeout, the error, the input's kind, faces
-/// (triangles, patches or B-rep faces) and vertices (mesh vertices or points), the output's
+/// (triangles, patches or B-rep faces) and vertices (mesh vertices or points), the method
+/// (exact, parity or fast), how the output was made (kept, reoriented, cut, ...), the output's
 /// faces and vertices, whether it is valid (closed, manifold, oriented, no exact
 /// self-intersection), its components, the self-intersecting face pairs, the Hausdorff distance
 /// in finest cells to where the input bounds the solid (to a fine tessellation of a curved one;
@@ -64,6 +65,12 @@ pub struct Args {
     /// Do not weld STL and glTF vertices.
     #[arg(long)]
     pub no_weld: bool,
+    /// Remesh meshes that are closed but not consistently oriented (flipped faces: w is
+    /// fractional near them) by ray parity, the solid they enclose, as `gwn remesh --method
+    /// parity` (kept with their faces turned where that is proved); the manifest's method column
+    /// says which inputs were. Other inputs as without it.
+    #[arg(long)]
+    pub parity_where_flipped: bool,
     #[command(flatten)]
     pub knobs: RemeshKnobs,
 }
@@ -88,6 +95,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             weld: if args.no_weld { Some(false) } else { None },
         },
         keep_input: !args.knobs.always_remesh,
+        parity_where_flipped: args.parity_where_flipped,
     };
     let (rows, secs) = args.inputs.run(&job, &args.out, "remesh")?;
     let count = |s: Status| rows.iter().filter(|r| r.status == s).count();
@@ -107,6 +115,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
             .count()
     };
     let (inward, no_volume) = (empty("winds inward"), empty("no volume"));
+    let parity = rows
+        .iter()
+        .filter(|r| r.stats.get("method") == Some("\"parity\""))
+        .count();
+    let parity = if parity > 0 {
+        format!("; {parity} by parity (closed, faces flipped: the manifest's method column)")
+    } else {
+        String::new()
+    };
     let empties = if inward + no_volume > 0 {
         format!(
             "; {} outputs empty ({inward} wound inward, {no_volume} without volume: the \
@@ -119,7 +136,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     outln!(
         "remeshed {} inputs ({} done before, {redone} redone, {} failed, {} timed out) in \
          {secs:.3} s; {valid} outputs valid (closed, manifold, oriented, no self-intersection)\
-         {empties}; manifest: {}",
+         {empties}{parity}; manifest: {}",
         count(Status::Ok),
         count(Status::Done),
         count(Status::Failed),

@@ -142,7 +142,7 @@ def label_dataset(paths, out_dir, *, root=None, uniform=50_000, near=50_000,
 def remesh_dataset(paths, out_dir, res=128, *, root=None, format="ply", samples=10_000,
                    thicken_cells=None, weld=None, time_limit=None, bisect=None, simplify=True,
                    refine_plates=True, sub_cell_levels=None, planar_levels=None,
-                   always_remesh=False, threads=None, progress=None):
+                   always_remesh=False, parity_where_flipped=False, threads=None, progress=None):
     """Remeshes a dataset at w = 1/2, exactly as ``gwn remesh-dataset`` does.
 
     Per input: the closed, edge- and vertex-manifold, oriented surface ``gwn remesh`` makes at
@@ -161,12 +161,17 @@ def remesh_dataset(paths, out_dir, res=128, *, root=None, format="ply", samples=
     is a closed, manifold, oriented surface without self-intersections bounding ``w > 1/2``
     (exact tests) is written as it is (the row's ``kept``) unless ``always_remesh``; otherwise its
     clean components can be (``kept_faces``: the input's faces written as they are).
+    ``parity_where_flipped`` remeshes meshes that are closed but not consistently oriented
+    (flipped faces, where w is fractional) by ray parity, the solid they enclose, as
+    ``gwn.remesh(..., method="parity")`` (written with their faces turned where that is proved:
+    ``reoriented``); the row's ``method`` says which (``exact``, ``parity``, ``fast``).
 
     ``progress`` as in ``gwn.label_dataset``. Returns the manifest rows (dicts with ``mesh``,
     ``output``, ``status`` in ``ok``/``done``/``failed``/``timeout``, ``error``, ``input`` (the
     kind: ``mesh``, ``point cloud``, ``patch set``, ``STEP model``), ``faces`` (triangles,
     patches or B-rep faces), ``vertices`` (mesh vertices or points), ``output_faces``,
-    ``kept``, ``outcome`` (``kept``, ``cut``, ``partly kept``, ``remeshed`` or ``bounds nothing``),
+    ``method``, ``kept``, ``outcome`` (``kept``, ``reoriented``, ``cut``, ``partly kept``,
+    ``remeshed`` or ``bounds nothing``),
     ``kept_faces``, ``empty`` (``None``, or why an empty output is empty: ``winds inward`` or
     ``no volume``), ``output_vertices``, ``valid`` (closed, manifold, oriented, no exact
     self-intersection),
@@ -184,7 +189,7 @@ def remesh_dataset(paths, out_dir, res=128, *, root=None, format="ply", samples=
             time_limit=time_limit,
             bisect=bisect, simplify=simplify, refine_plates=refine_plates,
             sub_cell_levels=sub_cell_levels, planar_levels=planar_levels,
-            always_remesh=always_remesh),
+            always_remesh=always_remesh, parity_where_flipped=parity_where_flipped),
         threads=threads,
         progress=None if callback is None else (lambda line: callback(_json.loads(line))))
     return [_json.loads(r) for r in rows]

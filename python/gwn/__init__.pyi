@@ -393,6 +393,7 @@ def remesh_dataset(
     sub_cell_levels: Optional[int] = None,
     planar_levels: Optional[int] = None,
     always_remesh: bool = False,
+    parity_where_flipped: bool = False,
     threads: Optional[int] = None,
     progress: Union[None, bool, Callable[[dict], Any]] = None,
 ) -> list[dict]:

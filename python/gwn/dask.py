@@ -75,7 +75,8 @@ def _remesh_one(path, out_dir, root, res, options):
 def remesh_dataset(paths, out_dir, client=None, res=128, *, root=None, format="ply",
                    samples=10_000, thicken_cells=None, weld=None, time_limit=None, bisect=None,
                    simplify=True, refine_plates=True, sub_cell_levels=None, planar_levels=None,
-                   always_remesh=False, threads_per_task=1, progress=None):
+                   always_remesh=False, parity_where_flipped=False, threads_per_task=1,
+                   progress=None):
     """Remeshes ``paths`` into ``out_dir`` on a Dask cluster (``client``: a
     ``dask.distributed.Client``; default: the current one), one task per mesh. Options and
     ``progress`` as in ``gwn.remesh_dataset``; ``threads_per_task`` is the Rust thread count
@@ -90,7 +91,8 @@ def remesh_dataset(paths, out_dir, client=None, res=128, *, root=None, format="p
     options = _remesh_job_options(
         format=format, samples=samples, thicken_cells=thicken_cells, weld=weld,
         time_limit=time_limit, bisect=bisect, simplify=simplify, refine_plates=refine_plates, sub_cell_levels=sub_cell_levels,
-        planar_levels=planar_levels, always_remesh=always_remesh)
+        planar_levels=planar_levels, always_remesh=always_remesh,
+        parity_where_flipped=parity_where_flipped)
     options["threads"] = threads_per_task
     return _run(_remesh_one, paths, out_dir, client, root, format.lower(), progress, "remesh",
                 res=res, options=options)

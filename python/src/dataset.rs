@@ -190,6 +190,7 @@ fn remesh_job(
     sub_cell_levels: u32,
     planar_levels: u32,
     always_remesh: bool,
+    parity_where_flipped: bool,
 ) -> PyResult<RemeshJob> {
     let format =
         SurfaceFormat::of_path(std::path::Path::new(&format!("x.{format}"))).ok_or_else(|| {
@@ -209,6 +210,7 @@ fn remesh_job(
     job.options.sub_cell_levels = sub_cell_levels;
     job.options.planar_levels = planar_levels;
     job.keep_input = !always_remesh;
+    job.parity_where_flipped = parity_where_flipped;
     job.validate().map_err(PyValueError::new_err)?;
     Ok(job)
 }
@@ -227,6 +229,7 @@ fn remesh_job(
     simplify = true, refine_plates = true,
     sub_cell_levels = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS,
     planar_levels = gwn::products::remesh::DEFAULT_PLANAR_LEVELS, always_remesh = false,
+    parity_where_flipped = false,
     threads = None, progress = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn remesh_dataset(
@@ -246,6 +249,7 @@ pub fn remesh_dataset(
     sub_cell_levels: u32,
     planar_levels: u32,
     always_remesh: bool,
+    parity_where_flipped: bool,
     threads: Option<Threads>,
     progress: Option<PyObject>,
 ) -> PyResult<Vec<String>> {
@@ -262,6 +266,7 @@ pub fn remesh_dataset(
         sub_cell_levels,
         planar_levels,
         always_remesh,
+        parity_where_flipped,
     )?;
     run_job(py, job, paths, out_dir, root, threads, progress)
 }
@@ -276,6 +281,7 @@ pub fn remesh_dataset(
     simplify = true, refine_plates = true,
     sub_cell_levels = gwn::products::remesh::DEFAULT_SUB_CELL_LEVELS,
     planar_levels = gwn::products::remesh::DEFAULT_PLANAR_LEVELS, always_remesh = false,
+    parity_where_flipped = false,
     threads = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn remesh_file(
@@ -295,6 +301,7 @@ pub fn remesh_file(
     sub_cell_levels: u32,
     planar_levels: u32,
     always_remesh: bool,
+    parity_where_flipped: bool,
     threads: Option<Threads>,
 ) -> PyResult<String> {
     let job = remesh_job(
@@ -310,6 +317,7 @@ pub fn remesh_file(
         sub_cell_levels,
         planar_levels,
         always_remesh,
+        parity_where_flipped,
     )?;
     let root = std::path::absolute(&root).unwrap_or(root);
     threads::run(py, threads, move || {

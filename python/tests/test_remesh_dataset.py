@@ -100,6 +100,34 @@ def test_remesh_time_limit_is_a_timeout_error():
                                   gwn.remesh(V, F, res=16)[1])
 
 
+def write_flipped_cube(path):
+    """The unit cube with every other face flipped (closed, not consistently oriented) as OBJ."""
+    from conftest import CUBE_F, CUBE_V
+    faces = [f[::-1] if k % 2 else f for k, f in enumerate(CUBE_F)]
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text("".join(f"v {x} {y} {z}\n" for x, y, z in CUBE_V)
+                    + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in faces))
+    return path
+
+
+def test_remesh_dataset_parity_where_flipped(tmp_path):
+    """A closed mesh with flipped faces goes by parity on request, kept with its faces turned
+    (the faces ``gwn.remesh(method="parity")`` gives); the clean cube stays the exact method's."""
+    flipped = write_flipped_cube(tmp_path / "in" / "flipped.obj")
+    cube = copy_fixtures(tmp_path, {"cube.off": "cube.off"})[0]
+    rows = gwn.remesh_dataset([cube, flipped], tmp_path / "out", 16, samples=0,
+                              parity_where_flipped=True)
+    assert [r["method"] for r in rows] == ["exact", "parity"]
+    assert [r["outcome"] for r in rows] == ["kept", "reoriented"]
+    assert rows[1]["valid"] is True and rows[1]["kept_faces"] == 6
+    V, F = gwn.load(tmp_path / "out" / "flipped.obj.ply")
+    Vr, Fr = gwn.remesh(*gwn.load(flipped), res=16, method="parity")
+    np.testing.assert_array_equal(F, Fr)
+    np.testing.assert_array_equal(V, Vr)
+    off = gwn.remesh_dataset([flipped], tmp_path / "off", 16, samples=0)
+    assert off[0]["method"] == "exact" and off[0]["outcome"] == "remeshed"
+
+
 def test_dask_remesh_matches_serial(tmp_path):
     try:
         from dask.distributed import Client, LocalCluster
@@ -114,6 +142,10 @@ def test_dask_remesh_matches_serial(tmp_path):
                       dashboard_address=None) as cluster, Client(cluster) as client:
         rows = gwn.dask.remesh_dataset(paths, tmp_path / "dask", client, 24, **OPTS,
                                        format="obj")
+        flipped = write_flipped_cube(tmp_path / "in" / "flipped.obj")
+        parity = gwn.dask.remesh_dataset([flipped], tmp_path / "dask_parity", client, 16,
+                                         samples=0, parity_where_flipped=True)
+        assert parity[0]["method"] == "parity" and parity[0]["outcome"] == "reoriented"
         with pytest.raises(ValueError, match="both be written"):
             gwn.dask.remesh_dataset([paths[0], paths[0]], tmp_path / "twice", client)
         assert not (tmp_path / "twice").exists()

@@ -594,3 +594,89 @@ fn remesh_dataset_takes_step_models_patch_sets_and_point_clouds() {
     assert_eq!(rows[0].stats.get("input"), Some("\"STEP model\""));
     assert_eq!(rows[1].status, Status::Ok);
 }
+
+/// `parity_where_flipped` (`--parity-where-flipped`): a closed mesh with flipped faces is
+/// remeshed by parity, kept with its faces turned (the bytes `gwn remesh --method parity`
+/// writes), while a clean cube and an open box go the exact method's way; the manifest's
+/// `method` says which, and the CLI counts them. Off: the flipped cube's fractional `w` is
+/// remeshed.
+#[test]
+fn parity_where_flipped_remeshes_closed_flipped_meshes_by_their_parity() {
+    let scratch = Scratch::new("parity");
+    let dir = &scratch.0;
+    let input = dir.join("in");
+    std::fs::create_dir_all(&input).unwrap();
+    let cube = gwn::testing::unit_cube(false);
+    let flipped: Vec<[u32; 3]> = (cube.triangles().iter().enumerate())
+        .map(|(f, &[a, b, c])| if f % 2 == 1 { [a, c, b] } else { [a, b, c] })
+        .collect();
+    let flipped = gwn::Mesh::new(cube.positions().to_vec(), flipped).unwrap();
+    gwn::mesh::write_obj(
+        std::fs::File::create(input.join("flipped.obj")).unwrap(),
+        &flipped,
+    )
+    .unwrap();
+    gwn::mesh::write_obj(
+        std::fs::File::create(input.join("open.obj")).unwrap(),
+        &gwn::testing::unit_cube(true),
+    )
+    .unwrap();
+    std::fs::copy(fixture("cube.off"), input.join("cube.off")).unwrap();
+    let meshes: Vec<PathBuf> = ["cube.off", "flipped.obj", "open.obj"]
+        .iter()
+        .map(|n| input.join(n))
+        .collect();
+    let out = dir.join("out");
+    let job = RemeshJob {
+        samples: 0,
+        parity_where_flipped: true,
+        ..RemeshJob::new(16)
+    };
+    let rows = run_dataset(&job, &meshes, &out, None, |_| {}).unwrap();
+    let stat = |i: usize, name: &str| rows[i].stats.get(name).unwrap().to_string();
+    let column = |name: &str| (0..3).map(|i| stat(i, name)).collect::<Vec<_>>();
+    assert_eq!(column("method"), ["\"exact\"", "\"parity\"", "\"exact\""]);
+    assert_eq!(
+        column("outcome"),
+        ["\"kept\"", "\"reoriented\"", "\"remeshed\""]
+    );
+    assert_eq!(column("valid"), ["true", "true", "true"]);
+    // Six of the flipped cube's faces turned back, the other six written as they are.
+    assert_eq!(stat(1, "kept_faces"), "6");
+    assert_eq!(stat(1, "output_faces"), "12");
+    assert_eq!(
+        std::fs::read(out.join("flipped.obj.ply")).unwrap(),
+        remeshed_by_the_cli(&meshes[1], 16, dir, &["--method", "parity"])
+    );
+    // Off, as before: the exact method remeshes the flipped cube's fractional `w`, and the
+    // option's change redoes every output.
+    let off = RemeshJob {
+        parity_where_flipped: false,
+        ..job
+    };
+    let rows_off = run_dataset(&off, &meshes, &out, None, |_| {}).unwrap();
+    assert_eq!(rows_off[1].stats.get("method"), Some("\"exact\""));
+    assert_eq!(rows_off[1].stats.get("outcome"), Some("\"remeshed\""));
+    assert!(rows_off.iter().all(|r| r.redone.is_some()), "{rows_off:?}");
+    // The CLI: the same files, the parity inputs counted.
+    let (ok, stdout, stderr) = gwn(&[
+        "remesh-dataset",
+        input.to_str().unwrap(),
+        "--out",
+        dir.join("cli").to_str().unwrap(),
+        "--res",
+        "16",
+        "--samples",
+        "0",
+        "--parity-where-flipped",
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(
+        stdout.contains("; 1 by parity (closed, faces flipped"),
+        "{stdout}"
+    );
+    assert_eq!(
+        std::fs::read(dir.join("cli/flipped.obj.ply")).unwrap(),
+        remeshed_by_the_cli(&meshes[1], 16, dir, &["--method", "parity"])
+    );
+}

@@ -39,6 +39,8 @@ use super::thicken::{self, MeshField, ThickenedSheets};
 use super::write::{SurfaceFormat, write_surface};
 use super::{Keep, RemeshOptions, Remeshed, remesh_guided, remesh_mesh};
 use crate::eval::Evaluator;
+use crate::eval::antipodal::BoundaryBy;
+use crate::eval::parity::{CrossingParity, EdgeCensus};
 use crate::input::{Input, InputKind, load_input_with};
 use crate::io::LoadOptions;
 use crate::mesh::Mesh;
@@ -69,6 +71,13 @@ pub struct RemeshJob {
     /// Write a mesh that already is the boundary of its `w > ½` solid as it is
     /// ([`super::keep_input`]; the row's `kept`); `false` remeshes every input.
     pub keep_input: bool,
+    /// Remesh a mesh that is closed but not consistently oriented (flipped faces, where `w` is
+    /// fractional: [`crate::eval::parity::EdgeCensus::closed_but_not_oriented`]) by the parity
+    /// method, the solid it encloses, as `gwn remesh --method parity` does (with
+    /// [`RemeshJob::keep_input`], kept with its faces turned where
+    /// [`super::reorient::keep_reoriented`] proves it); every other input as without it. The
+    /// row's `method` says which. Off by default: `w > ½` is the remesh's definition.
+    pub parity_where_flipped: bool,
 }
 
 impl RemeshJob {
@@ -83,6 +92,7 @@ impl RemeshJob {
             load: LoadOptions::default(),
             time_limit: None,
             keep_input: true,
+            parity_where_flipped: false,
         }
     }
 }
@@ -119,6 +129,7 @@ impl MeshJob for RemeshJob {
         ("input", "null"),
         ("faces", "null"),
         ("vertices", "null"),
+        ("method", "null"),
         ("kept", "null"),
         ("outcome", "null"),
         ("kept_faces", "null"),
@@ -167,6 +178,10 @@ impl MeshJob for RemeshJob {
             ("evaluator_crossings", o.evaluator_crossings.to_string()),
             ("simplify", o.simplify.is_some().to_string()),
         ];
+        // Only when on: outputs made before the option existed stay reusable.
+        if self.parity_where_flipped {
+            fields.push(("parity_where_flipped", "true".into()));
+        }
         // Every simplification knob, so that a change to any of them redoes the output and
         // the manifest names it.
         if let Some(s) = &o.simplify {
@@ -259,7 +274,23 @@ impl MeshJob for RemeshJob {
         }
         in_time("loading")?;
         let bounds = input.bounding_box().ok_or("the input has no geometry")?;
-        let wn = EvaluatorSpec::default().build(&input)?;
+        // A closed mesh with flipped faces by its parity, on request.
+        let parity = input.mesh().filter(|mesh| {
+            self.parity_where_flipped
+                && EdgeCensus::of(mesh, BoundaryBy::default()).closed_but_not_oriented()
+        });
+        let wn: Box<dyn Evaluator> = match parity {
+            Some(mesh) => Box::new(CrossingParity::new(mesh)?),
+            None => EvaluatorSpec::default().build(&input)?,
+        };
+        stats.set(
+            "method",
+            json_string(match (&input, parity) {
+                (_, Some(_)) => "parity",
+                (Input::Cloud(_), None) => "fast",
+                _ => "exact",
+            }),
+        );
         let Some(mesh) = input.mesh() else {
             // A point cloud (the fast evaluator) or a curved input (its own surface hits place
             // the vertices): no triangles to guide the remesh or to thicken, as `gwn remesh`.
@@ -288,8 +319,10 @@ impl MeshJob for RemeshJob {
             .map(|k| bounds.max[k] - bounds.min[k])
             .fold(0.0, f64::max);
         let cell = extent / self.options.resolution as f64;
+        // A closed mesh has no open sheet to thicken.
         let thick = self
             .thicken_cells
+            .filter(|_| parity.is_none())
             .map(|k| ThickenedSheets::new(mesh, &*wn, k * cell))
             .transpose()?;
         let MeshField {
@@ -301,9 +334,12 @@ impl MeshJob for RemeshJob {
         in_time("building the evaluator")?;
         // Kept with its vertices merged by position, as the field's boundary is: not when
         // welding is off (a boundary by index).
-        let keep =
-            (self.keep_input && thick.is_none() && self.load.weld != Some(false)).then_some(mesh);
-        let out = self.remesh(field, Some(&guide), keep, bounds, deadline)?;
+        let keep = match parity {
+            _ if !(self.keep_input && thick.is_none() && self.load.weld != Some(false)) => Keep::No,
+            Some(_) => Keep::Parity,
+            None => Keep::Winding,
+        };
+        let out = self.remesh(field, Some(&guide), Some((mesh, keep)), bounds, deadline)?;
         self.finish(out, field, reference, bounds, deadline, stats)
     }
 }
@@ -344,12 +380,12 @@ fn input_name(kind: InputKind) -> &'static str {
 
 impl RemeshJob {
     /// [`remesh_guided`] under the job's options and `deadline`, its time limit named as the
-    /// job's; [`super::remesh_mesh`] with `kept` (the mesh, when it may be kept as it is).
+    /// job's; [`super::remesh_mesh`] with `mesh` (the mesh, and whether it may be kept).
     fn remesh(
         &self,
         field: &dyn Evaluator,
         guide: Option<&SegmentBvh>,
-        kept: Option<&Mesh>,
+        mesh: Option<(&Mesh, Keep)>,
         bounds: crate::BoundingBox,
         deadline: Option<(Instant, Duration)>,
     ) -> Result<Remeshed, RemeshJobError> {
@@ -357,8 +393,8 @@ impl RemeshJob {
             deadline: deadline.map(|(at, _)| at),
             ..self.options
         };
-        let out = match kept {
-            Some(mesh) => remesh_mesh(mesh, Keep::Winding, field, guide, bounds, &options, &|_| {}),
+        let out = match mesh {
+            Some((mesh, keep)) => remesh_mesh(mesh, keep, field, guide, bounds, &options, &|_| {}),
             None => remesh_guided(field, guide, bounds, &options, &|_| {}),
         };
         out.map_err(|e| -> RemeshJobError {
