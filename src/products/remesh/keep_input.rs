@@ -722,8 +722,14 @@ fn kept_or_cut(
             (pulled.positions, fixed, pulled.triangles, pulled.counts)
         }
     };
-    match bounds_its_solid(&positions, &fixed, &triangles) {
-        Ok(()) => Ok(KeptSurface {
+    // Step 2, then step 3's facts per component: its verdict, or that `w > ½` is nowhere.
+    let windings = embedded(&fixed, &triangles).and_then(|()| {
+        let surface =
+            Mesh::from_slices(&positions, &triangles).map_err(|_| NotKept::CoordinateRange)?;
+        component_windings(&surface, &fixed)
+    });
+    match windings.map(|w| (winding_verdict(&w), bounds_nothing(&w))) {
+        Ok((Ok(()), _)) => Ok(KeptSurface {
             positions,
             triangles,
             separated,
@@ -731,15 +737,14 @@ fn kept_or_cut(
             bounds_nothing: None,
         }),
         // Wound inward: the lattice would find `w > ½` nowhere, and need not look.
-        Err(why @ NotKept::Winding { .. }) if bounds_nothing(&positions, &fixed, &triangles) => {
-            Ok(KeptSurface {
-                positions: Vec::new(),
-                triangles: Vec::new(),
-                separated,
-                cut: None,
-                bounds_nothing: Some(why),
-            })
-        }
+        Ok((Err(why), true)) => Ok(KeptSurface {
+            positions: Vec::new(),
+            triangles: Vec::new(),
+            separated,
+            cut: None,
+            bounds_nothing: Some(why),
+        }),
+        Ok((Err(e), false)) => Err(given(e)),
         // Overlapping shells: their union, cut out of them, when that is provably the answer.
         Err(NotKept::SelfIntersecting { pairs, .. }) => {
             let cut =
@@ -925,37 +930,40 @@ pub(super) fn referenced<V: Copy>(values: &[V], triangles: &[[u32; 3]]) -> (Vec<
 /// Step 3 of the module documentation on a closed, manifold, oriented, embedded `surface` with
 /// its exact fixed-point vertices.
 pub(super) fn check_winding(surface: &Mesh, fixed: &[[i128; 3]]) -> Result<(), NotKept> {
+    winding_verdict(&component_windings(surface, fixed)?)
+}
+
+/// Step 3's facts `(o, s)` ([`component_winding`]) of every component of a closed, manifold,
+/// oriented, embedded `surface` with its exact fixed-point vertices, in [`components`]' order.
+fn component_windings(surface: &Mesh, fixed: &[[i128; 3]]) -> Result<Vec<(i64, i32)>, NotKept> {
     // The evaluator's own perturbation is what step 3 relies on: build it with the defaults
     // (ray `+z`), whatever evaluator the caller remeshes with.
     let wn = WindingNumber::new(surface).map_err(|_| NotKept::CoordinateRange)?;
-    for faces in components(surface.triangles()) {
-        let (outside, orientation) = component_winding(&wn, surface, fixed, &faces);
-        if !winds_right(outside, orientation) {
-            return Err(NotKept::Winding {
-                outside,
-                orientation,
-            });
-        }
-    }
-    Ok(())
+    Ok(components(surface.triangles())
+        .iter()
+        .map(|faces| component_winding(&wn, surface, fixed, faces))
+        .collect())
 }
 
-/// Whether `w ≤ 0` everywhere for a surface that passed steps 1 and 2 (closed, manifold,
-/// oriented, embedded), its vertices' exact coordinates `fixed`: off the surface `w` changes
-/// only across a component, and is constant along each side of one (its collar on that side is
-/// connected and meets no other component), so every value it takes is `0` (far away) or one
-/// of `o` and `o + s` for some component with `w = o` just outside it and orientation `s`.
-fn bounds_nothing(positions: &[[f64; 3]], fixed: &[[i128; 3]], triangles: &[[u32; 3]]) -> bool {
-    let Ok(surface) = Mesh::from_slices(positions, triangles) else {
-        return false;
-    };
-    let Ok(wn) = WindingNumber::new(&surface) else {
-        return false;
-    };
-    components(triangles).iter().all(|faces| {
-        let (outside, orientation) = component_winding(&wn, &surface, fixed, faces);
-        outside.max(outside + i64::from(orientation)) <= 0
-    })
+/// Step 3's verdict on the facts of [`component_windings`]: the first component that is not a
+/// wall of `{w > ½}` facing out of it.
+fn winding_verdict(windings: &[(i64, i32)]) -> Result<(), NotKept> {
+    match windings.iter().find(|&&(o, s)| !winds_right(o, s)) {
+        Some(&(outside, orientation)) => Err(NotKept::Winding {
+            outside,
+            orientation,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Whether `w ≤ 0` everywhere, from the facts of [`component_windings`] on a surface that
+/// passed steps 1 and 2 (closed, manifold, oriented, embedded): off the surface `w` changes only
+/// across a component, and is constant along each side of one (its collar on that side is
+/// connected and meets no other component), so every value it takes is `0` (far away) or one of
+/// `o` and `o + s` for some component with `w = o` just outside it and orientation `s`.
+fn bounds_nothing(windings: &[(i64, i32)]) -> bool {
+    windings.iter().all(|&(o, s)| o.max(o + i64::from(s)) <= 0)
 }
 
 /// The faces of each connected component (faces sharing a vertex are connected), each list in
