@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use clap::Args as ClapArgs;
 use gwn::products::remesh::crossings::SegmentBvh;
 use gwn::products::remesh::keep_input::{InputCheck, WhyEmpty};
+use gwn::products::remesh::reorient;
 use gwn::products::remesh::report::{
     DistanceReference, PhaseClock, RemeshReport, ReportPhase, curved_surface_for_distance,
 };
@@ -453,10 +454,23 @@ pub fn run(args: Args) -> Result<(), CliError> {
     {
         let census = EdgeCensus::of(mesh, method.boundary);
         if census.closed_but_not_oriented() {
+            // Whether parity would keep it (a linear check beside the remesh just run).
+            let turned = match reorient::keep_reoriented(mesh, bounds, &options) {
+                Ok(kept) => match kept.stats.input {
+                    Some(InputCheck::Reoriented { turned_faces, .. }) => Some(turned_faces),
+                    _ => None,
+                },
+                Err(_) => None,
+            };
+            let parity = match turned {
+                Some(n) => format!(
+                    "--method parity keeps it with {n} of its faces turned (proved, no lattice)"
+                ),
+                None => "--method parity remeshes the solid it encloses".to_string(),
+            };
             outln!(
                 "the input is closed but not consistently oriented ({} signed boundary edges): \
-                 w is fractional near its flipped faces; --method parity remeshes the solid it \
-                 encloses",
+                 w is fractional near its flipped faces; {parity}",
                 census.signed_boundary_edges
             )?;
         }

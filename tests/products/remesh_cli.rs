@@ -734,7 +734,7 @@ fn remesh_points_closed_unoriented_inputs_to_the_parity_method() {
     assert!(ok, "{stderr}");
     assert!(
         stdout.contains("the input is closed but not consistently oriented")
-            && stdout.contains("--method parity"),
+            && stdout.contains("--method parity keeps it with 6 of its faces turned"),
         "{stdout}"
     );
     // Kept with its six flipped faces turned back (no lattice), or remeshed on request.
