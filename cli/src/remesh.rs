@@ -283,6 +283,20 @@ pub fn run(args: Args) -> Result<(), CliError> {
         Some(InputCheck::Remeshed(why)) => {
             outln!("remeshed: the input is not kept as it is: {why}")?
         }
+        Some(InputCheck::Planar { repairs }) => {
+            let repairs = if repairs.is_empty() {
+                String::new()
+            } else {
+                format!(" ({repairs})")
+            };
+            outln!(
+                "{}: no lattice needed ({secs:.2} s): the input{repairs} lies in one plane and its \
+                 faces meet only at the corners and edges they share (exact), so |w| < 1/2 off \
+                 it and w > 1/2 nowhere",
+                args.out.display()
+            )?;
+            outln!("{topology}")?;
+        }
         Some(InputCheck::BoundsNothing { repairs, why }) => {
             let repairs = if repairs.is_empty() {
                 String::new()

@@ -171,7 +171,9 @@ fn remesh_dataset_writes_what_gwn_remesh_writes_and_resumes() {
     let kept_faces = |i: usize| kept[i].stats.get("kept_faces").unwrap().to_string();
     assert_eq!([kept_faces(0), kept_faces(2)], ["12", "0"]);
     let outcome = |i: usize| kept[i].stats.get("outcome").unwrap().to_string();
-    assert_eq!([outcome(0), outcome(2)], ["\"kept\"", "\"remeshed\""]);
+    // The lone triangle: a sheet in one plane, proved to bound nothing.
+    assert_eq!([outcome(0), outcome(2)], ["\"kept\"", "\"planar\""]);
+    assert_eq!(kept[2].stats.get("empty"), Some("\"no volume\""));
     // An inward tetrahedron: proved to bound nothing, and the row says it winds inward.
     let inward = dir.join("in/inward.obj");
     std::fs::write(

@@ -32,7 +32,9 @@
 //!    component is wrong but every one has `o ≤ 0` and `o + s ≤ 0` (wound inward), `{w > ½}`
 //!    is empty: `w` is constant along each side of a component (the collar there is connected
 //!    and meets no other), so those values and `0` far away are all it takes. The output is
-//!    then empty, proved ([`InputCheck::BoundsNothing`]), with no lattice.
+//!    then empty, proved ([`InputCheck::BoundsNothing`]), with no lattice. So is an open sheet
+//!    whose faces lie in one plane and meet only where they share corners and edges
+//!    (`a_sheet_in_one_plane`, [`InputCheck::Planar`]; tried before step 1).
 //! 4. **Size**: the input has at most the face count the remesh would aim for, the simplifier's
 //!    fraction of a dense marching cubes' count at this resolution, estimated from the input's
 //!    area: marching cubes puts a vertex on every lattice edge the surface crosses (the faces'
@@ -258,6 +260,14 @@ pub enum InputCheck {
     },
     /// The input was remeshed, for this reason.
     Remeshed(NotKept),
+    /// `{w > ½}` is empty, proved on the input (after the repairs of [`exact_repair`]): an
+    /// open sheet whose faces all lie in one plane and meet only at the corners and edges they
+    /// share (exact), so `|w| < ½` everywhere off it (`a_sheet_in_one_plane`). The output is
+    /// empty, without a lattice.
+    Planar {
+        /// What the repairs changed.
+        repairs: exact_repair::RepairCounts,
+    },
     /// `{w > ½}` is empty, proved on the input (after the repairs, pinches pulled apart): a
     /// closed, manifold, oriented surface without self-intersections whose every component has
     /// `w ≤ 0` on both of its sides (wound inward), so `w ≤ 0` everywhere. The output is empty,
@@ -289,7 +299,7 @@ impl InputCheck {
     }
 
     /// Its name in reports and manifests: `kept`, `reoriented`, `cut`, `partly kept`,
-    /// `remeshed` or `bounds nothing`.
+    /// `remeshed`, `bounds nothing` or `planar`.
     pub fn name(&self) -> &'static str {
         match self {
             InputCheck::Kept { .. } => "kept",
@@ -298,13 +308,18 @@ impl InputCheck {
             InputCheck::PartlyKept { .. } => "partly kept",
             InputCheck::Remeshed(_) => "remeshed",
             InputCheck::BoundsNothing { .. } => "bounds nothing",
+            InputCheck::Planar { .. } => "planar",
         }
     }
 
     /// Whether the output was decided without a lattice: the input's own surface, or nothing
     /// ([`InputCheck::BoundsNothing`]).
     pub fn skipped_the_lattice(&self) -> bool {
-        self.is_input_surface() || matches!(self, InputCheck::BoundsNothing { .. })
+        self.is_input_surface()
+            || matches!(
+                self,
+                InputCheck::BoundsNothing { .. } | InputCheck::Planar { .. }
+            )
     }
 }
 
@@ -427,6 +442,21 @@ pub fn keep_input(
         lattice,
     } = prepared(mesh, bounds, options)?;
     let mut repairs = repaired.counts;
+    // An open sheet in one plane: nothing to keep and, proved, nothing to find.
+    if !original.closed && a_sheet_in_one_plane(&fixed, &repaired.triangles) {
+        return Ok(Remeshed {
+            positions: Vec::new(),
+            triangles: Vec::new(),
+            fixed: Vec::new(),
+            ticks_per_cell: 0,
+            cell_size: lattice.largest_cell(),
+            cell_sizes: lattice.h,
+            stats: RemeshStats {
+                input: Some(InputCheck::Planar { repairs }),
+                ..RemeshStats::default()
+            },
+        });
+    }
     // A face written twice the same way, all such in one plane: the second copies out, which
     // changes `w` by less than ½ where the rest's `w` is an integer (`{w > ½}` unchanged). A
     // repeated face puts its edges in more than two faces, so a clean input skips the search.
@@ -964,6 +994,30 @@ fn winding_verdict(windings: &[(i64, i32)]) -> Result<(), NotKept> {
 /// `o` and `o + s` for some component with `w = o` just outside it and orientation `s`.
 fn bounds_nothing(windings: &[(i64, i32)]) -> bool {
     windings.iter().all(|&(o, s)| o.max(o + i64::from(s)) <= 0)
+}
+
+/// Whether `triangles` (no zero-area face), on the exact coordinates `fixed`, all lie in one
+/// plane and meet only at the corners and edges they share (the exact intersection test): then
+/// `|w| < ½` everywhere off them. Off the plane, every face subtends a solid angle of one sign
+/// per orientation, and their interiors are disjoint, so are the cones from the point over
+/// them: `|w| ≤ Σ|Ω_f| / 4π = Ω(∪ f) / 4π`, and a bounded region of a plane subtends less than
+/// the half space's `2π`. In the plane, off the faces, every `Ω_f` is 0; on a face, the exact
+/// evaluator answers at a point just off the plane (its perturbation), where the bound holds.
+pub(super) fn a_sheet_in_one_plane(fixed: &[[i128; 3]], triangles: &[[u32; 3]]) -> bool {
+    let Some(&first) = triangles.first() else {
+        return false;
+    };
+    let [a, b, c] = first.map(|v| fixed[v as usize]);
+    if <[i128; 3] as intersect::ExactPoint>::projection_axis(a, b, c).is_none() {
+        return false;
+    }
+    let in_plane = triangles
+        .iter()
+        .flatten()
+        .all(|&v| <[i128; 3] as intersect::ExactPoint>::orient(a, b, c, fixed[v as usize]) == 0);
+    in_plane
+        && self_intersections_wide(fixed, triangles, intersection_budget(triangles.len()))
+            .is_ok_and(|si| si.pairs == 0 && si.degenerate_faces == 0)
 }
 
 /// The faces of each connected component (faces sharing a vertex are connected), each list in

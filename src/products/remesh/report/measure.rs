@@ -351,6 +351,9 @@ impl RemeshReport {
             Some(InputCheck::Remeshed(why)) => {
                 members.push(("input_not_kept", json_string(&why.to_string())));
             }
+            Some(InputCheck::Planar { repairs }) => {
+                members.extend(input_changes(repairs, SeparatedCounts::default()));
+            }
             Some(InputCheck::BoundsNothing { repairs, why }) => {
                 members.extend(input_changes(repairs, SeparatedCounts::default()));
                 members.push(("input_not_kept", json_string(&why.to_string())));
