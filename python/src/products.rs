@@ -528,7 +528,9 @@ pub fn filter_tets<'py>(
 /// ``input_largest_move``); faces overlapping in one plane (a part standing on a plate) are
 /// replaced by what they add up to there (``input_coplanar_faces``,
 /// ``input_crossing_vertices``); otherwise its clean components can come back as they are with
-/// the rest remeshed (``partly kept``). With ``method="parity"``, a closed, manifold mesh
+/// the rest remeshed (``partly kept``); an open sheet in one plane whose faces meet only at
+/// shared corners and edges comes back empty at once (``planar``: ``|w| < 1/2`` everywhere,
+/// proved). With ``method="parity"``, a closed, manifold mesh
 /// without self-intersections comes back with its faces turned to face out of the parity's
 /// solid (``reoriented``, ``input_turned_faces``; cavities inward), proved the same way.
 /// ``always_remesh=True`` remeshes it all anyway, as
