@@ -444,18 +444,8 @@ pub fn keep_input(
     let mut repairs = repaired.counts;
     // An open sheet in one plane: nothing to keep and, proved, nothing to find.
     if !original.closed && a_sheet_in_one_plane(&fixed, &repaired.triangles) {
-        return Ok(Remeshed {
-            positions: Vec::new(),
-            triangles: Vec::new(),
-            fixed: Vec::new(),
-            ticks_per_cell: 0,
-            cell_size: lattice.largest_cell(),
-            cell_sizes: lattice.h,
-            stats: RemeshStats {
-                input: Some(InputCheck::Planar { repairs }),
-                ..RemeshStats::default()
-            },
-        });
+        let input = InputCheck::Planar { repairs };
+        return Ok(without_a_lattice(Vec::new(), Vec::new(), &lattice, input));
     }
     // A face written twice the same way, all such in one plane: the second copies out, which
     // changes `w` by less than ½ where the rest's `w` is an integer (`{w > ½}` unchanged). A
@@ -473,9 +463,7 @@ pub fn keep_input(
         None => repaired.triangles,
     };
     let (positions, fixed, triangles) = if !repairs.is_empty() {
-        let (kept, triangles) = referenced(&fixed, &repaired_triangles);
-        let (positions, _) = referenced(&positions, &repaired_triangles);
-        (positions, kept, triangles)
+        referenced_exact(&positions, &fixed, &repaired_triangles)
     } else {
         (positions, fixed, repaired_triangles)
     };
@@ -574,7 +562,17 @@ pub fn keep_input(
         },
     };
     let (positions, triangles) = (surface.positions, surface.triangles);
-    Ok(Remeshed {
+    Ok(without_a_lattice(positions, triangles, &lattice, input))
+}
+
+/// An output decided without a lattice (the input's surface, or nothing): `input` says how.
+pub(super) fn without_a_lattice(
+    positions: Vec<[f64; 3]>,
+    triangles: Vec<[u32; 3]>,
+    lattice: &Lattice,
+    input: InputCheck,
+) -> Remeshed {
+    Remeshed {
         positions,
         triangles,
         fixed: Vec::new(),
@@ -585,7 +583,22 @@ pub fn keep_input(
             input: Some(input),
             ..RemeshStats::default()
         },
-    })
+    }
+}
+
+/// A surface's vertices, their exact fixed-point coordinates, and its faces.
+pub(super) type ExactSurface = (Vec<[f64; 3]>, Vec<[i128; 3]>, Vec<[u32; 3]>);
+
+/// The vertices `triangles` refer to, their exact coordinates, and the triangles renumbered to
+/// them ([`referenced`] on both).
+pub(super) fn referenced_exact(
+    positions: &[[f64; 3]],
+    fixed: &[[i128; 3]],
+    triangles: &[[u32; 3]],
+) -> ExactSurface {
+    let (kept, renumbered) = referenced(fixed, triangles);
+    let (positions, _) = referenced(positions, triangles);
+    (positions, kept, renumbered)
 }
 
 /// The input as [`keep_input`] and [`super::reorient::keep_reoriented`] take it (see the

@@ -33,10 +33,10 @@ use crate::kernel::predicates::closed_surface_orientation;
 
 use super::keep_input::{
     self, InputCheck, NotKept, Prepared, check_winding, component_winding, components, embedded,
-    referenced, topology_problem,
+    referenced_exact, topology_problem, without_a_lattice,
 };
 use super::report::TopologyReport;
-use super::{RemeshOptions, RemeshStats, Remeshed};
+use super::{RemeshOptions, Remeshed};
 
 /// The input with its faces turned to face out of the parity method's solid, as the remesh of
 /// `mesh` under that method (with `bounds` and `options` as the remesh would take them), when
@@ -73,9 +73,7 @@ pub fn keep_reoriented(
     let (positions, fixed, triangles) = if repairs.is_empty() {
         (positions, fixed, repaired.triangles)
     } else {
-        let (kept, triangles) = referenced(&fixed, &repaired.triangles);
-        let (positions, _) = referenced(&positions, &repaired.triangles);
-        (positions, kept, triangles)
+        referenced_exact(&positions, &fixed, &repaired.triangles)
     };
     // Step 1 but the orientation, which is what this mends.
     match topology_problem(&TopologyReport::of(&positions, &triangles)) {
@@ -119,21 +117,11 @@ pub fn keep_reoriented(
         .zip(&turned)
         .filter(|(a, b)| a != b)
         .count();
-    Ok(Remeshed {
-        positions,
-        triangles: turned,
-        fixed: Vec::new(),
-        ticks_per_cell: 0,
-        cell_size: lattice.largest_cell(),
-        cell_sizes: lattice.h,
-        stats: RemeshStats {
-            input: Some(InputCheck::Reoriented {
-                repairs,
-                turned_faces,
-            }),
-            ..RemeshStats::default()
-        },
-    })
+    let input = InputCheck::Reoriented {
+        repairs,
+        turned_faces,
+    };
+    Ok(without_a_lattice(positions, turned, &lattice, input))
 }
 
 /// `triangles` (every edge in exactly two faces) with faces turned so that the two faces of
