@@ -18,7 +18,6 @@ use gwn::products::remesh::{
 
 use crate::common::{CliError, outln};
 use crate::method::{MethodArgs, ToleranceArgs};
-use gwn::eval::parity::EdgeCensus;
 use gwn::spec::Method;
 
 /// Remesh at w = 1/2: a closed, edge- and vertex-manifold, consistently oriented surface of the
@@ -466,27 +465,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if let (Some(mesh), Method::Exact, None) =
         (input.mesh(), method.method_for(input.kind()), args.thicken)
     {
-        let census = EdgeCensus::of(mesh, method.boundary);
-        if census.closed_but_not_oriented() {
-            // Whether parity would keep it (a linear check beside the remesh just run).
-            let turned = match reorient::keep_reoriented(mesh, bounds, &options) {
-                Ok(kept) => match kept.stats.input {
-                    Some(InputCheck::Reoriented { turned_faces, .. }) => Some(turned_faces),
-                    _ => None,
-                },
-                Err(_) => None,
-            };
-            let parity = match turned {
-                Some(n) => format!(
-                    "--method parity keeps it with {n} of its faces turned (proved, no lattice)"
-                ),
-                None => "--method parity remeshes the solid it encloses".to_string(),
-            };
-            outln!(
-                "the input is closed but not consistently oriented ({} signed boundary edges): \
-                 w is fractional near its flipped faces; {parity}",
-                census.signed_boundary_edges
-            )?;
+        if let Some(flipped) = reorient::flipped_input(mesh, method.boundary, bounds, &options) {
+            outln!("{flipped}; {}", flipped.way_out("--method parity"))?;
         }
     }
     // An empty output is right where `w > ½` is empty, but rarely what was meant: say why.

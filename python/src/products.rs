@@ -575,7 +575,7 @@ pub fn remesh<'py>(
 
     use gwn::products::remesh::keep_input::WhyEmpty;
     use gwn::products::remesh::{
-        Keep, RemeshOptions, remesh_guided, remesh_mesh,
+        Keep, RemeshOptions, remesh_guided, remesh_mesh, reorient,
         thicken::{self, ThickenedSheets},
     };
     let method = spec_of(method, beta, order, tolerance)?;
@@ -707,10 +707,30 @@ pub fn remesh<'py>(
         });
         let empty = (out.triangles.is_empty() && thick.is_none() && !mesh.is_empty())
             .then(|| WhyEmpty::of_mesh(&mesh, bounds, &options, out.stats.input));
-        Ok((measured(out, field, request)?, empty))
+        let nowhere = out.stats.input.is_some_and(|i| i.skipped_the_lattice());
+        // As `gwn remesh` says it: a closed input with flipped faces has a fractional `w`.
+        let exact = method.method_for(gwn::input::InputKind::Mesh) == gwn::spec::Method::Exact;
+        let flipped = (exact && thick.is_none())
+            .then(|| reorient::flipped_input(&mesh, method.boundary, bounds, &options))
+            .flatten();
+        Ok((measured(out, field, request)?, empty, nowhere, flipped))
     })?
     .map_err(remesh_error)?;
-    let (out, empty) = out;
+    let (out, empty, nowhere, flipped) = out;
+    let warn = |message: String| {
+        PyErr::warn(
+            py,
+            &py.get_type::<pyo3::exceptions::PyUserWarning>(),
+            &std::ffi::CString::new(message).expect("no NUL in the message"),
+            1,
+        )
+    };
+    if let Some(flipped) = flipped {
+        warn(format!(
+            "remesh: {flipped}; {}",
+            flipped.way_out("method='parity'")
+        ))?;
+    }
     // As `gwn remesh` prints it: an empty output is right where `w > 1/2` is empty, but rarely
     // what was meant.
     if let Some(why) = empty {
@@ -718,15 +738,14 @@ pub fn remesh<'py>(
             WhyEmpty::WindsInward => "method='parity' remeshes the solid it encloses",
             WhyEmpty::NoVolume => "thicken=EPS closes open sheets into thin solids; a finer res",
         };
-        PyErr::warn(
-            py,
-            &py.get_type::<pyo3::exceptions::PyUserWarning>(),
-            &std::ffi::CString::new(format!(
-                "remesh: the output is empty: w > 1/2 at no point of the lattice; {why}: {way_out}"
-            ))
-            .expect("no NUL in the message"),
-            1,
-        )?;
+        let nowhere = if nowhere {
+            "w > 1/2 nowhere"
+        } else {
+            "w > 1/2 at no point of the lattice"
+        };
+        warn(format!(
+            "remesh: the output is empty: {nowhere}; {why}: {way_out}"
+        ))?;
     }
     surface_tuple(py, out)
 }

@@ -59,6 +59,18 @@ def test_remesh_with_parity_encloses_the_cube():
     assert report["hausdorff_cells"] < 1
 
 
+def test_remesh_of_a_flipped_closed_mesh_warns_and_names_parity():
+    # The exact method's w is fractional inside: said, with what parity would do.
+    with pytest.warns(UserWarning, match=r"closed but not consistently oriented \(\d+ signed "
+                      r"boundary edges\).*method='parity' keeps it with 6 of its faces turned"):
+        gwn.remesh(CUBE_V, FLIPPED_F, res=8)
+    # Nothing to say about a consistently oriented cube.
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        gwn.remesh(CUBE_V, CUBE_F, res=8)
+
+
 def test_the_parity_evaluator_pickles_with_its_ray_and_has_no_gradient():
     import pickle
 

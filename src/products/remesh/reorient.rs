@@ -28,7 +28,8 @@
 
 use crate::Mesh;
 use crate::base::bounding_box::BoundingBox;
-use crate::eval::antipodal::WindingNumber;
+use crate::eval::antipodal::{BoundaryBy, WindingNumber};
+use crate::eval::parity::EdgeCensus;
 use crate::kernel::predicates::closed_surface_orientation;
 
 use super::keep_input::{
@@ -212,4 +213,62 @@ fn top_vertex(positions: &[[f64; 3]], faces: impl Iterator<Item = [u32; 3]>) -> 
         .flatten()
         .max_by(|&a, &b| lex(a).partial_cmp(&lex(b)).expect("finite coordinates"))
         .expect("a component has faces")
+}
+
+/// What a remesh under the exact method tells the user about a mesh that is closed but not
+/// consistently oriented (`gwn remesh`'s line, `gwn.remesh`'s warning): `w` is fractional near
+/// its flipped faces, and the parity method is the way to the solid it encloses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FlippedInput {
+    /// Edges of its signed boundary ([`EdgeCensus::signed_boundary_edges`]).
+    pub signed_boundary_edges: usize,
+    /// Faces [`keep_reoriented`] turns to keep it, when it does.
+    pub turned_faces: Option<usize>,
+}
+
+/// [`FlippedInput`] for `mesh` (its edges matched `by` position or index, as the exact
+/// evaluator matched them), when it is closed but not consistently oriented
+/// ([`EdgeCensus::closed_but_not_oriented`]); `bounds` and `options` as the remesh took them.
+pub fn flipped_input(
+    mesh: &Mesh,
+    by: BoundaryBy,
+    bounds: BoundingBox,
+    options: &RemeshOptions,
+) -> Option<FlippedInput> {
+    let census = EdgeCensus::of(mesh, by);
+    if !census.closed_but_not_oriented() {
+        return None;
+    }
+    let turned_faces = match keep_reoriented(mesh, bounds, options).map(|k| k.stats.input) {
+        Ok(Some(InputCheck::Reoriented { turned_faces, .. })) => Some(turned_faces),
+        _ => None,
+    };
+    Some(FlippedInput {
+        signed_boundary_edges: census.signed_boundary_edges,
+        turned_faces,
+    })
+}
+
+impl FlippedInput {
+    /// The way out, naming the parity method as the caller spells it (`--method parity`,
+    /// `method='parity'`).
+    pub fn way_out(&self, parity: &str) -> String {
+        match self.turned_faces {
+            Some(n) => {
+                format!("{parity} keeps it with {n} of its faces turned (proved, no lattice)")
+            }
+            None => format!("{parity} remeshes the solid it encloses"),
+        }
+    }
+}
+
+impl std::fmt::Display for FlippedInput {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "the input is closed but not consistently oriented ({} signed boundary edges): w is \
+             fractional near its flipped faces",
+            self.signed_boundary_edges
+        )
+    }
 }
