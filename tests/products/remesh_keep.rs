@@ -1011,7 +1011,7 @@ fn flat_sheets_bound_nothing() {
         Mesh::from_slices(&p, &t).unwrap()
     };
     let fan = Mesh::from_slices(
-        // A zero-area face along the x axis, and vertex 4 on the edge (0, 2) of face 1.
+        // A zero-area face along the x axis (face 1), and vertex 4 inside the edge (2, 0) of face 0.
         &[
             [0., 0., 0.],
             [2., 0., 0.],

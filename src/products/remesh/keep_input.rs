@@ -1068,20 +1068,25 @@ pub(super) fn component_winding(
     faces: &[u32],
 ) -> (i64, i32) {
     let (triangles, positions) = (surface.triangles(), surface.positions());
-    let lex = |v: u32| {
-        let p = positions[v as usize];
-        (p[0], p[1], p[2])
-    };
     let component = faces.iter().map(|&f| triangles[f as usize]);
-    let top = component
-        .clone()
-        .flatten()
-        .max_by(|&a, &b| lex(a).partial_cmp(&lex(b)).expect("finite coordinates"))
-        .expect("a component has faces");
+    let top = top_vertex(positions, component.clone());
     // `w` there is an integer (no boundary: χ alone); compare it as one.
     let outside = wn.eval(positions[top as usize]).round() as i64;
     let orientation = closed_surface_orientation(fixed, component, fixed[top as usize]);
     (outside, orientation)
+}
+
+/// The lexicographically largest vertex of some faces (finite coordinates): a point of theirs
+/// above all of them, hence outside their convex hull.
+pub(super) fn top_vertex(positions: &[[f64; 3]], faces: impl Iterator<Item = [u32; 3]>) -> u32 {
+    let lex = |v: u32| {
+        let p = positions[v as usize];
+        (p[0], p[1], p[2])
+    };
+    faces
+        .flatten()
+        .max_by(|&a, &b| lex(a).partial_cmp(&lex(b)).expect("finite coordinates"))
+        .expect("a component has faces")
 }
 
 /// Whether a component with `w = outside` just outside it and this orientation is a wall of

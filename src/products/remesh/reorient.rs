@@ -34,7 +34,7 @@ use crate::kernel::predicates::closed_surface_orientation;
 
 use super::keep_input::{
     self, InputCheck, NotKept, Prepared, check_winding, component_winding, components, embedded,
-    referenced_exact, topology_problem, without_a_lattice,
+    referenced_exact, top_vertex, topology_problem, without_a_lattice,
 };
 use super::report::TopologyReport;
 use super::{RemeshOptions, Remeshed};
@@ -200,19 +200,6 @@ fn turn(triangles: &mut [[u32; 3]], faces: &[u32]) {
         let [a, b, c] = triangles[f as usize];
         triangles[f as usize] = [a, c, b];
     }
-}
-
-/// The lexicographically largest vertex of some faces (an apex for the volume's sign: any
-/// point gives the same sign on a closed surface, one of its vertices keeps the terms small).
-fn top_vertex(positions: &[[f64; 3]], faces: impl Iterator<Item = [u32; 3]>) -> u32 {
-    let lex = |v: u32| {
-        let p = positions[v as usize];
-        (p[0], p[1], p[2])
-    };
-    faces
-        .flatten()
-        .max_by(|&a, &b| lex(a).partial_cmp(&lex(b)).expect("finite coordinates"))
-        .expect("a component has faces")
 }
 
 /// What a remesh under the exact method tells the user about a mesh that is closed but not
