@@ -1,7 +1,7 @@
 //! gwn's fast (Barnes–Hut) evaluator at the documented β is at least as accurate as libigl's fast
 //! winding number (`FastWindingNumberBVH`, order 2, accuracy_scale 2) on every mesh of the shared
-//! corpus libigl reads: the max error against the direct sum, over the same points, may not exceed
-//! libigl's. libigl's errors are constants measured once (libigl is not needed here), with
+//! corpus libigl reads: the max error against the exact value, over the same points, may not
+//! exceed libigl's. libigl's errors are constants measured once (libigl is not needed here), with
 //!
 //! ```text
 //! benches/peers/run.sh --help >/dev/null 2>&1; # creates benches/peers/.venv with libigl 2.6.3
@@ -18,7 +18,7 @@ use crate::common;
 use rayon::prelude::*;
 
 use gwn::Mesh;
-use gwn::eval::direct::winding_number_direct_batch;
+use gwn::eval::antipodal::WindingNumber;
 use gwn::eval::fast::{Admissibility, FastParams, FastWindingNumber};
 use gwn::products::sdf::SignedDistance;
 
@@ -89,7 +89,14 @@ fn fast_is_at_least_as_accurate_as_libigl_on_the_corpus() {
                 .copied()
                 .filter(|&q| distance.unsigned(q) > 1e-6 * diag)
                 .collect();
-            let exact = winding_number_direct_batch(&mesh, &subset);
+            // The reference is the exact (Antipodal) evaluator, O(B + log F) per point, not the
+            // direct sum, O(F): on 10^7 triangle visits per mesh the direct sum was 85 % of this
+            // test's time. The two agree on this corpus to rounding (tests/exact/agreement.rs,
+            // `exact_agrees_with_direct_and_with_other_rays_on_the_shared_corpus`), far below
+            // the errors compared here (libigl's smallest is 9.5e-7).
+            let exact = WindingNumber::new(&mesh)
+                .expect("corpus mesh builds")
+                .eval_batch(&subset);
             let max_error = |fast: &FastWindingNumber| {
                 fast.eval_batch(&subset)
                     .iter()
