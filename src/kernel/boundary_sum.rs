@@ -21,14 +21,14 @@ use super::angle_sum::AngleSum;
 use super::angle_sum::AngleSumAvx2;
 use super::double_double::DoubleDouble;
 use super::input_predicates::{
-    InputPoint, LatticeFrame, exact_edge_moment, input_flat_denominator_sign, input_inside_segment,
-    input_orient2d,
+    InputPoint, LatticeFrame, along_the_ray_off_its_line, exact_edge_moment,
+    input_flat_denominator_sign, input_inside_segment, input_orient2d,
 };
 #[cfg(target_arch = "x86_64")]
 use super::lanes::Avx2;
 use super::lanes::{Portable, edge_term, horizontal_sq, projected_dot, vertex_factors};
 use super::predicates::{
-    ORIENT2D_FILTER_CONVERSION, ORIENT2D_FILTER_RELATIVE, Width, orient2d_filter_lanes,
+    ORIENT2D_FILTER_CONVERSION, ORIENT2D_FILTER_RELATIVE, Orient2d, Width, orient2d_filter_lanes,
     perturbed_orient2d_at, query_inside_segment_at,
 };
 use super::spherical::{EdgeSigns, antipodal_edge_area, antipodal_edge_area_accurate};
@@ -830,8 +830,15 @@ impl BoundaryEdges {
         qz_units: f64,
         accurate: bool,
     ) -> f64 {
-        let (o, query_inside_segment) = if pa.on_lattice() && pb.on_lattice() && q.residual_exact()
-        {
+        let (o, query_inside_segment) = if along_the_ray_off_its_line(q, pa, pb) {
+            (
+                Orient2d {
+                    sign: 0,
+                    degenerate: true,
+                },
+                false,
+            )
+        } else if pa.on_lattice() && pb.on_lattice() && q.residual_exact() {
             let (qi, r, a, b) = (q.n, q.r, pa.n, pb.n);
             let o = perturbed_orient2d_at::<W>(
                 [qi[0], qi[1]],

@@ -284,6 +284,23 @@ pub fn input_orient2d(
     exact_orient2d(q, a, b, lattice)
 }
 
+/// Whether the segment `a b` is parallel to the ray (its ends project along it to one point) and
+/// `q` is at least two cells from that point on a horizontal axis. Then [`input_orient2d`] is
+/// `{ sign: 0, degenerate: true }` for `q` without arithmetic: `det(a − q, b − q)` has two equal
+/// columns, and both ε coefficients, `a_y − b_y` and `b_x − a_x`, are zero; and `q_ε` is not inside
+/// the segment ([`input_inside_segment`]: `q` is off the segment's line, so `a − q` and `b − q`
+/// are not parallel). Exact from the lattice points and residuals alone: equal `n` and exact `r`
+/// on an axis are one value, and `|n_q − n_a| ≥ 2` with `|r| ≤ ½` leaves at least a cell between
+/// the two values. Why it is worth asking: such an edge's orientation is 0 for every query, which
+/// no `f64` filter can sign, so off the lattice each of its terms took the exact (`Dyadic`)
+/// orientation and inside-segment tests: a wall's vertical boundary edge under the default `+z`
+/// ray, at every evaluation (assimp-regr01 at res 256: 18 M such terms, half the remesh's CPU).
+#[inline]
+pub fn along_the_ray_off_its_line(q: &InputPoint, a: &InputPoint, b: &InputPoint) -> bool {
+    let same = |k: usize| a.n[k] == b.n[k] && a.r[k] == b.r[k] && a.exact[k] && b.exact[k];
+    same(0) && same(1) && (0..2).any(|k| q.n[k].abs_diff(a.n[k]) >= 2)
+}
+
 #[cold]
 fn exact_orient2d(q: &InputPoint, a: &InputPoint, b: &InputPoint, l: &LatticeFrame) -> Orient2d {
     count_fallback();
@@ -601,6 +618,54 @@ mod tests {
                 query_inside_segment(q, a, b)
             );
         }
+    }
+
+    /// The shortcut's claim, against the exact predicates it skips: for segments parallel to the
+    /// ray (off the lattice or on it) and queries around them, whenever it applies the perturbed
+    /// orientation is `{0, degenerate}` and `q_ε` is not inside the segment; and it applies to
+    /// no segment that is not parallel to the ray, and to no query within a cell of its line.
+    #[test]
+    fn segments_along_the_ray_seen_from_off_their_line() {
+        let l = LatticeFrame::default();
+        let mut rng = TestRng::new(23);
+        let mut applied = 0;
+        for round in 0..20_000 {
+            let mut c = |m: u64| rng.below(m) as i64 - (m / 2) as i64;
+            let residual = |v: i64| match v.rem_euclid(4) {
+                0 => 0.0,
+                1 => 2f64.powi(-70) * v as f64,
+                2 => 0.5 - 2f64.powi(-40),
+                _ => -0.25,
+            };
+            let (x, y) = (c(7), c(7));
+            let (rx, ry) = (residual(c(8)), residual(c(8)));
+            let a = at([x, y, c(9)], [rx, ry, residual(c(8))]);
+            let mut b = at([x, y, c(9)], [rx, ry, residual(c(8))]);
+            // One in four: not quite parallel (a residual or a lattice step apart).
+            match round % 8 {
+                0 => b.r[0] += 2f64.powi(-60),
+                1 => b.n[1] += 1,
+                _ => {}
+            }
+            let q = at([c(11), c(11), c(9)], [residual(c(8)), residual(c(8)), 0.0]);
+            let parallel = a.n[..2] == b.n[..2] && a.r[..2] == b.r[..2];
+            if along_the_ray_off_its_line(&q, &a, &b) {
+                applied += 1;
+                assert!(parallel, "{a:?} {b:?}");
+                assert_eq!(
+                    exact_orient2d(&q, &a, &b, &l),
+                    Orient2d {
+                        sign: 0,
+                        degenerate: true
+                    },
+                    "{q:?} {a:?} {b:?}"
+                );
+                assert!(!input_inside_segment(&q, &a, &b, &l), "{q:?} {a:?} {b:?}");
+            } else if parallel {
+                assert!((0..2).all(|k| q.n[k].abs_diff(a.n[k]) < 2), "{q:?} {a:?}");
+            }
+        }
+        assert!(applied > 5_000, "{applied}");
     }
 
     #[test]

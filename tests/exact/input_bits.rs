@@ -653,6 +653,104 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
+
+    /// Sheets with edges parallel to a coordinate axis (a wall's vertical edges: along the ray
+    /// for two of the six rays), corners of mixed magnitudes so that the lattice holds some of
+    /// them and not others; queries on such an edge's line (at its ends, inside, beyond), one ulp
+    /// off it, and anywhere. Every ray's value is the rational oracle's. Such an edge's terms take
+    /// a shortcut (`along_the_ray_off_its_line`) once the query is two cells off its line.
+    ///
+    /// Without `coordinate()`'s `1e15` family: with it this test found a defect that is not the
+    /// shortcut's (it fails with the shortcut removed too), kept as
+    /// `sliver_at_1e15_magnitudes_under_a_mirrored_frame` (ignored) until it is fixed.
+    #[test]
+    fn edges_along_an_axis_are_evaluated_exactly_for_every_ray(
+        c in prop::collection::vec(
+            prop_oneof![(-10.0f64..10.0), (-1e-3f64..1e-3), (-1e-20f64..1e-20), Just(0.0)],
+            8,
+        ),
+        axis in 0usize..3,
+        spread in prop::collection::vec(-2.0f64..2.0, 3),
+        pick in 0usize..9,
+    ) {
+        // Corners 0-1 and 2-3 differ only along `axis`; corner 4 lifts a third face off the plane.
+        let corner = |u: f64, v: f64, t: f64| {
+            let mut p = [0.0; 3];
+            p[axis] = t;
+            p[(axis + 1) % 3] = u;
+            p[(axis + 2) % 3] = v;
+            p
+        };
+        let p = vec![
+            corner(c[0], c[1], c[2]),
+            corner(c[0], c[1], c[3]),
+            corner(c[4], c[5], c[3]),
+            corner(c[4], c[5], c[2]),
+            corner(c[6], c[7], c[2] + c[3]),
+        ];
+        let mesh = Mesh::from_slices(&p, &[[0, 3, 2], [0, 2, 1], [1, 2, 4]]).unwrap();
+        let (a, b) = (p[0], p[1]);
+        let on_line = |t: f64| corner(c[0], c[1], t);
+        let mut queries = vec![
+            a,
+            b,
+            on_line(0.5 * c[2] + 0.5 * c[3]),
+            on_line(2.0 * c[3] - c[2]),
+            std::array::from_fn(|k| a[k] + spread[k]),
+            std::array::from_fn(|k| 0.5 * (a[k] + p[4][k]) + spread[k] * 1e-3),
+        ];
+        for s in [-1, 1] {
+            let mut q = on_line(0.5 * c[2] + 0.5 * c[3]);
+            q[(axis + 1) % 3] = ulps(q[(axis + 1) % 3], s);
+            queries.push(q);
+        }
+        let mut q = on_line(0.5 * c[2] + 0.5 * c[3]);
+        q[(axis + 2) % 3] = ulps(q[(axis + 2) % 3], 1);
+        queries.push(q);
+        let evaluators = all_rays(&mesh);
+        for q in [queries[pick % queries.len()], queries[(pick + 4) % queries.len()]] {
+            for (ray, wn) in &evaluators {
+                let want = exact_winding_number_rational(&mesh, q, *ray);
+                let w = wn.eval(q);
+                prop_assert!(want.is_narrow(), "{:?} q={:?}: the oracle's enclosure [{}, {}] is too wide to check", ray, q, want.lo, want.hi);
+                prop_assert!(want.contains(w, 1e-12), "{:?} q={:?}: {} not in [{}, {}]", ray, q, w, want.lo, want.hi);
+            }
+        }
+    }
+}
+
+/// A known defect (found 2026-12-08 by `edges_along_an_axis_are_evaluated_exactly_for_every_ray`
+/// with `1e15` coordinates; not fixed yet): a sheet in the plane `x = 0`, 1e15 long along `y`
+/// (the 60-bit cell is then about 1e-3), with a corner 8.4e-4 (under a cell) off the line of two
+/// others. Off the surface, five rays and the direct sum agree (-1.2101629500741e-5 at the first
+/// point) but `-x` gives 2.1005590110e-5; with `z` mirrored it is `+x` that is wrong: the frames
+/// whose `y` axis is the mesh's `-z`. A fractional error of 3e-5, not an integer, but far outside
+/// the documented accuracy.
+#[test]
+#[ignore = "known defect, see the doc comment: the NegX frame at 1e15 magnitudes"]
+fn sliver_at_1e15_magnitudes_under_a_mirrored_frame() {
+    let p = [
+        [0.0, 0.0, 8.05011069654107],
+        [0.0, 0.0, 0.0],
+        [0.0, 1e15, 0.0],
+        [0.0, 1e15, 8.05011069654107],
+        [0.0, -0.0008442093330105354, 8.05011069654107],
+    ];
+    let mesh = Mesh::from_slices(&p, &[[0, 3, 2], [0, 2, 1], [1, 2, 4]]).unwrap();
+    for q in [[0.5, 1.7, 7.1], [-0.5, 1.7, 7.1], [0.5, -0.0004, 8.0]] {
+        let want = direct::winding_number_direct(&mesh, q);
+        for (ray, wn) in all_rays(&mesh) {
+            let w = wn.eval(q);
+            assert!(
+                (w - want).abs() < 1e-12,
+                "{ray:?} at {q:?}: {w} against {want}"
+            );
+        }
+    }
+}
+
 /// The sweep on the shared closed meshes: every vertex moved by one ulp along ±x, ±y,
 /// ±z. Off the surface (an exact test decides) the six rays must give one integer; before the
 /// fix they disagreed on 102 of cgal-cow's 17,424 points and 606 of cgal-camel's 58,620.
