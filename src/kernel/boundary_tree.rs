@@ -176,14 +176,27 @@ fn leaf_moments(edges: &BoundaryEdges, range: std::ops::Range<usize>) -> LeafMom
     LeafMoments { moments: m, area }
 }
 
-/// Sorts open ends by lattice position, sums the multiplicities of equal positions (as the
-/// chains join edges: by lattice point) and drops the zeros.
+/// Sorts open ends by position, sums the multiplicities of equal positions and drops the zeros.
+/// Positions are the inputs' exact values (lattice point and residual; the world value where the
+/// residual is not exact), not the lattice point alone: two inputs a cell apart can share one,
+/// and merging their ends (`+1` at one and `-1` at the other cancel) would drop a spoke the
+/// node's expansion needs (as the chains join edges, [`BoundaryEdges`]'s build). An end given as
+/// its lattice point (an edge on the lattice) and the same vertex given as an input merge.
 fn merge_ends(mut ends: Vec<(InputPoint, i32)>) -> Vec<(InputPoint, i32)> {
-    ends.sort_by_key(|(v, _)| v.n);
+    let key = |v: &InputPoint| {
+        let bits = |c: [f64; 3]| c.map(|x| (x + 0.0).to_bits());
+        let world = if v.residual_exact() {
+            [0; 3]
+        } else {
+            bits(v.world)
+        };
+        (v.n, bits(v.r), world)
+    };
+    ends.sort_by_key(|(v, _)| key(v));
     let mut merged: Vec<(InputPoint, i32)> = Vec::with_capacity(ends.len());
     for (v, m) in ends {
         match merged.last_mut() {
-            Some((w, n)) if w.n == v.n => *n += m,
+            Some((w, n)) if key(w) == key(&v) => *n += m,
             _ => merged.push((v, m)),
         }
     }

@@ -400,3 +400,53 @@ proptest! {
         check(&flat, &tree, &queries, &format!("hemisphere seed {seed}, τ={tolerance:e}, {ray:?}"));
     }
 }
+
+/// Slivers whose corners share lattice points with other corners (a 1e15 sheet, a corner 8.4e-4
+/// off the line of two others: under the 60-bit cell), 48 of them at different `x`, so that the
+/// hierarchy has nodes to expand: the expansions' open ends are merged by input position, not
+/// lattice point, and every ray stays within its bound of the flat loop, which is the direct
+/// sum's value (`sliver_at_1e15_magnitudes_under_a_mirrored_frame` in input_bits.rs).
+#[test]
+fn ends_a_cell_apart_are_not_merged() {
+    let mut p = Vec::new();
+    let mut t = Vec::new();
+    for k in 0..48u32 {
+        let x = f64::from(k) * 3.0e12;
+        let z = f64::from(k % 7) * 0.37 + 8.05011069654107;
+        let base = p.len() as u32;
+        p.extend([
+            [x, 0.0, z],
+            [x, 0.0, 0.0],
+            [x, 1e15, 0.0],
+            [x, 1e15, z],
+            [x, -0.0008442093330105354, z],
+        ]);
+        t.extend([[0, 3, 2], [0, 2, 1], [1, 2, 4]].map(|f: [u32; 3]| f.map(|i| base + i)));
+    }
+    let mesh = Mesh::from_slices(&p, &t).unwrap();
+    let mut rng = common::Rng(7);
+    let queries: Vec<[f64; 3]> = (0..300)
+        .map(|_| {
+            [
+                rng.range(-1e12, 1.5e14),
+                rng.range(-10.0, 20.0),
+                rng.range(-5.0, 15.0),
+            ]
+        })
+        .collect();
+    for ray in RayAxis::ALL {
+        let flat = with_tolerance(&mesh, 0.0, ray);
+        let tree = with_tolerance(&mesh, 1e-10, ray);
+        check(&flat, &tree, &queries, &format!("slivers, {ray:?}"));
+        for &q in queries.iter().take(40) {
+            let (w, want) = (
+                flat.eval(q),
+                gwn::eval::direct::winding_number_direct(&mesh, q),
+            );
+            assert!(
+                (w - want).abs() < 1e-11,
+                "{ray:?} at {q:?}: {w} against {want}"
+            );
+        }
+    }
+}
