@@ -22,7 +22,7 @@ use super::angle_sum::AngleSumAvx2;
 use super::double_double::DoubleDouble;
 use super::input_predicates::{
     InputPoint, LatticeFrame, along_the_ray_off_its_line, exact_edge_moment,
-    input_flat_denominator_sign, input_inside_segment, input_orient2d,
+    input_flat_denominator_sign, input_inside_segment, input_orient2d, parallel_to_the_ray,
 };
 #[cfg(target_arch = "x86_64")]
 use super::lanes::Avx2;
@@ -391,7 +391,12 @@ impl BoundaryEdges {
         });
         let parallel: Vec<bool> = (0..a.len())
             .map(|i| {
-                is_parallel_to_ray(a[i], b[i]) && inputs.as_ref().is_none_or(|x| !x.off_lattice[i])
+                // Off the lattice, only where the inputs are parallel too (the same argument:
+                // `parallel_to_the_ray`; `along_the_ray_off_its_line` says why it matters).
+                is_parallel_to_ray(a[i], b[i])
+                    && inputs
+                        .as_ref()
+                        .is_none_or(|x| !x.off_lattice[i] || parallel_to_the_ray(&x.a[i], &x.b[i]))
             })
             .collect();
         // Chained where an edge's end and the next one's start are the same lattice point *and*
@@ -1154,6 +1159,31 @@ mod tests {
             }
         }
         assert_eq!(checked, 6250);
+        // Off the lattice (residuals on every axis, the ends' equal on x and y), through both
+        // paths: what lets `parallel_to_the_ray` inputs leave the loops too.
+        let at = |n: [i64; 3], r: [f64; 3]| InputPoint {
+            n,
+            r,
+            world: [0.0; 3],
+            exact: [true; 3],
+        };
+        let residuals = [0.0, 0.25, -0.5 + 2f64.powi(-60), 2f64.powi(-70)];
+        for k in 0..4096_usize {
+            let pick = |shift: usize| residuals[(k >> shift) % 4];
+            let (rx, ry) = (pick(0), pick(2));
+            let a = at([1, -1, (k % 3) as i64], [rx, ry, pick(4)]);
+            let b = at([1, -1, (k % 5) as i64 - 2], [rx, ry, pick(6)]);
+            let q = at(
+                [(k >> 8) as i64 % 3, -1 - (k >> 10) as i64 % 2, 0],
+                [pick(8), pick(3), pick(5)],
+            );
+            assert!(parallel_to_the_ray(&a, &b));
+            for (z_exact, accurate) in [(true, false), (true, true), (false, false)] {
+                let area = BoundaryEdges::default()
+                    .exact_segment_area::<W128>(&a, &b, &q, z_exact, 0.25, accurate);
+                assert_eq!(area, 0.0, "a {a:?} b {b:?} q {q:?} {accurate}");
+            }
+        }
     }
 
     /// The split accurate path (the loop for every edge no test flags, the accurate terms for

@@ -297,8 +297,15 @@ pub fn input_orient2d(
 /// ray, at every evaluation (assimp-regr01 at res 256: 18 M such terms, half the remesh's CPU).
 #[inline]
 pub fn along_the_ray_off_its_line(q: &InputPoint, a: &InputPoint, b: &InputPoint) -> bool {
+    parallel_to_the_ray(a, b) && (0..2).any(|k| q.n[k].abs_diff(a.n[k]) >= 2)
+}
+
+/// Whether `a` and `b` have the same exact frame `x` and `y` (the segment is parallel to the ray,
+/// or has zero length): equal lattice points and exact, equal residuals on both axes.
+#[inline]
+pub fn parallel_to_the_ray(a: &InputPoint, b: &InputPoint) -> bool {
     let same = |k: usize| a.n[k] == b.n[k] && a.r[k] == b.r[k] && a.exact[k] && b.exact[k];
-    same(0) && same(1) && (0..2).any(|k| q.n[k].abs_diff(a.n[k]) >= 2)
+    same(0) && same(1)
 }
 
 #[cold]

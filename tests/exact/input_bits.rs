@@ -1793,7 +1793,11 @@ fn tiny_offsets_fuzz_corpus_and_random_inputs_agree_on_every_ray() {
         (0..len).map(|_| rng.next_u64() as u8).collect::<Vec<u8>>()
     }));
     for bytes in &inputs {
-        let case = gwn::testing::soup_with_tiny_offsets_from_bytes(bytes).unwrap();
+        // As the fuzz target: inputs too short for a case are skipped (a fuzz run adds such
+        // files to the corpus).
+        let Some(case) = gwn::testing::soup_with_tiny_offsets_from_bytes(bytes) else {
+            continue;
+        };
         let bad = gwn::testing::ray_disagreements(&case.mesh, &case.queries, 1e-10);
         assert!(bad.is_empty(), "{bytes:?}: {bad:?}");
         let bad = gwn::testing::oracle_disagreements(&case.mesh, &case.queries, 1e-10);
